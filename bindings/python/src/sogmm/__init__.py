@@ -1,0 +1,75 @@
+"""SOGMM: Self-Organizing Gaussian Mixture Models for RGB-D frames.
+
+A pure-Python (ctypes) binding of the C library libsogmm. Quick start::
+
+    import sogmm
+    cam = sogmm.Camera.from_json("intrinsics.json")
+    model = sogmm.SOGMM(bandwidth=0.02).fit_rgbd(depth, color, cam, decimate=5)
+    print(model.n_components_, model.lower_bound_)
+    sogmm.write_ply("samples.ply", model.sample(100_000, seed=0))
+"""
+
+from __future__ import annotations
+
+from . import _ffi
+from .camera import Camera, rgbd_to_points
+from .errors import (
+    BufferTooSmallError,
+    FormatError,
+    InternalError,
+    InvalidArgumentError,
+    InvalidDataError,
+    LimitError,
+    NotFittedError,
+    NotFoundError,
+    NullArgumentError,
+    NumericError,
+    SogmmError,
+    SogmmIOError,
+    SogmmMemoryError,
+)
+from .model import GMM, SOGMM, from_bytes, load
+from .ply import read_ply, write_ply
+
+__version__ = "0.1.0"
+
+#: ABI version this package expects (checked against the loaded library on import).
+ABI_VERSION = _ffi.ABI_VERSION
+
+
+def library_version() -> str:
+    """Version string of the loaded libsogmm ("MAJOR.MINOR.PATCH")."""
+    return _ffi.lib.sogmm_version_string().decode("ascii")
+
+
+def library_path() -> str:
+    """File the C library was loaded from."""
+    return str(_ffi.library_path)
+
+
+__all__ = [
+    "ABI_VERSION",
+    "BufferTooSmallError",
+    "Camera",
+    "FormatError",
+    "GMM",
+    "InternalError",
+    "InvalidArgumentError",
+    "InvalidDataError",
+    "LimitError",
+    "NotFittedError",
+    "NotFoundError",
+    "NullArgumentError",
+    "NumericError",
+    "SOGMM",
+    "SogmmError",
+    "SogmmIOError",
+    "SogmmMemoryError",
+    "from_bytes",
+    "library_path",
+    "library_version",
+    "load",
+    "read_ply",
+    "rgbd_to_points",
+    "write_ply",
+]

@@ -1,0 +1,347 @@
+"""ctypes layer over libsogmm (the C API of capi/include/sogmm/sogmm.h).
+
+Only handles, scalars and pointers cross the boundary: no struct is mirrored
+here. Every exported function is declared in ``_DECLARATIONS`` below; a test
+parses the C header and checks that the names and arities match.
+
+Library discovery (first match wins):
+  1. the ``SOGMM_LIBRARY_PATH`` environment variable (a file path);
+  2. the copy bundled in the package (``sogmm/_lib/``), as installed from a wheel;
+  3. the build tree of a source checkout (``<repo>/build*/capi/libsogmm.so*``,
+     newest first, sanitizer builds skipped).
+The library's ``sogmm_abi_version()`` must equal :data:`ABI_VERSION`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from ctypes import POINTER, c_char_p, c_double, c_int32, c_int64, c_size_t, c_uint8, c_uint32, c_uint64, c_void_p
+from pathlib import Path
+
+import numpy as np
+
+from .errors import error_for_status
+
+#: The SOGMM_ABI_VERSION this package was written for.
+ABI_VERSION = 1
+
+# ---- constants (mirror sogmm.h) ------------------------------------------
+OK = 0
+E_NOT_FOUND = -10
+
+OPT_BANDWIDTH = 100
+OPT_N_COMPONENTS = 101
+OPT_TOL = 102
+OPT_REG_COVAR = 103
+OPT_MAX_ITER = 104
+OPT_SEED = 105
+OPT_THREADS = 106
+OPT_MODE_COUNTER = 107
+MODE_COUNTER_FLAT_BINNED = 0
+MODE_COUNTER_GAUSSIAN_BLURRING = 1
+OPT_DEPTH_SCALE = 200
+OPT_DEPTH_MIN = 201
+OPT_DEPTH_MAX = 202
+OPT_DECIMATION = 203
+OPT_ZSTD_LEVEL = 300
+OPT_FLOAT64 = 301
+OPT_COMPRESS = 302
+OPT_MAX_DECODED_BYTES = 400
+OPT_VERIFY_CHECKSUMS = 401
+OPT_SAMPLE_TRUNCATION = 500
+
+COLOR_GRAY8 = 1
+COLOR_RGB8 = 2
+
+INFO_SUPPORT_SIZE = 1
+INFO_CREATED_UNIX_MS = 2
+INFO_FIT_ITERATIONS = 100
+INFO_FIT_CONVERGED = 101
+INFO_FIT_LOG_LIKELIHOOD = 102
+INFO_FIT_BANDWIDTH = 103
+INFO_FIT_N_COMPONENTS_REQUESTED = 104
+INFO_FIT_TOL = 105
+INFO_FIT_REG_COVAR = 106
+INFO_FIT_MAX_ITER = 107
+INFO_FIT_SEED = 108
+INFO_FIT_N_POINTS = 150
+INFO_FIT_SECONDS_MODE_COUNT = 151
+INFO_FIT_SECONDS_SEEDING = 152
+INFO_FIT_SECONDS_EM = 153
+INFO_FIT_SECONDS_TOTAL = 154
+INFO_CAMERA_WIDTH = 200
+INFO_CAMERA_HEIGHT = 201
+INFO_CAMERA_FX = 202
+INFO_CAMERA_FY = 203
+INFO_CAMERA_CX = 204
+INFO_CAMERA_CY = 205
+INFO_CAMERA_DECIMATION = 206
+INFO_CAMERA_DEPTH_SCALE = 207
+INFO_CAMERA_DEPTH_MIN = 208
+INFO_CAMERA_DEPTH_MAX = 209
+
+# ---- argument types ------------------------------------------------------
+_C = "C_CONTIGUOUS"
+F32_IN = np.ctypeslib.ndpointer(dtype=np.float32, flags=_C)
+F32_OUT = np.ctypeslib.ndpointer(dtype=np.float32, flags=(_C, "WRITEABLE"))
+F64_IN = np.ctypeslib.ndpointer(dtype=np.float64, flags=_C)
+F64_OUT = np.ctypeslib.ndpointer(dtype=np.float64, flags=(_C, "WRITEABLE"))
+U16_IN = np.ctypeslib.ndpointer(dtype=np.uint16, flags=_C)
+U8_IN = np.ctypeslib.ndpointer(dtype=np.uint8, flags=_C)
+
+HANDLE = c_void_p  # sogmm_model*, sogmm_options*, sogmm_buffer*
+HANDLE_OUT = POINTER(c_void_p)  # sogmm_xxx**
+STATUS = c_int32
+KEY = c_int32
+
+# name -> (restype, argtypes). Keep in the order of sogmm.h.
+_DECLARATIONS: dict[str, tuple[object, list[object]]] = {
+    "sogmm_version_number": (c_uint32, []),
+    "sogmm_version_string": (c_char_p, []),
+    "sogmm_abi_version": (c_uint32, []),
+    "sogmm_status_string": (c_char_p, [STATUS]),
+    "sogmm_last_error": (c_char_p, []),
+    "sogmm_options_create": (STATUS, [HANDLE_OUT]),
+    "sogmm_options_clone": (STATUS, [HANDLE_OUT, HANDLE]),
+    "sogmm_options_free": (None, [HANDLE]),
+    "sogmm_options_set_f64": (STATUS, [HANDLE, KEY, c_double]),
+    "sogmm_options_set_i64": (STATUS, [HANDLE, KEY, c_int64]),
+    "sogmm_options_get_f64": (STATUS, [HANDLE, KEY, POINTER(c_double)]),
+    "sogmm_options_get_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
+    "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
+    "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
+    "sogmm_fit_rgbd": (
+        STATUS,
+        [HANDLE_OUT, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, HANDLE],
+    ),
+    "sogmm_model_from_arrays_f32": (STATUS, [HANDLE_OUT, c_size_t, F32_IN, F32_IN, F32_IN, c_uint64]),
+    "sogmm_model_clone": (STATUS, [HANDLE_OUT, HANDLE]),
+    "sogmm_model_free": (None, [HANDLE]),
+    "sogmm_model_n_components": (STATUS, [HANDLE, POINTER(c_size_t)]),
+    "sogmm_model_get_weights_f32": (STATUS, [HANDLE, F32_OUT, c_size_t]),
+    "sogmm_model_get_means_f32": (STATUS, [HANDLE, F32_OUT, c_size_t]),
+    "sogmm_model_get_covariances_f32": (STATUS, [HANDLE, F32_OUT, c_size_t]),
+    "sogmm_model_get_info_f64": (STATUS, [HANDLE, KEY, POINTER(c_double)]),
+    "sogmm_model_get_info_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
+    "sogmm_model_get_pose": (STATUS, [HANDLE, F64_OUT]),
+    "sogmm_model_set_pose": (STATUS, [HANDLE, F64_IN]),
+    "sogmm_model_clear_pose": (STATUS, [HANDLE]),
+    "sogmm_model_get_value": (STATUS, [HANDLE, c_char_p, POINTER(c_char_p)]),
+    "sogmm_model_set_value": (STATUS, [HANDLE, c_char_p, c_char_p]),
+    "sogmm_model_value_count": (STATUS, [HANDLE, POINTER(c_size_t)]),
+    "sogmm_model_value_at": (STATUS, [HANDLE, c_size_t, POINTER(c_char_p), POINTER(c_char_p)]),
+    "sogmm_model_sample_f32": (STATUS, [HANDLE, c_size_t, c_uint64, c_int32, HANDLE, F32_OUT]),
+    "sogmm_model_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F32_OUT, F32_OUT]),
+    "sogmm_model_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, F64_OUT]),
+    "sogmm_model_merge": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
+    "sogmm_model_transform": (STATUS, [HANDLE_OUT, HANDLE, F64_IN]),
+    "sogmm_model_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
+    "sogmm_model_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
+    "sogmm_model_save_to_memory": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
+    "sogmm_model_load_from_memory": (STATUS, [HANDLE_OUT, c_void_p, c_size_t, HANDLE]),
+    "sogmm_buffer_data": (POINTER(c_uint8), [HANDLE]),
+    "sogmm_buffer_size": (c_size_t, [HANDLE]),
+    "sogmm_buffer_free": (None, [HANDLE]),
+}
+
+def _library_file_names() -> list[str]:
+    if sys.platform == "win32":
+        return ["sogmm.dll", "libsogmm.dll"]
+    if sys.platform == "darwin":
+        return ["libsogmm.dylib", "libsogmm.1.dylib"]
+    return ["libsogmm.so", "libsogmm.so.1"]
+
+
+def _is_sanitizer_build(build_dir: Path) -> bool:
+    """True for a build directory configured with SOGMM_SANITIZE=ON.
+
+    Loading an AddressSanitizer library into a normal Python aborts the
+    process, so such build trees are never picked automatically."""
+    if "asan" in build_dir.name.lower() or "sanit" in build_dir.name.lower():
+        return True
+    cache = build_dir / "CMakeCache.txt"
+    try:
+        text = cache.read_text(errors="replace")
+    except OSError:
+        return False
+    for line in text.splitlines():
+        if line.startswith("SOGMM_SANITIZE:") and line.split("=", 1)[-1].strip().upper() in ("ON", "1", "TRUE", "YES"):
+            return True
+    return False
+
+
+def _checkout_candidates() -> list[Path]:
+    """libsogmm files of the build trees of a source checkout, newest first."""
+    here = Path(__file__).resolve()
+    # <repo>/bindings/python/src/sogmm/_ffi.py
+    for root in here.parents:
+        if (root / "capi" / "include" / "sogmm" / "sogmm.h").is_file():
+            break
+    else:
+        return []
+    found = []
+    for build_dir in root.glob("build*"):
+        if not build_dir.is_dir() or _is_sanitizer_build(build_dir):
+            continue
+        for name in _library_file_names():
+            f = build_dir / "capi" / name
+            if f.is_file():
+                found.append(f)
+                break
+    found.sort(key=lambda p: p.resolve().stat().st_mtime, reverse=True)
+    return found
+
+
+def _candidates() -> list[tuple[str, Path]]:
+    env = os.environ.get("SOGMM_LIBRARY_PATH")
+    if env:
+        # An explicit choice is never silently replaced by another library.
+        return [("SOGMM_LIBRARY_PATH", Path(env))]
+    out: list[tuple[str, Path]] = []
+    bundled = Path(__file__).resolve().parent / "_lib"
+    for name in _library_file_names():
+        if (bundled / name).is_file():
+            out.append(("bundled", bundled / name))
+            break
+    out.extend(("build tree", p) for p in _checkout_candidates())
+    return out
+
+
+def _load() -> tuple[ctypes.CDLL, Path]:
+    tried = []
+    candidates = _candidates()
+    for origin, path in candidates:
+        if not path.is_file():
+            tried.append(f"{origin}: {path} (no such file)")
+            continue
+        try:
+            if sys.platform == "win32":  # pragma: no cover - not built on Windows yet
+                os.add_dll_directory(str(path.parent))
+            lib = ctypes.CDLL(str(path))
+        except OSError as e:
+            tried.append(f"{origin}: {path} ({e})")
+            continue
+        try:
+            abi = lib.sogmm_abi_version
+        except AttributeError:
+            tried.append(f"{origin}: {path} (not libsogmm: no sogmm_abi_version)")
+            continue
+        abi.restype = c_uint32
+        abi.argtypes = []
+        found_abi = int(abi())
+        if found_abi != ABI_VERSION:
+            raise ImportError(
+                f"sogmm: {path} ({origin}) has ABI version {found_abi}, but this package needs "
+                f"ABI version {ABI_VERSION}; install a matching wheel or point SOGMM_LIBRARY_PATH "
+                "at a matching libsogmm"
+            )
+        return lib, path
+    detail = "; ".join(tried) if tried else "no bundled library and no build tree found"
+    raise ImportError(
+        "sogmm: cannot load the C library libsogmm (" + detail + "). Install the sogmm wheel, set "
+        "SOGMM_LIBRARY_PATH to libsogmm.so, or build it in a checkout with "
+        "'cmake --build <build-dir> --target sogmm'."
+    )
+
+
+lib, library_path = _load()
+
+for _name, (_restype, _argtypes) in _DECLARATIONS.items():
+    _fn = getattr(lib, _name)
+    _fn.restype = _restype
+    _fn.argtypes = _argtypes
+
+
+def declarations() -> dict[str, tuple[object, list[object]]]:
+    """The ctypes declarations (name -> (restype, argtypes)); used by tests."""
+    return dict(_DECLARATIONS)
+
+
+def last_error() -> str:
+    return lib.sogmm_last_error().decode("utf-8", "replace")
+
+
+def check(status: int) -> None:
+    """Raise the SogmmError subclass for a non-zero status.
+
+    Must be called right after the C call, on the same thread, so that
+    sogmm_last_error() still describes that call."""
+    if status != OK:
+        message = last_error()
+        if not message:
+            message = lib.sogmm_status_string(status).decode("utf-8", "replace")
+        raise error_for_status(int(status), message)
+
+
+# Python-side names of the option keys (the C message names only the number).
+OPTION_NAMES = {
+    OPT_BANDWIDTH: "bandwidth",
+    OPT_N_COMPONENTS: "n_components",
+    OPT_TOL: "tol",
+    OPT_REG_COVAR: "reg_covar",
+    OPT_MAX_ITER: "max_iter",
+    OPT_SEED: "seed",
+    OPT_THREADS: "n_threads",
+    OPT_MODE_COUNTER: "mode_counter",
+    OPT_DEPTH_SCALE: "depth_scale",
+    OPT_DEPTH_MIN: "depth_min",
+    OPT_DEPTH_MAX: "depth_trunc",
+    OPT_DECIMATION: "decimate",
+    OPT_ZSTD_LEVEL: "zstd_level",
+    OPT_FLOAT64: "float64",
+    OPT_COMPRESS: "compress",
+    OPT_MAX_DECODED_BYTES: "max_decoded_bytes",
+    OPT_VERIFY_CHECKSUMS: "verify_checksums",
+    OPT_SAMPLE_TRUNCATION: "truncation",
+}
+
+
+def _check_option(status: int, key: int, value) -> None:
+    """check() for an option setter; the message is prefixed with the parameter's name."""
+    if status != OK:
+        message = last_error() or lib.sogmm_status_string(status).decode("utf-8", "replace")
+        name = OPTION_NAMES.get(key)
+        if name is not None:
+            message = f"{name} = {value!r} is invalid: {message}"
+        raise error_for_status(int(status), message)
+
+
+class Options:
+    """Owns a sogmm_options handle for the duration of one call (a context manager)."""
+
+    __slots__ = ("ptr",)
+
+    def __init__(self, f64: dict[int, float] | None = None, i64: dict[int, int] | None = None):
+        out = c_void_p()
+        check(lib.sogmm_options_create(ctypes.byref(out)))
+        self.ptr = out
+        try:
+            for key, value in (f64 or {}).items():
+                _check_option(lib.sogmm_options_set_f64(self.ptr, key, float(value)), key, value)
+            for key, value in (i64 or {}).items():
+                _check_option(lib.sogmm_options_set_i64(self.ptr, key, int(value)), key, value)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        if self.ptr:
+            lib.sogmm_options_free(self.ptr)
+            self.ptr = c_void_p()
+
+    def __enter__(self) -> "Options":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def buffer_to_bytes(buf: c_void_p) -> bytes:
+    """Copies a sogmm_buffer's bytes into a Python bytes object (does not free it)."""
+    size = lib.sogmm_buffer_size(buf)
+    if size == 0:
+        return b""
+    data = lib.sogmm_buffer_data(buf)
+    return ctypes.string_at(data, size)

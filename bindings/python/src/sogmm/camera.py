@@ -1,0 +1,232 @@
+"""Pinhole camera intrinsics and RGB-D back-projection.
+
+The C API fits RGB-D frames directly (``sogmm_fit_rgbd``) but exports no
+back-projection of its own, so :func:`rgbd_to_points` restates the core's
+few lines here (core/src/camera.cpp: nearest-neighbour decimation with
+source index floor(i * src / dst), intrinsics divided by the factor, valid
+depth in (depth_min, depth_trunc], gray = (0.299 R + 0.587 G + 0.114 B) / 255
+in float32). The tests check that fitting its output gives bit for bit the
+model that ``sogmm_fit_rgbd`` gives.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import FormatError, InvalidArgumentError
+
+__all__ = ["Camera", "rgbd_to_points"]
+
+COLOR_GRAY8 = 1
+COLOR_RGB8 = 2
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Pinhole intrinsics of full-size images (Open3D PinholeCameraIntrinsic names).
+
+    Pixel (u, v) at depth z back-projects to x = (u - cx) z / fx,
+    y = (v - cy) z / fy.
+    """
+
+    width: int
+    height: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+
+    def __post_init__(self):
+        for name in ("width", "height"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or int(v) != v or not (1 <= int(v) <= 2**31 - 1):
+                raise InvalidArgumentError(f"Camera.{name} must be an integer in [1, 2^31-1], got {v!r}")
+            object.__setattr__(self, name, int(v))
+        for name in ("fx", "fy", "cx", "cy"):
+            try:
+                v = float(getattr(self, name))
+            except (TypeError, ValueError):
+                raise InvalidArgumentError(f"Camera.{name} must be a number, got {getattr(self, name)!r}") from None
+            if not math.isfinite(v) or (name in ("fx", "fy") and not v > 0):
+                what = "finite and > 0" if name in ("fx", "fy") else "finite"
+                raise InvalidArgumentError(f"Camera.{name} = {v} is invalid (must be {what})")
+            object.__setattr__(self, name, v)
+
+    @property
+    def intrinsic_matrix(self) -> np.ndarray:
+        """The 3 x 3 matrix K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    @classmethod
+    def from_json(cls, path: str | os.PathLike) -> "Camera":
+        """Reads Open3D's PinholeCameraIntrinsic JSON: {"width", "height",
+        "intrinsic_matrix": 9 numbers, column-major}.
+
+        A missing file raises FileNotFoundError (an OSError); a malformed one
+        raises FormatError naming the field."""
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise FormatError(f"{path}: not valid JSON ({e})") from None
+        if not isinstance(doc, dict):
+            raise FormatError(f"{path}: expected a JSON object")
+        for field in ("width", "height", "intrinsic_matrix"):
+            if field not in doc:
+                raise FormatError(f"{path}: missing field '{field}'")
+        k = doc["intrinsic_matrix"]
+        if not isinstance(k, list) or len(k) != 9 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in k):
+            raise FormatError(f"{path}: 'intrinsic_matrix' must be a list of 9 numbers (column-major)")
+        for field in ("width", "height"):
+            if not isinstance(doc[field], int) or isinstance(doc[field], bool):
+                raise FormatError(f"{path}: '{field}' must be an integer")
+        # Column-major: [fx, 0, 0, 0, fy, 0, cx, cy, 1].
+        try:
+            return cls(doc["width"], doc["height"], k[0], k[4], k[6], k[7])
+        except InvalidArgumentError as e:
+            raise FormatError(f"{path}: {e}") from None
+
+    def to_json(self) -> str:
+        """Open3D PinholeCameraIntrinsic JSON text."""
+        k = [self.fx, 0.0, 0.0, 0.0, self.fy, 0.0, self.cx, self.cy, 1.0]
+        return json.dumps({"width": self.width, "height": self.height, "intrinsic_matrix": k}, indent=1)
+
+
+def _as_camera(camera) -> Camera:
+    if isinstance(camera, Camera):
+        return camera
+    raise InvalidArgumentError(f"camera must be a sogmm.Camera, got {type(camera).__name__}")
+
+
+def prepare_depth(depth, camera: Camera) -> np.ndarray:
+    """(H, W) raw depth as C-contiguous uint16 (no copy when it already is)."""
+    d = np.asarray(depth)
+    if d.ndim != 2:
+        raise InvalidArgumentError(f"depth must be a 2-D (height, width) array, got shape {d.shape}")
+    if d.shape != (camera.height, camera.width):
+        raise InvalidArgumentError(
+            f"depth has shape {d.shape} but the camera is {camera.width} x {camera.height} "
+            f"(expected shape ({camera.height}, {camera.width}))"
+        )
+    if d.dtype == np.uint16:
+        return np.ascontiguousarray(d)
+    if d.dtype.kind in "iu":
+        if d.size and (d.min() < 0 or d.max() > 65535):
+            raise InvalidArgumentError("depth values must fit in uint16 (0..65535 raw units)")
+        return np.ascontiguousarray(d, dtype=np.uint16)
+    raise InvalidArgumentError(
+        f"depth must hold raw integer units (uint16, depth_scale per metre), got dtype {d.dtype}; "
+        "for metric float depth pass (depth_m * depth_scale).astype(np.uint16)"
+    )
+
+
+def prepare_color(color, camera: Camera) -> tuple[str, np.ndarray]:
+    """Classifies the color image.
+
+    Returns ("gray8", uint8 (H, W)), ("rgb8", uint8 (H, W, 3)) or
+    ("grayf", float32 (H, W) in [0, 1]); C-contiguous, copied only if needed.
+    RGBA uint8 drops alpha."""
+    c = np.asarray(color)
+    hw = (camera.height, camera.width)
+    if c.shape[:2] != hw:
+        raise InvalidArgumentError(f"color has shape {c.shape}, expected ({camera.height}, {camera.width}[, 3])")
+    if c.ndim == 2:
+        if c.dtype == np.uint8:
+            return "gray8", np.ascontiguousarray(c)
+        if c.dtype.kind == "f":
+            return "grayf", np.ascontiguousarray(c, dtype=np.float32)
+        raise InvalidArgumentError(f"a gray image must be uint8 (0..255) or float (0..1), got dtype {c.dtype}")
+    if c.ndim == 3 and c.shape[2] in (3, 4):
+        if c.dtype != np.uint8:
+            raise InvalidArgumentError(f"an RGB image must be uint8, got dtype {c.dtype}")
+        return "rgb8", np.ascontiguousarray(c[:, :, :3])
+    raise InvalidArgumentError(f"color must be (H, W) gray or (H, W, 3) RGB, got shape {c.shape}")
+
+
+def gray_image(kind: str, color: np.ndarray) -> np.ndarray:
+    """Gray in [0, 1] as float32, computed as the core does (float arithmetic)."""
+    if kind == "gray8":
+        return color.astype(np.float32) / np.float32(255.0)
+    if kind == "rgb8":
+        r = color[:, :, 0].astype(np.float32)
+        g = color[:, :, 1].astype(np.float32)
+        b = color[:, :, 2].astype(np.float32)
+        return (np.float32(0.299) * r + np.float32(0.587) * g + np.float32(0.114) * b) / np.float32(255.0)
+    return color
+
+
+def check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera: Camera) -> tuple[float, float, float, int]:
+    depth_scale, depth_min, depth_trunc = float(depth_scale), float(depth_min), float(depth_trunc)
+    if not (math.isfinite(depth_scale) and depth_scale > 0):
+        raise InvalidArgumentError(f"depth_scale = {depth_scale} must be finite and > 0")
+    if not (math.isfinite(depth_min) and depth_min >= 0):
+        raise InvalidArgumentError(f"depth_min = {depth_min} must be finite and >= 0")
+    if not (math.isfinite(depth_trunc) and depth_trunc > depth_min):
+        raise InvalidArgumentError(f"depth_trunc = {depth_trunc} must be finite and > depth_min = {depth_min}")
+    if isinstance(decimate, bool) or int(decimate) != decimate or not (1 <= int(decimate) <= 1024):
+        raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer in [1, 1024]")
+    decimate = int(decimate)
+    if decimate > camera.width or decimate > camera.height:
+        raise InvalidArgumentError(
+            f"decimate = {decimate} leaves no pixel of a {camera.width} x {camera.height} image"
+        )
+    return depth_scale, depth_min, depth_trunc, decimate
+
+
+def rgbd_to_points(
+    depth,
+    color,
+    camera: Camera,
+    depth_scale: float = 1000.0,
+    depth_min: float = 0.1,
+    depth_trunc: float = 3.0,
+    decimate: int = 1,
+) -> np.ndarray:
+    """Back-projects the valid pixels of an RGB-D frame to (N, 4) float32 rows (x, y, z, gray).
+
+    Args:
+        depth: (H, W) raw depth, integer dtype (uint16), ``depth_scale`` units
+            per metre, 0 = no reading.
+        color: registered image: (H, W) gray uint8 or float in [0, 1], or
+            (H, W, 3) RGB uint8.
+        camera: intrinsics of the full-size images.
+        depth_min, depth_trunc: a pixel is valid when depth_min < z <= depth_trunc (metres).
+        decimate: integer factor; nearest-neighbour resizing to (W // d, H // d)
+            and intrinsics divided by d, as the C library does.
+
+    Points are in the camera frame (x right, y down, z forward), ordered row
+    by row, identical to what ``SOGMM.fit_rgbd`` fits.
+    """
+    camera = _as_camera(camera)
+    d_raw = prepare_depth(depth, camera)
+    kind, c = prepare_color(color, camera)
+    depth_scale, depth_min, depth_trunc, d = check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera)
+
+    W, H = camera.width, camera.height
+    dw, dh = W // d, H // d
+    su = np.minimum((np.arange(dw, dtype=np.int64) * W) // dw, W - 1)
+    sv = np.minimum((np.arange(dh, dtype=np.int64) * H) // dh, H - 1)
+    fx, fy, cx, cy = camera.fx / d, camera.fy / d, camera.cx / d, camera.cy / d
+
+    z = d_raw[np.ix_(sv, su)].astype(np.float64) * (1.0 / depth_scale)
+    valid = (z > depth_min) & (z <= depth_trunc)
+    vv, uu = np.nonzero(valid)  # row-major order
+    zz = z[vv, uu]
+    if kind == "grayf":
+        gray = c[np.ix_(sv, su)][vv, uu]
+    else:
+        # Convert only the pixels that are used (same float arithmetic per pixel).
+        picked = c[np.ix_(sv, su)][vv, uu]
+        gray = gray_image(kind, picked[None, ...])[0]
+    out = np.empty((zz.size, 4), dtype=np.float32)
+    out[:, 0] = (uu.astype(np.float64) - cx) * zz / fx
+    out[:, 1] = (vv.astype(np.float64) - cy) * zz / fy
+    out[:, 2] = zz
+    out[:, 3] = gray
+    return out

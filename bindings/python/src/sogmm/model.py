@@ -1,0 +1,590 @@
+"""Models: GMM (any 4-D mixture held by libsogmm) and SOGMM (the estimator).
+
+Arrays go in as C-contiguous float32 (converted with np.ascontiguousarray, no
+copy when the layout already fits) and come out in arrays allocated here and
+filled by C. Each model owns one ``sogmm_model`` handle, released by
+weakref.finalize (or early by ``close()`` / a ``with`` block).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import weakref
+from ctypes import byref, c_char_p, c_double, c_int64, c_size_t, c_void_p
+
+import numpy as np
+
+from . import _ffi
+from ._ffi import check, lib
+from .camera import Camera, check_depth_options, prepare_color, prepare_depth, rgbd_to_points
+from .errors import InvalidArgumentError, NotFittedError, NotFoundError
+
+__all__ = ["GMM", "SOGMM", "load", "from_bytes"]
+
+
+# ---- input conversion ----------------------------------------------------
+def _real_array(x, dtype, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(x)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgumentError(f"{name} must be a numeric array ({e})") from None
+    if a.dtype.kind not in "biuf":
+        raise InvalidArgumentError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    return np.ascontiguousarray(a, dtype=dtype)
+
+
+def _rows(x, cols: tuple[int, ...], name: str) -> np.ndarray:
+    a = _real_array(x, np.float32, name)
+    if a.ndim != 2 or a.shape[1] not in cols:
+        want = " or ".join(str(c) for c in cols)
+        raise InvalidArgumentError(f"{name} must be a 2-D array with {want} columns, got shape {a.shape}")
+    return a
+
+
+def _pose(pose) -> np.ndarray:
+    p = _real_array(pose, np.float64, "pose")
+    if p.shape != (4, 4):
+        raise InvalidArgumentError(f"pose must be a 4 x 4 matrix, got shape {p.shape}")
+    return p
+
+
+def _count(n, name: str) -> int:
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+        raise InvalidArgumentError(f"{name} must be a non-negative integer, got {n!r}")
+    return int(n)
+
+
+def _write_options(float64: bool, compress: bool, zstd_level: int) -> _ffi.Options:
+    return _ffi.Options(
+        i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level}
+    )
+
+
+def _read_options(verify_checksums: bool, max_decoded_bytes: int) -> _ffi.Options:
+    return _ffi.Options(
+        i64={_ffi.OPT_VERIFY_CHECKSUMS: int(bool(verify_checksums)), _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
+    )
+
+
+class GMM:
+    """A 4-D Gaussian mixture over (x, y, z, gray) held by libsogmm.
+
+    Create one with :meth:`from_arrays`, :func:`sogmm.load`,
+    :func:`sogmm.from_bytes`, or by fitting a :class:`SOGMM`. Attributes
+    follow scikit-learn's GaussianMixture: ``weights_`` (M,), ``means_``
+    (M, 4), ``covariances_`` (M, 4, 4), all float32 and read-only.
+    """
+
+    _ptr: int | None = None
+    _finalizer = None
+
+    # ---- handle management ----------------------------------------------
+    @classmethod
+    def _wrap(cls, ptr: c_void_p) -> "GMM":
+        obj = cls.__new__(cls)
+        obj._attach(ptr)
+        return obj
+
+    def _attach(self, ptr: c_void_p) -> None:
+        self._release()
+        self._ptr = int(ptr.value)
+        self._cache = {}
+        self._finalizer = weakref.finalize(self, lib.sogmm_model_free, c_void_p(self._ptr))
+
+    def _release(self) -> None:
+        if self._finalizer is not None:
+            self._finalizer()  # frees the handle exactly once
+        self._finalizer = None
+        self._ptr = None
+        self._cache = {}
+
+    def _h(self) -> c_void_p:
+        if self._ptr is None:
+            raise NotFittedError(
+                f"this {type(self).__name__} holds no model (not fitted yet, or closed): call fit() first"
+            )
+        return c_void_p(self._ptr)
+
+    def close(self) -> None:
+        """Releases the C model now (otherwise done when the object is collected)."""
+        self._release()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ---- construction ----------------------------------------------------
+    @classmethod
+    def from_arrays(cls, weights, means, covariances, support_size: int = 0) -> "GMM":
+        """A model from M weights, M x 4 means and M x 4 x 4 covariances (copied).
+
+        ``support_size`` is the number of points the model stands for (used to
+        weight merges; 0 = unknown). Weights must sum to 1 within 1e-4 and
+        covariances be symmetric positive definite (InvalidDataError /
+        NumericError otherwise)."""
+        w = _real_array(weights, np.float32, "weights")
+        mu = _real_array(means, np.float32, "means")
+        cov = _real_array(covariances, np.float32, "covariances")
+        if w.ndim != 1:
+            raise InvalidArgumentError(f"weights must be 1-D (M,), got shape {w.shape}")
+        m = w.shape[0]
+        if mu.shape != (m, 4):
+            raise InvalidArgumentError(f"means must have shape ({m}, 4), got {mu.shape}")
+        if cov.shape != (m, 4, 4):
+            raise InvalidArgumentError(f"covariances must have shape ({m}, 4, 4), got {cov.shape}")
+        support_size = _count(support_size, "support_size")
+        out = c_void_p()
+        check(lib.sogmm_model_from_arrays_f32(byref(out), m, w, mu, cov, support_size))
+        return GMM._wrap(out)
+
+    def copy(self) -> "GMM":
+        """Deep copy of the model and its metadata (a GMM)."""
+        out = c_void_p()
+        check(lib.sogmm_model_clone(byref(out), self._h()))
+        return GMM._wrap(out)
+
+    # ---- arrays and report -------------------------------------------------
+    @property
+    def n_components_(self) -> int:
+        n = c_size_t()
+        check(lib.sogmm_model_n_components(self._h(), byref(n)))
+        return int(n.value)
+
+    def _array(self, name: str, getter, shape_tail: tuple[int, ...]) -> np.ndarray:
+        h = self._h()
+        cached = self._cache.get(name)
+        if cached is not None:
+            return cached
+        m = self.n_components_
+        out = np.empty((m,) + shape_tail, dtype=np.float32)
+        check(getter(h, out, out.size))
+        out.flags.writeable = False
+        self._cache[name] = out
+        return out
+
+    @property
+    def weights_(self) -> np.ndarray:
+        return self._array("weights", lib.sogmm_model_get_weights_f32, ())
+
+    @property
+    def means_(self) -> np.ndarray:
+        return self._array("means", lib.sogmm_model_get_means_f32, (4,))
+
+    @property
+    def covariances_(self) -> np.ndarray:
+        return self._array("covariances", lib.sogmm_model_get_covariances_f32, (4, 4))
+
+    def _info_i64(self, key: int) -> int | None:
+        v = c_int64()
+        try:
+            check(lib.sogmm_model_get_info_i64(self._h(), key, byref(v)))
+        except NotFoundError:
+            return None
+        return int(v.value)
+
+    def _info_f64(self, key: int) -> float | None:
+        v = c_double()
+        try:
+            check(lib.sogmm_model_get_info_f64(self._h(), key, byref(v)))
+        except NotFoundError:
+            return None
+        return float(v.value)
+
+    @property
+    def support_size_(self) -> int:
+        """Number of points the model stands for."""
+        return self._info_i64(_ffi.INFO_SUPPORT_SIZE)
+
+    @property
+    def converged_(self) -> bool | None:
+        """True if EM stopped on the tolerance (None: no fit record)."""
+        v = self._info_i64(_ffi.INFO_FIT_CONVERGED)
+        return None if v is None else bool(v)
+
+    @property
+    def n_iter_(self) -> int | None:
+        """EM iterations run (None: no fit record)."""
+        return self._info_i64(_ffi.INFO_FIT_ITERATIONS)
+
+    @property
+    def lower_bound_(self) -> float | None:
+        """Final mean log-likelihood per point of the fit (None: no fit record)."""
+        return self._info_f64(_ffi.INFO_FIT_LOG_LIKELIHOOD)
+
+    @property
+    def camera_(self) -> Camera | None:
+        """The camera of an RGB-D fit (full-size intrinsics), else None."""
+        w = self._info_i64(_ffi.INFO_CAMERA_WIDTH)
+        if w is None:
+            return None
+        return Camera(
+            w,
+            self._info_i64(_ffi.INFO_CAMERA_HEIGHT),
+            self._info_f64(_ffi.INFO_CAMERA_FX),
+            self._info_f64(_ffi.INFO_CAMERA_FY),
+            self._info_f64(_ffi.INFO_CAMERA_CX),
+            self._info_f64(_ffi.INFO_CAMERA_CY),
+        )
+
+    _INFO_KEYS = {
+        "support_size": (_ffi.INFO_SUPPORT_SIZE, "i"),
+        "created_unix_ms": (_ffi.INFO_CREATED_UNIX_MS, "i"),
+        "fit_iterations": (_ffi.INFO_FIT_ITERATIONS, "i"),
+        "fit_converged": (_ffi.INFO_FIT_CONVERGED, "i"),
+        "fit_log_likelihood": (_ffi.INFO_FIT_LOG_LIKELIHOOD, "f"),
+        "fit_bandwidth": (_ffi.INFO_FIT_BANDWIDTH, "f"),
+        "fit_n_components_requested": (_ffi.INFO_FIT_N_COMPONENTS_REQUESTED, "i"),
+        "fit_tol": (_ffi.INFO_FIT_TOL, "f"),
+        "fit_reg_covar": (_ffi.INFO_FIT_REG_COVAR, "f"),
+        "fit_max_iter": (_ffi.INFO_FIT_MAX_ITER, "i"),
+        "fit_seed": (_ffi.INFO_FIT_SEED, "i"),
+        "fit_n_points": (_ffi.INFO_FIT_N_POINTS, "i"),
+        "fit_seconds_mode_count": (_ffi.INFO_FIT_SECONDS_MODE_COUNT, "f"),
+        "fit_seconds_seeding": (_ffi.INFO_FIT_SECONDS_SEEDING, "f"),
+        "fit_seconds_em": (_ffi.INFO_FIT_SECONDS_EM, "f"),
+        "fit_seconds_total": (_ffi.INFO_FIT_SECONDS_TOTAL, "f"),
+        "camera_width": (_ffi.INFO_CAMERA_WIDTH, "i"),
+        "camera_height": (_ffi.INFO_CAMERA_HEIGHT, "i"),
+        "camera_fx": (_ffi.INFO_CAMERA_FX, "f"),
+        "camera_fy": (_ffi.INFO_CAMERA_FY, "f"),
+        "camera_cx": (_ffi.INFO_CAMERA_CX, "f"),
+        "camera_cy": (_ffi.INFO_CAMERA_CY, "f"),
+        "camera_decimation": (_ffi.INFO_CAMERA_DECIMATION, "i"),
+        "camera_depth_scale": (_ffi.INFO_CAMERA_DEPTH_SCALE, "f"),
+        "camera_depth_min": (_ffi.INFO_CAMERA_DEPTH_MIN, "f"),
+        "camera_depth_max": (_ffi.INFO_CAMERA_DEPTH_MAX, "f"),
+    }
+
+    def info(self) -> dict:
+        """Every fit-report, camera and timing value the model has (absent ones left out)."""
+        out = {}
+        for name, (key, kind) in self._INFO_KEYS.items():
+            v = self._info_i64(key) if kind == "i" else self._info_f64(key)
+            if v is not None:
+                out[name] = v
+        return out
+
+    # ---- pose and key/values -----------------------------------------------
+    @property
+    def pose(self) -> np.ndarray | None:
+        """4 x 4 rigid transform of the model's frame to the world (None if unset).
+
+        Assigning validates it (InvalidArgumentError unless rigid); None clears it."""
+        out = np.empty((4, 4), dtype=np.float64)
+        try:
+            check(lib.sogmm_model_get_pose(self._h(), out))
+        except NotFoundError:
+            return None
+        return out
+
+    @pose.setter
+    def pose(self, value) -> None:
+        if value is None:
+            check(lib.sogmm_model_clear_pose(self._h()))
+        else:
+            check(lib.sogmm_model_set_pose(self._h(), _pose(value)))
+
+    @property
+    def metadata(self) -> dict[str, str]:
+        """Copy of the free-form key/value strings (stored in .sogmm files)."""
+        h = self._h()
+        n = c_size_t()
+        check(lib.sogmm_model_value_count(h, byref(n)))
+        out = {}
+        for i in range(n.value):
+            k, v = c_char_p(), c_char_p()
+            check(lib.sogmm_model_value_at(h, i, byref(k), byref(v)))
+            out[k.value.decode("utf-8")] = v.value.decode("utf-8")
+        return out
+
+    def set_metadata(self, key: str, value: str) -> None:
+        """Adds or replaces one key/value string."""
+        if not isinstance(key, str) or not isinstance(value, str):
+            raise InvalidArgumentError("metadata keys and values must be str")
+        if "\0" in key or "\0" in value:
+            raise InvalidArgumentError("metadata keys and values must not contain NUL characters")
+        check(lib.sogmm_model_set_value(self._h(), key.encode("utf-8"), value.encode("utf-8")))
+
+    # ---- inference -------------------------------------------------------
+    def score_samples(self, X) -> np.ndarray:
+        """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
+        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,)."""
+        h = self._h()
+        x = _rows(X, (3, 4), "X")
+        out = np.empty(x.shape[0], dtype=np.float64)
+        check(lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], out))
+        return out
+
+    def score(self, X) -> float:
+        """Mean log-density of the rows of X (see score_samples)."""
+        return float(np.mean(self.score_samples(X)))
+
+    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
+               spatial_only: bool = False) -> np.ndarray:
+        """Draws n_samples points, (n, 4) float32 rows (x, y, z, gray), grouped by
+        component (or (n, 3) with spatial_only). The same seed gives the same
+        samples; seed=None draws a fresh one. ``truncation`` (in standard
+        deviations, may be inf) bounds each draw."""
+        h = self._h()
+        n = _count(n_samples, "n_samples")
+        if seed is None:
+            seed = secrets.randbits(64)
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+            raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
+        seed = int(seed) & 0xFFFFFFFFFFFFFFFF
+        dims = 3 if spatial_only else 4
+        out = np.empty((n, dims), dtype=np.float32)
+        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
+            check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
+        return out
+
+    def regress_gray(self, xyz) -> tuple[np.ndarray, np.ndarray]:
+        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays."""
+        h = self._h()
+        x = _rows(xyz, (3,), "xyz")
+        mean = np.empty(x.shape[0], dtype=np.float32)
+        var = np.empty(x.shape[0], dtype=np.float32)
+        check(lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], mean, var))
+        return mean, var
+
+    def merge(self, other: "GMM") -> "GMM":
+        """A new model with the components of both, weighted by support size."""
+        if not isinstance(other, GMM):
+            raise InvalidArgumentError(f"merge needs a GMM, got {type(other).__name__}")
+        out = c_void_p()
+        check(lib.sogmm_model_merge(byref(out), self._h(), other._h()))
+        return GMM._wrap(out)
+
+    def transform(self, pose) -> "GMM":
+        """A new model moved by the 4 x 4 rigid transform ``pose``: means -> R mu + t."""
+        p = _pose(pose)
+        out = c_void_p()
+        check(lib.sogmm_model_transform(byref(out), self._h(), p))
+        return GMM._wrap(out)
+
+    # ---- files and bytes ---------------------------------------------------
+    def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,
+             zstd_level: int = 19) -> None:
+        """Writes a .sogmm file atomically (temporary file + rename)."""
+        h = self._h()
+        p = os.fsencode(os.fspath(path))
+        with _write_options(float64, compress, zstd_level) as o:
+            check(lib.sogmm_model_save(h, p, o.ptr))
+
+    def to_bytes(self, *, float64: bool = False, compress: bool = True, zstd_level: int = 19) -> bytes:
+        """The bytes of a .sogmm file."""
+        h = self._h()
+        buf = c_void_p()
+        with _write_options(float64, compress, zstd_level) as o:
+            check(lib.sogmm_model_save_to_memory(byref(buf), h, o.ptr))
+        try:
+            return _ffi.buffer_to_bytes(buf)
+        finally:
+            lib.sogmm_buffer_free(buf)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = True, max_decoded_bytes: int = 0) -> "GMM":
+        """Reads a .sogmm file (SogmmIOError if it cannot be read, FormatError if invalid)."""
+        p = os.fsencode(os.fspath(path))
+        out = c_void_p()
+        with _read_options(verify_checksums, max_decoded_bytes) as o:
+            check(lib.sogmm_model_load(byref(out), p, o.ptr))
+        return GMM._wrap(out)
+
+    @classmethod
+    def from_bytes(cls, data, *, verify_checksums: bool = True, max_decoded_bytes: int = 0) -> "GMM":
+        """Reads a model from the bytes of a .sogmm file (bytes, bytearray, memoryview)."""
+        if isinstance(data, str):
+            raise InvalidArgumentError("from_bytes needs a bytes-like object, got str")
+        try:
+            buf = np.frombuffer(data, dtype=np.uint8)  # no copy for bytes, bytearray, memoryview
+        except (TypeError, ValueError, BufferError):
+            try:
+                buf = np.frombuffer(memoryview(data).tobytes(), dtype=np.uint8)
+            except TypeError:
+                raise InvalidArgumentError(
+                    f"from_bytes needs a bytes-like object, got {type(data).__name__}") from None
+        out = c_void_p()
+        with _read_options(verify_checksums, max_decoded_bytes) as o:
+            check(lib.sogmm_model_load_from_memory(byref(out), buf.ctypes.data, buf.size, o.ptr))
+        return GMM._wrap(out)
+
+    # ---- pickling and copies -------------------------------------------------
+    def __getstate__(self):
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_ptr", "_finalizer", "_cache")}
+        state["_sogmm_bytes"] = self.to_bytes(compress=True) if self._ptr is not None else None
+        return state
+
+    def __setstate__(self, state):
+        state = dict(state)
+        data = state.pop("_sogmm_bytes", None)
+        self.__dict__.update(state)
+        self._ptr = None
+        self._finalizer = None
+        self._cache = {}
+        if data is not None:
+            self._attach(GMM.from_bytes(data)._detach())
+
+    def _detach(self) -> c_void_p:
+        """Hands the handle over to the caller (this object then holds none)."""
+        ptr = self._h()
+        if self._finalizer is not None:
+            self._finalizer.detach()
+        self._finalizer = None
+        self._ptr = None
+        self._cache = {}
+        return ptr
+
+    def __copy__(self):
+        import copy as _copy
+
+        return _copy.deepcopy(self)
+
+    def __deepcopy__(self, memo):
+        obj = type(self).__new__(type(self))
+        obj.__dict__.update({k: v for k, v in self.__dict__.items() if k not in ("_ptr", "_finalizer", "_cache")})
+        obj._ptr = None
+        obj._finalizer = None
+        obj._cache = {}
+        if self._ptr is not None:
+            obj._attach(self.copy()._detach())
+        return obj
+
+    def __repr__(self) -> str:
+        if self._ptr is None:
+            return f"<{type(self).__name__} (no model)>"
+        return f"<GMM n_components={self.n_components_} support_size={self.support_size_}>"
+
+
+_MODE_COUNTERS = {
+    "flat_binned": _ffi.MODE_COUNTER_FLAT_BINNED,
+    "gaussian_blurring": _ffi.MODE_COUNTER_GAUSSIAN_BLURRING,
+}
+
+
+class SOGMM(GMM):
+    """Self-organizing Gaussian mixture model of (x, y, z, gray) points.
+
+    Parameters:
+        bandwidth: mean-shift bandwidth that decides the number of components
+            (ignored when n_components is set).
+        seed: random seed (k-means++ seeding).
+        tol: EM stops when the mean log-likelihood changes by less than tol.
+        reg_covar: added to the covariance diagonals.
+        max_iter: EM iterations at most.
+        n_components: None = self-organizing; an int K fits exactly K components.
+        n_threads: worker threads of the fit (0 = all cores).
+        mode_counter: "flat_binned" (default) or "gaussian_blurring".
+
+    After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
+    """
+
+    def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float = 1e-6,
+                 max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
+                 mode_counter: str = "flat_binned"):
+        self.bandwidth = bandwidth
+        self.seed = seed
+        self.tol = tol
+        self.reg_covar = reg_covar
+        self.max_iter = max_iter
+        self.n_components = n_components
+        self.n_threads = n_threads
+        self.mode_counter = mode_counter
+        self._ptr = None
+        self._finalizer = None
+        self._cache = {}
+
+    _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter")
+
+    def get_params(self, deep: bool = True) -> dict:
+        return {k: getattr(self, k) for k in self._PARAMS}
+
+    def set_params(self, **params) -> "SOGMM":
+        for k, v in params.items():
+            if k not in self._PARAMS:
+                raise InvalidArgumentError(f"unknown parameter {k!r} for SOGMM")
+            setattr(self, k, v)
+        return self
+
+    def _fit_options(self, extra_f64=None, extra_i64=None) -> _ffi.Options:
+        if self.mode_counter not in _MODE_COUNTERS:
+            raise InvalidArgumentError(f"mode_counter must be one of {sorted(_MODE_COUNTERS)}, got {self.mode_counter!r}")
+        k = self.n_components
+        if k is None:
+            k = 0
+        elif isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise InvalidArgumentError(f"n_components must be None or an int >= 1, got {k!r}")
+        for name in ("seed", "max_iter", "n_threads"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise InvalidArgumentError(f"{name} must be an int, got {v!r}")
+        seed = int(self.seed) & 0xFFFFFFFFFFFFFFFF
+        if seed >= 2**63:
+            seed -= 2**64  # the uint64 seed's bits as an int64
+        f64 = {_ffi.OPT_BANDWIDTH: self.bandwidth, _ffi.OPT_TOL: self.tol, _ffi.OPT_REG_COVAR: self.reg_covar}
+        i64 = {
+            _ffi.OPT_N_COMPONENTS: int(k),
+            _ffi.OPT_MAX_ITER: int(self.max_iter),
+            _ffi.OPT_SEED: seed,
+            _ffi.OPT_THREADS: int(self.n_threads),
+            _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
+        }
+        f64.update(extra_f64 or {})
+        i64.update(extra_i64 or {})
+        for key, v in f64.items():
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise InvalidArgumentError(f"option {key} must be a number, got {v!r}")
+        return _ffi.Options(f64=f64, i64=i64)
+
+    def fit(self, X, y=None) -> "SOGMM":
+        """Fits the model to (n, 4) points (x, y, z, gray). Returns self."""
+        x = _rows(X, (4,), "X")
+        out = c_void_p()
+        with self._fit_options() as o:
+            check(lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
+        self._attach(out)
+        return self
+
+    def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = 1000.0, depth_min: float = 0.1,
+                 depth_trunc: float = 3.0, decimate: int = 1) -> "SOGMM":
+        """Fits the model to one RGB-D frame (arguments as :func:`sogmm.rgbd_to_points`).
+
+        uint8 gray or RGB color goes straight to the C library, which records
+        the camera in the model (``camera_``). Float gray is back-projected in
+        Python and fitted as points (no camera record). Returns self."""
+        if not isinstance(camera, Camera):
+            raise InvalidArgumentError(f"camera must be a sogmm.Camera, got {type(camera).__name__}")
+        d = prepare_depth(depth, camera)
+        kind, c = prepare_color(color, camera)
+        depth_scale, depth_min, depth_trunc, decimate = check_depth_options(
+            depth_scale, depth_min, depth_trunc, decimate, camera
+        )
+        if kind == "grayf":
+            return self.fit(rgbd_to_points(d, c, camera, depth_scale, depth_min, depth_trunc, decimate))
+        fmt = _ffi.COLOR_GRAY8 if kind == "gray8" else _ffi.COLOR_RGB8
+        out = c_void_p()
+        extra_f64 = {_ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
+        with self._fit_options(extra_f64, {_ffi.OPT_DECIMATION: decimate}) as o:
+            check(lib.sogmm_fit_rgbd(byref(out), d, c.reshape(-1), fmt, camera.width, camera.height,
+                                     camera.fx, camera.fy, camera.cx, camera.cy, o.ptr))
+        self._attach(out)
+        return self
+
+    def __repr__(self) -> str:
+        params = ", ".join(f"{k}={getattr(self, k)!r}" for k in self._PARAMS)
+        fitted = f" fitted: M={self.n_components_}" if self._ptr is not None else ""
+        return f"SOGMM({params}){fitted}"
+
+
+def load(path: str | os.PathLike, **kwargs) -> GMM:
+    """Reads a .sogmm file; see :meth:`GMM.load`."""
+    return GMM.load(path, **kwargs)
+
+
+def from_bytes(data, **kwargs) -> GMM:
+    """Reads a model from .sogmm bytes; see :meth:`GMM.from_bytes`."""
+    return GMM.from_bytes(data, **kwargs)
+

@@ -1,0 +1,361 @@
+/*
+ * sogmm.h - the stable C API of SOGMM (Self-Organizing Gaussian Mixture
+ * Models for RGB-D frames). This is the only public header of libsogmm.
+ *
+ * It is C99 and compiles as C and as C++. Every symbol and constant starts
+ * with sogmm_ / SOGMM_. The full reference, with the bad-input table and the
+ * thread-safety rules, is spec/api.md.
+ *
+ * Conventions (apply to every function unless its comment says otherwise)
+ * ---------------------------------------------------------------------
+ * - Handles (sogmm_model, sogmm_options, sogmm_buffer) are opaque. A function
+ *   that creates a handle takes its out-pointer FIRST; on failure it stores
+ *   NULL there (when the out-pointer itself is not NULL). The caller owns
+ *   every created handle and releases it with the matching *_free function.
+ *   Every *_free function accepts NULL and then does nothing.
+ * - Fallible functions return sogmm_status: SOGMM_OK (0) or a negative
+ *   SOGMM_E_* code. Out-parameters are written only on success (except the
+ *   NULL stored into a handle out-pointer on failure).
+ * - Input arrays and strings belong to the caller. They are read only during
+ *   the call and copied if kept (nothing the caller passes is retained).
+ * - Output arrays are allocated by the caller, row-major, with the element
+ *   type in the function name (_f32 = float, _f64 = double).
+ * - Points are (x, y, z, gray) rows: metres in the model's frame, gray in
+ *   [0, 1]. Covariances are always full, symmetric 4 x 4, row-major.
+ * - Pointers returned by the library (const char*, const uint8_t*) are owned
+ *   by the library; how long they stay valid is stated per function.
+ * - No function aborts the process on bad input, and no C++ exception ever
+ *   leaves the library.
+ * - Thread safety: distinct handles may be used from different threads at
+ *   the same time. Functions taking a const handle only read it and may run
+ *   concurrently on the same handle; a function taking a non-const handle
+ *   needs exclusive use of that handle. sogmm_last_error is per thread.
+ */
+#ifndef SOGMM_SOGMM_H
+#define SOGMM_SOGMM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---- export / deprecation macros -------------------------------------- */
+#if defined(_WIN32) || defined(__CYGWIN__)
+#  if defined(SOGMM_BUILDING_LIBRARY)
+#    define SOGMM_API __declspec(dllexport)
+#  elif defined(SOGMM_STATIC)
+#    define SOGMM_API
+#  else
+#    define SOGMM_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__) && __GNUC__ >= 4
+#  define SOGMM_API __attribute__((visibility("default")))
+#else
+#  define SOGMM_API
+#endif
+
+#if defined(__GNUC__) || defined(__clang__)
+#  define SOGMM_DEPRECATED(msg) __attribute__((deprecated(msg)))
+#elif defined(_MSC_VER)
+#  define SOGMM_DEPRECATED(msg) __declspec(deprecated(msg))
+#else
+#  define SOGMM_DEPRECATED(msg)
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- versions --------------------------------------------------------- */
+/* Compile-time version of this header. SOGMM_VERSION_NUMBER is
+ * MAJOR * 10000 + MINOR * 100 + PATCH. Compare with sogmm_version_number()
+ * at run time to detect a header/library mismatch. */
+#define SOGMM_VERSION_MAJOR 0
+#define SOGMM_VERSION_MINOR 1
+#define SOGMM_VERSION_PATCH 0
+#define SOGMM_VERSION_NUMBER \
+  (SOGMM_VERSION_MAJOR * 10000 + SOGMM_VERSION_MINOR * 100 + SOGMM_VERSION_PATCH)
+#define SOGMM_VERSION_STRING "0.1.0"
+/* ABI version: bumped only on an incompatible change of this API. The shared
+ * library's SONAME is libsogmm.so.<SOGMM_ABI_VERSION>. Bindings that load the
+ * library dynamically must check sogmm_abi_version() == the value they were
+ * written for. */
+#define SOGMM_ABI_VERSION 1
+
+/* Runtime version of the loaded library, same encoding as
+ * SOGMM_VERSION_NUMBER. Never fails. */
+SOGMM_API uint32_t sogmm_version_number(void);
+/* "MAJOR.MINOR.PATCH" of the loaded library; static storage. Never NULL. */
+SOGMM_API const char* sogmm_version_string(void);
+/* SOGMM_ABI_VERSION of the loaded library. Never fails. */
+SOGMM_API uint32_t sogmm_abi_version(void);
+
+/* ---- status codes ----------------------------------------------------- */
+/* Fixed width for FFI. Codes are frozen; new codes are only ever appended
+ * (next free negative number). Treat any unknown negative code as failure. */
+typedef int32_t sogmm_status;
+
+#define SOGMM_OK 0
+#define SOGMM_E_NULL_ARG (-1)         /* a required pointer argument is NULL */
+#define SOGMM_E_INVALID_ARG (-2)      /* a scalar parameter is out of range, or an unknown key */
+#define SOGMM_E_INVALID_DATA (-3)     /* array contents unusable: empty, NaN/Inf, broken model */
+#define SOGMM_E_NUMERIC (-4)          /* numerical failure: covariance not SPD, NaN result */
+#define SOGMM_E_IO (-5)               /* a file could not be opened, read or written */
+#define SOGMM_E_FORMAT (-6)           /* bytes are not a valid / supported .sogmm document */
+#define SOGMM_E_LIMIT (-7)            /* a size limit is exceeded (decoded size, size overflow) */
+#define SOGMM_E_NOMEM (-8)            /* memory allocation failed */
+#define SOGMM_E_BUFFER_TOO_SMALL (-9) /* a caller's output capacity is too small */
+#define SOGMM_E_NOT_FOUND (-10)       /* the requested value is not present (unknown metadata) */
+#define SOGMM_E_INTERNAL (-11)        /* unexpected internal error (a bug: please report) */
+
+/* Static, never-NULL description of a status, e.g. "invalid argument".
+ * Unknown codes give "unknown status". */
+SOGMM_API const char* sogmm_status_string(sogmm_status status);
+
+/* Message of the last failure on the calling thread, naming what was wrong.
+ * Every status-returning function clears it on entry (so it is "" after a
+ * success) and sets it on failure. Never NULL; owned by the library; valid
+ * until the next sogmm_* call on the same thread. */
+SOGMM_API const char* sogmm_last_error(void);
+
+/* ---- opaque handles --------------------------------------------------- */
+typedef struct sogmm_model sogmm_model;     /* a fitted 4-D GMM + metadata */
+typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, save, load, sample */
+typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
+
+/* ---- options ---------------------------------------------------------- */
+/* Key of a parameter. Each key has one type: set/get it with the _f64 or
+ * _i64 function named in its comment; the other one returns
+ * SOGMM_E_INVALID_ARG. Values outside the stated range are rejected by the
+ * setter with SOGMM_E_INVALID_ARG and leave the handle unchanged. Functions
+ * ignore keys that do not concern them. Passing NULL where a
+ * `const sogmm_options*` is expected means "all defaults". */
+typedef int32_t sogmm_key;
+
+/* Fit (mode count + k-means++ + EM). */
+#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite; default 0.02: mean-shift bandwidth */
+#define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
+#define SOGMM_OPT_TOL 102          /* f64, > 0, finite; default 1e-3: EM stop tolerance */
+#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite; default 1e-6: added to covariance diagonals */
+#define SOGMM_OPT_MAX_ITER 104     /* i64, [1, 2^31-1]; default 100: EM iterations at most */
+#define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
+#define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores */
+#define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default FLAT_BINNED */
+#define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
+#define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
+
+/* RGB-D back-projection (sogmm_fit_rgbd only). */
+#define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite; default 1000: raw depth units per metre */
+#define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
+#define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
+#define SOGMM_OPT_DECIMATION 203  /* i64, [1, 1024]; default 1: integer decimation factor */
+
+/* Writing .sogmm (save, save_to_memory). */
+#define SOGMM_OPT_ZSTD_LEVEL 300 /* i64, [1, 22]; default 19 */
+#define SOGMM_OPT_FLOAT64 301    /* i64, 0 or 1; default 0: store arrays as float64 */
+#define SOGMM_OPT_COMPRESS 302   /* i64, 0 or 1; default 1: zstd-compress the arrays */
+
+/* Reading .sogmm (load, load_from_memory). */
+#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap */
+#define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
+
+/* Sampling (sogmm_model_sample_f32). */
+#define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
+
+/* Keys >= 1000 are experimental and may change in any release. */
+
+/* Creates an options handle holding every default. Caller frees it. */
+SOGMM_API sogmm_status sogmm_options_create(sogmm_options** out);
+/* Deep copy of `src`. Caller frees it. */
+SOGMM_API sogmm_status sogmm_options_clone(sogmm_options** out, const sogmm_options* src);
+/* Releases `options`. NULL is a no-op. */
+SOGMM_API void sogmm_options_free(sogmm_options* options);
+SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key key, double value);
+SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key key, int64_t value);
+SOGMM_API sogmm_status sogmm_options_get_f64(const sogmm_options* options, sogmm_key key, double* out);
+SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm_key key, int64_t* out);
+
+/* ---- fitting ---------------------------------------------------------- */
+/* Fits a model to n points (x, y, z, gray): `points` holds n * 4 floats.
+ * Uses the fit keys of `options` (NULL = defaults). With
+ * SOGMM_OPT_N_COMPONENTS = K > 0 the mode count is skipped (fixed K).
+ * The model records the fit report and the fit parameters (see
+ * SOGMM_INFO_*). Errors: n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA;
+ * K > n -> SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
+                                            const sogmm_options* options);
+
+/* Same as sogmm_fit_points_f32 with exactly k components (k >= 1, k <= n),
+ * overriding SOGMM_OPT_N_COMPONENTS. */
+SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
+                                                    size_t k, const sogmm_options* options);
+
+/* Layout of the color image given to sogmm_fit_rgbd. */
+#define SOGMM_COLOR_GRAY8 1 /* width * height bytes, gray 0..255 */
+#define SOGMM_COLOR_RGB8 2  /* width * height * 3 bytes, interleaved R, G, B */
+
+/* Fits a model to one RGB-D frame. `depth` holds width * height uint16
+ * values (raw units, SOGMM_OPT_DEPTH_SCALE per metre, 0 = no reading),
+ * `color` the registered image in `color_format`, both row-major.
+ * Intrinsics are those of the full-size images (fx, fy > 0, all finite).
+ * Decimation and the valid depth range come from `options` (NULL =
+ * defaults). The model records the camera (SOGMM_INFO_CAMERA_*).
+ * Errors: width/height 0 or > INT32_MAX, bad intrinsics, unknown color
+ * format, bad depth range -> SOGMM_E_INVALID_ARG; no valid pixel ->
+ * SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
+                                      int32_t color_format, uint32_t width, uint32_t height, double fx,
+                                      double fy, double cx, double cy, const sogmm_options* options);
+
+/* ---- models from arrays, copies, release ------------------------------ */
+/* Builds a model from m components: `weights` (m floats, >= 0, summing to 1
+ * within 1e-4), `means` (m * 4) and `covariances` (m * 16, symmetric
+ * positive definite 4 x 4). `support_size` is the number of points the model
+ * stands for (weights merges; 0 = unknown). The arrays are copied.
+ * Errors: m == 0, NaN/Inf, bad weights, asymmetric covariance ->
+ * SOGMM_E_INVALID_DATA; covariance not positive definite -> SOGMM_E_NUMERIC. */
+SOGMM_API sogmm_status sogmm_model_from_arrays_f32(sogmm_model** out, size_t m, const float* weights,
+                                                   const float* means, const float* covariances,
+                                                   uint64_t support_size);
+/* Deep copy of `model` including its metadata. */
+SOGMM_API sogmm_status sogmm_model_clone(sogmm_model** out, const sogmm_model* model);
+/* Releases `model`. NULL is a no-op. */
+SOGMM_API void sogmm_model_free(sogmm_model* model);
+
+/* ---- arrays ----------------------------------------------------------- */
+/* Number of components M (always >= 1 for a valid handle). */
+SOGMM_API sogmm_status sogmm_model_n_components(const sogmm_model* model, size_t* out);
+/* Copy the M weights / M x 4 means / M x 4 x 4 covariances into `out`, which
+ * has room for `capacity` floats; capacity must be >= M, 4 M, 16 M
+ * respectively, else SOGMM_E_BUFFER_TOO_SMALL. */
+SOGMM_API sogmm_status sogmm_model_get_weights_f32(const sogmm_model* model, float* out, size_t capacity);
+SOGMM_API sogmm_status sogmm_model_get_means_f32(const sogmm_model* model, float* out, size_t capacity);
+SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model, float* out,
+                                                       size_t capacity);
+
+/* ---- fit report and metadata ------------------------------------------ */
+/* Read-only information keys; types as with options. A value that the
+ * model does not have returns SOGMM_E_NOT_FOUND (e.g. the fit report of a
+ * model built from arrays, or the timings of a loaded model). */
+#define SOGMM_INFO_SUPPORT_SIZE 1    /* i64: points the model stands for (always present) */
+#define SOGMM_INFO_CREATED_UNIX_MS 2 /* i64: creation time, ms since 1970 UTC (0 = unknown) */
+/* Fit report and parameters: present for fitted models and files that store them. */
+#define SOGMM_INFO_FIT_ITERATIONS 100     /* i64: EM iterations run */
+#define SOGMM_INFO_FIT_CONVERGED 101      /* i64: 1 if EM stopped on the tolerance */
+#define SOGMM_INFO_FIT_LOG_LIKELIHOOD 102 /* f64: final mean log-likelihood per point */
+#define SOGMM_INFO_FIT_BANDWIDTH 103      /* f64: bandwidth (0 for a fixed-K fit) */
+#define SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED 104 /* i64: K of a fixed-K fit, 0 = self-organizing */
+#define SOGMM_INFO_FIT_TOL 105            /* f64 */
+#define SOGMM_INFO_FIT_REG_COVAR 106      /* f64 */
+#define SOGMM_INFO_FIT_MAX_ITER 107       /* i64 */
+#define SOGMM_INFO_FIT_SEED 108           /* i64: the uint64 seed's bits */
+/* Timings: present only for a model fitted in this process (not stored in files). */
+#define SOGMM_INFO_FIT_N_POINTS 150              /* i64: points given to the fit */
+#define SOGMM_INFO_FIT_SECONDS_MODE_COUNT 151    /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_SEEDING 152       /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_EM 153            /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_TOTAL 154         /* f64 */
+/* Camera the points came from: present for sogmm_fit_rgbd models and files that store it. */
+#define SOGMM_INFO_CAMERA_WIDTH 200       /* i64: full-size image width, pixels */
+#define SOGMM_INFO_CAMERA_HEIGHT 201      /* i64 */
+#define SOGMM_INFO_CAMERA_FX 202          /* f64 */
+#define SOGMM_INFO_CAMERA_FY 203          /* f64 */
+#define SOGMM_INFO_CAMERA_CX 204          /* f64 */
+#define SOGMM_INFO_CAMERA_CY 205          /* f64 */
+#define SOGMM_INFO_CAMERA_DECIMATION 206  /* i64 */
+#define SOGMM_INFO_CAMERA_DEPTH_SCALE 207 /* f64 */
+#define SOGMM_INFO_CAMERA_DEPTH_MIN 208   /* f64 */
+#define SOGMM_INFO_CAMERA_DEPTH_MAX 209   /* f64 */
+
+SOGMM_API sogmm_status sogmm_model_get_info_f64(const sogmm_model* model, sogmm_key key, double* out);
+SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_key key, int64_t* out);
+
+/* Pose of the model's frame in the world: 16 doubles, row-major 4 x 4 rigid
+ * transform [R t; 0 0 0 1] (camera-to-world for a fitted frame).
+ * get: SOGMM_E_NOT_FOUND if no pose is set. set: copies `pose`; it must be
+ * finite and rigid (R^T R = I and det R = 1 within 1e-4, last row 0 0 0 1),
+ * else SOGMM_E_INVALID_ARG. clear: removes the pose. */
+SOGMM_API sogmm_status sogmm_model_get_pose(const sogmm_model* model, double* pose_out);
+SOGMM_API sogmm_status sogmm_model_set_pose(sogmm_model* model, const double* pose);
+SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);
+
+/* Free-form key/value metadata (UTF-8 strings, NUL-terminated, stored in
+ * .sogmm files). get: *value_out points to the library-owned value, valid
+ * until `model` is next modified or freed; SOGMM_E_NOT_FOUND if absent.
+ * set: adds the pair or replaces the value of an existing key; an empty key
+ * is SOGMM_E_INVALID_ARG. count / at: enumerate pairs in insertion order;
+ * index >= count is SOGMM_E_INVALID_ARG; pointers as for get. */
+SOGMM_API sogmm_status sogmm_model_get_value(const sogmm_model* model, const char* key,
+                                             const char** value_out);
+SOGMM_API sogmm_status sogmm_model_set_value(sogmm_model* model, const char* key, const char* value);
+SOGMM_API sogmm_status sogmm_model_value_count(const sogmm_model* model, size_t* out);
+SOGMM_API sogmm_status sogmm_model_value_at(const sogmm_model* model, size_t index, const char** key_out,
+                                            const char** value_out);
+
+/* ---- inference -------------------------------------------------------- */
+/* Draws n points, written as n rows of `dims` floats (dims = 4: x, y, z,
+ * gray; dims = 3: x, y, z, the spatial marginal) into `out` (n * dims
+ * floats), grouped by component. Same seed, same samples. Truncation from
+ * SOGMM_OPT_SAMPLE_TRUNCATION (NULL options = 2.5). n == 0 writes nothing
+ * (out may then be NULL). */
+SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n, uint64_t seed,
+                                              int32_t dims, const sogmm_options* options, float* out);
+
+/* Expected gray at n 3-D points (`xyz`: n * 3 floats) into `mean_out` (n
+ * floats) and, if `variance_out` is not NULL, the conditional variance (n
+ * floats). n == 0 writes nothing (pointers may then be NULL). NaN/Inf input
+ * -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                    float* mean_out, float* variance_out);
+
+/* Log-density of n points under the model into `out` (n doubles). dims = 4:
+ * rows of (x, y, z, gray), joint density; dims = 3: rows of (x, y, z), the
+ * marginal over gray. n == 0 writes nothing. NaN/Inf input ->
+ * SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
+                                                     size_t n, int32_t dims, double* out);
+
+/* New model with the components of a and b, weights re-weighted by support
+ * size (equal if both are 0); support size a + b. Both must be in the same
+ * frame. The result has no fit report, camera, pose or key/values. a may
+ * equal b. */
+SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b);
+
+/* New model = `model` moved by the rigid transform `pose` (16 doubles,
+ * row-major [R t; 0 1], rules as sogmm_model_set_pose): means -> R mu + t,
+ * spatial covariance blocks rotated. Metadata is copied; a stored pose P
+ * becomes P * pose^-1 so that the result still maps to the same world. */
+SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_model* model,
+                                             const double* pose);
+
+/* ---- .sogmm files and memory ------------------------------------------ */
+/* Writes `model` to `path` atomically (a temporary file renamed into place:
+ * on failure the previous file, if any, is untouched). Write keys of
+ * `options` apply. Errors: cannot write -> SOGMM_E_IO. */
+SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* path,
+                                        const sogmm_options* options);
+/* Reads a model from `path`. Read keys of `options` apply. Errors: cannot
+ * open/read -> SOGMM_E_IO; not a valid .sogmm -> SOGMM_E_FORMAT; checksum or
+ * content invalid -> SOGMM_E_FORMAT / SOGMM_E_INVALID_DATA / SOGMM_E_NUMERIC;
+ * decoded size above the cap -> SOGMM_E_LIMIT. */
+SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, const sogmm_options* options);
+/* Serialises `model` into a new buffer (the bytes of a .sogmm file). */
+SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogmm_model* model,
+                                                  const sogmm_options* options);
+/* Reads a model from `size` bytes at `data` (copied as needed). Errors as
+ * sogmm_model_load without SOGMM_E_IO; size == 0 -> SOGMM_E_FORMAT. */
+SOGMM_API sogmm_status sogmm_model_load_from_memory(sogmm_model** out, const void* data, size_t size,
+                                                    const sogmm_options* options);
+
+/* ---- buffers ---------------------------------------------------------- */
+/* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.
+ * NULL buffer -> NULL / 0. These never fail and do not touch
+ * sogmm_last_error. */
+SOGMM_API const uint8_t* sogmm_buffer_data(const sogmm_buffer* buffer);
+SOGMM_API size_t sogmm_buffer_size(const sogmm_buffer* buffer);
+/* Releases `buffer` and its bytes. NULL is a no-op. */
+SOGMM_API void sogmm_buffer_free(sogmm_buffer* buffer);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* SOGMM_SOGMM_H */

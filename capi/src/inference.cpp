@@ -1,0 +1,120 @@
+// Inference on a model: sample, regress gray, score, merge, transform.
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "internal.hpp"
+#include "sogmm/inference.hpp"
+
+namespace {
+
+using sogmm_capi::fail;
+using sogmm_capi::require_nonnull;
+
+void require_dims(int32_t dims) {
+  if (dims != 3 && dims != 4)
+    fail(SOGMM_E_INVALID_ARG, "dims = " + std::to_string(dims) + " (must be 3 or 4)");
+}
+
+/// a * b for row-major 4x4 matrices.
+std::array<double, 16> mul4(const std::array<double, 16>& a, const std::array<double, 16>& b) {
+  std::array<double, 16> c{};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double s = 0.0;
+      for (int k = 0; k < 4; ++k) s += a[4 * i + k] * b[4 * k + j];
+      c[4 * i + j] = s;
+    }
+  return c;
+}
+
+/// Inverse of a rigid transform [R t; 0 1]: [R^T -R^T t; 0 1].
+std::array<double, 16> rigid_inverse(const std::array<double, 16>& p) {
+  std::array<double, 16> q{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) q[4 * i + j] = p[4 * j + i];
+    q[4 * i + 3] = -(p[0 * 4 + i] * p[3] + p[1 * 4 + i] * p[7] + p[2 * 4 + i] * p[11]);
+  }
+  q[15] = 1.0;
+  return q;
+}
+
+}  // namespace
+
+extern "C" {
+
+SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n, uint64_t seed,
+                                              int32_t dims, const sogmm_options* options, float* out) {
+  SOGMM_TRY {
+    require_nonnull(model, "model");
+    require_dims(dims);
+    if (n == 0) return SOGMM_OK;
+    require_nonnull(out, "out");
+    sogmm_capi::checked_mul(n, static_cast<std::size_t>(dims), "samples");
+    const double truncation = sogmm_capi::opts_or_default(options).sample_truncation;
+    sogmm::sample(model->model.gmm, n, seed, dims, out, truncation);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                    float* mean_out, float* variance_out) {
+  SOGMM_TRY {
+    require_nonnull(model, "model");
+    if (n == 0) return SOGMM_OK;
+    require_nonnull(xyz, "xyz");
+    require_nonnull(mean_out, "mean_out");
+    sogmm_capi::require_finite(xyz, sogmm_capi::checked_mul(n, 3, "xyz"), "xyz");
+    sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
+                                                     size_t n, int32_t dims, double* out) {
+  SOGMM_TRY {
+    require_nonnull(model, "model");
+    require_dims(dims);
+    if (n == 0) return SOGMM_OK;
+    require_nonnull(points, "points");
+    require_nonnull(out, "out");
+    sogmm_capi::require_finite(points, sogmm_capi::checked_mul(n, static_cast<std::size_t>(dims), "points"),
+                               "points");
+    sogmm::score_samples(model->model.gmm, points, n, dims, out);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    require_nonnull(a, "a");
+    require_nonnull(b, "b");
+    auto handle = std::make_unique<sogmm_model>();
+    handle->model.gmm = sogmm::merge(a->model.gmm, b->model.gmm);
+    handle->model.created_unix_ms = sogmm_capi::creation_time_now();
+    *out = handle.release();
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_model* model,
+                                             const double* pose) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    require_nonnull(model, "model");
+    require_nonnull(pose, "pose");
+    sogmm_capi::require_rigid(pose, "pose");
+    std::array<double, 16> t;
+    for (int i = 0; i < 16; ++i) t[i] = pose[i];
+    auto handle = std::make_unique<sogmm_model>(*model);
+    handle->model.gmm = sogmm::transform(model->model.gmm, t);
+    if (handle->model.pose) handle->model.pose = mul4(*handle->model.pose, rigid_inverse(t));
+    *out = handle.release();
+  }
+  SOGMM_CATCH
+}
+
+}  // extern "C"

@@ -1,0 +1,127 @@
+// Internals shared by the C API translation units: handle definitions, the
+// try/catch wrapper that turns every C++ exception into a status, and small
+// argument checks. Never installed.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sogmm/model.hpp"
+#include "sogmm/sogmm.h"
+
+// ---- handles -----------------------------------------------------------
+
+struct sogmm_options {
+  // fit
+  double bandwidth = 0.02;
+  std::int64_t n_components = 0;
+  double tol = 1e-3;
+  double reg_covar = 1e-6;
+  std::int64_t max_iter = 100;
+  std::int64_t seed = 0;
+  std::int64_t threads = 0;
+  std::int64_t mode_counter = SOGMM_MODE_COUNTER_FLAT_BINNED;
+  // RGB-D
+  double depth_scale = 1000.0;
+  double depth_min = 0.1;
+  double depth_max = 3.0;
+  std::int64_t decimation = 1;
+  // write
+  std::int64_t zstd_level = 19;
+  std::int64_t float64 = 0;
+  std::int64_t compress = 1;
+  // read
+  std::int64_t max_decoded_bytes = 0;
+  std::int64_t verify_checksums = 1;
+  // sample
+  double sample_truncation = 2.5;
+};
+
+/// Timings of a fit run in this process (not part of the file format).
+struct sogmm_fit_timings {
+  bool known = false;
+  std::uint64_t n_points = 0;
+  double seconds_mode_count = 0.0;
+  double seconds_seeding = 0.0;
+  double seconds_em = 0.0;
+  double seconds_total = 0.0;
+};
+
+struct sogmm_model {
+  sogmm::Model model;
+  sogmm_fit_timings timings;
+};
+
+struct sogmm_buffer {
+  std::vector<std::uint8_t> bytes;
+};
+
+namespace sogmm_capi {
+
+/// Thrown inside the C API for argument problems detected by the wrapper
+/// itself; carries the status directly.
+struct StatusError {
+  sogmm_status status;
+  std::string message;
+};
+
+[[noreturn]] void fail(sogmm_status status, const std::string& message);
+
+/// Clears the thread's last-error message (on entry of every fallible call).
+void clear_error() noexcept;
+/// Sets the thread's last-error message and returns `status`.
+sogmm_status set_error(sogmm_status status, const char* message) noexcept;
+/// Maps the exception being handled (call only inside a catch block) to a
+/// status and message.
+sogmm_status handle_current_exception() noexcept;
+
+/// Milliseconds since 1970 UTC, for Model::created_unix_ms.
+std::int64_t creation_time_now();
+
+/// Shared defaults for "NULL options".
+const sogmm_options& default_options();
+inline const sogmm_options& opts_or_default(const sogmm_options* o) {
+  return o ? *o : default_options();
+}
+
+inline void require_nonnull(const void* p, const char* name) {
+  if (!p) fail(SOGMM_E_NULL_ARG, std::string(name) + " is NULL");
+}
+
+/// n * k in size_t, SOGMM_E_LIMIT on overflow.
+inline std::size_t checked_mul(std::size_t n, std::size_t k, const char* what) {
+  if (k != 0 && n > std::numeric_limits<std::size_t>::max() / k)
+    fail(SOGMM_E_LIMIT, std::string(what) + ": size overflows");
+  return n * k;
+}
+
+/// SOGMM_E_INVALID_DATA unless all `count` floats are finite.
+void require_finite(const float* values, std::size_t count, const char* what);
+
+/// SOGMM_E_INVALID_ARG unless the 16 doubles are a finite rigid transform.
+void require_rigid(const double* pose, const char* what);
+
+/// Stores NULL into a handle out-pointer if it is not NULL (on failure).
+template <typename T>
+inline void reset_out(T** out) noexcept {
+  if (out) *out = nullptr;
+}
+
+}  // namespace sogmm_capi
+
+/// Body wrapper: clears the last error, runs the statements, returns
+/// SOGMM_OK; any exception becomes a status. Use as
+///   SOGMM_TRY { ...; } SOGMM_CATCH
+#define SOGMM_TRY            \
+  sogmm_capi::clear_error(); \
+  try
+#define SOGMM_CATCH                                    \
+  catch (...) {                                        \
+    return sogmm_capi::handle_current_exception();     \
+  }                                                    \
+  return SOGMM_OK;

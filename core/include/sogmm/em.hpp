@@ -1,0 +1,45 @@
+// Expectation-maximisation for a full-covariance 4-D Gaussian mixture.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sogmm/gmm.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// Parameters of the EM. Defaults are the paper's.
+struct EmOptions {
+  double tol = 1e-3;        ///< stop when |change of mean log-likelihood| < tol
+  double reg_covar = 1e-6;  ///< added to every covariance diagonal in every M-step
+  int max_iter = 100;       ///< at most this many E+M iterations
+  int threads = 0;          ///< worker threads; 0 = all available cores
+};
+
+/// What the EM did.
+struct EmReport {
+  int iterations = 0;             ///< E+M iterations run
+  bool converged = false;         ///< stopped on tol rather than max_iter
+  double log_likelihood = 0.0;    ///< mean log-likelihood per point, computed in the
+                                  ///< last E-step (scikit-learn's lower_bound_)
+};
+
+/// Fits a GMM by EM starting from one-hot responsibilities on the seed points
+/// (the paper's and scikit-learn's k-means++ initialisation): the first model
+/// has means = seed points, covariances = reg_covar I and equal weights.
+/// Memory is O(N + K): points are processed in fixed-size blocks through a
+/// fused E+M pass, and partial sums are reduced in a fixed order, so the
+/// result is bit-identical for any thread count. Parameters are float32; all
+/// sums are accumulated in double across blocks.
+/// Throws Error(InvalidArgument) for bad options or seed indices, and
+/// Error(InvalidData) for empty or non-finite points.
+Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indices,
+           const EmOptions& options, EmReport* report = nullptr);
+
+/// Runs EM from a given model (means, covariances, weights) instead of seeds.
+Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options,
+                EmReport* report = nullptr);
+
+}  // namespace sogmm

@@ -1,0 +1,57 @@
+// The whole SOGMM fit of one point cloud: mode count -> k-means++ -> EM.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "sogmm/em.hpp"
+#include "sogmm/gmm.hpp"
+#include "sogmm/mean_shift.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// How the number of components is chosen.
+enum class ModeCounter {
+  FlatBinned,        ///< flat-kernel mean shift with bin seeding (authors' code; default)
+  GaussianBlurring,  ///< Gaussian blurring mean shift (the paper's description)
+};
+
+/// Parameters of a fit. Set `n_components` > 0 for the fixed-K baseline
+/// (the paper's FC), which skips the mode count.
+struct FitOptions {
+  double bandwidth = 0.02;          ///< mean-shift bandwidth sigma (the one SOGMM parameter)
+  std::size_t n_components = 0;     ///< 0 = self-organizing; K > 0 = fixed-K fit
+  ModeCounter mode_counter = ModeCounter::FlatBinned;
+  MeanShiftOptions mean_shift;      ///< flat mean-shift details
+  std::uint64_t seed = 0;           ///< seeds k-means++; same seed, same model
+  EmOptions em;                     ///< EM tolerances and threads
+};
+
+/// Which stage a fit is in, for progress reports.
+enum class FitStage { ModeCount, Seeding, Em };
+
+/// Called between stages and after each EM iteration (iteration, mean
+/// log-likelihood); may be empty.
+using FitProgress = std::function<void(FitStage stage, int iteration, double log_likelihood)>;
+
+/// A fitted model and how it was obtained.
+struct FitResult {
+  Gmm gmm;
+  EmReport em;
+  std::size_t n_points = 0;
+  double seconds_mode_count = 0.0;
+  double seconds_seeding = 0.0;
+  double seconds_em = 0.0;
+  double seconds_total = 0.0;
+};
+
+/// Fits a SOGMM (or a fixed-K GMM) to a cloud in the camera frame. Throws
+/// Error(InvalidArgument) for bandwidth <= 0 or K outside [1, N],
+/// Error(InvalidData) for an empty or non-finite cloud, Error(Numeric) if the
+/// result fails validation.
+FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress = {});
+
+}  // namespace sogmm

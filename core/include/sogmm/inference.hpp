@@ -1,0 +1,58 @@
+// What users do with a fitted model: score, sample, regress gray, merge, move.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sogmm/gmm.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// Log-density of each of `n` points under the model. `dims` = 4: rows of 4
+/// floats (x, y, z, gray), joint density; `dims` = 3: rows of 3 floats (x, y,
+/// z), the marginal over gray. Writes n doubles to `out`. Computed in double
+/// with log-sum-exp. Throws Error(InvalidArgument) for dims not 3 or 4,
+/// Error(InvalidData) for non-finite input, Error(Numeric) for an invalid model.
+void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out);
+
+/// Mean of score_samples (the average log-likelihood, scikit-learn's score).
+double mean_log_likelihood(const Gmm& gmm, const float* points, std::size_t n, int dims);
+
+/// Draws `n` points from the model: per-component counts are multinomial in
+/// the weights; each draw is mu + L z with L the Cholesky factor of the
+/// covariance and each coordinate of z standard normal redrawn until
+/// |z_i| < `truncation` (2.5, the authors' choice; infinity = untruncated).
+/// Rows of 4 floats (x, y, z, gray) are written to `out` grouped by component.
+/// The same seed gives the same samples. `dims` = 3 writes only (x, y, z),
+/// which is the 3-D marginal sampled the same way.
+void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* out,
+            double truncation = 2.5);
+
+/// Expected gray at 3-D points, the mixture of the per-component conditionals
+/// g | xyz (the paper's regression): weights w_m(x) ~ pi_m N(x | mu_xyz,
+/// Sigma_xx) normalised in the log domain (so a point far from every
+/// component takes the gray of the nearest ones, never 0 by underflow), means
+/// lambda_m(x) = mu_g + Sigma_gx Sigma_xx^-1 (x - mu_xyz). `variance`, if not
+/// null, receives the variance of the mixture conditional:
+/// sum_m w_m (nu_m^2 + lambda_m^2) - mean^2, nu_m^2 = Sigma_gg - Sigma_gx
+/// Sigma_xx^-1 Sigma_xg. `xyz` holds n rows of 3 floats.
+void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance);
+
+/// Merges two models into one: components are concatenated and weights
+/// re-weighted by support size (w = w_a S_a / (S_a + S_b) for a's
+/// components). If both support sizes are 0 the models count equally.
+/// The support size of the result is S_a + S_b.
+Gmm merge(const Gmm& a, const Gmm& b);
+
+/// Applies a rigid transform (row-major 4x4, [R t; 0 1]) to the spatial part:
+/// mu_xyz -> R mu_xyz + t, Sigma_xx -> R Sigma_xx R^T, Sigma_gx -> Sigma_gx R^T.
+/// Throws Error(InvalidArgument) unless R is a rotation within 1e-4.
+Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose);
+
+/// Bytes of the model as the paper counts them: 4 M (1 + 10 + 4).
+std::size_t paper_model_bytes(const Gmm& gmm);
+
+}  // namespace sogmm

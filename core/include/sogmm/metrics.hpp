@@ -1,0 +1,59 @@
+// How good a model is against the frame it came from (the paper's metrics).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "sogmm/camera.hpp"
+#include "sogmm/gmm.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// Peak signal-to-noise ratios of regressed gray against the frame's gray.
+struct PsnrResult {
+  /// Honest: data range 1, only pixels valid in the ground truth, over the
+  /// decimated canvas. The headline figure.
+  double psnr = 0.0;
+  /// As the authors' evaluation computes it: data range 2 (inferred from the
+  /// -1 empty pixels) and every pixel of the decimated canvas counted, the
+  /// empty ones as perfect. Add 13.98 dB to compare with the paper's printed
+  /// values (their benchmark also keeps the 640x480 canvas).
+  double psnr_paper = 0.0;
+  double mse = 0.0;  ///< mean squared gray error over valid pixels
+};
+
+/// Regresses gray at every ground-truth point, projects regressed and true gray
+/// into two images of `camera` (z-buffer, empty = -1) and compares them.
+/// `truth` holds the ground-truth points (x, y, z, gray) in the camera frame.
+PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera);
+
+/// PSNR from two images with -1 for empty pixels. Honest: data range 1, pixels
+/// where `truth` >= 0. Paper: data range 2, all pixels.
+PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels);
+
+/// Geometric reconstruction quality from samples.
+struct ReconstructionResult {
+  /// Mean distance from each sampled point to the nearest ground-truth point (m).
+  double mre = 0.0;
+  /// Named as in the authors' code, where the names are swapped relative to the
+  /// usual convention: `precision` = fraction of ground-truth points within
+  /// the threshold of a sample (usually called recall), `recall` = fraction of
+  /// samples within the threshold of a ground-truth point (usually precision).
+  double precision = 0.0;
+  double recall = 0.0;
+  double fscore = 0.0;  ///< harmonic mean of the two (unaffected by naming)
+};
+
+/// Draws as many 3-D samples as there are ground-truth points (seeded) and
+/// computes MRE and precision/recall/F-score at `threshold` metres with exact
+/// nearest neighbours (k-d tree).
+ReconstructionResult reconstruction_metrics(const Gmm& gmm, const PointsView& truth,
+                                            double threshold = 0.01, std::uint64_t seed = 0);
+
+/// Same, against an explicit reconstructed cloud (rows of 3 or 4 floats given
+/// by `stride`), e.g. the output of another map representation.
+ReconstructionResult compare_clouds(const float* reconstructed, std::size_t n, int stride,
+                                    const PointsView& truth, double threshold = 0.01);
+
+}  // namespace sogmm

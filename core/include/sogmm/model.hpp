@@ -1,0 +1,57 @@
+// A fitted model with the metadata a user needs later (what the .sogmm file stores).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sogmm/camera.hpp"
+#include "sogmm/gmm.hpp"
+
+namespace sogmm {
+
+/// How the model was fitted and how the fit ended. A default-constructed
+/// value means "unknown" (e.g. a model built from arrays).
+struct FitInfo {
+  bool known = false;              ///< false: the model was not produced by a fit
+  double bandwidth = 0.0;          ///< mean-shift bandwidth; 0 for a fixed-K fit
+  std::uint64_t n_components_requested = 0;  ///< K of a fixed-K fit; 0 = self-organizing
+  double tol = 0.0;
+  double reg_covar = 0.0;
+  std::int32_t max_iter = 0;
+  std::int32_t n_iter = 0;         ///< EM iterations run
+  bool converged = false;
+  double log_likelihood = 0.0;     ///< final mean log-likelihood per point
+  std::uint64_t seed = 0;
+};
+
+/// The camera and depth conversion the model's points came from.
+struct CameraInfo {
+  bool known = false;
+  Camera camera;                   ///< full-resolution intrinsics
+  std::int32_t decimation = 1;
+  double depth_scale = 1000.0;
+  double depth_min = 0.1;
+  double depth_max = 3.0;
+};
+
+/// A model plus metadata. The Gmm is what all numerical operations use.
+struct Model {
+  Gmm gmm;
+  FitInfo fit;
+  CameraInfo camera;
+  /// Camera-to-world pose, row-major 4x4 rigid transform, if known.
+  std::optional<std::array<double, 16>> pose;
+  std::string producer_name = "sogmm";
+  std::string producer_version;    ///< filled by the writer when empty
+  std::int64_t created_unix_ms = 0;  ///< creation time, ms since 1970 UTC; 0 = unknown
+  std::vector<std::pair<std::string, std::string>> key_values;  ///< free-form metadata
+};
+
+/// Library version, "MAJOR.MINOR.PATCH".
+const char* version_string();
+
+}  // namespace sogmm

@@ -1,0 +1,137 @@
+// Pinhole camera, decimation and back-projection.
+#include "sogmm/camera.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "sogmm/error.hpp"
+
+namespace sogmm {
+
+void validate(const Camera& c) {
+  require(c.width > 0 && c.height > 0, ErrorCode::InvalidArgument,
+          "camera size must be positive, got " + std::to_string(c.width) + "x" + std::to_string(c.height));
+  require(std::isfinite(c.fx) && std::isfinite(c.fy) && c.fx > 0 && c.fy > 0, ErrorCode::InvalidArgument,
+          "camera focal lengths fx, fy must be positive and finite");
+  require(std::isfinite(c.cx) && std::isfinite(c.cy), ErrorCode::InvalidArgument,
+          "camera principal point cx, cy must be finite");
+}
+
+void validate(const DepthOptions& o) {
+  require(std::isfinite(o.depth_scale) && o.depth_scale > 0, ErrorCode::InvalidArgument,
+          "depth scale must be positive, got " + std::to_string(o.depth_scale));
+  require(std::isfinite(o.depth_min) && std::isfinite(o.depth_max) && o.depth_min >= 0 && o.depth_min < o.depth_max,
+          ErrorCode::InvalidArgument,
+          "depth range must satisfy 0 <= min < max, got (" + std::to_string(o.depth_min) + ", " +
+              std::to_string(o.depth_max) + "]");
+  require(o.decimate >= 1, ErrorCode::InvalidArgument,
+          "decimation factor must be >= 1, got " + std::to_string(o.decimate));
+}
+
+Camera decimated(const Camera& camera, int d) {
+  require(d >= 1, ErrorCode::InvalidArgument, "decimation factor must be >= 1, got " + std::to_string(d));
+  require(camera.width / d >= 1 && camera.height / d >= 1, ErrorCode::InvalidArgument,
+          "decimation factor " + std::to_string(d) + " leaves no pixels of a " + std::to_string(camera.width) + "x" +
+              std::to_string(camera.height) + " image");
+  Camera out = camera;
+  out.width = camera.width / d;
+  out.height = camera.height / d;
+  out.fx /= d;
+  out.fy /= d;
+  out.cx /= d;
+  out.cy /= d;
+  return out;
+}
+
+int nearest_source_index(int i, int src, int dst) {
+  // OpenCV INTER_NEAREST: floor(i * src / dst), clamped to the image. Integer
+  // arithmetic avoids the rounding that would shift pixels for odd sizes.
+  const long long s = static_cast<long long>(i) * src / dst;
+  return static_cast<int>(s < src ? s : src - 1);
+}
+
+float gray_from_rgb(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+  return (0.299f * r + 0.587f * g + 0.114f * b) / 255.0f;
+}
+
+GrayImage gray_from_rgb_image(const std::uint8_t* rgb, int width, int height) {
+  require(rgb != nullptr && width > 0 && height > 0, ErrorCode::InvalidData, "color image is empty");
+  GrayImage out{width, height, std::vector<float>(static_cast<std::size_t>(width) * height)};
+  for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = gray_from_rgb(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+  return out;
+}
+
+GrayImage gray_from_u8_image(const std::uint8_t* gray, int width, int height) {
+  require(gray != nullptr && width > 0 && height > 0, ErrorCode::InvalidData, "gray image is empty");
+  GrayImage out{width, height, std::vector<float>(static_cast<std::size_t>(width) * height)};
+  for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = gray[i] / 255.0f;
+  return out;
+}
+
+namespace {
+
+// Visits the valid pixels of the decimated frame in row-major order.
+template <typename Visit>
+void for_each_valid_pixel(const RgbdView& frame, const DepthOptions& options, Visit&& visit) {
+  validate(frame.camera);
+  validate(options);
+  require(frame.depth != nullptr, ErrorCode::InvalidData, "depth image is empty");
+  require(frame.gray != nullptr, ErrorCode::InvalidData, "gray image is empty");
+  const Camera cam = decimated(frame.camera, options.decimate);
+  const double inv_scale = 1.0 / options.depth_scale;
+  for (int v = 0; v < cam.height; ++v) {
+    const int sv = nearest_source_index(v, frame.camera.height, cam.height);
+    for (int u = 0; u < cam.width; ++u) {
+      const int su = nearest_source_index(u, frame.camera.width, cam.width);
+      const std::size_t src = static_cast<std::size_t>(sv) * frame.camera.width + su;
+      const double z = frame.depth[src] * inv_scale;
+      if (!(z > options.depth_min && z <= options.depth_max)) continue;
+      visit(cam, u, v, z, frame.gray[src]);
+    }
+  }
+}
+
+}  // namespace
+
+PointCloud backproject(const RgbdView& frame, const DepthOptions& options) {
+  PointCloud cloud;
+  for_each_valid_pixel(frame, options, [&](const Camera& cam, int u, int v, double z, float g) {
+    cloud.xyzg.push_back(static_cast<float>((u - cam.cx) * z / cam.fx));
+    cloud.xyzg.push_back(static_cast<float>((v - cam.cy) * z / cam.fy));
+    cloud.xyzg.push_back(static_cast<float>(z));
+    cloud.xyzg.push_back(g);
+  });
+  return cloud;
+}
+
+std::vector<std::int32_t> valid_pixel_indices(const RgbdView& frame, const DepthOptions& options) {
+  std::vector<std::int32_t> indices;
+  for_each_valid_pixel(frame, options, [&](const Camera& cam, int u, int v, double, float) {
+    indices.push_back(v * cam.width + u);
+  });
+  return indices;
+}
+
+std::vector<float> project_to_image(const PointsView& points, const float* values, const Camera& camera, float empty) {
+  validate(camera);
+  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  std::vector<float> image(pixels, empty);
+  std::vector<float> zbuf(pixels, std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < points.size; ++i) {
+    const float* p = points[i];
+    const double z = p[2];
+    if (!(z > 0.0) || !std::isfinite(p[0]) || !std::isfinite(p[1])) continue;
+    const double u = std::nearbyint(camera.fx * p[0] / z + camera.cx);
+    const double v = std::nearbyint(camera.fy * p[1] / z + camera.cy);
+    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
+    const std::size_t idx = static_cast<std::size_t>(v) * camera.width + static_cast<std::size_t>(u);
+    if (z < zbuf[idx]) {
+      zbuf[idx] = static_cast<float>(z);
+      image[idx] = values[i];
+    }
+  }
+  return image;
+}
+
+}  // namespace sogmm

@@ -1,0 +1,237 @@
+// EM driver: blocked, fused E+M passes with a fixed reduction order.
+#include "sogmm/em.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "em_kernel.hpp"
+#include "sogmm/error.hpp"
+
+namespace sogmm {
+namespace {
+
+using detail::kBlock;
+using detail::kParamStride;
+using detail::kStatStride;
+
+constexpr double kLog2Pi = 1.8378770664093454836;
+// scikit-learn adds 10 * machine epsilon to every component's responsibility
+// sum so that an empty component does not divide by zero.
+constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
+// Chunks of points processed in one parallel wave. Fixed (not the thread
+// count), so the order in which partial sums are added never changes.
+constexpr std::size_t kWave = 16;
+constexpr std::size_t kMaxBlocksPerChunk = 32;
+
+void check_options(const EmOptions& o) {
+  require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
+          "EM tol must be finite and >= 0, got " + std::to_string(o.tol));
+  require(std::isfinite(o.reg_covar) && o.reg_covar >= 0, ErrorCode::InvalidArgument,
+          "EM reg_covar must be finite and >= 0, got " + std::to_string(o.reg_covar));
+  require(o.max_iter >= 1, ErrorCode::InvalidArgument, "EM max_iter must be >= 1, got " + std::to_string(o.max_iter));
+  require(o.threads >= 0, ErrorCode::InvalidArgument, "EM threads must be >= 0, got " + std::to_string(o.threads));
+}
+
+// Points as four coordinate arrays (structure of arrays), padded to whole blocks.
+struct SoaPoints {
+  std::vector<float> x, y, z, g;
+  std::size_t n = 0;
+  explicit SoaPoints(const PointsView& pts) : n(pts.size) {
+    const std::size_t padded = (n + kBlock - 1) / kBlock * kBlock;
+    x.assign(padded, 0.f);
+    y.assign(padded, 0.f);
+    z.assign(padded, 0.f);
+    g.assign(padded, 0.f);
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] = pts[i][0];
+      y[i] = pts[i][1];
+      z[i] = pts[i][2];
+      g[i] = pts[i][3];
+    }
+  }
+};
+
+// Writes component k's packed kernel parameters from its float covariance.
+// The precision Cholesky factor U = L^-T (covariance = L L^T) is computed in
+// double by a triangular solve. Returns false when the covariance is not
+// positive definite.
+bool pack_component(const Gmm& gmm, std::size_t k, double log_weight, float* out) {
+  Eigen::Matrix4d cov = Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
+  Eigen::LLT<Eigen::Matrix4d> llt(cov);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix4d l = llt.matrixL();
+  if (!(l.diagonal().minCoeff() > 0.0)) return false;
+  const Eigen::Matrix4d u = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d::Identity()).transpose();
+  for (int i = 0; i < 4; ++i) out[i] = gmm.mean(k)[i];
+  int t = 4;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) out[t++] = static_cast<float>(u(i, j));
+  out[14] = static_cast<float>(log_weight + u.diagonal().array().log().sum() - 2.0 * kLog2Pi);
+  out[15] = 0.f;
+  return std::isfinite(out[14]);
+}
+
+// Packs every component. A covariance that is numerically not positive
+// definite even after regularisation gets escalating extra diagonal loading
+// rather than producing NaN; if even that fails the fit stops with an error.
+void pack_all(Gmm& gmm, const std::vector<double>& log_weights, double reg_covar, std::vector<float>& params) {
+  const std::size_t m = gmm.size();
+  params.assign(m * kParamStride, 0.f);
+  for (std::size_t k = 0; k < m; ++k) {
+    double extra = std::max(reg_covar, 1e-12);
+    int attempts = 0;
+    while (!pack_component(gmm, k, log_weights[k], &params[k * kParamStride])) {
+      require(++attempts <= 12, ErrorCode::Numeric,
+              "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
+      float* c = gmm.covariances.data() + 16 * k;
+      for (int i = 0; i < 4; ++i) c[5 * i] += static_cast<float>(extra);
+      extra *= 10.0;
+    }
+  }
+}
+
+// M-step for one component from its centred statistics; returns sum r + guard.
+double m_step_component(const double* st, double reg_covar, float* mean, float* cov) {
+  const double nk = st[0] + kEmptyGuard;
+  if (st[0] <= 0.0) {
+    // No point is responsible: keep the mean, reset the shape to the regulariser.
+    for (int i = 0; i < 16; ++i) cov[i] = (i % 5 == 0) ? static_cast<float>(reg_covar) : 0.f;
+    return nk;
+  }
+  double delta[4];
+  for (int i = 0; i < 4; ++i) delta[i] = st[1 + i] / nk;
+  // sum r (d - delta)(d - delta)^T / nk with d centred at the old mean.
+  const double shrink = st[0] / nk;
+  int t = 5;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i; j < 4; ++j) {
+      double c = st[t++] / nk - 2.0 * delta[i] * delta[j] + shrink * delta[i] * delta[j];
+      if (i == j) c += reg_covar;
+      cov[4 * i + j] = cov[4 * j + i] = static_cast<float>(c);
+    }
+  }
+  for (int i = 0; i < 4; ++i) mean[i] = static_cast<float>(mean[i] + delta[i]);
+  return nk;
+}
+
+Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, const EmOptions& options,
+           EmReport* report) {
+  const std::size_t n = points.size, m = gmm.size();
+  const SoaPoints soa(points);
+  const std::size_t n_blocks = (n + kBlock - 1) / kBlock;
+  const std::size_t blocks_per_chunk = std::clamp<std::size_t>((n_blocks + kWave - 1) / kWave, 1, kMaxBlocksPerChunk);
+  const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const detail::EmBlockFn kernel = detail::em_block_kernel();
+
+  std::vector<float> params;
+  std::vector<double> slot_stats(kWave * m * kStatStride);
+  std::vector<double> slot_ll(kWave);
+  std::vector<float> slot_scratch(kWave * (kBlock + 1) * m);
+  std::vector<double> stats(m * kStatStride);
+
+  EmReport rep;
+  double previous = -std::numeric_limits<double>::infinity();
+  for (int iter = 1; iter <= options.max_iter; ++iter) {
+    pack_all(gmm, log_weights, options.reg_covar, params);
+    std::fill(stats.begin(), stats.end(), 0.0);
+    double total_ll = 0.0;
+    for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
+      const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+      for (std::size_t s = 0; s < wave_chunks; ++s) {
+        double* st = &slot_stats[s * m * kStatStride];
+        std::fill(st, st + m * kStatStride, 0.0);
+        float* scratch = &slot_scratch[s * (kBlock + 1) * m];
+        double ll = 0.0;
+        const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
+        const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
+        for (std::size_t b = b0; b < b1; ++b) {
+          const std::size_t first = b * kBlock;
+          const int count = static_cast<int>(std::min<std::size_t>(kBlock, n - first));
+          const float* coords[4] = {&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]};
+          ll += kernel(coords, count, params.data(), m, scratch, st);
+        }
+        slot_ll[s] = ll;
+      }
+      // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
+      for (std::size_t s = 0; s < wave_chunks; ++s) {
+        const double* st = &slot_stats[s * m * kStatStride];
+        for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
+        total_ll += slot_ll[s];
+      }
+    }
+    const double mean_ll = total_ll / static_cast<double>(n);
+    require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
+                                                            std::to_string(iter));
+
+    // M-step.
+    double weight_sum = 0.0;
+    std::vector<double> nk(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, gmm.means.data() + 4 * k,
+                               gmm.covariances.data() + 16 * k);
+      weight_sum += nk[k];
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+      const double w = nk[k] / weight_sum;
+      gmm.weights[k] = static_cast<float>(w);
+      log_weights[k] = std::log(w);
+    }
+
+    rep.iterations = iter;
+    rep.log_likelihood = mean_ll;
+    if (std::fabs(mean_ll - previous) < options.tol) {
+      rep.converged = true;
+      break;
+    }
+    previous = mean_ll;
+  }
+  gmm.support_size = n;
+  if (report) *report = rep;
+  return gmm;
+}
+
+}  // namespace
+
+Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indices, const EmOptions& options,
+           EmReport* report) {
+  check_options(options);
+  require_finite_points(points, "EM input");
+  const std::size_t m = seed_indices.size();
+  require(m >= 1 && m <= points.size, ErrorCode::InvalidArgument,
+          "number of components must be in [1, N = " + std::to_string(points.size) + "], got " + std::to_string(m));
+  Gmm init;
+  init.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    require(seed_indices[k] < points.size, ErrorCode::InvalidArgument,
+            "seed index " + std::to_string(seed_indices[k]) + " is out of range");
+    for (int i = 0; i < 4; ++i) init.means[4 * k + i] = points[seed_indices[k]][i];
+    for (int i = 0; i < 16; ++i) init.covariances[16 * k + i] = (i % 5 == 0) ? static_cast<float>(options.reg_covar) : 0.f;
+    init.weights[k] = 1.0f / static_cast<float>(m);
+  }
+  // One-hot responsibilities on the seeds give each component weight 1 / N
+  // before normalisation (scikit-learn's _initialize); only the first
+  // iteration's log-likelihood sees the difference.
+  std::vector<double> log_weights(m, -std::log(static_cast<double>(points.size)));
+  return run_em(points, std::move(init), std::move(log_weights), options, report);
+}
+
+Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options, EmReport* report) {
+  check_options(options);
+  require_finite_points(points, "EM input");
+  validate(initial);
+  std::vector<double> log_weights(initial.size());
+  for (std::size_t k = 0; k < initial.size(); ++k)
+    log_weights[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
+  return run_em(points, initial, std::move(log_weights), options, report);
+}
+
+}  // namespace sogmm

@@ -1,0 +1,121 @@
+// One EM block, compiled once per instruction set (see em_kernel.hpp). The
+// loops run over the points of a block with the component's parameters
+// broadcast, so the compiler vectorizes them at whatever width the
+// translation unit is compiled for.
+#include <cmath>
+#include <limits>
+
+#include "em_kernel.hpp"
+#include "fast_exp.hpp"
+
+#ifndef SOGMM_ISA
+#error "compile with -DSOGMM_ISA=<name>"
+#endif
+
+namespace sogmm::detail::SOGMM_ISA {
+
+double em_block(const float* const xyzg[4], int count, const float* params, std::size_t m, float* scratch,
+                double* stats) {
+  const float* __restrict px = xyzg[0];
+  const float* __restrict py = xyzg[1];
+  const float* __restrict pz = xyzg[2];
+  const float* __restrict pg = xyzg[3];
+  alignas(64) float mx[kBlock];
+  alignas(64) float sum[kBlock];
+  alignas(64) float inv_sum[kBlock];
+  float* __restrict row_max = scratch + m * kBlock;  // per component: largest e in this block
+
+  for (int p = 0; p < kBlock; ++p) mx[p] = -std::numeric_limits<float>::infinity();
+
+  // Log-density of every point under every component: log w + log det U
+  // - 2 log 2 pi - |d^T U|^2 / 2 with d = x - mu and U upper triangular.
+  for (std::size_t k = 0; k < m; ++k) {
+    const float* q = params + k * kParamStride;
+    const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
+    const float u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
+                u23 = q[12], u33 = q[13], c = q[14];
+    float* __restrict lp = scratch + k * kBlock;
+#pragma omp simd
+    for (int p = 0; p < count; ++p) {
+      const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
+      const float y0 = d0 * u00;
+      const float y1 = d0 * u01 + d1 * u11;
+      const float y2 = d0 * u02 + d1 * u12 + d2 * u22;
+      const float y3 = d0 * u03 + d1 * u13 + d2 * u23 + d3 * u33;
+      const float l = c - 0.5f * (y0 * y0 + y1 * y1 + y2 * y2 + y3 * y3);
+      lp[p] = l;
+      mx[p] = l > mx[p] ? l : mx[p];  // (a ternary vectorizes where fmax on a stored array did not)
+    }
+  }
+
+  // exp(lp - max) in place, and its sum per point (log-sum-exp).
+  for (int p = 0; p < kBlock; ++p) sum[p] = 0.0f;
+  for (std::size_t k = 0; k < m; ++k) {
+    float* __restrict e = scratch + k * kBlock;
+    float emax = 0.0f;
+#pragma omp simd reduction(max : emax)
+    for (int p = 0; p < count; ++p) {
+      const float v = fast_exp(e[p] - mx[p]);
+      e[p] = v;
+      sum[p] += v;
+      emax = v > emax ? v : emax;
+    }
+    row_max[k] = emax;
+  }
+  double log_likelihood = 0.0;
+  for (int p = 0; p < count; ++p) {
+    log_likelihood += static_cast<double>(mx[p]) + std::log(static_cast<double>(sum[p]));
+    inv_sum[p] = 1.0f / sum[p];
+  }
+
+  // Sufficient statistics centred at each component's mean. A component whose
+  // responsibilities are all exactly 0 in this block adds nothing: skip it.
+  for (std::size_t k = 0; k < m; ++k) {
+    if (row_max[k] == 0.0f) continue;
+    const float* q = params + k * kParamStride;
+    const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
+    const float* __restrict e = scratch + k * kBlock;
+    float s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0;
+    float c00 = 0, c01 = 0, c02 = 0, c03 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
+#pragma omp simd reduction(+ : s0, s1, s2, s3, s4, c00, c01, c02, c03, c11, c12, c13, c22, c23, c33)
+    for (int p = 0; p < count; ++p) {
+      const float r = e[p] * inv_sum[p];
+      const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
+      const float r0 = r * d0, r1 = r * d1, r2 = r * d2, r3 = r * d3;
+      s0 += r;
+      s1 += r0;
+      s2 += r1;
+      s3 += r2;
+      s4 += r3;
+      c00 += r0 * d0;
+      c01 += r0 * d1;
+      c02 += r0 * d2;
+      c03 += r0 * d3;
+      c11 += r1 * d1;
+      c12 += r1 * d2;
+      c13 += r1 * d3;
+      c22 += r2 * d2;
+      c23 += r2 * d3;
+      c33 += r3 * d3;
+    }
+    double* st = stats + k * kStatStride;
+    st[0] += s0;
+    st[1] += s1;
+    st[2] += s2;
+    st[3] += s3;
+    st[4] += s4;
+    st[5] += c00;
+    st[6] += c01;
+    st[7] += c02;
+    st[8] += c03;
+    st[9] += c11;
+    st[10] += c12;
+    st[11] += c13;
+    st[12] += c22;
+    st[13] += c23;
+    st[14] += c33;
+  }
+  return log_likelihood;
+}
+
+}  // namespace sogmm::detail::SOGMM_ISA

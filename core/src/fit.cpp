@@ -1,0 +1,80 @@
+// The whole fit: mode count -> k-means++ -> EM.
+#include "sogmm/fit.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "sogmm/error.hpp"
+#include "sogmm/kmeanspp.hpp"
+
+namespace sogmm {
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+// Sets the OpenMP thread count of the calling thread for the duration of a
+// fit and restores the caller's setting afterwards, even on error.
+class ScopedOmpThreads {
+ public:
+  explicit ScopedOmpThreads(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
+  ~ScopedOmpThreads() { omp_set_num_threads(saved_); }
+  ScopedOmpThreads(const ScopedOmpThreads&) = delete;
+  ScopedOmpThreads& operator=(const ScopedOmpThreads&) = delete;
+
+ private:
+  int saved_;
+};
+}  // namespace
+
+FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  require_finite_points(points, "point cloud");
+  const bool fixed_k = options.n_components > 0;
+  if (!fixed_k) {
+    require(std::isfinite(options.bandwidth) && options.bandwidth > 0, ErrorCode::InvalidArgument,
+            "bandwidth must be positive and finite, got " + std::to_string(options.bandwidth));
+  } else {
+    require(options.n_components <= points.size, ErrorCode::InvalidArgument,
+            "number of components K = " + std::to_string(options.n_components) +
+                " exceeds the number of points N = " + std::to_string(points.size));
+  }
+  require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
+  const int threads = options.em.threads > 0 ? options.em.threads : omp_get_max_threads();
+  const ScopedOmpThreads scoped_threads(threads);
+
+  FitResult result;
+  result.n_points = points.size;
+  std::size_t k = options.n_components;
+  if (!fixed_k) {
+    if (progress) progress(FitStage::ModeCount, 0, 0.0);
+    const auto t = std::chrono::steady_clock::now();
+    const std::vector<double> features = range_gray_features(points);
+    const MeanShiftResult modes = options.mode_counter == ModeCounter::FlatBinned
+                                      ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
+                                      : mean_shift_gaussian_blurring(features, options.bandwidth);
+    k = std::min<std::size_t>(std::max<std::size_t>(modes.size(), 1), points.size);
+    result.seconds_mode_count = seconds_since(t);
+  }
+
+  if (progress) progress(FitStage::Seeding, 0, 0.0);
+  auto t = std::chrono::steady_clock::now();
+  const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed);
+  result.seconds_seeding = seconds_since(t);
+
+  if (progress) progress(FitStage::Em, 0, 0.0);
+  t = std::chrono::steady_clock::now();
+  EmOptions em = options.em;
+  em.threads = threads;
+  result.gmm = fit_em(points, seeds, em, &result.em);
+  result.seconds_em = seconds_since(t);
+  if (progress) progress(FitStage::Em, result.em.iterations, result.em.log_likelihood);
+
+  validate(result.gmm);
+  result.seconds_total = seconds_since(t0);
+  return result;
+}
+
+}  // namespace sogmm

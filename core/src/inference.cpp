@@ -1,0 +1,229 @@
+// Scoring, sampling, gray regression, merging and rigid transforms of a model.
+#include "sogmm/inference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "sogmm/error.hpp"
+#include "sogmm/random.hpp"
+
+namespace sogmm {
+namespace {
+
+constexpr double kLog2Pi = 1.8378770664093454836;
+using Mat4 = Eigen::Matrix4d;
+using Mat3 = Eigen::Matrix3d;
+
+Mat4 covariance_of(const Gmm& gmm, std::size_t k) {
+  return Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
+}
+Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
+  return Eigen::Map<const Eigen::Vector4f>(gmm.mean(k)).cast<double>();
+}
+
+// Per-component quantities for Gaussian densities in D dimensions (D = 3 or
+// 4): the inverse Cholesky factor and log(weight) - log det(L) - D/2 log 2 pi.
+template <int D>
+struct DensityCache {
+  std::vector<Eigen::Matrix<double, D, 1>> mean;
+  std::vector<Eigen::Matrix<double, D, D>> inv_l;
+  std::vector<double> log_const;
+
+  explicit DensityCache(const Gmm& gmm) {
+    validate(gmm);
+    const std::size_t m = gmm.size();
+    mean.resize(m);
+    inv_l.resize(m);
+    log_const.resize(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      const Eigen::Matrix<double, D, D> c = covariance_of(gmm, k).template topLeftCorner<D, D>();
+      Eigen::LLT<Eigen::Matrix<double, D, D>> llt(c);
+      const Eigen::Matrix<double, D, D> l = llt.matrixL();
+      inv_l[k] = l.template triangularView<Eigen::Lower>().solve(Eigen::Matrix<double, D, D>::Identity());
+      mean[k] = mean_of(gmm, k).template head<D>();
+      const double w = gmm.weights[k];
+      log_const[k] = (w > 0 ? std::log(w) : -std::numeric_limits<double>::infinity()) -
+                     l.diagonal().array().log().sum() - 0.5 * D * kLog2Pi;
+    }
+  }
+  // log(w_k N(x | mu_k, Sigma_k)).
+  double log_component(std::size_t k, const Eigen::Matrix<double, D, 1>& x) const {
+    return log_const[k] - 0.5 * (inv_l[k] * (x - mean[k])).squaredNorm();
+  }
+};
+
+double log_sum_exp(const double* v, std::size_t n) {
+  const double mx = *std::max_element(v, v + n);
+  if (!std::isfinite(mx)) return mx;
+  double s = 0.0;
+  for (std::size_t i = 0; i < n; ++i) s += std::exp(v[i] - mx);
+  return mx + std::log(s);
+}
+
+void require_finite(const float* v, std::size_t count, const char* what) {
+  for (std::size_t i = 0; i < count; ++i)
+    require(std::isfinite(v[i]), ErrorCode::InvalidData,
+            std::string(what) + " has a non-finite value (NaN or Inf) at row " + std::to_string(i / 3));
+}
+
+template <int D>
+void score_dims(const Gmm& gmm, const float* points, std::size_t n, double* out) {
+  const DensityCache<D> cache(gmm);
+  const std::size_t m = gmm.size();
+#pragma omp parallel
+  {
+    std::vector<double> lp(m);
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Matrix<double, D, 1> x = Eigen::Map<const Eigen::Matrix<float, D, 1>>(points + D * i).template cast<double>();
+      for (std::size_t k = 0; k < m; ++k) lp[k] = cache.log_component(k, x);
+      out[i] = log_sum_exp(lp.data(), m);
+    }
+  }
+}
+
+}  // namespace
+
+void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out) {
+  require(dims == 3 || dims == 4, ErrorCode::InvalidArgument, "dims must be 3 or 4, got " + std::to_string(dims));
+  if (n == 0) return;
+  require(points != nullptr && out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
+  require_finite(points, n * dims, "points to score");
+  if (dims == 4)
+    score_dims<4>(gmm, points, n, out);
+  else
+    score_dims<3>(gmm, points, n, out);
+}
+
+double mean_log_likelihood(const Gmm& gmm, const float* points, std::size_t n, int dims) {
+  require(n > 0, ErrorCode::InvalidData, "no points to score");
+  std::vector<double> lp(n);
+  score_samples(gmm, points, n, dims, lp.data());
+  double s = 0.0;
+  for (double v : lp) s += v;
+  return s / static_cast<double>(n);
+}
+
+void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* out, double truncation) {
+  require(dims == 3 || dims == 4, ErrorCode::InvalidArgument, "dims must be 3 or 4, got " + std::to_string(dims));
+  require(truncation > 0, ErrorCode::InvalidArgument, "truncation must be > 0");
+  validate(gmm);
+  if (n == 0) return;
+  require(out != nullptr, ErrorCode::InvalidArgument, "output must not be null");
+  const std::size_t m = gmm.size();
+  Rng rng(seed);
+  // Multinomial counts: each draw picks a component by its cumulative weight.
+  std::vector<double> cumulative(m);
+  double running = 0.0;
+  for (std::size_t k = 0; k < m; ++k) cumulative[k] = (running += gmm.weights[k]);
+  std::vector<std::size_t> counts(m, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = rng.uniform() * running;
+    const std::size_t k = std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin();
+    ++counts[std::min(k, m - 1)];
+  }
+  std::size_t row = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (counts[k] == 0) continue;
+    const Mat4 l = Eigen::LLT<Mat4>(covariance_of(gmm, k)).matrixL();
+    const Eigen::Vector4d mu = mean_of(gmm, k);
+    for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
+      Eigen::Vector4d z;
+      for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : rng.truncated_normal(truncation);
+      const Eigen::Vector4d x = mu + l * z;
+      for (int i = 0; i < dims; ++i) out[dims * row + i] = static_cast<float>(x[i]);
+    }
+  }
+}
+
+void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_out, float* variance_out) {
+  if (n == 0) return;
+  require(xyz != nullptr && mean_out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
+  require_finite(xyz, 3 * n, "points to regress");
+  const DensityCache<3> cache(gmm);
+  const std::size_t m = gmm.size();
+  // Per component: gain A = Sigma_gx Sigma_xx^-1 and conditional variance.
+  std::vector<Eigen::RowVector3d> gain(m);
+  std::vector<double> cond_var(m), mean_g(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    const Mat4 c = covariance_of(gmm, k);
+    const Mat3 sxx = c.topLeftCorner<3, 3>();
+    const Eigen::Vector3d sxg = c.topRightCorner<3, 1>();
+    gain[k] = Eigen::LLT<Mat3>(sxx).solve(sxg).transpose();
+    cond_var[k] = std::max(0.0, c(3, 3) - gain[k].dot(sxg));
+    mean_g[k] = gmm.mean(k)[3];
+  }
+#pragma omp parallel
+  {
+    std::vector<double> lw(m);
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3f>(xyz + 3 * i).cast<double>();
+      for (std::size_t k = 0; k < m; ++k) lw[k] = cache.log_component(k, x);
+      const double lse = log_sum_exp(lw.data(), m);
+      double mu = 0.0, second = 0.0;
+      for (std::size_t k = 0; k < m; ++k) {
+        const double w = std::exp(lw[k] - lse);
+        if (w == 0.0) continue;
+        const double lambda = mean_g[k] + gain[k].dot(x - cache.mean[k]);
+        mu += w * lambda;
+        second += w * (cond_var[k] + lambda * lambda);
+      }
+      mean_out[i] = static_cast<float>(mu);
+      if (variance_out) variance_out[i] = static_cast<float>(std::max(0.0, second - mu * mu));
+    }
+  }
+}
+
+Gmm merge(const Gmm& a, const Gmm& b) {
+  validate(a);
+  validate(b);
+  const double sa = static_cast<double>(a.support_size), sb = static_cast<double>(b.support_size);
+  const double fa = (sa + sb > 0) ? sa / (sa + sb) : 0.5;
+  const double fb = 1.0 - fa;
+  Gmm out;
+  out.support_size = a.support_size + b.support_size;
+  out.weights.reserve(a.size() + b.size());
+  for (float w : a.weights) out.weights.push_back(static_cast<float>(w * fa));
+  for (float w : b.weights) out.weights.push_back(static_cast<float>(w * fb));
+  out.means = a.means;
+  out.means.insert(out.means.end(), b.means.begin(), b.means.end());
+  out.covariances = a.covariances;
+  out.covariances.insert(out.covariances.end(), b.covariances.begin(), b.covariances.end());
+  return out;
+}
+
+Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
+  validate(gmm);
+  const Eigen::Matrix4d t = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(pose.data());
+  require(t.allFinite(), ErrorCode::InvalidArgument, "pose has a non-finite value");
+  const Mat3 r = t.topLeftCorner<3, 3>();
+  require((r * r.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-4 && std::fabs(r.determinant() - 1.0) < 1e-4,
+          ErrorCode::InvalidArgument, "pose is not a rigid transform (rotation part is not orthonormal with det 1)");
+  require(std::fabs(t(3, 0)) + std::fabs(t(3, 1)) + std::fabs(t(3, 2)) + std::fabs(t(3, 3) - 1.0) < 1e-9,
+          ErrorCode::InvalidArgument, "pose's last row must be [0 0 0 1]");
+  // Acting on (x, y, z, g) with the block-diagonal [R 0; 0 1].
+  Mat4 a = Mat4::Identity();
+  a.topLeftCorner<3, 3>() = r;
+  Eigen::Vector4d shift = Eigen::Vector4d::Zero();
+  shift.head<3>() = t.topRightCorner<3, 1>();
+  Gmm out = gmm;
+  for (std::size_t k = 0; k < gmm.size(); ++k) {
+    const Eigen::Vector4d mu = a * mean_of(gmm, k) + shift;
+    Mat4 c = a * covariance_of(gmm, k) * a.transpose();
+    c = 0.5 * (c + c.transpose());
+    for (int i = 0; i < 4; ++i) out.means[4 * k + i] = static_cast<float>(mu[i]);
+    for (int i = 0; i < 16; ++i) out.covariances[16 * k + i] = static_cast<float>(c(i / 4, i % 4));
+  }
+  return out;
+}
+
+std::size_t paper_model_bytes(const Gmm& gmm) { return 4 * gmm.size() * (1 + 10 + 4); }
+
+}  // namespace sogmm

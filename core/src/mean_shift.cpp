@@ -1,0 +1,187 @@
+// Mode counting by mean shift on (range, gray) features.
+#include "sogmm/mean_shift.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "grid2d.hpp"
+#include "sogmm/error.hpp"
+
+namespace sogmm {
+namespace {
+
+void check_inputs(const std::vector<double>& points2d, double bandwidth) {
+  require(std::isfinite(bandwidth) && bandwidth > 0, ErrorCode::InvalidArgument,
+          "bandwidth must be positive and finite, got " + std::to_string(bandwidth));
+  require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
+          "mean shift needs a non-empty N x 2 array");
+  for (double v : points2d)
+    require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
+}
+
+// Centres of the occupied cells of the bin-seeding grid.
+std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, BinAnchor anchor) {
+  double min_x = 0.0, min_y = 0.0;
+  if (anchor == BinAnchor::DataMin) {
+    min_x = min_y = INFINITY;
+    for (std::size_t i = 0; i < xy.size(); i += 2) {
+      min_x = std::min(min_x, xy[i]);
+      min_y = std::min(min_y, xy[i + 1]);
+    }
+  }
+  auto cell = [&](double v, double lo) {
+    // Zero anchor: numpy's round (half to even) as scikit-learn's get_bin_seeds.
+    return anchor == BinAnchor::Zero ? static_cast<std::int64_t>(std::nearbyint(v / bandwidth))
+                                     : static_cast<std::int64_t>(std::floor((v - lo) / bandwidth + 0.5));
+  };
+  std::map<std::pair<std::int64_t, std::int64_t>, int> occupied;  // ordered: seeds in a fixed order
+  for (std::size_t i = 0; i < xy.size(); i += 2) occupied[{cell(xy[i], min_x), cell(xy[i + 1], min_y)}] = 1;
+  std::vector<double> seeds;
+  seeds.reserve(2 * occupied.size());
+  for (const auto& kv : occupied) {
+    seeds.push_back(kv.first.first * bandwidth + min_x);
+    seeds.push_back(kv.first.second * bandwidth + min_y);
+  }
+  return seeds;
+}
+
+struct Mode {
+  double x, y;
+  std::size_t strength;
+};
+
+// Orders modes strongest first (ties: larger centre first, as scikit-learn's
+// sort of (intensity, centre) tuples in reverse), drops exact duplicates and
+// every mode within `radius` of a stronger kept one.
+MeanShiftResult suppress_near_duplicates(std::vector<Mode> modes, double radius) {
+  std::sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) {
+    if (a.strength != b.strength) return a.strength > b.strength;
+    if (a.x != b.x) return a.x > b.x;
+    return a.y > b.y;
+  });
+  modes.erase(std::unique(modes.begin(), modes.end(),
+                          [](const Mode& a, const Mode& b) { return a.x == b.x && a.y == b.y; }),
+              modes.end());
+  std::vector<double> xy(2 * modes.size());
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    xy[2 * i] = modes[i].x;
+    xy[2 * i + 1] = modes[i].y;
+  }
+  MeanShiftResult result;
+  if (modes.empty()) return result;
+  detail::Grid2d grid(xy.data(), modes.size(), radius);
+  std::vector<char> unique(modes.size(), 1);
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    if (!unique[i]) continue;
+    grid.for_each_within(modes[i].x, modes[i].y, radius, [&](std::uint32_t j) { unique[j] = 0; });
+    unique[i] = 1;
+  }
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    if (!unique[i]) continue;
+    result.centers.push_back(modes[i].x);
+    result.centers.push_back(modes[i].y);
+    result.strengths.push_back(modes[i].strength);
+  }
+  return result;
+}
+
+}  // namespace
+
+MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth, const MeanShiftOptions& options) {
+  check_inputs(xy, bandwidth);
+  require(options.max_iter >= 0 && options.stop_fraction >= 0, ErrorCode::InvalidArgument,
+          "mean shift max_iter and stop_fraction must be >= 0");
+  const std::size_t n = xy.size() / 2;
+  const detail::Grid2d grid(xy.data(), n, bandwidth);
+  const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
+  const std::size_t n_seeds = seeds.size() / 2;
+  const double stop = options.stop_fraction * bandwidth;
+  std::vector<Mode> modes(n_seeds);
+
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::size_t s = 0; s < n_seeds; ++s) {
+    double mx = seeds[2 * s], my = seeds[2 * s + 1];
+    std::size_t within = 0;
+    for (int it = 0;; ++it) {
+      double sx = 0.0, sy = 0.0;
+      std::size_t count = 0;
+      grid.for_each_within(mx, my, bandwidth, [&](std::uint32_t i) {
+        sx += xy[2 * i];
+        sy += xy[2 * i + 1];
+        ++count;
+      });
+      within = count;
+      if (count == 0) break;
+      const double nx = sx / count, ny = sy / count;
+      const double moved = std::hypot(nx - mx, ny - my);
+      mx = nx;
+      my = ny;
+      if (moved <= stop || it == options.max_iter) break;
+    }
+    modes[s] = {mx, my, within};
+  }
+  // Seeds that saw no point are not modes.
+  modes.erase(std::remove_if(modes.begin(), modes.end(), [](const Mode& m) { return m.strength == 0; }), modes.end());
+  return suppress_near_duplicates(std::move(modes), bandwidth);
+}
+
+MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, double bandwidth, int max_iter) {
+  check_inputs(xy0, bandwidth);
+  require(max_iter >= 1, ErrorCode::InvalidArgument, "max_iter must be >= 1");
+  const std::size_t n = xy0.size() / 2;
+  std::vector<double> xy = xy0, next(xy.size());
+  const double radius = 3.0 * bandwidth;
+  const double inv2s2 = 1.0 / (2.0 * bandwidth * bandwidth);
+  const double stop2 = (1e-3 * bandwidth) * (1e-3 * bandwidth);
+  for (int it = 0; it < max_iter; ++it) {
+    const detail::Grid2d grid(xy.data(), n, radius);
+    double moved2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : moved2)
+    for (std::size_t i = 0; i < n; ++i) {
+      double sw = 0.0, sx = 0.0, sy = 0.0;
+      const double x = xy[2 * i], y = xy[2 * i + 1];
+      grid.for_each_within(x, y, radius, [&](std::uint32_t j) {
+        const double dx = xy[2 * j] - x, dy = xy[2 * j + 1] - y;
+        const double w = std::exp(-(dx * dx + dy * dy) * inv2s2);
+        sw += w;
+        sx += w * xy[2 * j];
+        sy += w * xy[2 * j + 1];
+      });
+      next[2 * i] = sx / sw;
+      next[2 * i + 1] = sy / sw;
+      moved2 += (next[2 * i] - x) * (next[2 * i] - x) + (next[2 * i + 1] - y) * (next[2 * i + 1] - y);
+    }
+    xy.swap(next);
+    if (moved2 / n < stop2) break;
+  }
+  // Collapse the blurred points into modes: greedy assignment to a mode within
+  // bandwidth / 2, in point order (deterministic).
+  std::vector<Mode> modes;
+  std::vector<double> centers;
+  for (std::size_t i = 0; i < n; ++i) {
+    bool assigned = false;
+    for (std::size_t m = 0; m < modes.size() && !assigned; ++m) {
+      if (std::hypot(modes[m].x - xy[2 * i], modes[m].y - xy[2 * i + 1]) <= 0.5 * bandwidth) {
+        ++modes[m].strength;
+        assigned = true;
+      }
+    }
+    if (!assigned) modes.push_back({xy[2 * i], xy[2 * i + 1], 1});
+  }
+  return suppress_near_duplicates(std::move(modes), 0.5 * bandwidth);
+}
+
+std::vector<double> range_gray_features(const PointsView& points) {
+  std::vector<double> f(2 * points.size);
+  for (std::size_t i = 0; i < points.size; ++i) {
+    const float* p = points[i];
+    f[2 * i] = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+    f[2 * i + 1] = p[3];
+  }
+  return f;
+}
+
+}  // namespace sogmm

@@ -1,0 +1,125 @@
+// The .sogmm file format: reading, writing and verifying SOGMM models.
+//
+// The normative description of the bytes is spec/format.md; the metadata
+// schema is spec/sogmm.fbs. This header is the C++ face of it.
+//
+// Errors: every function reports a problem by throwing sogmm::Error (in fact
+// a sogmm::format::FormatError, which adds a stable reason identifier from
+// spec/format.md section 9):
+//   ErrorCode::Format       structure, version, feature, encoding or checksum problem
+//   ErrorCode::Limit        a declared size is over ReadOptions::max_decoded_bytes
+//   ErrorCode::InvalidData  M = 0, array lengths that disagree with M, bad pose
+//   ErrorCode::Numeric      NaN/Inf, weights not summing to 1, non-symmetric or
+//                           non-positive-definite covariance
+//   ErrorCode::Io           a file cannot be opened, read or written
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sogmm/error.hpp"
+#include "sogmm/model.hpp"
+
+namespace sogmm::format {
+
+/// Format version this library writes (and the newest it knows).
+inline constexpr std::uint16_t kFormatMajor = 1;
+inline constexpr std::uint16_t kFormatMinor = 0;
+
+/// Default cap on the total decoded size of the bulk arrays (1 GiB, enough
+/// for about 17 million float32 components). See spec/format.md section 8.
+inline constexpr std::uint64_t kDefaultMaxDecodedBytes = std::uint64_t{1} << 30;
+
+/// How a model is encoded.
+struct WriteOptions {
+  int zstd_level = 19;   ///< zstd compression level, 1..22 (clamped)
+  bool float64 = false;  ///< store arrays as float64 (exact widening of the float32 values)
+  bool compress = true;  ///< false: arrays stored raw (no filter, no codec), component-major
+};
+
+/// How a file is read.
+struct ReadOptions {
+  /// Reject files whose arrays declare more decoded bytes than this (total
+  /// over weights, means and covariances), before allocating anything.
+  std::uint64_t max_decoded_bytes = kDefaultMaxDecodedBytes;
+  /// Check the CRC-32C of the metadata and of every decoded array.
+  bool verify_checksums = true;
+};
+
+/// A sogmm::Error raised by this module, with the stable reason identifier
+/// that spec/format.md section 9 assigns to each rejection ("bad_magic",
+/// "truncated", "checksum_mismatch", ...). what() starts with the reason.
+class FormatError : public Error {
+ public:
+  FormatError(ErrorCode code, std::string reason, const std::string& detail)
+      : Error(code, reason + ": " + detail), reason_(std::move(reason)) {}
+  /// The reason identifier, e.g. "not_spd".
+  const std::string& reason() const noexcept { return reason_; }
+
+ private:
+  std::string reason_;
+};
+
+/// Encodes a model into the bytes of a .sogmm file. Refuses (throws
+/// Error(InvalidData/Numeric), nothing written) a model that a reader would
+/// reject. An empty producer_version is written as sogmm::version_string().
+/// Covariances are stored packed (upper triangle) when every matrix is
+/// bit-exactly symmetric, else in full, so the round trip is always bit-exact.
+std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options = {});
+
+/// Decodes and fully verifies the bytes of a .sogmm file.
+Model from_bytes(const void* data, std::size_t size, const ReadOptions& options = {});
+
+/// Writes a .sogmm file atomically: a temporary file in the same directory is
+/// written, fsync'ed and renamed over `path`. On failure the previous file (if
+/// any) is untouched and no temporary file is left; throws Error(Io).
+void save(const std::string& path, const Model& model, const WriteOptions& options = {});
+
+/// Reads and fully verifies a .sogmm file. Throws Error(Io) when it cannot be read.
+Model load(const std::string& path, const ReadOptions& options = {});
+
+/// How one array is encoded in a file.
+struct ArrayInfo {
+  std::string dtype;          ///< "f32" or "f64"
+  std::string order;          ///< "component_major" or "column_major"
+  std::string filter;         ///< "none" or "byte_stream_split"
+  std::string codec;          ///< "none" or "zstd"
+  std::uint64_t offset = 0;   ///< file offset of the stored bytes
+  std::uint64_t stored_length = 0;
+  std::uint64_t decoded_length = 0;
+  std::uint32_t crc32c = 0;   ///< declared CRC-32C of the decoded bytes
+};
+
+/// Everything about a file except the bulk arrays: obtained by reading and
+/// verifying only the header and the metadata block (no decompression).
+struct FileInfo {
+  std::uint16_t format_major = 0;
+  std::uint16_t format_minor = 0;
+  std::uint64_t file_length = 0;
+  std::uint64_t metadata_length = 0;
+  std::uint64_t features_required = 0;
+  std::uint64_t features_used = 0;
+  std::string covariance_layout;  ///< "upper_packed" or "full"
+  std::uint64_t n_components = 0;
+  ArrayInfo weights, means, covariances;
+  /// The metadata as a Model whose Gmm holds no arrays (only support_size).
+  Model metadata;
+};
+
+/// Reads and verifies the header and the metadata block of a whole file in
+/// memory (steps 1 to 12 of spec/format.md section 9: everything except
+/// decoding the arrays and checking their values). No decompression.
+FileInfo read_info(const void* data, std::size_t size, const ReadOptions& options = {});
+
+/// read_info() on a file, reading only its header, metadata block and last 4
+/// bytes. Throws Error(Io) when the file cannot be read.
+FileInfo read_info_file(const std::string& path, const ReadOptions& options = {});
+
+/// Canonical JSON dump of a model and its file information (spec/format.md
+/// section 10): fixed key order, 2-space indentation, numbers written so that
+/// parsing them gives back the exact value. `info` may be null (model only).
+std::string to_canonical_json(const Model& model, const FileInfo* info = nullptr);
+
+}  // namespace sogmm::format

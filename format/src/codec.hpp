@@ -1,0 +1,45 @@
+// Array encoding pipeline (spec/format.md section 5): element order,
+// byte-stream split and zstd framing, in both directions.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace sogmm::format::detail {
+
+// Enum values as in spec/sogmm.fbs (kept numeric here so this file does not
+// depend on generated code).
+enum : std::uint8_t { kDTypeF32 = 0, kDTypeF64 = 1 };
+enum : std::uint8_t { kOrderComponentMajor = 0, kOrderColumnMajor = 1 };
+enum : std::uint8_t { kFilterNone = 0, kFilterByteStreamSplit = 1 };
+enum : std::uint8_t { kCodecNone = 0, kCodecZstd = 1 };
+
+/// How one array is encoded.
+struct Encoding {
+  std::uint8_t order = kOrderComponentMajor;
+  std::uint8_t filter = kFilterNone;
+  std::uint8_t codec = kCodecNone;
+};
+
+/// Shape of an array: `rows` components of `cols` elements of `width` bytes.
+struct Shape {
+  std::uint64_t rows = 0;
+  std::uint64_t cols = 0;
+  std::uint64_t width = 0;
+  std::uint64_t bytes() const { return rows * cols * width; }
+};
+
+/// Canonical bytes (component-major, little-endian) -> stored bytes.
+/// With the zstd codec and the byte-stream split, each of the `width`
+/// streams becomes its own zstd frame (frames are concatenated).
+std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonical, const Shape& shape,
+                                       const Encoding& encoding, int zstd_level);
+
+/// Stored bytes -> canonical bytes (exactly shape.bytes() of them). Throws
+/// FormatError("decompression_failed") when the zstd data is bad or does not
+/// decode to exactly shape.bytes() bytes; never allocates more than that.
+std::vector<std::uint8_t> decode_array(const std::uint8_t* stored, std::size_t stored_length, const Shape& shape,
+                                       const Encoding& encoding);
+
+}  // namespace sogmm::format::detail

@@ -1,0 +1,67 @@
+// Container framing of a .sogmm file (spec/format.md section 3): the 32-byte
+// header, the metadata block, the body and the 4-byte trailer.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "sogmm/format.hpp"
+
+namespace sogmm::format::detail {
+
+/// First 8 bytes of every file: 0x89 'S' 'O' 'G' CR LF 0x1A LF.
+inline constexpr std::array<std::uint8_t, 8> kMagic = {0x89, 'S', 'O', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+/// Last 4 bytes of every file, also the FlatBuffers file identifier.
+inline constexpr std::array<std::uint8_t, 4> kEndMagic = {'S', 'G', 'M', 'M'};
+inline constexpr std::size_t kHeaderSize = 32;
+inline constexpr std::size_t kTrailerSize = 4;
+inline constexpr std::size_t kMinFileSize = kHeaderSize + kTrailerSize;
+/// Feature bits this reader knows (format 1.0 defines none).
+inline constexpr std::uint64_t kKnownFeatures = 0;
+
+/// The fixed header fields.
+struct Header {
+  std::uint16_t major = kFormatMajor;
+  std::uint16_t minor = kFormatMinor;
+  std::uint32_t flags = 0;
+  std::uint64_t file_length = 0;
+  std::uint32_t metadata_length = 0;
+  std::uint32_t metadata_crc32c = 0;
+};
+
+/// Rounds up to a multiple of 8.
+inline std::uint64_t pad8(std::uint64_t n) { return (n + 7) & ~std::uint64_t{7}; }
+
+template <typename T>
+T load_le(const std::uint8_t* p) {
+  T v = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i) v |= static_cast<T>(static_cast<T>(p[i]) << (8 * i));
+  return v;
+}
+template <typename T>
+void store_le(std::uint8_t* p, T v) {
+  for (std::size_t i = 0; i < sizeof(T); ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+/// Throws FormatError(code, reason, detail).
+[[noreturn]] void fail(ErrorCode code, const char* reason, const std::string& detail);
+
+/// Serialises a header into 32 bytes.
+void write_header(std::uint8_t* out, const Header& header);
+
+/// Steps 1-8 of the reading procedure (spec/format.md section 9) on the
+/// first `prefix_size` bytes of a file of `file_size` bytes whose last 4
+/// bytes are `trailer`: magic, size, version, flags, length, trailer,
+/// metadata bounds and the metadata checksum (when `prefix_size` covers the
+/// metadata). Returns the header.
+Header check_container(const std::uint8_t* prefix, std::size_t prefix_size, std::uint64_t file_size,
+                       const std::uint8_t* trailer, bool verify_checksums);
+
+/// Offset of the body: header + metadata padded to 8.
+inline std::uint64_t body_start(const Header& h) { return kHeaderSize + pad8(h.metadata_length); }
+
+}  // namespace sogmm::format::detail

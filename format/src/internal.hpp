@@ -1,0 +1,49 @@
+// Internal hooks of the format module, for tests and the conformance-vector
+// generator only. Not installed, not part of the public API.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sogmm/format.hpp"
+
+namespace sogmm::format::detail {
+
+/// Deliberate deviations from a normal write, used to produce the invalid and
+/// "future" conformance vectors. A default Tweaks is a normal write.
+struct Tweaks {
+  bool validate = true;                 ///< false: write even an invalid model
+  std::uint16_t major = kFormatMajor;   ///< header version
+  std::uint16_t minor = kFormatMinor;
+  std::uint64_t features_required = 0;
+  std::uint64_t features_used = 0;
+  std::optional<std::uint64_t> n_components;  ///< declared M (default: the model's)
+  bool lengths_follow_declared_m = false;     ///< decoded_length fields computed from declared M
+  bool force_full_layout = false;             ///< store covariances as FULL even when symmetric
+  std::uint32_t covariance_crc_xor = 0;       ///< corrupts the declared covariance CRC
+  std::optional<std::uint8_t> means_codec;    ///< overrides the declared codec of the means
+  std::optional<std::uint64_t> means_offset;  ///< overrides the declared offset of the means
+  std::optional<std::uint32_t> dims;          ///< overrides dims (written even when 4)
+  std::optional<std::vector<std::string>> axis_units;  ///< overrides the axis units
+  std::optional<std::vector<double>> raw_pose;         ///< pose vector written as is (any length)
+  bool unknown_optional_fields = false;  ///< appends fields with ids unknown to format 1.0
+};
+
+/// to_bytes() with tweaks.
+std::vector<std::uint8_t> encode(const Model& model, const WriteOptions& options, const Tweaks& tweaks);
+
+/// Recomputes the metadata CRC in the header after the metadata was patched.
+void refresh_metadata_crc(std::vector<std::uint8_t>& file);
+
+/// Fault injection for save(): when set, called at each stage of the atomic
+/// write; returning true makes that stage fail as if the system call had.
+enum class SaveStage { Open, WriteHalf, Fsync, Rename };
+using SaveFaultHook = bool (*)(SaveStage stage);
+void set_save_fault_hook(SaveFaultHook hook);
+
+/// Writes `bytes` to `path` atomically (what save() uses).
+void atomic_write(const std::string& path, const std::vector<std::uint8_t>& bytes);
+
+}  // namespace sogmm::format::detail

@@ -1,0 +1,44 @@
+// Mapping between sogmm::Model and the FlatBuffers metadata block
+// (spec/sogmm.fbs), and the metadata checks (spec/format.md section 9, steps 9-16).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "container.hpp"
+#include "internal.hpp"
+
+namespace sogmm::format::detail {
+
+/// One array's metadata record (the fields of table Array).
+struct ArrayRecord {
+  std::uint8_t dtype = 0, order = 0, filter = 0, codec = 0;
+  std::uint64_t offset = 0, stored_length = 0, decoded_length = 0;
+  std::uint32_t crc32c = 0;
+};
+
+/// Index of the arrays in the records below.
+enum { kWeights = 0, kMeans = 1, kCovariances = 2 };
+
+/// Builds the metadata FlatBuffer of `model` (arrays excluded) with the given
+/// array records, declared M and covariance layout.
+std::vector<std::uint8_t> build_metadata(const Model& model, const ArrayRecord (&arrays)[3], std::uint64_t n_declared,
+                                         bool packed, const Tweaks& tweaks);
+
+/// The metadata once verified.
+struct ParsedMetadata {
+  FileInfo info;
+  ArrayRecord arrays[3];
+  bool packed = true;
+};
+
+/// Steps 9-16: verifies the FlatBuffer, the features, the metadata values,
+/// the encodings, M, the declared lengths, the size cap and the buffer layout.
+ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& header, const ReadOptions& options);
+
+/// Number of columns C of array `which` (1, 4, 10 or 16).
+inline std::uint64_t columns(int which, bool packed) {
+  return which == kWeights ? 1 : which == kMeans ? 4 : (packed ? 10 : 16);
+}
+
+}  // namespace sogmm::format::detail

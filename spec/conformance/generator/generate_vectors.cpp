@@ -1,0 +1,349 @@
+// Generates the .sogmm conformance vectors of spec/conformance/ (format 1.0).
+//
+// RUN ONCE, THEN FROZEN: the vectors and manifest.json in spec/conformance/
+// are released artefacts. Never regenerate them over the committed files;
+// new vectors get new names (and are appended to the manifest).
+//
+// Usage: sogmm_conformance_generate OUT_DIR DEPTH.u16 GRAY.f32 WIDTH HEIGHT
+// (the raw frame comes from frame_to_raw.py; it is fitted with sogmm::fit).
+// Writes OUT_DIR/{valid,invalid}/*.sogmm, OUT_DIR/valid/*.json (canonical
+// dumps) and OUT_DIR/manifest.json.
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "internal.hpp"
+#include "sogmm/camera.hpp"
+#include "sogmm/fit.hpp"
+#include "sogmm/format.hpp"
+
+namespace {
+
+using namespace sogmm;
+namespace fmt = sogmm::format;
+namespace det = sogmm::format::detail;
+
+std::string g_out;
+std::vector<std::string> g_entries;
+
+std::string quote(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+void write_file(const std::string& rel, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream f(g_out + "/" + rel, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (!f) throw std::runtime_error("cannot write " + rel);
+}
+
+void valid(const std::string& name, const std::vector<std::uint8_t>& bytes, const std::string& description) {
+  const std::string rel = "valid/" + name + ".sogmm";
+  write_file(rel, bytes);
+  const Model m = fmt::from_bytes(bytes.data(), bytes.size());  // must be valid for our reader too
+  const fmt::FileInfo info = fmt::read_info(bytes.data(), bytes.size());
+  // Stored compact (same values as the canonical dump, no indentation).
+  const std::string json = nlohmann::ordered_json::parse(fmt::to_canonical_json(m, &info)).dump() + "\n";
+  write_file("valid/" + name + ".json", std::vector<std::uint8_t>(json.begin(), json.end()));
+  g_entries.push_back("    {\"file\": " + quote(rel) + ", \"expect\": \"valid\", \"json\": " +
+                      quote("valid/" + name + ".json") + ",\n     \"description\": " + quote(description) + "}");
+}
+
+void invalid(const std::string& name, const std::vector<std::uint8_t>& bytes, const std::string& category,
+             const std::string& reason, const std::string& description) {
+  const std::string rel = "invalid/" + name + ".sogmm";
+  write_file(rel, bytes);
+  // Our own reader must agree before the vector is written into the manifest.
+  try {
+    fmt::from_bytes(bytes.data(), bytes.size());
+    throw std::runtime_error(name + ": accepted by the reference reader");
+  } catch (const fmt::FormatError& e) {
+    if (e.reason() != reason) throw std::runtime_error(name + ": reference reader says " + e.what());
+  }
+  g_entries.push_back("    {\"file\": " + quote(rel) + ", \"expect\": \"invalid\", \"category\": " + quote(category) +
+                      ", \"reason\": " + quote(reason) + ",\n     \"description\": " + quote(description) + "}");
+}
+
+// A small synthetic model with SPD covariances rounded symmetrically to float.
+Model synthetic(std::size_t m, std::uint32_t seed) {
+  std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 1;
+  auto u = [&]() {
+    s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+    return static_cast<double>(s >> 11) / 9007199254740992.0;
+  };
+  Model model;
+  Gmm& g = model.gmm;
+  g.resize(m);
+  std::vector<double> w(m);
+  double sum = 0;
+  for (auto& x : w) sum += (x = 0.1 + u());
+  for (std::size_t k = 0; k < m; ++k) {
+    g.weights[k] = static_cast<float>(w[k] / sum);
+    const double mean[4] = {2 * u() - 1, 1.5 * u() - 0.75, 0.5 + 2 * u(), u()};
+    for (int i = 0; i < 4; ++i) g.means[4 * k + i] = static_cast<float>(mean[i]);
+    double a[4][4];
+    for (auto& r : a)
+      for (double& x : r) x = 0.05 * (u() - 0.5);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j) {
+        double c = i == j ? 1e-5 : 0.0;
+        for (int t = 0; t < 4; ++t) c += a[i][t] * a[j][t];
+        g.covariances[16 * k + 4 * i + j] = g.covariances[16 * k + 4 * j + i] = static_cast<float>(c);
+      }
+  }
+  g.support_size = 100 * m;
+  model.producer_name = "sogmm-conformance";
+  model.producer_version = "1.0.0";
+  return model;
+}
+
+std::vector<std::uint8_t> read_raw(const std::string& path, std::size_t bytes) {
+  std::ifstream f(path, std::ios::binary);
+  std::vector<std::uint8_t> out(bytes);
+  f.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(bytes));
+  if (!f) throw std::runtime_error("cannot read " + path);
+  return out;
+}
+
+std::vector<std::uint8_t> cut(std::vector<std::uint8_t> b, std::size_t n) {
+  b.resize(n);
+  return b;
+}
+
+std::vector<std::uint8_t> uncompressed(const Model& m) {
+  fmt::WriteOptions o;
+  o.compress = false;
+  return fmt::to_bytes(m, o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 6) {
+    std::cerr << "usage: " << argv[0] << " OUT_DIR DEPTH.u16 GRAY.f32 WIDTH HEIGHT\n";
+    return 2;
+  }
+  try {
+    g_out = argv[1];
+    ::mkdir((g_out + "/valid").c_str(), 0755);
+    ::mkdir((g_out + "/invalid").c_str(), 0755);
+    const int width = std::stoi(argv[4]), height = std::stoi(argv[5]);
+    const std::size_t npix = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+
+    // --- a real fitted model: livingroom frame 0, decimation 5, bandwidth 0.02
+    const std::vector<std::uint8_t> depth_raw = read_raw(argv[2], 2 * npix);
+    const std::vector<std::uint8_t> gray_raw = read_raw(argv[3], 4 * npix);
+    std::vector<std::uint16_t> depth(npix);
+    std::vector<float> gray(npix);
+    std::memcpy(depth.data(), depth_raw.data(), depth_raw.size());
+    std::memcpy(gray.data(), gray_raw.data(), gray_raw.size());
+    RgbdView frame{depth.data(), gray.data(), Camera{width, height, 525.0, 525.0, 319.5, 239.5}};
+    DepthOptions depth_options;
+    depth_options.decimate = 5;
+    const PointCloud cloud = backproject(frame, depth_options);
+    FitOptions fit_options;
+    fit_options.bandwidth = 0.02;
+    fit_options.seed = 7;
+    fit_options.em.threads = 1;
+    const FitResult fit = sogmm::fit(cloud.view(), fit_options);
+    Model fitted;
+    fitted.gmm = fit.gmm;
+    fitted.fit = FitInfo{true, 0.02, 0, fit_options.em.tol, fit_options.em.reg_covar, fit_options.em.max_iter,
+                         fit.em.iterations, fit.em.converged, fit.em.log_likelihood, 7};
+    fitted.camera.known = true;
+    fitted.camera.camera = frame.camera;
+    fitted.camera.decimation = 5;
+    fitted.pose = std::array<double, 16>{-0.2739592186924325, 0.021819345900466677, -0.9614937663021573,
+                                         -0.31057997014702826, 8.33962904204855e-19, -0.9997426093226981,
+                                         -0.02268733357278151, 0.5730122438481298, -0.9617413095492113,
+                                         -0.006215404179813816, 0.27388870414358013, 2.1264800183565487,
+                                         0.0, 0.0, 0.0, 1.0};  // livingroom/trajectory.log, frame 0
+    fitted.producer_name = "sogmm";
+    fitted.producer_version = "0.1.0";
+    fitted.created_unix_ms = 1767225600000;  // 2026-01-01T00:00:00Z, fixed for reproducibility
+    fitted.key_values = {{"source", "livingroom/00000 (Augmented ICL-NUIM via Open3D test data)"}};
+
+    // --- valid vectors
+    Model one = synthetic(1, 1);
+    one.gmm.weights[0] = 1.0f;
+    valid("one_component", fmt::to_bytes(one), "M = 1, no optional metadata tables");
+    valid("fitted_livingroom", fmt::to_bytes(fitted),
+          "real SOGMM fit of livingroom frame 0 (d = 5, bandwidth 0.02), compressed float32");
+    Model all = synthetic(8, 2);
+    all.fit = FitInfo{true, 0.0, 8, 1e-3, 1e-6, 100, 23, false, -1.75, 12345678901234567ull};
+    all.camera.known = true;
+    all.camera.camera = Camera{640, 480, 517.3, 516.5, 318.6, 255.3};
+    all.camera.decimation = 4;
+    all.camera.depth_scale = 5000.0;
+    all.camera.depth_min = 0.2;
+    all.camera.depth_max = 4.5;
+    all.pose = std::array<double, 16>{0, -1, 0, 1.25, 1, 0, 0, -2.5, 0, 0, 1, 0.75, 0, 0, 0, 1};
+    all.created_unix_ms = 1700000000123;
+    all.key_values = {{"dataset", "tum"}, {"note", "unicode \xce\xbb \xe2\x9c\x93"}, {"note", "repeated key"},
+                      {"", "empty key"}};
+    valid("all_metadata", fmt::to_bytes(all), "every metadata field set, repeated and empty keys");
+    fmt::WriteOptions f64;
+    f64.float64 = true;
+    valid("float64", fmt::to_bytes(synthetic(16, 3), f64), "float64 arrays, compressed");
+    valid("uncompressed", uncompressed(synthetic(16, 4)), "no filter, no codec, component-major");
+    Model full = synthetic(4, 5);
+    full.gmm.covariances[16 * 1 + 2] = std::nextafter(full.gmm.covariances[16 * 1 + 2], 1.0f);
+    valid("full_covariance_layout", fmt::to_bytes(full), "covariances stored FULL (one is not bit-symmetric)");
+    det::Tweaks future;
+    future.minor = 1;
+    future.features_used = 1u << 5;
+    future.unknown_optional_fields = true;
+    valid("future_minor", det::encode(synthetic(6, 6), {}, future),
+          "format 1.1 with unknown optional fields 20 and 21 and unknown optional feature bit 5");
+
+    // --- invalid vectors
+    const Model base = synthetic(6, 9);
+    const std::vector<std::uint8_t> good = fmt::to_bytes(base);
+    const std::vector<std::uint8_t> raw = uncompressed(base);
+    const fmt::FileInfo info = fmt::read_info(good.data(), good.size());
+    const fmt::FileInfo raw_info = fmt::read_info(raw.data(), raw.size());
+    auto patched = [&](std::vector<std::uint8_t> b, std::size_t off, std::uint8_t v) {
+      b[off] = v;
+      return b;
+    };
+    invalid("bad_magic", patched(good, 1, 'X'), "format", "bad_magic", "second signature byte changed");
+    std::vector<std::uint8_t> crlf;
+    for (std::uint8_t c : good) {
+      if (c == '\n') crlf.push_back('\r');
+      crlf.push_back(c);
+    }
+    invalid("text_mode_lf_to_crlf", crlf, "format", "bad_magic", "LF -> CR LF conversion (text-mode transfer)");
+    invalid("truncated_empty", {}, "format", "truncated", "empty file");
+    invalid("truncated_7", cut(good, 7), "format", "truncated", "cut inside the signature");
+    invalid("truncated_20", cut(good, 20), "format", "truncated", "cut inside the header");
+    invalid("truncated_in_metadata", cut(good, 32 + info.metadata_length / 2), "format", "truncated",
+            "cut inside the metadata");
+    invalid("truncated_in_body", cut(good, info.covariances.offset + 5), "format", "truncated",
+            "cut inside the covariances");
+    invalid("truncated_last_byte", cut(good, good.size() - 1), "format", "truncated", "last byte missing");
+    invalid("unknown_major", patched(good, 8, 2), "format", "unsupported_version", "format version 2.0");
+    invalid("header_flags", patched(good, 12, 1), "format", "bad_header", "reserved header flags set");
+    std::vector<std::uint8_t> trailing = good;
+    trailing.insert(trailing.end(), {'S', 'G', 'M', 'M'});
+    invalid("trailing_data", trailing, "format", "bad_header", "4 bytes after the declared file length");
+    invalid("bad_trailer", patched(good, good.size() - 2, 'X'), "format", "bad_trailer", "end marker damaged");
+    det::Tweaks t;
+    t.features_required = 1u << 5;
+    invalid("unknown_required_feature", det::encode(base, {}, t), "format", "unsupported_feature",
+            "features_required has bit 5, unknown in 1.0");
+    t = {};
+    t.minor = 1;
+    t.features_required = 1u << 0;
+    invalid("future_minor_required_feature", det::encode(base, {}, t), "format", "unsupported_feature",
+            "format 1.1 requiring feature bit 0");
+    invalid("metadata_checksum", patched(good, 32 + 40, good[32 + 40] ^ 0x04), "format", "checksum_mismatch",
+            "one metadata bit flipped, header CRC not updated");
+    invalid("array_checksum", patched(raw, raw_info.means.offset + 6, raw[raw_info.means.offset + 6] ^ 0x01), "format",
+            "checksum_mismatch", "one bit of an uncompressed mean flipped");
+    t = {};
+    t.covariance_crc_xor = 0x00010000;
+    invalid("array_checksum_declared", det::encode(base, {}, t), "format", "checksum_mismatch",
+            "declared CRC-32C of the covariances wrong");
+    std::vector<std::uint8_t> b = good;
+    b[32] = 0xF0, b[33] = 0xFF, b[34] = 0xFF, b[35] = 0x00;
+    det::refresh_metadata_crc(b);
+    invalid("flatbuffer_root_out_of_bounds", b, "format", "bad_metadata", "root table offset beyond the metadata");
+    b = good;
+    {
+      const std::uint32_t root = b[32] | b[33] << 8 | b[34] << 16 | static_cast<std::uint32_t>(b[35]) << 24;
+      const std::size_t at = 32 + root;
+      b[at] = 0x00, b[at + 1] = 0x00, b[at + 2] = 0x00, b[at + 3] = 0x80;  // soffset to vtable: INT32_MIN
+    }
+    det::refresh_metadata_crc(b);
+    invalid("flatbuffer_vtable_out_of_bounds", b, "format", "bad_metadata", "root vtable offset out of range");
+    b = patched(good, 36 + 3, 'X');
+    det::refresh_metadata_crc(b);
+    invalid("flatbuffer_identifier", b, "format", "bad_metadata", "FlatBuffers file identifier is not SGMM");
+    t = {};
+    t.dims = 3;
+    invalid("dims_3", det::encode(base, {}, t), "format", "bad_metadata", "dims = 3");
+    t = {};
+    t.means_codec = 7;
+    invalid("unknown_codec", det::encode(base, {}, t), "format", "unsupported_encoding", "means codec 7");
+    t = {};
+    t.n_components = std::uint64_t{1} << 26;
+    t.lengths_follow_declared_m = true;
+    invalid("declared_size_over_cap", det::encode(base, {}, t), "limit", "limit",
+            "M = 2^26 with consistent lengths: 4 GiB declared, over the 1 GiB default cap");
+    t = {};
+    t.means_offset = info.means.offset + 4;
+    invalid("misaligned_offset", det::encode(base, {}, t), "format", "bad_layout", "means offset not a multiple of 8");
+    t.means_offset = info.weights.offset;
+    invalid("overlapping_arrays", det::encode(base, {}, t), "format", "bad_layout", "means overlap weights");
+    const std::vector<std::uint8_t> big = fmt::to_bytes(synthetic(200, 10));
+    const fmt::FileInfo big_info = fmt::read_info(big.data(), big.size());
+    if (big_info.covariances.codec != "zstd") throw std::runtime_error("expected zstd covariances");
+    b = big;
+    b[big_info.covariances.offset] ^= 0xFF;  // first zstd frame magic
+    invalid("zstd_bad_frame", b, "format", "decompression_failed", "covariances' first zstd frame magic damaged");
+    t = {};
+    t.n_components = 0;
+    invalid("zero_components", det::encode(base, {}, t), "invalid_data", "empty", "M = 0");
+    t.n_components = 5;
+    invalid("length_mismatch", det::encode(base, {}, t), "invalid_data", "length_mismatch",
+            "M = 5 declared, arrays hold 6 components");
+    det::Tweaks nv;
+    nv.validate = false;
+    Model bad = base;
+    bad.gmm.means[9] = std::numeric_limits<float>::quiet_NaN();
+    invalid("nan_mean", det::encode(bad, {}, nv), "numeric", "non_finite", "a mean coordinate is NaN");
+    bad = base;
+    bad.gmm.covariances[16 * 4 + 5] = std::numeric_limits<float>::infinity();
+    invalid("inf_covariance", det::encode(bad, {}, nv), "numeric", "non_finite", "a covariance diagonal is +Inf");
+    bad = base;
+    for (int i = 0; i < 4; ++i) bad.gmm.covariances[16 * 3 + 5 * i] = -bad.gmm.covariances[16 * 3 + 5 * i];
+    invalid("not_positive_definite", det::encode(bad, {}, nv), "numeric", "not_spd",
+            "component 3's covariance is negative definite");
+    bad = base;
+    bad.gmm.covariances[16 * 2 + 1] = bad.gmm.covariances[16 * 2 + 4] =
+        2.0f * std::sqrt(bad.gmm.covariances[16 * 2] * bad.gmm.covariances[16 * 2 + 5]);
+    invalid("not_positive_definite_offdiag", det::encode(bad, {}, nv), "numeric", "not_spd",
+            "positive diagonal, correlation 2 between x and y");
+    bad = base;
+    bad.gmm.covariances[16 * 1 + 3] += 0.001f;
+    invalid("not_symmetric", det::encode(bad, {}, nv), "numeric", "not_symmetric",
+            "FULL layout, covariance 1 asymmetric beyond 1e-5 relative");
+    bad = base;
+    bad.gmm.weights[0] *= 1.5f;
+    invalid("weights_sum", det::encode(bad, {}, nv), "numeric", "bad_weights", "weights sum to about 1.1");
+    bad = base;
+    bad.gmm.weights[1] += bad.gmm.weights[0] + 0.125f;
+    bad.gmm.weights[0] = -0.125f;
+    invalid("negative_weight", det::encode(bad, {}, nv), "numeric", "bad_weights", "a negative weight, sum 1");
+    bad = base;
+    bad.pose = std::array<double, 16>{2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    invalid("pose_not_rigid", det::encode(bad, {}, nv), "invalid_data", "bad_pose", "pose scales x by 2");
+
+    std::ofstream manifest(g_out + "/manifest.json");
+    manifest << "{\n  \"format\": \"sogmm-conformance\",\n  \"manifest_version\": 1,\n"
+             << "  \"format_version\": \"1.0\",\n"
+             << "  \"note\": \"Frozen. Generated once by generator/generate_vectors.cpp; see README.md.\",\n"
+             << "  \"vectors\": [\n";
+    for (std::size_t i = 0; i < g_entries.size(); ++i) manifest << g_entries[i] << (i + 1 < g_entries.size() ? ",\n" : "\n");
+    manifest << "  ]\n}\n";
+    std::cout << g_entries.size() << " vectors written to " << g_out << " (fitted model: M = " << fitted.gmm.size()
+              << ", " << fmt::to_bytes(fitted).size() << " bytes)\n";
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

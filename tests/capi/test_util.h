@@ -1,0 +1,133 @@
+/* Helpers shared by the plain-C tests of the C API: a tiny check framework
+ * and synthetic data (a seeded 4-D cluster cloud and an RGB-D frame). */
+#ifndef SOGMM_TEST_UTIL_H
+#define SOGMM_TEST_UTIL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sogmm/sogmm.h"
+
+static int g_failures = 0;
+static int g_checks = 0;
+
+/* Checks that `expr` (a sogmm_status) equals `expected`; prints the
+ * last-error message on a mismatch. */
+#define EXPECT_STATUS(expr, expected)                                                         \
+  do {                                                                                        \
+    sogmm_status s_ = (expr);                                                                 \
+    ++g_checks;                                                                               \
+    if (s_ != (expected)) {                                                                   \
+      ++g_failures;                                                                           \
+      fprintf(stderr, "%s:%d: %s\n  returned %d (%s), expected %d (%s); last error: %s\n",    \
+              __FILE__, __LINE__, #expr, (int)s_, sogmm_status_string(s_), (int)(expected),   \
+              sogmm_status_string(expected), sogmm_last_error());                             \
+    }                                                                                         \
+  } while (0)
+
+#define EXPECT_OK(expr) EXPECT_STATUS(expr, SOGMM_OK)
+
+#define EXPECT_TRUE(cond)                                                                     \
+  do {                                                                                        \
+    ++g_checks;                                                                               \
+    if (!(cond)) {                                                                            \
+      ++g_failures;                                                                           \
+      fprintf(stderr, "%s:%d: expected %s\n", __FILE__, __LINE__, #cond);                     \
+    }                                                                                         \
+  } while (0)
+
+#define EXPECT_NEAR(a, b, tol) EXPECT_TRUE(fabs((double)(a) - (double)(b)) <= (tol))
+
+/* Fatal check: stops the test (the rest depends on it). */
+#define REQUIRE_OK(expr)                                                                      \
+  do {                                                                                        \
+    sogmm_status s_ = (expr);                                                                 \
+    ++g_checks;                                                                               \
+    if (s_ != SOGMM_OK) {                                                                     \
+      fprintf(stderr, "%s:%d: %s failed: %d (%s): %s\n", __FILE__, __LINE__, #expr, (int)s_, \
+              sogmm_status_string(s_), sogmm_last_error());                                   \
+      exit(1);                                                                                \
+    }                                                                                         \
+  } while (0)
+
+static inline int test_summary(const char* name) {
+  if (g_failures) {
+    fprintf(stderr, "%s: %d of %d checks FAILED\n", name, g_failures, g_checks);
+    return 1;
+  }
+  printf("%s: all %d checks passed\n", name, g_checks);
+  return 0;
+}
+
+/* splitmix64-style generator: deterministic everywhere. */
+static inline uint64_t test_rng_next(uint64_t* state) {
+  uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+static inline double test_rng_uniform(uint64_t* state) {
+  return (double)(test_rng_next(state) >> 11) * (1.0 / 9007199254740992.0);
+}
+static inline double test_rng_normal(uint64_t* state) {
+  double u1, u2;
+  do u1 = test_rng_uniform(state); while (u1 <= 0.0);
+  u2 = test_rng_uniform(state);
+  return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+/* The three cluster centres (x, y, z, gray) used by make_clusters. */
+static const float k_centres[3][4] = {
+    {0.0f, 0.0f, 1.0f, 0.2f}, {0.5f, 0.0f, 1.5f, 0.5f}, {0.0f, 0.5f, 2.0f, 0.8f}};
+
+/* n points (n * 4 floats, caller frees) in three tight, well separated
+ * Gaussian clusters, point i in cluster i % 3. */
+static inline float* make_clusters(size_t n, uint64_t seed) {
+  float* p = (float*)malloc(n * 4 * sizeof(float));
+  size_t i;
+  int d;
+  if (!p) exit(2);
+  for (i = 0; i < n; ++i) {
+    const float* c = k_centres[i % 3];
+    for (d = 0; d < 4; ++d) p[4 * i + d] = c[d] + (float)(0.02 * test_rng_normal(&seed));
+  }
+  return p;
+}
+
+/* A w x h frame of a tilted plane (depth in millimetres, 1.0 m to 1.6 m
+ * across the image) with a gray / color pattern of three bands. Invalid
+ * (zero) depth in the first column. Caller frees the three buffers. */
+static inline void make_frame(uint32_t w, uint32_t h, uint16_t** depth, uint8_t** gray, uint8_t** rgb) {
+  uint32_t u, v;
+  *depth = (uint16_t*)malloc((size_t)w * h * sizeof(uint16_t));
+  *gray = (uint8_t*)malloc((size_t)w * h);
+  *rgb = (uint8_t*)malloc((size_t)w * h * 3);
+  if (!*depth || !*gray || !*rgb) exit(2);
+  for (v = 0; v < h; ++v) {
+    for (u = 0; u < w; ++u) {
+      size_t i = (size_t)v * w + u;
+      uint8_t g = (uint8_t)(u < w / 3 ? 40 : (u < 2 * w / 3 ? 128 : 220));
+      (*depth)[i] = (uint16_t)(u == 0 ? 0 : 1000 + (600 * u) / w);
+      (*gray)[i] = g;
+      (*rgb)[3 * i + 0] = g;
+      (*rgb)[3 * i + 1] = g;
+      (*rgb)[3 * i + 2] = g;
+    }
+  }
+}
+
+/* Writes `size` bytes to `path`; returns 0 on success. */
+static inline int write_file(const char* path, const void* data, size_t size) {
+  FILE* f = fopen(path, "wb");
+  if (!f) return -1;
+  if (size && fwrite(data, 1, size, f) != size) {
+    fclose(f);
+    return -1;
+  }
+  return fclose(f) == 0 ? 0 : -1;
+}
+
+#endif /* SOGMM_TEST_UTIL_H */

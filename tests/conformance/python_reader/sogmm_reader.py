@@ -1,0 +1,467 @@
+"""An independent reader of .sogmm files, written from spec/format.md only.
+
+It does not use the SOGMM library: only the Python standard library, the
+`flatbuffers` runtime (table access) and `zstandard` from PyPI. Its purpose is
+to prove that spec/format.md is enough to implement the format.
+
+    read(data, max_decoded_bytes=1 << 30, verify_checksums=True) -> dict
+
+returns the canonical dump (spec/format.md section 10) as a dict, or raises
+SogmmError(category, reason, message) with the category and reason that
+section 9 assigns to the first failing check.
+"""
+import math
+import struct
+
+import flatbuffers.table
+import zstandard
+
+MAGIC = b"\x89SOG\r\n\x1a\n"
+END_MAGIC = b"SGMM"
+HEADER_SIZE = 32
+TRAILER_SIZE = 4
+KNOWN_FEATURES = 0
+DEFAULT_MAX_DECODED_BYTES = 1 << 30
+MAX_DEPTH = 64
+MAX_TABLES = 100000
+
+
+class SogmmError(Exception):
+    def __init__(self, category, reason, message):
+        super().__init__(f"{reason}: {message}")
+        self.category = category
+        self.reason = reason
+
+
+def _fail(category, reason, message):
+    raise SogmmError(category, reason, message)
+
+
+def _format(reason, message):
+    _fail("format", reason, message)
+
+
+# ---------------------------------------------------------------- CRC-32C
+def _crc_table():
+    table = []
+    for i in range(256):
+        c = i
+        for _ in range(8):
+            c = (c >> 1) ^ 0x82F63B78 if c & 1 else c >> 1
+        table.append(c)
+    return table
+
+
+_CRC_TABLE = _crc_table()
+
+
+def crc32c(data):
+    c = 0xFFFFFFFF
+    t = _CRC_TABLE
+    for b in data:
+        c = (c >> 8) ^ t[(c ^ b) & 0xFF]
+    return c ^ 0xFFFFFFFF
+
+
+# ---------------------------------------------------------------- FlatBuffers, verified
+class _Bad(Exception):
+    pass
+
+
+class _Verifier:
+    """Bounds/alignment checks of spec section 4.3 before any access."""
+
+    def __init__(self, buf):
+        self.buf = buf
+        self.n = len(buf)
+        self.tables = 0
+
+    def check(self, pos, size, align=1):
+        if pos < 0 or size < 0 or pos + size > self.n or pos % align:
+            raise _Bad(f"{size} bytes at {pos} out of bounds or misaligned")
+
+    def u8(self, pos):
+        self.check(pos, 1)
+        return self.buf[pos]
+
+    def u16(self, pos):
+        self.check(pos, 2, 2)
+        return struct.unpack_from("<H", self.buf, pos)[0]
+
+    def u32(self, pos):
+        self.check(pos, 4, 4)
+        return struct.unpack_from("<I", self.buf, pos)[0]
+
+    def i32(self, pos):
+        self.check(pos, 4, 4)
+        return struct.unpack_from("<i", self.buf, pos)[0]
+
+
+class _Table:
+    def __init__(self, v, pos, depth):
+        if depth > MAX_DEPTH:
+            raise _Bad("nesting too deep")
+        v.tables += 1
+        if v.tables > MAX_TABLES:
+            raise _Bad("too many tables")
+        self.v = v
+        self.depth = depth
+        self.pos = pos
+        vt = pos - v.i32(pos)
+        self.vt_size = v.u16(vt)
+        v.check(vt, self.vt_size, 2)
+        if self.vt_size < 4 or self.vt_size % 2:
+            raise _Bad("bad vtable size")
+        v.check(pos, v.u16(vt + 2))
+        self.t = flatbuffers.table.Table(v.buf, pos)
+
+    def _field(self, fid, size):
+        o = self.t.Offset(4 + 2 * fid) if 4 + 2 * fid < self.vt_size else 0
+        if o:
+            self.v.check(self.pos + o, size, size)
+        return o
+
+    def scalar(self, fid, fmt, default):
+        size = struct.calcsize("<" + fmt)
+        o = self._field(fid, size)
+        return struct.unpack_from("<" + fmt, self.v.buf, self.pos + o)[0] if o else default
+
+    def _target(self, fid):
+        o = self._field(fid, 4)
+        if not o:
+            return None
+        at = self.pos + o
+        return at + self.v.u32(at)
+
+    def table(self, fid):
+        t = self._target(fid)
+        return None if t is None else _Table(self.v, t, self.depth + 1)
+
+    def _vector(self, fid, elem):
+        t = self._target(fid)
+        if t is None:
+            return None
+        n = self.v.u32(t)
+        self.v.check(t + 4, n * elem, min(elem, 8))
+        return t + 4, n
+
+    def string_at(self, t):
+        n = self.v.u32(t)
+        self.v.check(t + 4, n + 1)
+        if self.v.buf[t + 4 + n] != 0:
+            raise _Bad("string not NUL-terminated")
+        return bytes(self.v.buf[t + 4:t + 4 + n]).decode("utf-8")
+
+    def string(self, fid):
+        t = self._target(fid)
+        return None if t is None else self.string_at(t)
+
+    def strings(self, fid):
+        vec = self._vector(fid, 4)
+        if vec is None:
+            return None
+        start, n = vec
+        return [self.string_at(start + 4 * i + self.v.u32(start + 4 * i)) for i in range(n)]
+
+    def tables_(self, fid):
+        vec = self._vector(fid, 4)
+        if vec is None:
+            return None
+        start, n = vec
+        return [_Table(self.v, start + 4 * i + self.v.u32(start + 4 * i), self.depth + 1) for i in range(n)]
+
+    def doubles(self, fid):
+        vec = self._vector(fid, 8)
+        if vec is None:
+            return None
+        start, n = vec
+        return list(struct.unpack_from(f"<{n}d", self.v.buf, start))
+
+
+# ---------------------------------------------------------------- schema
+DTYPES = {0: ("f32", 4, "f"), 1: ("f64", 8, "d")}
+ORDERS = {0: "component_major", 1: "column_major"}
+FILTERS = {0: "none", 1: "byte_stream_split"}
+CODECS = {0: "none", 1: "zstd"}
+LAYOUTS = {0: "upper_packed", 1: "full"}
+ARRAY_NAMES = ("weights", "means", "covariances")
+UPPER = [(0, 0), (0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3)]
+
+
+def _array_record(t):
+    return {
+        "dtype": t.scalar(0, "B", 0), "order": t.scalar(1, "B", 0), "filter": t.scalar(2, "B", 0),
+        "codec": t.scalar(3, "B", 0), "offset": t.scalar(4, "Q", 0), "stored_length": t.scalar(5, "Q", 0),
+        "decoded_length": t.scalar(6, "Q", 0), "crc32c": t.scalar(7, "I", 0),
+    }
+
+
+def _read_all_metadata(root):
+    """Touches every known field (so the whole block is verified)."""
+    m = {}
+    m["n_components"] = root.scalar(0, "Q", 0)
+    m["dims"] = root.scalar(1, "I", 4)
+    m["support_size"] = root.scalar(2, "Q", 0)
+    m["covariance_layout"] = root.scalar(3, "B", 0)
+    arrays = []
+    for fid in (4, 5, 6):
+        t = root.table(fid)
+        if t is None:
+            raise _Bad(f"required field {ARRAY_NAMES[fid - 4]} missing")
+        arrays.append(_array_record(t))
+    m["arrays"] = arrays
+    m["features_required"] = root.scalar(7, "Q", 0)
+    m["features_used"] = root.scalar(8, "Q", 0)
+    m["axis_labels"] = root.strings(9)
+    m["axis_units"] = root.strings(10)
+    m["gray_min"] = root.scalar(11, "d", 0.0)
+    m["gray_max"] = root.scalar(12, "d", 1.0)
+    f = root.table(13)
+    m["fit"] = None if f is None else {
+        "bandwidth": f.scalar(0, "d", 0.0), "n_components_requested": f.scalar(1, "Q", 0),
+        "tol": f.scalar(2, "d", 0.0), "reg_covar": f.scalar(3, "d", 0.0), "max_iter": f.scalar(4, "i", 0),
+        "n_iter": f.scalar(5, "i", 0), "converged": bool(f.scalar(6, "B", 0)),
+        "log_likelihood": f.scalar(7, "d", 0.0), "seed": f.scalar(8, "Q", 0)}
+    c = root.table(14)
+    m["camera"] = None if c is None else {
+        "width": c.scalar(0, "i", 0), "height": c.scalar(1, "i", 0), "fx": c.scalar(2, "d", 0.0),
+        "fy": c.scalar(3, "d", 0.0), "cx": c.scalar(4, "d", 0.0), "cy": c.scalar(5, "d", 0.0),
+        "decimation": c.scalar(6, "i", 1), "depth_scale": c.scalar(7, "d", 1000.0),
+        "depth_min": c.scalar(8, "d", 0.1), "depth_max": c.scalar(9, "d", 3.0)}
+    m["pose"] = root.doubles(15)
+    m["producer_name"] = root.string(16) or ""
+    m["producer_version"] = root.string(17) or ""
+    m["created_unix_ms"] = root.scalar(18, "q", 0)
+    kvs = root.tables_(19) or []
+    m["key_values"] = [[kv.string(0) or "", kv.string(1) or ""] for kv in kvs]
+    return m
+
+
+# ---------------------------------------------------------------- checks and decoding
+def _check_pose(p):
+    if not all(math.isfinite(x) for x in p):
+        _fail("invalid_data", "bad_pose", "pose has a non-finite entry")
+    if p[12:16] != [0.0, 0.0, 0.0, 1.0]:
+        _fail("invalid_data", "bad_pose", "last row is not 0 0 0 1")
+    for i in range(3):
+        for j in range(3):
+            dot = sum(p[k * 4 + i] * p[k * 4 + j] for k in range(3))
+            if abs(dot - (1.0 if i == j else 0.0)) > 1e-3:
+                _fail("invalid_data", "bad_pose", "rotation not orthonormal")
+    det = (p[0] * (p[5] * p[10] - p[6] * p[9]) - p[1] * (p[4] * p[10] - p[6] * p[8])
+           + p[2] * (p[4] * p[9] - p[5] * p[8]))
+    if not det > 0:
+        _fail("invalid_data", "bad_pose", "rotation is a reflection")
+
+
+def _zstd_frames(stored, expected):
+    out = bytearray()
+    pos = 0
+    while pos < len(stored):
+        if stored[pos:pos + 4] != b"\x28\xb5\x2f\xfd":
+            _format("decompression_failed", "not a zstd frame")
+        d = zstandard.ZstdDecompressor().decompressobj()
+        consumed = None
+        try:
+            # Small input chunks keep every output burst bounded (bomb-safe).
+            for i in range(pos, len(stored), 256):
+                chunk = stored[i:i + 256]
+                out += d.decompress(chunk)
+                if len(out) > expected:
+                    _format("decompression_failed", "decodes to more than declared")
+                if d.eof:
+                    consumed = i + len(chunk) - len(d.unused_data)
+                    break
+        except zstandard.ZstdError as e:
+            _format("decompression_failed", str(e))
+        if consumed is None:
+            _format("decompression_failed", "incomplete zstd frame")
+        pos = consumed
+    if len(out) != expected:
+        _format("decompression_failed", f"decodes to {len(out)} bytes, {expected} declared")
+    return bytes(out)
+
+
+def _decode(stored, rec, rows, cols):
+    _, w, _ = DTYPES[rec["dtype"]]
+    n = rows * cols
+    data = _zstd_frames(stored, n * w) if rec["codec"] == 1 else bytes(stored)
+    if rec["filter"] == 1:  # byte k of element i is at k * n + i
+        joined = bytearray(n * w)
+        for k in range(w):
+            joined[k::w] = data[k * n:(k + 1) * n]
+        data = bytes(joined)
+    if rec["order"] == 1:  # column-major -> component-major
+        comp = bytearray(n * w)
+        for c in range(cols):
+            for r in range(rows):
+                src = (c * rows + r) * w
+                dst = (r * cols + c) * w
+                comp[dst:dst + w] = data[src:src + w]
+        data = bytes(comp)
+    return data
+
+
+def _cholesky_ok(a):
+    l = [[0.0] * 4 for _ in range(4)]
+    for j in range(4):
+        d = a[j][j]
+        for k in range(j):
+            d -= l[j][k] * l[j][k]
+        if not d > 0.0:
+            return False
+        l[j][j] = math.sqrt(d)
+        for i in range(j + 1, 4):
+            s = a[i][j]
+            for k in range(j):
+                s -= l[i][k] * l[j][k]
+            l[i][j] = s / l[j][j]
+    return True
+
+
+# ---------------------------------------------------------------- the procedure of section 9
+def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=True, metadata_only=False):
+    data = bytes(data)
+    size = len(data)
+    # 1-2
+    k = min(size, 8)
+    if data[:k] != MAGIC[:k]:
+        _format("bad_magic", "wrong signature")
+    if size < HEADER_SIZE + TRAILER_SIZE:
+        _format("truncated", "shorter than header + trailer")
+    major, minor, flags, file_length, meta_len, meta_crc = struct.unpack_from("<HHIQII", data, 8)
+    # 3-7
+    if major != 1:
+        _format("unsupported_version", f"major version {major}")
+    if flags != 0:
+        _format("bad_header", "reserved flags set")
+    if file_length > size:
+        _format("truncated", "file shorter than declared")
+    if file_length < size:
+        _format("bad_header", "trailing data")
+    if data[-4:] != END_MAGIC:
+        _format("bad_trailer", "end marker missing")
+    body_start = HEADER_SIZE + (meta_len + 7) // 8 * 8
+    if meta_len < 8 or body_start + TRAILER_SIZE > file_length:
+        _format("bad_header", "metadata length out of range")
+    meta = data[HEADER_SIZE:HEADER_SIZE + meta_len]
+    # 8
+    if verify_checksums and crc32c(meta) != meta_crc:
+        _format("checksum_mismatch", "metadata CRC-32C")
+    # 9
+    if meta[4:8] != b"SGMM":
+        _format("bad_metadata", "file identifier")
+    try:
+        v = _Verifier(meta)
+        root = _Table(v, v.u32(0), 1)
+        md = _read_all_metadata(root)
+    except (_Bad, UnicodeDecodeError, struct.error) as e:
+        _format("bad_metadata", f"FlatBuffers verification failed: {e}")
+    # 10
+    if md["features_required"] & ~KNOWN_FEATURES:
+        _format("unsupported_feature", hex(md["features_required"]))
+    # 11
+    if md["dims"] != 4:
+        _format("bad_metadata", "dims != 4")
+    if md["axis_labels"] is not None and md["axis_labels"] != ["x", "y", "z", "gray"]:
+        _format("bad_metadata", "axis labels")
+    if md["axis_units"] is not None and md["axis_units"] != ["m", "m", "m", "1"]:
+        _format("bad_metadata", "axis units")
+    if md["gray_min"] != 0.0 or md["gray_max"] != 1.0:
+        _format("bad_metadata", "gray range")
+    if md["pose"] is not None:
+        if len(md["pose"]) != 16:
+            _format("bad_metadata", "pose length")
+        _check_pose(md["pose"])
+    # 12
+    if md["covariance_layout"] not in LAYOUTS:
+        _format("unsupported_encoding", "covariance layout")
+    for rec in md["arrays"]:
+        if (rec["dtype"] not in DTYPES or rec["order"] not in ORDERS or rec["filter"] not in FILTERS
+                or rec["codec"] not in CODECS):
+            _format("unsupported_encoding", "unknown enum value")
+    # 13
+    m = md["n_components"]
+    if m == 0:
+        _fail("invalid_data", "empty", "M = 0")
+    # 14-15
+    packed = md["covariance_layout"] == 0
+    cols = (1, 4, 10 if packed else 16)
+    total = 0
+    for rec, c in zip(md["arrays"], cols):
+        expected = m * c * DTYPES[rec["dtype"]][1]
+        if rec["decoded_length"] != expected or expected >= 1 << 64:
+            _fail("invalid_data", "length_mismatch", "decoded length disagrees with M")
+        total += expected
+    if total > max_decoded_bytes:
+        _fail("limit", "limit", f"{total} decoded bytes declared")
+    # 16
+    body_end = file_length - TRAILER_SIZE
+    for i, rec in enumerate(md["arrays"]):
+        off, n = rec["offset"], rec["stored_length"]
+        if off % 8 or off < body_start or off + n > body_end:
+            _format("bad_layout", "array outside the body or misaligned")
+        if rec["codec"] == 0 and n != rec["decoded_length"]:
+            _format("bad_layout", "raw array length")
+        for other in md["arrays"][:i]:
+            if off < other["offset"] + other["stored_length"] and other["offset"] < off + n:
+                _format("bad_layout", "arrays overlap")
+    out = {
+        "file": {
+            "format_version": f"{major}.{minor}", "file_length": file_length, "metadata_length": meta_len,
+            "features_required": md["features_required"], "features_used": md["features_used"],
+            "covariance_layout": LAYOUTS[md["covariance_layout"]],
+        },
+    }
+    for name, rec in zip(ARRAY_NAMES, md["arrays"]):
+        out["file"][name] = {
+            "dtype": DTYPES[rec["dtype"]][0], "order": ORDERS[rec["order"]], "filter": FILTERS[rec["filter"]],
+            "codec": CODECS[rec["codec"]], "offset": rec["offset"], "stored_length": rec["stored_length"],
+            "decoded_length": rec["decoded_length"], "crc32c": rec["crc32c"]}
+    out.update({
+        "n_components": m, "support_size": md["support_size"],
+        "axis_labels": ["x", "y", "z", "gray"], "axis_units": ["m", "m", "m", "1"],
+        "fit": md["fit"], "camera": md["camera"], "pose": md["pose"],
+        "producer_name": md["producer_name"], "producer_version": md["producer_version"],
+        "created_unix_ms": md["created_unix_ms"], "key_values": md["key_values"],
+    })
+    if metadata_only:
+        return out
+    # 17-18
+    values = []
+    for name, rec, c in zip(ARRAY_NAMES, md["arrays"], cols):
+        raw = _decode(data[rec["offset"]:rec["offset"] + rec["stored_length"]], rec, m, c)
+        if verify_checksums and crc32c(raw) != rec["crc32c"]:
+            _format("checksum_mismatch", f"{name} CRC-32C")
+        _, w, code = DTYPES[rec["dtype"]]
+        values.append(list(struct.unpack(f"<{m * c}{code}", raw)))
+    weights, means, cov = values
+    # 19
+    if not all(math.isfinite(x) for arr in values for x in arr):
+        _fail("numeric", "non_finite", "NaN or infinity in the arrays")
+    if any(x < 0 for x in weights):
+        _fail("numeric", "bad_weights", "negative weight")
+    s = 0.0
+    for x in weights:
+        s += x
+    if abs(s - 1.0) > 1e-4:
+        _fail("numeric", "bad_weights", f"weights sum to {s}")
+    mats = []
+    for k in range(m):
+        if packed:
+            a = [[0.0] * 4 for _ in range(4)]
+            for t, (i, j) in enumerate(UPPER):
+                a[i][j] = a[j][i] = cov[10 * k + t]
+        else:
+            a = [cov[16 * k + 4 * i:16 * k + 4 * i + 4] for i in range(4)]
+            scale = max(abs(x) for row in a for x in row)
+            asym = max(abs(a[i][j] - a[j][i]) for i in range(4) for j in range(4))
+            if asym > 1e-5 * scale:
+                _fail("numeric", "not_symmetric", f"component {k}")
+        if not _cholesky_ok(a):
+            _fail("numeric", "not_spd", f"component {k}")
+        mats.append(a)
+    out["weights"] = weights
+    out["means"] = [means[4 * k:4 * k + 4] for k in range(m)]
+    out["covariances"] = mats
+    return out

@@ -1,0 +1,231 @@
+// merge (support-size re-weighting), rigid transform (closed form and density
+// invariance), paper byte count, and validate().
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "sogmm/inference.hpp"
+#include "test_util.hpp"
+
+using sogmm_test::cov_of;
+using sogmm_test::mean_of;
+using sogmm_test::set_component;
+
+namespace {
+
+Eigen::Matrix4d spd(double a, double b, double c, double d, double off) {
+  Eigen::Matrix4d m = Eigen::Vector4d(a, b, c, d).asDiagonal();
+  m(0, 1) = m(1, 0) = off;
+  m(2, 3) = m(3, 2) = -off / 2;
+  m(0, 3) = m(3, 0) = off / 3;
+  return m;
+}
+
+sogmm::Gmm model_a() {
+  sogmm::Gmm g;
+  g.resize(2);
+  set_component(g, 0, 0.25, Eigen::Vector4d(0.1, 0.2, 1.0, 0.3), spd(0.04, 0.03, 0.02, 0.01, 0.005));
+  set_component(g, 1, 0.75, Eigen::Vector4d(-0.3, 0.0, 1.5, 0.6), spd(0.02, 0.05, 0.03, 0.02, -0.004));
+  g.support_size = 100;
+  return g;
+}
+sogmm::Gmm model_b() {
+  sogmm::Gmm g;
+  g.resize(1);
+  set_component(g, 0, 1.0, Eigen::Vector4d(0.5, -0.5, 2.0, 0.9), spd(0.06, 0.02, 0.04, 0.03, 0.01));
+  g.support_size = 300;
+  return g;
+}
+
+}  // namespace
+
+TEST(Merge, ReweightsBySupportSize) {
+  const sogmm::Gmm a = model_a(), b = model_b();
+  const sogmm::Gmm m = sogmm::merge(a, b);
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(m.support_size, 400u);
+  // 0.25 * 100/400, 0.75 * 100/400, 1 * 300/400
+  EXPECT_NEAR(m.weights[0], 0.0625, 1e-7);
+  EXPECT_NEAR(m.weights[1], 0.1875, 1e-7);
+  EXPECT_NEAR(m.weights[2], 0.75, 1e-7);
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(m.means[i], a.means[i]);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(m.means[8 + i], b.means[i]);
+  for (int i = 0; i < 32; ++i) EXPECT_EQ(m.covariances[i], a.covariances[i]);
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(m.covariances[32 + i], b.covariances[i]);
+  EXPECT_TRUE(sogmm_test::model_is_valid(m));
+}
+
+TEST(Merge, ZeroSupportCountsEqually) {
+  sogmm::Gmm a = model_a(), b = model_b();
+  a.support_size = 0;
+  b.support_size = 0;
+  const sogmm::Gmm m = sogmm::merge(a, b);
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(m.support_size, 0u);
+  EXPECT_NEAR(m.weights[0], 0.125, 1e-7);
+  EXPECT_NEAR(m.weights[1], 0.375, 1e-7);
+  EXPECT_NEAR(m.weights[2], 0.5, 1e-7);
+}
+
+TEST(Merge, DensityIsSupportWeightedAverage) {
+  // p_merged = (S_a p_a + S_b p_b) / (S_a + S_b) at any point.
+  const sogmm::Gmm a = model_a(), b = model_b(), m = sogmm::merge(a, b);
+  const float x[12] = {0.1f, 0.2f, 1.1f, 0.3f, 0.4f, -0.4f, 1.9f, 0.8f, 0.0f, 0.0f, 1.5f, 0.5f};
+  double la[3], lb[3], lm[3];
+  sogmm::score_samples(a, x, 3, 4, la);
+  sogmm::score_samples(b, x, 3, 4, lb);
+  sogmm::score_samples(m, x, 3, 4, lm);
+  for (int i = 0; i < 3; ++i) {
+    const double e = std::log(0.25 * std::exp(la[i]) + 0.75 * std::exp(lb[i]));
+    EXPECT_NEAR(lm[i], e, 1e-5) << i;
+  }
+}
+
+namespace {
+std::array<double, 16> pose_of(const Eigen::Matrix3d& r, const Eigen::Vector3d& t) {
+  std::array<double, 16> p{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) p[4 * i + j] = r(i, j);
+    p[4 * i + 3] = t(i);
+  }
+  p[15] = 1.0;
+  return p;
+}
+}  // namespace
+
+TEST(Transform, ClosedForm) {
+  const sogmm::Gmm a = model_a();
+  const Eigen::Matrix3d r =
+      (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitX()) *
+       Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitY()))
+          .toRotationMatrix();
+  const Eigen::Vector3d t(1.0, -2.0, 0.5);
+  const sogmm::Gmm b = sogmm::transform(a, pose_of(r, t));
+  ASSERT_EQ(b.size(), a.size());
+  EXPECT_EQ(b.support_size, a.support_size);
+  Eigen::Matrix4d big = Eigen::Matrix4d::Identity();
+  big.topLeftCorner<3, 3>() = r;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(b.weights[k], a.weights[k]);
+    Eigen::Vector4d mu = mean_of(a, k);
+    Eigen::Vector4d emu = mu;
+    emu.head<3>() = r * mu.head<3>() + t;
+    const Eigen::Matrix4d ecov = big * cov_of(a, k) * big.transpose();
+    EXPECT_LT((mean_of(b, k) - emu).cwiseAbs().maxCoeff(), 1e-5) << "component " << k;
+    EXPECT_LT((cov_of(b, k) - ecov).cwiseAbs().maxCoeff(), 1e-6) << "component " << k;
+  }
+  EXPECT_TRUE(sogmm_test::model_is_valid(b));
+}
+
+TEST(Transform, DensityAndRegressionInvariant) {
+  // p'(T x) = p(x) (|det R| = 1) and the regressed gray moves with the point.
+  const sogmm::Gmm a = model_a();
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d t(-0.3, 0.8, 2.0);
+  const sogmm::Gmm b = sogmm::transform(a, pose_of(r, t));
+  const std::vector<float> x = {0.1f, 0.2f, 1.1f, 0.3f, -0.2f, 0.1f, 1.4f, 0.5f, 0.3f, -0.1f, 1.2f, 0.7f};
+  std::vector<float> y(x.size()), x3, y3;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d p(x[4 * i], x[4 * i + 1], x[4 * i + 2]);
+    const Eigen::Vector3d q = r * p + t;
+    for (int d = 0; d < 3; ++d) {
+      y[4 * i + d] = static_cast<float>(q(d));
+      x3.push_back(x[4 * i + d]);
+      y3.push_back(y[4 * i + d]);
+    }
+    y[4 * i + 3] = x[4 * i + 3];
+  }
+  double la[3], lb[3];
+  sogmm::score_samples(a, x.data(), 3, 4, la);
+  sogmm::score_samples(b, y.data(), 3, 4, lb);
+  float ga[3], gb[3], va[3], vb[3];
+  sogmm::regress_gray(a, x3.data(), 3, ga, va);
+  sogmm::regress_gray(b, y3.data(), 3, gb, vb);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(lb[i], la[i], 2e-3) << i;  // float32 rounding of rotated points and parameters
+    EXPECT_NEAR(gb[i], ga[i], 1e-4) << i;
+    EXPECT_NEAR(vb[i], va[i], 1e-4) << i;
+  }
+}
+
+TEST(Transform, SamplesOfTransformedModelMatchTransformedSamples) {
+  // Moments of samples from transform(g) equal those of transformed samples of g.
+  const sogmm::Gmm a = model_b();
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d t(1, 2, 3);
+  const sogmm::Gmm b = sogmm::transform(a, pose_of(r, t));
+  const std::size_t n = 50000;
+  std::vector<float> sa(4 * n), sb(4 * n);
+  sogmm::sample(a, n, 1, 4, sa.data());
+  sogmm::sample(b, n, 2, 4, sb.data());
+  Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mb = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    ma += r * Eigen::Vector3d(sa[4 * i], sa[4 * i + 1], sa[4 * i + 2]) + t;
+    mb += Eigen::Vector3d(sb[4 * i], sb[4 * i + 1], sb[4 * i + 2]);
+  }
+  ma /= n;
+  mb /= n;
+  // Rz(90) maps (0.5, -0.5, 2) to (0.5, 0.5, 2); plus t: (1.5, 2.5, 5).
+  const Eigen::Vector3d e(1.5, 2.5, 5.0);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_NEAR(ma(d), e(d), 5 * std::sqrt(0.06 / n));
+    EXPECT_NEAR(mb(d), e(d), 5 * std::sqrt(0.06 / n));
+  }
+}
+
+TEST(Transform, RejectsNonRotation) {
+  const sogmm::Gmm a = model_a();
+  Eigen::Matrix3d s = Eigen::Matrix3d::Identity();
+  s(0, 0) = 2.0;  // scaling
+  sogmm_test::expect_error([&] { sogmm::transform(a, pose_of(s, Eigen::Vector3d::Zero())); },
+                           sogmm::ErrorCode::InvalidArgument, {"rotation"}, "scaling pose");
+  Eigen::Matrix3d refl = Eigen::Matrix3d::Identity();
+  refl(2, 2) = -1.0;  // reflection: orthogonal but det = -1
+  sogmm_test::expect_error([&] { sogmm::transform(a, pose_of(refl, Eigen::Vector3d::Zero())); },
+                           sogmm::ErrorCode::InvalidArgument, {"rotation"}, "reflection pose");
+}
+
+TEST(ModelBytes, PaperCount) {
+  EXPECT_EQ(sogmm::paper_model_bytes(model_a()), 4u * 2u * 15u);
+  EXPECT_EQ(sogmm::paper_model_bytes(sogmm::merge(model_a(), model_b())), 180u);
+}
+
+TEST(Validate, AcceptsValidRejectsBroken) {
+  // gmm.hpp documents "Error(InvalidData or Numeric)" without a mapping.
+  const auto kEither = {sogmm::ErrorCode::InvalidData, sogmm::ErrorCode::Numeric};
+  const sogmm::Gmm good = model_a();
+  EXPECT_TRUE(sogmm_test::model_is_valid(good));
+  EXPECT_NO_THROW(sogmm::validate(good));
+
+  sogmm::Gmm w = good;
+  w.weights[1] = 0.5f;  // sums to 0.75
+  EXPECT_FALSE(sogmm::validation_error(w).empty());
+  sogmm_test::expect_error_codes([&] { sogmm::validate(w); }, kEither, {"weight"},
+                           "weights not summing to 1");
+
+  sogmm::Gmm nan = good;
+  nan.means[5] = std::nanf("");
+  sogmm_test::expect_error_codes([&] { sogmm::validate(nan); }, kEither,
+                           {"finite", "nan"}, "NaN mean");
+
+  sogmm::Gmm npd = good;
+  set_component(npd, 1, 0.75, mean_of(good, 1), Eigen::Vector4d(0.02, -0.01, 0.03, 0.02).asDiagonal().toDenseMatrix());
+  const std::string msg = sogmm::validation_error(npd);
+  EXPECT_NE(msg.find('1'), std::string::npos) << "message should name component 1: " << msg;
+  sogmm_test::expect_error_codes([&] { sogmm::validate(npd); }, kEither,
+                           {"positive definite", "positive-definite", "cholesky"}, "non-SPD covariance");
+
+  sogmm::Gmm asym = good;
+  asym.covariances[16 + 1] += 0.01f;
+  sogmm_test::expect_error_codes([&] { sogmm::validate(asym); }, kEither, {"symmetric"},
+                           "asymmetric covariance");
+
+  sogmm::Gmm empty;
+  EXPECT_FALSE(sogmm::validation_error(empty).empty());
+  sogmm::Gmm sizes = good;
+  sizes.means.pop_back();
+  EXPECT_FALSE(sogmm::validation_error(sizes).empty());
+}

@@ -1,0 +1,101 @@
+// Real frames (livingroom 00000, TUM): fit at d = 5, bandwidth 0.02; validity
+// and M within 2% of the authors' 628. Skips with a message when the data
+// folder is absent.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sogmm/camera.hpp"
+#include "sogmm/fit.hpp"
+#include "sogmm/inference.hpp"
+#include "test_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Frame {
+  cv::Mat depth;  // CV_16U
+  sogmm::GrayImage gray;
+  sogmm::Camera camera;
+};
+
+Frame load_frame(const fs::path& color, const fs::path& depth, const fs::path& intrinsics) {
+  Frame f;
+  cv::Mat bgr = cv::imread(color.string(), cv::IMREAD_COLOR);
+  f.depth = cv::imread(depth.string(), cv::IMREAD_UNCHANGED);
+  if (bgr.empty() || f.depth.empty() || f.depth.type() != CV_16U)
+    throw std::runtime_error("cannot read frame " + color.string() + " / " + depth.string());
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  if (!rgb.isContinuous()) rgb = rgb.clone();
+  f.gray = sogmm::gray_from_rgb_image(rgb.ptr<std::uint8_t>(), rgb.cols, rgb.rows);
+  f.camera = sogmm::read_intrinsics_json(intrinsics.string());
+  return f;
+}
+
+sogmm::PointCloud cloud_of(const Frame& f, double depth_scale, int d) {
+  if (!f.depth.isContinuous()) throw std::runtime_error("depth not continuous");
+  sogmm::RgbdView view{f.depth.ptr<std::uint16_t>(), f.gray.pixels.data(), f.camera};
+  sogmm::DepthOptions o;
+  o.depth_scale = depth_scale;
+  o.decimate = d;
+  return sogmm::backproject(view, o);
+}
+
+}  // namespace
+
+TEST(RealFrames, LivingroomFrame0Bandwidth002) {
+  const fs::path dir = fs::path(SOGMM_SHARED_DATA) / "rgbd" / "livingroom";
+  if (!fs::is_directory(dir)) GTEST_SKIP() << "real-frame data folder " << dir << " is absent";
+  const Frame f = load_frame(dir / "color" / "00000.jpg", dir / "depth" / "00000.png", dir / "intrinsics.json");
+  EXPECT_EQ(f.camera.width, 640);
+  EXPECT_EQ(f.camera.height, 480);
+  const sogmm::PointCloud pc = cloud_of(f, 1000.0, 5);
+  // About 12k valid points at 128x96 (reference.md: N = 10674).
+  EXPECT_GT(pc.size(), 9000u);
+  EXPECT_LE(pc.size(), 128u * 96u);
+  sogmm::FitOptions o;
+  o.bandwidth = 0.02;
+  const auto t0 = std::chrono::steady_clock::now();
+  const sogmm::FitResult r = sogmm::fit(pc.view(), o);
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  RecordProperty("components", static_cast<int>(r.gmm.size()));
+  RecordProperty("points", static_cast<int>(pc.size()));
+  std::printf("livingroom 00000: N = %zu, M = %zu, EM iterations %d, LL %.4f, %.2f s\n", pc.size(), r.gmm.size(),
+              r.em.iterations, r.em.log_likelihood, secs);
+  EXPECT_TRUE(sogmm_test::model_is_valid(r.gmm));
+  EXPECT_EQ(r.n_points, pc.size());
+  EXPECT_TRUE(std::isfinite(r.em.log_likelihood));
+  // Authors' code: M = 628 at 0.02; acceptance within 2%.
+  EXPECT_GE(r.gmm.size(), 616u);
+  EXPECT_LE(r.gmm.size(), 640u);
+  // The model explains its own points better than a single Gaussian would.
+  sogmm::FitOptions one;
+  one.n_components = 1;
+  const sogmm::FitResult r1 = sogmm::fit(pc.view(), one);
+  EXPECT_GT(r.em.log_likelihood, r1.em.log_likelihood + 1.0);
+  // Regressed gray is finite and in a sane range at every point.
+  std::vector<float> xyz, g(pc.size());
+  for (std::size_t i = 0; i < pc.size(); ++i)
+    xyz.insert(xyz.end(), {pc.xyzg[4 * i], pc.xyzg[4 * i + 1], pc.xyzg[4 * i + 2]});
+  sogmm::regress_gray(r.gmm, xyz.data(), pc.size(), g.data(), nullptr);
+  for (std::size_t i = 0; i < pc.size(); ++i) ASSERT_TRUE(std::isfinite(g[i]) && g[i] > -0.5f && g[i] < 1.5f) << i;
+}
+
+TEST(RealFrames, TumFrameFitIsValid) {
+  const fs::path dir = fs::path(SOGMM_SHARED_DATA) / "rgbd" / "tum";
+  if (!fs::is_directory(dir)) GTEST_SKIP() << "real-frame data folder " << dir << " is absent";
+  const Frame f = load_frame(dir / "color.png", dir / "depth.png", dir / "intrinsics.json");
+  const sogmm::PointCloud pc = cloud_of(f, 5000.0, 5);
+  ASSERT_GT(pc.size(), 1000u);
+  sogmm::FitOptions o;
+  o.bandwidth = 0.03;
+  const sogmm::FitResult r = sogmm::fit(pc.view(), o);
+  std::printf("tum: N = %zu, M = %zu, EM iterations %d\n", pc.size(), r.gmm.size(), r.em.iterations);
+  EXPECT_GT(r.gmm.size(), 10u);
+  EXPECT_TRUE(sogmm_test::model_is_valid(r.gmm));
+}

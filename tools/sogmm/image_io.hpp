@@ -1,0 +1,31 @@
+// Reading RGB-D frames from image files (OpenCV lives here, not in the core).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sogmm/camera.hpp"
+
+namespace sogmm::tools {
+
+/// A frame loaded from files: 16-bit depth and gray in [0, 1], same size.
+struct LoadedFrame {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint16_t> depth;
+  std::vector<float> gray;
+  /// View for the core with the given intrinsics.
+  RgbdView view(const Camera& camera) const { return {depth.data(), gray.data(), camera}; }
+};
+
+/// Loads a 16-bit (or 8-bit, widened) single-channel depth PNG and a color or
+/// gray image (PNG/JPEG); color becomes gray with 0.299/0.587/0.114. Throws
+/// sogmm::Error(Io) for unreadable files and Error(InvalidData) for wrong
+/// channel counts or images of different sizes, naming the file.
+LoadedFrame load_frame(const std::string& depth_path, const std::string& color_path);
+
+/// Writes an 8-bit or 16-bit image as PNG atomically; throws Error(Io).
+void write_png(const std::string& path, int width, int height, int channels, const std::uint8_t* data);
+
+}  // namespace sogmm::tools
