@@ -37,26 +37,124 @@ void check_options(const EmOptions& o) {
           "EM reg_covar must be finite and >= 0, got " + std::to_string(o.reg_covar));
   require(o.max_iter >= 1, ErrorCode::InvalidArgument, "EM max_iter must be >= 1, got " + std::to_string(o.max_iter));
   require(o.threads >= 0, ErrorCode::InvalidArgument, "EM threads must be >= 0, got " + std::to_string(o.threads));
+  require(std::isfinite(o.truncation_nats) && o.truncation_nats >= 0, ErrorCode::InvalidArgument,
+          "EM truncation_nats must be finite and >= 0 (0 = exact), got " + std::to_string(o.truncation_nats));
 }
 
-// Points as four coordinate arrays (structure of arrays), padded to whole blocks.
+// Points as four coordinate arrays (structure of arrays), padded to whole
+// blocks. With `spatial_order`, points are sorted along a Z-order curve of 5 cm
+// voxels so that each block is spatially compact (what the truncated E-step
+// needs); sums then run in that order.
 struct SoaPoints {
   std::vector<float> x, y, z, g;
   std::size_t n = 0;
-  explicit SoaPoints(const PointsView& pts) : n(pts.size) {
-    const std::size_t padded = (n + kBlock - 1) / kBlock * kBlock;
+  std::size_t n_blocks = 0;
+  std::vector<float> box;  // per block: min[4], max[4]
+
+  SoaPoints(const PointsView& pts, bool spatial_order) : n(pts.size) {
+    std::vector<std::uint32_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
+    if (spatial_order) sort_by_z_order(pts, order);
+    n_blocks = (n + kBlock - 1) / kBlock;
+    const std::size_t padded = n_blocks * kBlock;
     x.assign(padded, 0.f);
     y.assign(padded, 0.f);
     z.assign(padded, 0.f);
     g.assign(padded, 0.f);
     for (std::size_t i = 0; i < n; ++i) {
-      x[i] = pts[i][0];
-      y[i] = pts[i][1];
-      z[i] = pts[i][2];
-      g[i] = pts[i][3];
+      const float* p = pts[order[i]];
+      x[i] = p[0];
+      y[i] = p[1];
+      z[i] = p[2];
+      g[i] = p[3];
+    }
+    box.resize(8 * n_blocks);
+    for (std::size_t b = 0; b < n_blocks; ++b) {
+      float* bb = &box[8 * b];
+      for (int j = 0; j < 4; ++j) {
+        bb[j] = std::numeric_limits<float>::infinity();
+        bb[4 + j] = -std::numeric_limits<float>::infinity();
+      }
+      for (std::size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+        const float v[4] = {x[i], y[i], z[i], g[i]};
+        for (int j = 0; j < 4; ++j) {
+          bb[j] = std::min(bb[j], v[j]);
+          bb[4 + j] = std::max(bb[4 + j], v[j]);
+        }
+      }
+    }
+  }
+
+ private:
+  static std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  }
+  static void sort_by_z_order(const PointsView& pts, std::vector<std::uint32_t>& order) {
+    float lo[3] = {INFINITY, INFINITY, INFINITY};
+    for (std::size_t i = 0; i < pts.size; ++i)
+      for (int j = 0; j < 3; ++j) lo[j] = std::min(lo[j], pts[i][j]);
+    std::vector<std::uint64_t> key(pts.size);
+    for (std::size_t i = 0; i < pts.size; ++i) {
+      std::uint64_t c[3];
+      for (int j = 0; j < 3; ++j)
+        c[j] = static_cast<std::uint64_t>(std::min(2097151.0, std::floor((pts[i][j] - lo[j]) / 0.05)));
+      key[i] = spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2;
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+  }
+};
+
+// Per-component bounds for the truncated E-step: an upper bound of the
+// log-density over a box uses the smallest distance from the mean to the box
+// and 1 / trace(Sigma) <= smallest eigenvalue of the precision; a lower bound
+// uses the largest distance and |U|_F^2 >= largest eigenvalue of the precision.
+struct ComponentBounds {
+  std::vector<double> inv_trace, prec_norm2;
+  void compute(const Gmm& gmm, const std::vector<float>& params) {
+    const std::size_t m = gmm.size();
+    inv_trace.resize(m);
+    prec_norm2.resize(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      const float* c = gmm.covariance(k);
+      inv_trace[k] = 1.0 / (double(c[0]) + c[5] + c[10] + c[15]);
+      double f = 0.0;
+      for (int t = 4; t < 14; ++t) f += double(params[k * kParamStride + t]) * params[k * kParamStride + t];
+      prec_norm2[k] = f;
     }
   }
 };
+
+// The components a block must evaluate: those whose best possible
+// log-density in the block's box is within `nats` of the best guaranteed one.
+void active_components(const float* box, const std::vector<float>& params, const ComponentBounds& bounds,
+                       double nats, std::vector<std::uint32_t>& active, std::vector<double>& upper) {
+  const std::size_t m = bounds.inv_trace.size();
+  upper.resize(m);
+  double best_lower = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < m; ++k) {
+    const float* q = &params[k * kParamStride];
+    double near2 = 0.0, far2 = 0.0;
+    for (int j = 0; j < 4; ++j) {
+      const double lo = box[j] - q[j], hi = box[4 + j] - q[j];
+      const double near = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
+      const double far = std::max(std::fabs(lo), std::fabs(hi));
+      near2 += near * near;
+      far2 += far * far;
+    }
+    upper[k] = q[14] - 0.5 * near2 * bounds.inv_trace[k];
+    best_lower = std::max(best_lower, q[14] - 0.5 * far2 * bounds.prec_norm2[k]);
+  }
+  active.clear();
+  const double cut = best_lower - nats;
+  for (std::size_t k = 0; k < m; ++k)
+    if (upper[k] >= cut) active.push_back(static_cast<std::uint32_t>(k));
+}
 
 // Writes component k's packed kernel parameters from its float covariance.
 // The precision Cholesky factor U = L^-T (covariance = L L^T) is computed in
@@ -124,23 +222,30 @@ double m_step_component(const double* st, double reg_covar, float* mean, float* 
 Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, const EmOptions& options,
            EmReport* report) {
   const std::size_t n = points.size, m = gmm.size();
-  const SoaPoints soa(points);
-  const std::size_t n_blocks = (n + kBlock - 1) / kBlock;
+  const bool truncated = options.truncation_nats > 0;
+  const SoaPoints soa(points, truncated);
+  const std::size_t n_blocks = soa.n_blocks;
   const std::size_t blocks_per_chunk = std::clamp<std::size_t>((n_blocks + kWave - 1) / kWave, 1, kMaxBlocksPerChunk);
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   const detail::EmBlockFn kernel = detail::em_block_kernel();
 
   std::vector<float> params;
+  std::vector<std::uint32_t> all(m);
+  for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
+  ComponentBounds bounds;
   std::vector<double> slot_stats(kWave * m * kStatStride);
   std::vector<double> slot_ll(kWave);
+  std::vector<double> slot_pairs(kWave);
   std::vector<float> slot_scratch(kWave * (kBlock + 1) * m);
   std::vector<double> stats(m * kStatStride);
 
   EmReport rep;
+  double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
   for (int iter = 1; iter <= options.max_iter; ++iter) {
     pack_all(gmm, log_weights, options.reg_covar, params);
+    if (truncated) bounds.compute(gmm, params);
     std::fill(stats.begin(), stats.end(), 0.0);
     double total_ll = 0.0;
     for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
@@ -150,22 +255,32 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
         double* st = &slot_stats[s * m * kStatStride];
         std::fill(st, st + m * kStatStride, 0.0);
         float* scratch = &slot_scratch[s * (kBlock + 1) * m];
-        double ll = 0.0;
+        std::vector<std::uint32_t> active;
+        std::vector<double> upper;
+        double ll = 0.0, pairs = 0.0;
         const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
         const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
         for (std::size_t b = b0; b < b1; ++b) {
           const std::size_t first = b * kBlock;
           const int count = static_cast<int>(std::min<std::size_t>(kBlock, n - first));
           const float* coords[4] = {&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]};
-          ll += kernel(coords, count, params.data(), m, scratch, st);
+          const std::vector<std::uint32_t>* list = &all;
+          if (truncated) {
+            active_components(&soa.box[8 * b], params, bounds, options.truncation_nats, active, upper);
+            list = &active;
+          }
+          ll += kernel(coords, count, params.data(), list->data(), list->size(), scratch, st);
+          pairs += static_cast<double>(count) * list->size();
         }
         slot_ll[s] = ll;
+        slot_pairs[s] = pairs;
       }
       // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
       for (std::size_t s = 0; s < wave_chunks; ++s) {
         const double* st = &slot_stats[s * m * kStatStride];
         for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
         total_ll += slot_ll[s];
+        pairs_evaluated += slot_pairs[s];
       }
     }
     const double mean_ll = total_ll / static_cast<double>(n);
@@ -194,6 +309,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
     }
     previous = mean_ll;
   }
+  rep.pair_fraction = pairs_evaluated / (static_cast<double>(n) * m * rep.iterations);
   gmm.support_size = n;
   if (report) *report = rep;
   return gmm;

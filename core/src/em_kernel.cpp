@@ -14,8 +14,8 @@
 
 namespace sogmm::detail::SOGMM_ISA {
 
-double em_block(const float* const xyzg[4], int count, const float* params, std::size_t m, float* scratch,
-                double* stats) {
+double em_block(const float* const xyzg[4], int count, const float* params, const std::uint32_t* active,
+                std::size_t m, float* scratch, double* stats) {
   const float* __restrict px = xyzg[0];
   const float* __restrict py = xyzg[1];
   const float* __restrict pz = xyzg[2];
@@ -30,7 +30,7 @@ double em_block(const float* const xyzg[4], int count, const float* params, std:
   // Log-density of every point under every component: log w + log det U
   // - 2 log 2 pi - |d^T U|^2 / 2 with d = x - mu and U upper triangular.
   for (std::size_t k = 0; k < m; ++k) {
-    const float* q = params + k * kParamStride;
+    const float* q = params + active[k] * kParamStride;
     const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
     const float u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
                 u23 = q[12], u33 = q[13], c = q[14];
@@ -72,7 +72,7 @@ double em_block(const float* const xyzg[4], int count, const float* params, std:
   // responsibilities are all exactly 0 in this block adds nothing: skip it.
   for (std::size_t k = 0; k < m; ++k) {
     if (row_max[k] == 0.0f) continue;
-    const float* q = params + k * kParamStride;
+    const float* q = params + active[k] * kParamStride;
     const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
     const float* __restrict e = scratch + k * kBlock;
     float s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0;
@@ -98,7 +98,7 @@ double em_block(const float* const xyzg[4], int count, const float* params, std:
       c23 += r2 * d3;
       c33 += r3 * d3;
     }
-    double* st = stats + k * kStatStride;
+    double* st = stats + active[k] * kStatStride;
     st[0] += s0;
     st[1] += s1;
     st[2] += s2;

@@ -31,6 +31,10 @@ class ScopedOmpThreads {
 
 FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
+  // Limits first: nothing is read or allocated for an oversized request.
+  require(points.size <= kMaxPoints, ErrorCode::Limit,
+          "N = " + std::to_string(points.size) + " points exceeds the limit of " + std::to_string(kMaxPoints) +
+              " points per fit");
   require_finite_points(points, "point cloud");
   const bool fixed_k = options.n_components > 0;
   if (!fixed_k) {
@@ -40,6 +44,9 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
     require(options.n_components <= points.size, ErrorCode::InvalidArgument,
             "number of components K = " + std::to_string(options.n_components) +
                 " exceeds the number of points N = " + std::to_string(points.size));
+    require(options.n_components <= kMaxComponents, ErrorCode::Limit,
+            "K = " + std::to_string(options.n_components) + " components exceeds the limit of " +
+                std::to_string(kMaxComponents) + " components per fit");
   }
   require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
   const int threads = options.em.threads > 0 ? options.em.threads : omp_get_max_threads();
@@ -56,6 +63,10 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
                                       ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
                                       : mean_shift_gaussian_blurring(features, options.bandwidth);
     k = std::min<std::size_t>(std::max<std::size_t>(modes.size(), 1), points.size);
+    require(k <= kMaxComponents, ErrorCode::Limit,
+            "the mode count found " + std::to_string(k) + " components with bandwidth " +
+                std::to_string(options.bandwidth) + ", over the limit of " + std::to_string(kMaxComponents) +
+                " components per fit: use a larger bandwidth");
     result.seconds_mode_count = seconds_since(t);
   }
 

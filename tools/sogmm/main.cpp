@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "bench/bench.hpp"
 #include "cli_common.hpp"
 #include "sogmm/model.hpp"
 
@@ -10,7 +11,7 @@ int main(int argc, char** argv) {
   CLI::App app{"sogmm: self-organizing Gaussian mixture models of RGB-D frames"};
   app.set_version_flag("--version", std::string("sogmm ") + sogmm::version_string());
   app.require_subcommand(1);
-  std::vector<Command> commands = {add_demo_command(app), add_eval_command(app)};
+  std::vector<Command> commands = {add_demo_command(app), add_eval_command(app), add_bench_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

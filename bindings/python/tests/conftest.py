@@ -28,6 +28,11 @@ except ImportError:
     import sogmm  # noqa: F401,E402
 
 
+def pytest_report_header(config):
+    return [f"sogmm package: {Path(sogmm.__file__).parent}", f"libsogmm: {sogmm.library_path()} ({sogmm.library_version()})",
+            f"data: {data_dir()} ({'present' if data_dir().is_dir() else 'absent'})"]
+
+
 def data_dir() -> Path:
     env = os.environ.get("SOGMM_DATA_DIR")
     if env:

@@ -13,6 +13,17 @@
 
 namespace sogmm {
 
+/// Resource limits of a fit. A fit refuses larger inputs up front with
+/// Error(ErrorCode::Limit) (the C API's SOGMM_E_LIMIT) instead of running out
+/// of memory or time:
+/// - kMaxPoints: at most 2^26 (67,108,864) points per fit (1 GiB of float32
+///   input; internal point indices are 32-bit).
+/// - kMaxComponents: at most 2^16 (65,536) components, whether requested as a
+///   fixed K or counted by the mode counter (a bandwidth so small that it finds
+///   more modes is refused; use a larger bandwidth).
+inline constexpr std::size_t kMaxPoints = std::size_t{1} << 26;
+inline constexpr std::size_t kMaxComponents = std::size_t{1} << 16;
+
 /// How the number of components is chosen.
 enum class ModeCounter {
   FlatBinned,        ///< flat-kernel mean shift with bin seeding (authors' code; default)
@@ -49,9 +60,10 @@ struct FitResult {
 };
 
 /// Fits a SOGMM (or a fixed-K GMM) to a cloud in the camera frame. Throws
-/// Error(InvalidArgument) for bandwidth <= 0 or K outside [1, N],
-/// Error(InvalidData) for an empty or non-finite cloud, Error(Numeric) if the
-/// result fails validation.
+/// Error(Limit) for N > kMaxPoints or K > kMaxComponents (checked before the
+/// points are read), Error(InvalidArgument) for bandwidth <= 0 or K outside
+/// [1, N], Error(InvalidData) for an empty or non-finite cloud, Error(Numeric)
+/// if the result fails validation.
 FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress = {});
 
 }  // namespace sogmm
