@@ -25,6 +25,7 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
   f.em.reg_covar = o.reg_covar;
   f.em.max_iter = static_cast<int>(o.max_iter);
   f.em.threads = static_cast<int>(o.threads);
+  f.em.truncation_nats = o.truncation_nats;
   return f;
 }
 

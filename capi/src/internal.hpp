@@ -26,6 +26,7 @@ struct sogmm_options {
   std::int64_t seed = 0;
   std::int64_t threads = 0;
   std::int64_t mode_counter = SOGMM_MODE_COUNTER_FLAT_BINNED;
+  double truncation_nats = 0.0;  // SOGMM_OPT_TRUNCATION_NATS: 0 = exact E-step
   // RGB-D
   double depth_scale = 1000.0;
   double depth_min = 0.1;

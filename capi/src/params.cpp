@@ -19,6 +19,7 @@ KeyType key_type(sogmm_key key) {
     case SOGMM_OPT_DEPTH_MIN:
     case SOGMM_OPT_DEPTH_MAX:
     case SOGMM_OPT_SAMPLE_TRUNCATION:
+    case SOGMM_OPT_TRUNCATION_NATS:
       return KeyType::F64;
     case SOGMM_OPT_N_COMPONENTS:
     case SOGMM_OPT_MAX_ITER:
@@ -68,6 +69,7 @@ double* f64_slot(sogmm_options& o, sogmm_key key) {
     case SOGMM_OPT_DEPTH_MIN: return &o.depth_min;
     case SOGMM_OPT_DEPTH_MAX: return &o.depth_max;
     case SOGMM_OPT_SAMPLE_TRUNCATION: return &o.sample_truncation;
+    case SOGMM_OPT_TRUNCATION_NATS: return &o.truncation_nats;
     default: return nullptr;
   }
 }
@@ -133,6 +135,7 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_DEPTH_MIN: check_f64(key, v, std::isfinite(v) && v >= 0, ">= 0, finite"); break;
       case SOGMM_OPT_DEPTH_MAX: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       case SOGMM_OPT_SAMPLE_TRUNCATION: check_f64(key, v, v > 0, "> 0"); break;
+      case SOGMM_OPT_TRUNCATION_NATS: check_f64(key, v, std::isfinite(v) && v >= 0, ">= 0, finite"); break;
       default: break;
     }
     *f64_slot(*options, key) = v;

@@ -110,50 +110,71 @@ struct SoaPoints {
   }
 };
 
-// Per-component bounds for the truncated E-step: an upper bound of the
-// log-density over a box uses the smallest distance from the mean to the box
-// and 1 / trace(Sigma) <= smallest eigenvalue of the precision; a lower bound
-// uses the largest distance and |U|_F^2 >= largest eigenvalue of the precision.
-struct ComponentBounds {
-  std::vector<double> inv_trace, prec_norm2;
-  void compute(const Gmm& gmm, const std::vector<float>& params) {
-    const std::size_t m = gmm.size();
-    inv_trace.resize(m);
-    prec_norm2.resize(m);
-    for (std::size_t k = 0; k < m; ++k) {
-      const float* c = gmm.covariance(k);
-      inv_trace[k] = 1.0 / (double(c[0]) + c[5] + c[10] + c[15]);
-      double f = 0.0;
-      for (int t = 4; t < 14; ++t) f += double(params[k * kParamStride + t]) * params[k * kParamStride + t];
-      prec_norm2[k] = f;
-    }
+// The truncated E-step's bound. For x in a block's bounding box B,
+// log w_k N(x | mu_k, Sigma_k) = c_k - |U_k^T (x - mu_k)|^2 / 2, and each
+// coordinate y_j = sum_{i<=j} U_ij (x_i - mu_i) lies in an interval that
+// interval arithmetic gives from B; the squared distance of each interval from
+// 0 bounds y_j^2 below. This follows the component's orientation, so thin
+// planar components are bounded tightly too.
+double log_density_upper_bound(const float* q, const float* box) {
+  double lo[4], hi[4];
+  for (int i = 0; i < 4; ++i) {
+    lo[i] = static_cast<double>(box[i]) - q[i];
+    hi[i] = static_cast<double>(box[4 + i]) - q[i];
   }
-};
+  // Column j of U (upper triangular, packed row-major from q[4]): U_ij, i <= j.
+  static constexpr int kIndex[4][4] = {{4, 5, 6, 7}, {-1, 8, 9, 10}, {-1, -1, 11, 12}, {-1, -1, -1, 13}};
+  double q_min = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    double ylo = 0.0, yhi = 0.0;
+    for (int i = 0; i <= j; ++i) {
+      const double u = q[kIndex[i][j]];
+      const double a = u * lo[i], b = u * hi[i];
+      ylo += std::min(a, b);
+      yhi += std::max(a, b);
+    }
+    const double gap = ylo > 0 ? ylo : (yhi < 0 ? -yhi : 0.0);
+    q_min += gap * gap;
+  }
+  return q[14] - 0.5 * q_min;
+}
 
-// The components a block must evaluate: those whose best possible
-// log-density in the block's box is within `nats` of the best guaranteed one.
-void active_components(const float* box, const std::vector<float>& params, const ComponentBounds& bounds,
-                       double nats, std::vector<std::uint32_t>& active, std::vector<double>& upper) {
-  const std::size_t m = bounds.inv_trace.size();
+// Chooses and evaluates the components of one block for the truncated E-step.
+// It starts from `warm` (the components that mattered for this block in the
+// previous iteration; on the first iteration, the kFirst components with the
+// highest upper bound), then adds every other component whose upper bound is
+// within `nats` of the lowest per-point maximum found: all others are provably
+// more than `nats` below every point's best. The evaluated list is left in
+// `list` (warm first, then the additions in ascending order) and its
+// log-density rows in `rows`.
+void truncated_log_density(const detail::EmKernels& kernels, const detail::Block& block, const float* box,
+                           const std::vector<float>& params, double nats, const std::vector<std::uint32_t>& warm,
+                           std::vector<double>& upper, std::vector<char>& taken, std::vector<std::uint32_t>& list,
+                           float* rows, float* max_lp) {
+  constexpr std::size_t kFirst = 32;
+  const std::size_t m = params.size() / kParamStride;
   upper.resize(m);
-  double best_lower = -std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < m; ++k) {
-    const float* q = &params[k * kParamStride];
-    double near2 = 0.0, far2 = 0.0;
-    for (int j = 0; j < 4; ++j) {
-      const double lo = box[j] - q[j], hi = box[4 + j] - q[j];
-      const double near = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
-      const double far = std::max(std::fabs(lo), std::fabs(hi));
-      near2 += near * near;
-      far2 += far * far;
-    }
-    upper[k] = q[14] - 0.5 * near2 * bounds.inv_trace[k];
-    best_lower = std::max(best_lower, q[14] - 0.5 * far2 * bounds.prec_norm2[k]);
+  for (std::size_t k = 0; k < m; ++k) upper[k] = log_density_upper_bound(&params[k * kParamStride], box);
+  list = warm;
+  if (list.empty()) {
+    std::vector<std::uint32_t> idx(m);
+    for (std::size_t k = 0; k < m; ++k) idx[k] = static_cast<std::uint32_t>(k);
+    const std::size_t first = std::min(m, kFirst);
+    std::nth_element(idx.begin(), idx.begin() + (first - 1), idx.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return upper[a] > upper[b]; });
+    list.assign(idx.begin(), idx.begin() + first);
+    std::sort(list.begin(), list.end());
   }
-  active.clear();
-  const double cut = best_lower - nats;
+  kernels.log_density(block, params.data(), list.data(), list.size(), rows, max_lp);
+  float worst = max_lp[0];
+  for (int p = 1; p < block.count; ++p) worst = std::min(worst, max_lp[p]);
+  const double cut = static_cast<double>(worst) - nats;
+  taken.assign(m, 0);
+  for (std::uint32_t k : list) taken[k] = 1;
+  const std::size_t first = list.size();
   for (std::size_t k = 0; k < m; ++k)
-    if (upper[k] >= cut) active.push_back(static_cast<std::uint32_t>(k));
+    if (!taken[k] && upper[k] >= cut) list.push_back(static_cast<std::uint32_t>(k));
+  kernels.log_density(block, params.data(), list.data() + first, list.size() - first, rows + first * kBlock, max_lp);
 }
 
 // Writes component k's packed kernel parameters from its float covariance.
@@ -228,16 +249,17 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
   const std::size_t blocks_per_chunk = std::clamp<std::size_t>((n_blocks + kWave - 1) / kWave, 1, kMaxBlocksPerChunk);
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
-  const detail::EmBlockFn kernel = detail::em_block_kernel();
+  const detail::EmKernels& kernels = detail::em_kernels();
 
   std::vector<float> params;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
-  ComponentBounds bounds;
   std::vector<double> slot_stats(kWave * m * kStatStride);
   std::vector<double> slot_ll(kWave);
   std::vector<double> slot_pairs(kWave);
   std::vector<float> slot_scratch(kWave * (kBlock + 1) * m);
+  // Truncated E-step: per block, the components that mattered last iteration.
+  std::vector<std::vector<std::uint32_t>> warm(truncated ? n_blocks : 0);
   std::vector<double> stats(m * kStatStride);
 
   EmReport rep;
@@ -245,7 +267,6 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
   double previous = -std::numeric_limits<double>::infinity();
   for (int iter = 1; iter <= options.max_iter; ++iter) {
     pack_all(gmm, log_weights, options.reg_covar, params);
-    if (truncated) bounds.compute(gmm, params);
     std::fill(stats.begin(), stats.end(), 0.0);
     double total_ll = 0.0;
     for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
@@ -255,22 +276,39 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
         double* st = &slot_stats[s * m * kStatStride];
         std::fill(st, st + m * kStatStride, 0.0);
         float* scratch = &slot_scratch[s * (kBlock + 1) * m];
-        std::vector<std::uint32_t> active;
+        std::vector<std::uint32_t> list;
         std::vector<double> upper;
+        std::vector<char> taken;
+        alignas(64) float max_lp[kBlock];
         double ll = 0.0, pairs = 0.0;
         const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
         const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
         for (std::size_t b = b0; b < b1; ++b) {
           const std::size_t first = b * kBlock;
-          const int count = static_cast<int>(std::min<std::size_t>(kBlock, n - first));
-          const float* coords[4] = {&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]};
-          const std::vector<std::uint32_t>* list = &all;
+          const detail::Block block{{&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]},
+                                    static_cast<int>(std::min<std::size_t>(kBlock, n - first))};
+          std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
+          const std::vector<std::uint32_t>* evaluated = &all;
           if (truncated) {
-            active_components(&soa.box[8 * b], params, bounds, options.truncation_nats, active, upper);
-            list = &active;
+            truncated_log_density(kernels, block, &soa.box[8 * b], params, options.truncation_nats, warm[b],
+                                  upper, taken, list, scratch, max_lp);
+            evaluated = &list;
+          } else {
+            kernels.log_density(block, params.data(), all.data(), m, scratch, max_lp);
           }
-          ll += kernel(coords, count, params.data(), list->data(), list->size(), scratch, st);
-          pairs += static_cast<double>(count) * list->size();
+          const std::size_t ne = evaluated->size();
+          float* row_max = scratch + ne * kBlock;
+          ll += kernels.finish(block, params.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
+          pairs += static_cast<double>(block.count) * ne;
+          if (truncated) {
+            // Next iteration starts from the components some point of this
+            // block still gives at least exp(-nats) of its best weight.
+            const float keep = std::exp(static_cast<float>(-options.truncation_nats));
+            warm[b].clear();
+            for (std::size_t i = 0; i < ne; ++i)
+              if (row_max[i] >= keep) warm[b].push_back(list[i]);
+            std::sort(warm[b].begin(), warm[b].end());
+          }
         }
         slot_ll[s] = ll;
         slot_pairs[s] = pairs;

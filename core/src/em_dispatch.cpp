@@ -1,45 +1,41 @@
-// Picks the EM block kernel for the running CPU.
-#include "em_kernel.hpp"
-
+// Picks the EM block kernels for the running CPU.
 #include <cstdlib>
 #include <string>
 
+#include "em_kernel.hpp"
+
 namespace sogmm::detail {
-namespace sse2 {
-double em_block(const float* const[4], int, const float*, const std::uint32_t*, std::size_t, float*, double*);
-}
-namespace avx2 {
-double em_block(const float* const[4], int, const float*, const std::uint32_t*, std::size_t, float*, double*);
-}
-namespace avx512 {
-double em_block(const float* const[4], int, const float*, const std::uint32_t*, std::size_t, float*, double*);
-}
+
+#define SOGMM_DECLARE_KERNELS(isa)                                                                            \
+  namespace isa {                                                                                              \
+  void em_log_density(const Block&, const float*, const std::uint32_t*, std::size_t, float*, float*);         \
+  double em_finish(const Block&, const float*, const std::uint32_t*, std::size_t, float*, const float*, float*, \
+                   double*);                                                                                   \
+  }
+SOGMM_DECLARE_KERNELS(sse2)
+SOGMM_DECLARE_KERNELS(avx2)
+SOGMM_DECLARE_KERNELS(avx512)
+#undef SOGMM_DECLARE_KERNELS
 
 namespace {
-struct Choice {
-  EmBlockFn fn;
-  const char* name;
-};
 // SOGMM_ISA=sse2|avx2 caps the choice (for benchmarks and for testing the
 // narrower kernels on a wide machine); it never enables more than the CPU has.
-Choice choose() {
+EmKernels choose() {
   __builtin_cpu_init();
   const char* cap = std::getenv("SOGMM_ISA");
   const std::string limit = cap ? cap : "";
-  if (limit == "sse2") return {&sse2::em_block, "sse2"};
-  if (limit != "avx2" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq") &&
-      __builtin_cpu_supports("avx512bw"))
-    return {&avx512::em_block, "avx512"};
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {&avx2::em_block, "avx2"};
-  return {&sse2::em_block, "sse2"};
-}
-const Choice& chosen() {
-  static const Choice c = choose();
-  return c;
+  if (limit != "sse2" && limit != "avx2" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw"))
+    return {&avx512::em_log_density, &avx512::em_finish, "avx512"};
+  if (limit != "sse2" && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    return {&avx2::em_log_density, &avx2::em_finish, "avx2"};
+  return {&sse2::em_log_density, &sse2::em_finish, "sse2"};
 }
 }  // namespace
 
-EmBlockFn em_block_kernel() { return chosen().fn; }
-const char* em_kernel_isa() { return chosen().name; }
+const EmKernels& em_kernels() {
+  static const EmKernels k = choose();
+  return k;
+}
 
 }  // namespace sogmm::detail

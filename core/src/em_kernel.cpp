@@ -1,7 +1,7 @@
-// One EM block, compiled once per instruction set (see em_kernel.hpp). The
-// loops run over the points of a block with the component's parameters
-// broadcast, so the compiler vectorizes them at whatever width the
-// translation unit is compiled for.
+// The EM block kernels, compiled once per instruction set (see
+// em_kernel.hpp). The loops run over the points of a block with the
+// component's parameters broadcast, so the compiler vectorizes them at
+// whatever width the translation unit is compiled for.
 #include <cmath>
 #include <limits>
 
@@ -14,27 +14,21 @@
 
 namespace sogmm::detail::SOGMM_ISA {
 
-double em_block(const float* const xyzg[4], int count, const float* params, const std::uint32_t* active,
-                std::size_t m, float* scratch, double* stats) {
-  const float* __restrict px = xyzg[0];
-  const float* __restrict py = xyzg[1];
-  const float* __restrict pz = xyzg[2];
-  const float* __restrict pg = xyzg[3];
-  alignas(64) float mx[kBlock];
-  alignas(64) float sum[kBlock];
-  alignas(64) float inv_sum[kBlock];
-  float* __restrict row_max = scratch + m * kBlock;  // per component: largest e in this block
-
-  for (int p = 0; p < kBlock; ++p) mx[p] = -std::numeric_limits<float>::infinity();
-
-  // Log-density of every point under every component: log w + log det U
-  // - 2 log 2 pi - |d^T U|^2 / 2 with d = x - mu and U upper triangular.
-  for (std::size_t k = 0; k < m; ++k) {
-    const float* q = params + active[k] * kParamStride;
+void em_log_density(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
+                    float* rows, float* max_lp) {
+  const float* __restrict px = block.xyzg[0];
+  const float* __restrict py = block.xyzg[1];
+  const float* __restrict pz = block.xyzg[2];
+  const float* __restrict pg = block.xyzg[3];
+  float* __restrict mx = max_lp;
+  const int count = block.count;
+  // log w + log det U - 2 log 2 pi - |d^T U|^2 / 2 with d = x - mu, U upper triangular.
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* q = params + components[i] * kParamStride;
     const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
     const float u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
                 u23 = q[12], u33 = q[13], c = q[14];
-    float* __restrict lp = scratch + k * kBlock;
+    float* __restrict lp = rows + i * kBlock;
 #pragma omp simd
     for (int p = 0; p < count; ++p) {
       const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
@@ -47,11 +41,23 @@ double em_block(const float* const xyzg[4], int count, const float* params, cons
       mx[p] = l > mx[p] ? l : mx[p];  // (a ternary vectorizes where fmax on a stored array did not)
     }
   }
+}
+
+double em_finish(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
+                 float* rows, const float* max_lp, float* row_max, double* stats) {
+  const float* __restrict px = block.xyzg[0];
+  const float* __restrict py = block.xyzg[1];
+  const float* __restrict pz = block.xyzg[2];
+  const float* __restrict pg = block.xyzg[3];
+  const float* __restrict mx = max_lp;
+  const int count = block.count;
+  alignas(64) float sum[kBlock];
+  alignas(64) float inv_sum[kBlock];
 
   // exp(lp - max) in place, and its sum per point (log-sum-exp).
   for (int p = 0; p < kBlock; ++p) sum[p] = 0.0f;
-  for (std::size_t k = 0; k < m; ++k) {
-    float* __restrict e = scratch + k * kBlock;
+  for (std::size_t i = 0; i < n; ++i) {
+    float* __restrict e = rows + i * kBlock;
     float emax = 0.0f;
 #pragma omp simd reduction(max : emax)
     for (int p = 0; p < count; ++p) {
@@ -60,7 +66,7 @@ double em_block(const float* const xyzg[4], int count, const float* params, cons
       sum[p] += v;
       emax = v > emax ? v : emax;
     }
-    row_max[k] = emax;
+    row_max[i] = emax;
   }
   double log_likelihood = 0.0;
   for (int p = 0; p < count; ++p) {
@@ -70,11 +76,11 @@ double em_block(const float* const xyzg[4], int count, const float* params, cons
 
   // Sufficient statistics centred at each component's mean. A component whose
   // responsibilities are all exactly 0 in this block adds nothing: skip it.
-  for (std::size_t k = 0; k < m; ++k) {
-    if (row_max[k] == 0.0f) continue;
-    const float* q = params + active[k] * kParamStride;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (row_max[i] == 0.0f) continue;
+    const float* q = params + components[i] * kParamStride;
     const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
-    const float* __restrict e = scratch + k * kBlock;
+    const float* __restrict e = rows + i * kBlock;
     float s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0;
     float c00 = 0, c01 = 0, c02 = 0, c03 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
 #pragma omp simd reduction(+ : s0, s1, s2, s3, s4, c00, c01, c02, c03, c11, c12, c13, c22, c23, c33)
@@ -98,7 +104,7 @@ double em_block(const float* const xyzg[4], int count, const float* params, cons
       c23 += r2 * d3;
       c33 += r3 * d3;
     }
-    double* st = stats + active[k] * kStatStride;
+    double* st = stats + components[i] * kStatStride;
     st[0] += s0;
     st[1] += s1;
     st[2] += s2;

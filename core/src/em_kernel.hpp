@@ -1,7 +1,7 @@
 // The dense inner work of one EM iteration over a block of points (private).
 //
 // em_kernel.cpp is compiled once per instruction set (SSE2 baseline, AVX2,
-// AVX-512) into separate namespaces; em_block() picks the best one the CPU
+// AVX-512) into separate namespaces; em_kernels() picks the best one the CPU
 // supports at run time, so the portable build never executes an instruction
 // the machine lacks (no SIGILL) yet uses wide vectors where present.
 #pragma once
@@ -24,20 +24,34 @@ inline constexpr int kParamStride = 16;
 /// sum r d d^T (10, same order as U).
 inline constexpr int kStatStride = 15;
 
-/// One block: `count` <= kBlock points given as four coordinate arrays.
-/// Computes each point's log-density under the `n_active` components listed in
-/// `active` (indices into `params`; all M for the exact E-step), the point's
-/// log-sum-exp, the responsibilities, and adds the block's statistics
-/// (accumulated in float within the block, then in double) into `stats`
-/// (M x kStatStride, indexed by component). `scratch` holds
-/// (kBlock + 1) x n_active floats. Returns the sum of the points'
-/// log-likelihoods.
-using EmBlockFn = double (*)(const float* const xyzg[4], int count, const float* params,
-                             const std::uint32_t* active, std::size_t n_active, float* scratch, double* stats);
+/// A block of `count` <= kBlock points as four coordinate arrays.
+struct Block {
+  const float* xyzg[4];
+  int count;
+};
 
-/// The kernel for this CPU (resolved once).
-EmBlockFn em_block_kernel();
-/// Name of the instruction set the kernel uses ("avx512", "avx2", "sse2").
-const char* em_kernel_isa();
+/// Log-density of the block's points under the `n` components listed in
+/// `components` (indices into `params`): row i of `rows` (kBlock floats each)
+/// receives component components[i]; `max_lp` (kBlock floats) is raised to the
+/// running maximum per point. Rows for more components can be appended by
+/// further calls before em_finish.
+using EmLogDensityFn = void (*)(const Block& block, const float* params, const std::uint32_t* components,
+                                std::size_t n, float* rows, float* max_lp);
+
+/// Turns the `n` rows of log-densities into responsibilities (log-sum-exp per
+/// point over the rows) and adds the block's sufficient statistics
+/// (accumulated in float within the block, then in double) into `stats`
+/// (M x kStatStride, indexed by component). `row_max` is n floats of scratch.
+/// Returns the sum of the points' log-likelihoods.
+using EmFinishFn = double (*)(const Block& block, const float* params, const std::uint32_t* components,
+                              std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats);
+
+/// The kernels for this CPU (resolved once).
+struct EmKernels {
+  EmLogDensityFn log_density;
+  EmFinishFn finish;
+  const char* isa;  ///< "avx512", "avx2" or "sse2"
+};
+const EmKernels& em_kernels();
 
 }  // namespace sogmm::detail

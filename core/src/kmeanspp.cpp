@@ -67,8 +67,11 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
     }
     // Potential after adding each candidate = potential - gain, where gain is
     // what the points that move to the candidate save.
-    // (Serial: the work per step is small, and thousands of tiny parallel
-    // regions cost more than they save, badly so on a loaded machine.)
+    // Candidates in parallel only for large clouds: for small ones the work
+    // per step is tiny and thousands of parallel regions cost more than they
+    // save. Each gain is summed serially, so the result does not depend on
+    // the thread count.
+#pragma omp parallel for schedule(dynamic, 1) if (n >= 65536)
     for (int t = 0; t < trials; ++t) {
       const float* cand = points[candidates[t]];
       double g = 0.0;

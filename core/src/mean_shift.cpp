@@ -20,6 +20,44 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
           "mean shift needs a non-empty N x 2 array");
   for (double v : points2d)
     require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
+  // Grid and bin indices are (coordinate - origin) / bandwidth and
+  // coordinate / bandwidth converted to 64-bit integers: bound both so that the
+  // conversions are exact and defined (a larger ratio could never be gridded
+  // anyway: the grid's own cell limit is 1e8).
+  constexpr double kMaxCellsPerAxis = 1.0e8;
+  constexpr double kMaxBinIndex = 1.0e15;
+  for (int axis = 0; axis < 2; ++axis) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::size_t i = axis; i < points2d.size(); i += 2) {
+      lo = std::min(lo, points2d[i]);
+      hi = std::max(hi, points2d[i]);
+    }
+    const double extent = (hi - lo) / bandwidth;
+    const double magnitude = std::max(std::fabs(lo), std::fabs(hi)) / bandwidth;
+    require(extent <= kMaxCellsPerAxis && magnitude <= kMaxBinIndex, ErrorCode::Limit,
+            std::string("bandwidth ") + std::to_string(bandwidth) + " is too small for the " +
+                (axis == 0 ? "range" : "gray") + " values of the data (from " + std::to_string(lo) + " to " +
+                std::to_string(hi) + "): use a larger bandwidth");
+  }
+}
+
+// Side of the cells of a neighbour grid for queries of radius `radius`: the
+// radius itself, or more when the points span more than max(1024, 2 sqrt(n) + 1)
+// radii on an axis, so that the dense grid has at most about max(2^20, 4 n)
+// cells however far apart the points are: a handful of scattered points
+// cannot make the grid allocate gigabytes. Queries stay exact (a cell is never
+// smaller than the radius), and real clouds (metres of range and gray in
+// [0, 1] against a centimetre bandwidth) keep cells equal to the radius.
+double grid_cell(const std::vector<double>& xy, double radius) {
+  const std::size_t n = xy.size() / 2;
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (std::size_t i = 0; i < xy.size(); ++i) {
+    lo[i % 2] = std::min(lo[i % 2], xy[i]);
+    hi[i % 2] = std::max(hi[i % 2], xy[i]);
+  }
+  const double extent = n == 0 ? 0.0 : std::max(hi[0] - lo[0], hi[1] - lo[1]);
+  const double per_axis = std::max(1024.0, 2.0 * std::sqrt(static_cast<double>(n)) + 1.0);
+  return std::max(radius, extent / per_axis);
 }
 
 // Centres of the occupied cells of the bin-seeding grid.
@@ -72,7 +110,7 @@ MeanShiftResult suppress_near_duplicates(std::vector<Mode> modes, double radius)
   }
   MeanShiftResult result;
   if (modes.empty()) return result;
-  detail::Grid2d grid(xy.data(), modes.size(), radius);
+  detail::Grid2d grid(xy.data(), modes.size(), grid_cell(xy, radius));
   std::vector<char> unique(modes.size(), 1);
   for (std::size_t i = 0; i < modes.size(); ++i) {
     if (!unique[i]) continue;
@@ -95,7 +133,7 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   require(options.max_iter >= 0 && options.stop_fraction >= 0, ErrorCode::InvalidArgument,
           "mean shift max_iter and stop_fraction must be >= 0");
   const std::size_t n = xy.size() / 2;
-  const detail::Grid2d grid(xy.data(), n, bandwidth);
+  const detail::Grid2d grid(xy.data(), n, grid_cell(xy, bandwidth));
   const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
   const double stop = options.stop_fraction * bandwidth;
@@ -137,7 +175,7 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
   const double inv2s2 = 1.0 / (2.0 * bandwidth * bandwidth);
   const double stop2 = (1e-3 * bandwidth) * (1e-3 * bandwidth);
   for (int it = 0; it < max_iter; ++it) {
-    const detail::Grid2d grid(xy.data(), n, radius);
+    const detail::Grid2d grid(xy.data(), n, grid_cell(xy, radius));
     double moved2 = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : moved2)
     for (std::size_t i = 0; i < n; ++i) {

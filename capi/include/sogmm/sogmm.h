@@ -139,6 +139,9 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
 #define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores */
 #define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default FLAT_BINNED */
+#define SOGMM_OPT_TRUNCATION_NATS 108 /* f64, >= 0, finite; default 0 = exact E-step. > 0: truncated E-step
+                                       * that skips components provably more than this many nats below
+                                       * every point's best in a block (25: each skipped term < 1.4e-11) */
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 

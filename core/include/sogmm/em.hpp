@@ -22,10 +22,10 @@ struct EmOptions {
   /// its log-density is below every point's best component by more than
   /// `truncation_nats`, so each skipped term weighs less than
   /// exp(-truncation_nats) of the point's largest one (25 nats: < 1.4e-11).
-  /// The bounds use the component's mean, trace of its covariance and
-  /// Frobenius norm of its precision Cholesky factor against the block's
-  /// bounding box. From the tight k-means++ start nothing can be proven far,
-  /// so the first iterations are exact by construction.
+  /// The bound is interval arithmetic of the whitened coordinates U^T (x - mu)
+  /// over the block's bounding box, compared with the per-point maxima of
+  /// the components already evaluated, so it holds from the first iteration
+  /// on (the tight k-means++ start included) without any fallback.
   double truncation_nats = 0.0;
 };
 
