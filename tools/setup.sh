@@ -21,7 +21,7 @@ DEBIAN_PACKAGES=(
   libnanoflann-dev                                # exact nearest neighbours (metrics)
   libcli11-dev nlohmann-json3-dev                 # CLI parsing, JSON
   liboctomap-dev                                  # optional OctoMap baseline in `sogmm bench`
-  clang libclang-rt-14-dev                        # fuzzing and sanitizers
+  clang libclang-rt-14-dev libomp-14-dev          # fuzzing and sanitizers (clang's OpenMP)
   python3 python3-pip python3-venv
 )
 need_install=()

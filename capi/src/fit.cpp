@@ -34,6 +34,10 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
 sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o) {
   if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: nothing to fit");
   const std::size_t count = sogmm_capi::checked_mul(n, 4, "points");
+  // The size limit first, so an oversized input is refused before it is read.
+  if (n > sogmm::kMaxPoints)
+    fail(SOGMM_E_LIMIT, "n = " + std::to_string(n) + " points exceeds the limit of " +
+                            std::to_string(sogmm::kMaxPoints) + " per fit");
   // Checked here, before any parallel region of the core runs.
   sogmm_capi::require_finite(points, count, "points");
   if (k > n)

@@ -241,7 +241,7 @@ double m_step_component(const double* st, double reg_covar, float* mean, float* 
 }
 
 Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, const EmOptions& options,
-           EmReport* report) {
+           EmReport* report, const EmIterationCallback& on_iteration) {
   const std::size_t n = points.size, m = gmm.size();
   const bool truncated = options.truncation_nats > 0;
   const SoaPoints soa(points, truncated);
@@ -341,6 +341,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
 
     rep.iterations = iter;
     rep.log_likelihood = mean_ll;
+    if (on_iteration) on_iteration(iter, mean_ll);
     if (std::fabs(mean_ll - previous) < options.tol) {
       rep.converged = true;
       break;
@@ -356,7 +357,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
 }  // namespace
 
 Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indices, const EmOptions& options,
-           EmReport* report) {
+           EmReport* report, const EmIterationCallback& on_iteration) {
   check_options(options);
   require_finite_points(points, "EM input");
   const std::size_t m = seed_indices.size();
@@ -375,17 +376,18 @@ Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indice
   // before normalisation (scikit-learn's _initialize); only the first
   // iteration's log-likelihood sees the difference.
   std::vector<double> log_weights(m, -std::log(static_cast<double>(points.size)));
-  return run_em(points, std::move(init), std::move(log_weights), options, report);
+  return run_em(points, std::move(init), std::move(log_weights), options, report, on_iteration);
 }
 
-Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options, EmReport* report) {
+Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options, EmReport* report,
+                const EmIterationCallback& on_iteration) {
   check_options(options);
   require_finite_points(points, "EM input");
   validate(initial);
   std::vector<double> log_weights(initial.size());
   for (std::size_t k = 0; k < initial.size(); ++k)
     log_weights[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
-  return run_em(points, initial, std::move(log_weights), options, report);
+  return run_em(points, initial, std::move(log_weights), options, report, on_iteration);
 }
 
 }  // namespace sogmm

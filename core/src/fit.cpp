@@ -70,7 +70,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
     result.seconds_mode_count = seconds_since(t);
   }
 
-  if (progress) progress(FitStage::Seeding, 0, 0.0);
+  if (progress) progress(FitStage::Seeding, static_cast<int>(k), 0.0);
   auto t = std::chrono::steady_clock::now();
   const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed);
   result.seconds_seeding = seconds_since(t);
@@ -79,9 +79,10 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
   t = std::chrono::steady_clock::now();
   EmOptions em = options.em;
   em.threads = threads;
-  result.gmm = fit_em(points, seeds, em, &result.em);
+  EmIterationCallback on_iteration;
+  if (progress) on_iteration = [&progress](int iteration, double ll) { progress(FitStage::Em, iteration, ll); };
+  result.gmm = fit_em(points, seeds, em, &result.em, on_iteration);
   result.seconds_em = seconds_since(t);
-  if (progress) progress(FitStage::Em, result.em.iterations, result.em.log_likelihood);
 
   validate(result.gmm);
   result.seconds_total = seconds_since(t0);

@@ -94,7 +94,9 @@ std::string to_canonical_json(const Model& model, const FileInfo* info) {
     j["means"] = mu;
     j["covariances"] = cov;
   }
-  return j.dump(2) + "\n";
+  // Strings from a file are not guaranteed to be valid UTF-8: invalid bytes
+  // become U+FFFD instead of an exception (the dump is for reading).
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace sogmm::format

@@ -26,7 +26,7 @@ namespace {
 
 constexpr std::size_t kMaxFuzzPoints = 256;
 
-void check_model(const sogmm_model* model, std::size_t n) {
+void check_model(const sogmm_model* model, std::size_t n, const sogmm_options* o) {
   std::size_t m = 0;
   FUZZ_CHECK(sogmm_model_n_components(model, &m) == SOGMM_OK);
   FUZZ_CHECK(m >= 1 && m <= n);
@@ -47,7 +47,7 @@ void check_model(const sogmm_model* model, std::size_t n) {
   FUZZ_CHECK(!std::isnan(ll));
   // A fitted model can be saved and read back.
   sogmm_buffer* buf = nullptr;
-  FUZZ_CHECK(sogmm_model_save_to_memory(&buf, model, nullptr) == SOGMM_OK);
+  FUZZ_CHECK(sogmm_model_save_to_memory(&buf, model, o) == SOGMM_OK);
   sogmm_model* back = nullptr;
   FUZZ_CHECK(sogmm_model_load_from_memory(&back, sogmm_buffer_data(buf), sogmm_buffer_size(buf), nullptr) ==
              SOGMM_OK);
@@ -88,6 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sogmm_options* o = nullptr;
   FUZZ_CHECK(sogmm_options_create(&o) == SOGMM_OK);
   FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
+  FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 1) == SOGMM_OK);
   FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 1 + iters % 8) == SOGMM_OK);
   FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, seed) == SOGMM_OK);
   if (flags & 2) FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MODE_COUNTER, SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING) == SOGMM_OK);
@@ -124,7 +125,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (s == SOGMM_OK) {
     FUZZ_CHECK(model != nullptr);
-    check_model(model, n);
+    check_model(model, n, o);
   } else {
     FUZZ_CHECK(model == nullptr && sogmm_last_error()[0] != '\0');
     // Valid input may still fail only with a clear numerical or limit status.

@@ -1,10 +1,14 @@
 #include "cli_common.hpp"
 
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdio>
 #include <new>
 
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
+#include <memory>
 
 namespace sogmm::tools {
 
@@ -49,6 +53,10 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();
   app.add_option("--reg-covar", o.em.reg_covar, "covariance regulariser")->capture_default_str();
+  app.add_option("--truncate", o.em.truncation_nats,
+                 "truncated E-step: skip components provably this many nats below each point's best "
+                 "(0 = exact; 20 is a good value for full frames)")
+      ->capture_default_str();
 }
 
 Evaluation evaluate(FitResult fit, const PointsView& truth, const Camera& decimated_camera, std::uint64_t seed) {
@@ -58,6 +66,124 @@ Evaluation evaluate(FitResult fit, const PointsView& truth, const Camera& decima
   e.model_bytes = paper_model_bytes(fit.gmm);
   e.fit = std::move(fit);
   return e;
+}
+
+bool any_given(const CLI::App& app, std::initializer_list<const char*> names) {
+  for (const char* n : names)
+    if (app.count(n) > 0) return true;
+  return false;
+}
+
+bool camera_flags_given(const CameraFlags& f) {
+  return !f.intrinsics.empty() || f.fx > 0 || f.fy > 0 || f.width > 0 || f.height > 0 || f.cx != 0 || f.cy != 0;
+}
+
+Camera camera_from_flags(const CameraFlags& f) {
+  const bool explicit_camera = f.fx > 0 || f.fy > 0 || f.width > 0 || f.height > 0;
+  if (!f.intrinsics.empty()) {
+    require(!explicit_camera, ErrorCode::InvalidArgument, "give either --intrinsics or --fx/--fy/--cx/--cy, not both");
+    return read_intrinsics_json(f.intrinsics);
+  }
+  require(f.width > 0 && f.height > 0 && f.fx > 0 && f.fy > 0, ErrorCode::InvalidArgument,
+          "camera flags need all of --width --height --fx --fy --cx --cy (or --intrinsics FILE)");
+  const Camera cam{f.width, f.height, f.fx, f.fy, f.cx, f.cy};
+  validate(cam);
+  return cam;
+}
+
+ProgressMode progress_mode(bool quiet, bool lines) {
+  if (quiet) return ProgressMode::Off;
+  if (::isatty(::fileno(stderr))) return ProgressMode::Live;
+  return lines ? ProgressMode::Lines : ProgressMode::Off;
+}
+
+void ProgressPrinter::show(const std::string& text, bool keep) {
+  if (mode_ == ProgressMode::Off) return;
+  if (mode_ == ProgressMode::Lines) {
+    std::fprintf(stderr, "%s\n", text.c_str());
+  } else {
+    std::fprintf(stderr, "\r\033[2K%s%s", text.c_str(), keep ? "\n" : "");
+    live_pending_ = !keep;
+  }
+  std::fflush(stderr);
+}
+
+void ProgressPrinter::line(const std::string& text) { show(text, true); }
+
+void ProgressPrinter::finish() {
+  if (mode_ == ProgressMode::Live && live_pending_) {
+    std::fprintf(stderr, "\r\033[2K");
+    std::fflush(stderr);
+    live_pending_ = false;
+  }
+}
+
+void ProgressPrinter::em_done(const std::string& label, const FitResult& r) {
+  if (mode_ != ProgressMode::Lines) return;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "EM done in %.3f s: %d iterations, mean log-likelihood %.4f", r.seconds_em,
+                r.em.iterations, r.em.log_likelihood);
+  show(label + ": " + buf, true);
+}
+
+FitProgress ProgressPrinter::fit_callback(const std::string& label) {
+  if (mode_ == ProgressMode::Off) return {};
+  struct Clock {
+    std::chrono::steady_clock::time_point start;
+    std::string done;  // finished stages, "mode count 0.04 s, seeding 0.12 s"
+    const char* current = nullptr;
+  };
+  auto c = std::make_shared<Clock>();
+  return [this, c, label](FitStage stage, int iteration, double ll) {
+    const auto now = std::chrono::steady_clock::now();
+    char buf[160];
+    auto close_stage = [&]() {
+      if (c->current == nullptr) return;
+      const double s = std::chrono::duration<double>(now - c->start).count();
+      std::snprintf(buf, sizeof buf, "%s %.3f s", c->current, s);
+      if (!c->done.empty()) c->done += ", ";
+      c->done += buf;
+      if (mode_ == ProgressMode::Lines) {
+        std::snprintf(buf, sizeof buf, "%s done in %.3f s", c->current, s);
+        show(label + ": " + buf, true);
+      }
+    };
+    if (stage == FitStage::Em && iteration > 0) {  // after an EM iteration
+      const double s = std::chrono::duration<double>(now - c->start).count();
+      std::snprintf(buf, sizeof buf, "EM iteration %d, mean log-likelihood %.4f (%.3f s)", iteration, ll, s);
+      // Live: every iteration on one line; lines: every 10th, to keep logs short.
+      if (mode_ == ProgressMode::Lines) {
+        if (iteration % 10 == 0) show(label + ": " + buf, true);
+      } else {
+        show(label + ": " + c->done + (c->done.empty() ? "" : "; ") + buf, false);
+      }
+      return;
+    }
+    close_stage();
+    c->current = stage == FitStage::ModeCount ? "mode count" : stage == FitStage::Seeding ? "seeding" : "EM";
+    c->start = now;
+    const std::string what = stage == FitStage::ModeCount ? "mode count (mean shift)..."
+                             : stage == FitStage::Seeding ? "seeding (k-means++)..."
+                                                          : "EM...";
+    show(label + ": " + (mode_ == ProgressMode::Live && !c->done.empty() ? c->done + "; " : std::string()) + what,
+         mode_ == ProgressMode::Lines);
+  };
+}
+
+std::int64_t unix_ms_now() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string human_bytes(std::uint64_t bytes) {
+  char buf[96];
+  if (bytes < 1024)
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(bytes));
+  else if (bytes < 1024 * 1024)
+    std::snprintf(buf, sizeof buf, "%.1f KiB (%llu bytes)", bytes / 1024.0, static_cast<unsigned long long>(bytes));
+  else
+    std::snprintf(buf, sizeof buf, "%.2f MiB (%llu bytes)", bytes / 1048576.0, static_cast<unsigned long long>(bytes));
+  return buf;
 }
 
 int run_guarded(const std::function<int()>& body) {

@@ -1,7 +1,9 @@
 // Pieces shared by the `sogmm` subcommands: camera flags, evaluation, errors.
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -60,4 +62,45 @@ struct Command {
 };
 Command add_demo_command(CLI::App& root);
 Command add_eval_command(CLI::App& root);
+Command add_fit_command(CLI::App& root);
+Command add_render_command(CLI::App& root);
+Command add_sample_command(CLI::App& root);
+
+/// True when any of the named options was given on the command line.
+bool any_given(const CLI::App& app, std::initializer_list<const char*> names);
+
+/// The camera flags were used (--intrinsics or any of --fx/--fy/--cx/--cy/--width/--height).
+bool camera_flags_given(const CameraFlags& flags);
+/// Camera from explicit flags only (no frame to take the size from: --width
+/// and --height are then required). Throws Error(InvalidArgument).
+Camera camera_from_flags(const CameraFlags& flags);
+
+/// Where fit progress goes: nowhere, plain lines, or one live line on a terminal.
+enum class ProgressMode { Off, Lines, Live };
+/// Off with --quiet; Live when stderr is a terminal; Lines with --progress; else Off.
+ProgressMode progress_mode(bool quiet, bool lines);
+
+/// Prints fit stages on stderr (see ProgressMode); `label` prefixes each line.
+class ProgressPrinter {
+ public:
+  explicit ProgressPrinter(ProgressMode mode) : mode_(mode) {}
+  /// The callback for sogmm::fit(); stage times are measured between calls.
+  FitProgress fit_callback(const std::string& label);
+  /// A line that stays (e.g. "frame 2/3 done"): printed in Lines and Live modes.
+  void line(const std::string& text);
+  /// "EM done in T s: I iterations, mean log-likelihood L" after a fit (Lines mode).
+  void em_done(const std::string& label, const FitResult& r);
+  /// Clears a pending live line.
+  void finish();
+
+ private:
+  void show(const std::string& text, bool keep);
+  ProgressMode mode_;
+  bool live_pending_ = false;
+};
+
+/// Milliseconds since 1970 UTC, now.
+std::int64_t unix_ms_now();
+/// Human byte count, e.g. "41.2 KiB (42188 bytes)".
+std::string human_bytes(std::uint64_t bytes);
 }  // namespace sogmm::tools

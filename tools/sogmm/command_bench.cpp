@@ -66,7 +66,7 @@ std::string shell_quote(const std::string& s) {
 
 Command add_bench_command(CLI::App& root) {
   struct State {
-    std::string depth, color, frames_dir, out = "sogmm-bench";
+    std::string depth, color, frames_dir, name, out = "sogmm-bench";
     CameraFlags camera;
     DepthOptions depth_options;
     bench::BenchConfig config;
@@ -94,6 +94,7 @@ Command add_bench_command(CLI::App& root) {
   depth->needs(color);
   color->needs(depth);
   dir->excludes(depth)->excludes(color);
+  app->add_option("--name", s->name, "frame name in the table (default: the depth file's stem)")->needs(depth);
   add_camera_flags(*app, s->camera, s->depth_options);
   app->add_option("--out", s->out, "output folder for results.csv and the plots")->capture_default_str();
   app->add_option("--methods", s->methods, "comma-separated families to run: octomap, ndt, fc, sogmm")
@@ -101,6 +102,8 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--octomap-res", s->config.octomap_resolutions, "OctoMap leaf sizes (m)")
       ->delimiter(',')
       ->capture_default_str();
+  app->add_flag("!--octomap-no-raycast", s->config.octomap_ray_cast,
+                "OctoMap: mark only the endpoint voxels (no free space; smaller .ot file)");
   app->add_option("--ndt-res", s->config.ndt_resolutions, "NDT voxel sizes (m)")->delimiter(',')->capture_default_str();
   app->add_option("--fc-components", s->config.fc_components, "fixed K of the FC GMMs (capped at N)")
       ->delimiter(',')
@@ -135,7 +138,15 @@ Command add_bench_command(CLI::App& root) {
                                            camera_flags.fy > 0 || camera_flags.width > 0 || camera_flags.height > 0;
               if (!explicit_camera && fs::is_regular_file(intr)) camera_flags.intrinsics = intr.string();
             } else {
-              frames.push_back({fs::path(s->depth).stem().string(), s->depth, s->color});
+              // Frame name: --name, else the depth file's stem, or its folder's
+              // name when the stem says nothing ("tum/depth.png" -> "tum").
+              std::string name = s->name;
+              if (name.empty()) {
+                const fs::path d = fs::absolute(s->depth);
+                name = d.stem().string();
+                if (name == "depth" && d.has_parent_path()) name = d.parent_path().filename().string();
+              }
+              frames.push_back({name, s->depth, s->color});
             }
 
             std::vector<std::string> notes;

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "file_util.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm::tools {
@@ -25,20 +26,17 @@ cv::Mat read_image(const std::string& path, int flags, const char* what) {
 }
 }  // namespace
 
-LoadedFrame load_frame(const std::string& depth_path, const std::string& color_path) {
+namespace {
+cv::Mat read_depth(const std::string& depth_path) {
   const cv::Mat depth = read_image(depth_path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR, "depth");
   require(depth.channels() == 1, ErrorCode::InvalidData,
           depth_path + ": depth image must have one channel, has " + std::to_string(depth.channels()));
   require(depth.depth() == CV_16U || depth.depth() == CV_8U, ErrorCode::InvalidData,
           depth_path + ": depth image must be 16-bit (or 8-bit) unsigned integers");
-  const cv::Mat color = read_image(color_path, cv::IMREAD_UNCHANGED, "color");
-  require(color.depth() == CV_8U, ErrorCode::InvalidData, color_path + ": color image must be 8-bit");
-  require(color.cols == depth.cols && color.rows == depth.rows, ErrorCode::InvalidData,
-          "images of different sizes: depth " + depth_path + " is " + std::to_string(depth.cols) + "x" +
-              std::to_string(depth.rows) + ", color " + color_path + " is " + std::to_string(color.cols) + "x" +
-              std::to_string(color.rows));
+  return depth;
+}
 
-  LoadedFrame frame;
+void copy_depth(const cv::Mat& depth, LoadedFrame& frame) {
   frame.width = depth.cols;
   frame.height = depth.rows;
   cv::Mat depth16;
@@ -47,6 +45,27 @@ LoadedFrame load_frame(const std::string& depth_path, const std::string& color_p
   for (int v = 0; v < frame.height; ++v)
     std::copy(depth16.ptr<std::uint16_t>(v), depth16.ptr<std::uint16_t>(v) + frame.width,
               frame.depth.begin() + static_cast<std::size_t>(v) * frame.width);
+}
+}  // namespace
+
+LoadedFrame load_depth(const std::string& depth_path) {
+  LoadedFrame frame;
+  copy_depth(read_depth(depth_path), frame);
+  frame.gray.assign(frame.depth.size(), 0.f);
+  return frame;
+}
+
+LoadedFrame load_frame(const std::string& depth_path, const std::string& color_path) {
+  const cv::Mat depth = read_depth(depth_path);
+  const cv::Mat color = read_image(color_path, cv::IMREAD_UNCHANGED, "color");
+  require(color.depth() == CV_8U, ErrorCode::InvalidData, color_path + ": color image must be 8-bit");
+  require(color.cols == depth.cols && color.rows == depth.rows, ErrorCode::InvalidData,
+          "images of different sizes: depth " + depth_path + " is " + std::to_string(depth.cols) + "x" +
+              std::to_string(depth.rows) + ", color " + color_path + " is " + std::to_string(color.cols) + "x" +
+              std::to_string(color.rows));
+
+  LoadedFrame frame;
+  copy_depth(depth, frame);
 
   cv::Mat rgb;
   switch (color.channels()) {
@@ -67,15 +86,14 @@ void write_png(const std::string& path, int width, int height, int channels, con
   const cv::Mat img(height, width, channels == 3 ? CV_8UC3 : CV_8UC1, const_cast<std::uint8_t*>(data));
   std::vector<std::uint8_t> bytes;
   require(cv::imencode(".png", img, bytes), ErrorCode::Io, path + ": cannot encode PNG");
-  const std::string tmp = path + ".tmp";
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  require(f != nullptr, ErrorCode::Io, path + ": cannot write (directory missing or not writable)");
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw Error(ErrorCode::Io, path + ": write failed");
-  }
+  write_file_atomic(path, bytes.data(), bytes.size());
+}
+
+void write_png16(const std::string& path, int width, int height, const std::uint16_t* data) {
+  const cv::Mat img(height, width, CV_16UC1, const_cast<std::uint16_t*>(data));
+  std::vector<std::uint8_t> bytes;
+  require(cv::imencode(".png", img, bytes), ErrorCode::Io, path + ": cannot encode PNG");
+  write_file_atomic(path, bytes.data(), bytes.size());
 }
 
 }  // namespace sogmm::tools

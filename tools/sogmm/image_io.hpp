@@ -25,7 +25,13 @@ struct LoadedFrame {
 /// channel counts or images of different sizes, naming the file.
 LoadedFrame load_frame(const std::string& depth_path, const std::string& color_path);
 
-/// Writes an 8-bit or 16-bit image as PNG atomically; throws Error(Io).
+/// Loads only a depth image (as load_frame); the gray is all zeros.
+LoadedFrame load_depth(const std::string& depth_path);
+
+/// Writes an 8-bit image (1 channel gray or 3 channels in OpenCV's BGR order)
+/// as PNG atomically; throws Error(Io).
 void write_png(const std::string& path, int width, int height, int channels, const std::uint8_t* data);
+/// Writes a 16-bit single-channel image (e.g. depth in millimetres) as PNG atomically.
+void write_png16(const std::string& path, int width, int height, const std::uint16_t* data);
 
 }  // namespace sogmm::tools

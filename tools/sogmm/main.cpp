@@ -11,7 +11,18 @@ int main(int argc, char** argv) {
   CLI::App app{"sogmm: self-organizing Gaussian mixture models of RGB-D frames"};
   app.set_version_flag("--version", std::string("sogmm ") + sogmm::version_string());
   app.require_subcommand(1);
-  std::vector<Command> commands = {add_demo_command(app), add_eval_command(app), add_bench_command(app)};
+  app.footer(
+      "Exit codes: 0 ok, 2 usage error, 3 invalid input data, 4 I/O error (one line on stderr names the\n"
+      "file and the problem). Run sogmm SUBCOMMAND --help for the flags and an example.\n\n"
+      "Example (a frame of ../shared/data/rgbd/livingroom):\n"
+      "  D=../shared/data/rgbd/livingroom\n"
+      "  sogmm fit --depth $D/depth/00000.png --color $D/color/00000.jpg --intrinsics $D/intrinsics.json \\\n"
+      "    --decimate 5 --bandwidth 0.02 -o frame0.sogmm\n"
+      "  sogmm eval frame0.sogmm --depth $D/depth/00000.png --color $D/color/00000.jpg\n"
+      "  sogmm render frame0.sogmm --compare --depth $D/depth/00000.png --color $D/color/00000.jpg -o cmp.png\n"
+      "  sogmm sample frame0.sogmm -n 100000 -o samples.ply --ellipsoids ellipsoids.ply");
+  std::vector<Command> commands = {add_demo_command(app), add_eval_command(app), add_fit_command(app),
+                                   add_render_command(app), add_sample_command(app), add_bench_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

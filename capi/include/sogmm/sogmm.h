@@ -100,7 +100,8 @@ typedef int32_t sogmm_status;
 #define SOGMM_E_NUMERIC (-4)          /* numerical failure: covariance not SPD, NaN result */
 #define SOGMM_E_IO (-5)               /* a file could not be opened, read or written */
 #define SOGMM_E_FORMAT (-6)           /* bytes are not a valid / supported .sogmm document */
-#define SOGMM_E_LIMIT (-7)            /* a size limit is exceeded (decoded size, size overflow) */
+#define SOGMM_E_LIMIT (-7)            /* a size limit is exceeded (decoded size, size overflow, more than
+                                       * 2^26 points or 2^16 components in a fit) */
 #define SOGMM_E_NOMEM (-8)            /* memory allocation failed */
 #define SOGMM_E_BUFFER_TOO_SMALL (-9) /* a caller's output capacity is too small */
 #define SOGMM_E_NOT_FOUND (-10)       /* the requested value is not present (unknown metadata) */

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "sogmm/gmm.hpp"
@@ -40,6 +41,10 @@ struct EmReport {
   double pair_fraction = 1.0;
 };
 
+/// Called after each EM iteration with the iteration number (from 1) and the
+/// mean log-likelihood of that iteration's E-step; may be empty.
+using EmIterationCallback = std::function<void(int iteration, double log_likelihood)>;
+
 /// Fits a GMM by EM starting from one-hot responsibilities on the seed points
 /// (the paper's and scikit-learn's k-means++ initialisation): the first model
 /// has means = seed points, covariances = reg_covar I and equal weights.
@@ -50,10 +55,10 @@ struct EmReport {
 /// Throws Error(InvalidArgument) for bad options or seed indices, and
 /// Error(InvalidData) for empty or non-finite points.
 Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indices,
-           const EmOptions& options, EmReport* report = nullptr);
+           const EmOptions& options, EmReport* report = nullptr, const EmIterationCallback& on_iteration = {});
 
 /// Runs EM from a given model (means, covariances, weights) instead of seeds.
 Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options,
-                EmReport* report = nullptr);
+                EmReport* report = nullptr, const EmIterationCallback& on_iteration = {});
 
 }  // namespace sogmm

@@ -44,8 +44,10 @@ struct FitOptions {
 /// Which stage a fit is in, for progress reports.
 enum class FitStage { ModeCount, Seeding, Em };
 
-/// Called between stages and after each EM iteration (iteration, mean
-/// log-likelihood); may be empty.
+/// Called at the start of each stage and after each EM iteration; may be
+/// empty. ModeCount: (0, 0). Seeding: (K, 0), the number of components about
+/// to be seeded. Em: (0, 0) at the start, then (iteration, mean
+/// log-likelihood of that iteration's E-step) after each iteration.
 using FitProgress = std::function<void(FitStage stage, int iteration, double log_likelihood)>;
 
 /// A fitted model and how it was obtained.

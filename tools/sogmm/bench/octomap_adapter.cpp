@@ -54,7 +54,7 @@ OctoMapModel::~OctoMapModel() = default;
 
 double OctoMapModel::resolution() const { return impl_->tree.getResolution(); }
 
-void OctoMapModel::build(const PointsView& points) {
+void OctoMapModel::build(const PointsView& points, bool ray_cast) {
   require_finite_points(points, "OctoMap input cloud");
   Impl& m = *impl_;
   octomap::Pointcloud scan;
@@ -77,7 +77,11 @@ void OctoMapModel::build(const PointsView& points) {
   // One scan from the camera origin, ray casting, no range limit. lazy_eval
   // keeps the finest leaves until colours are set, then inner nodes are
   // updated and the tree pruned (ColorOcTree prunes only equal colours).
-  m.tree.insertPointCloud(scan, octomap::point3d(0, 0, 0), -1.0, /*lazy_eval=*/true, /*discretize=*/false);
+  if (ray_cast) {
+    m.tree.insertPointCloud(scan, octomap::point3d(0, 0, 0), -1.0, /*lazy_eval=*/true, /*discretize=*/false);
+  } else {
+    for (const octomap::OcTreeKey& key : m.keys) m.tree.updateNode(key, true, /*lazy_eval=*/true);
+  }
   m.tree.updateInnerOccupancy();
   for (std::size_t k = 0; k < m.keys.size(); ++k) {
     LeafStats& s = m.stats[k];
@@ -168,7 +172,7 @@ OctoMapModel::OctoMapModel(double) {
 }
 OctoMapModel::~OctoMapModel() = default;
 double OctoMapModel::resolution() const { return 0.0; }
-void OctoMapModel::build(const PointsView&) {}
+void OctoMapModel::build(const PointsView&, bool) {}
 std::size_t OctoMapModel::occupied_leaves() const { return 0; }
 std::size_t OctoMapModel::tree_nodes() const { return 0; }
 float OctoMapModel::gray_at(const float*, std::size_t*) const { return 0.0f; }

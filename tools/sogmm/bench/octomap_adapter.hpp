@@ -33,9 +33,11 @@ class OctoMapModel {
   OctoMapModel(const OctoMapModel&) = delete;
   OctoMapModel& operator=(const OctoMapModel&) = delete;
 
-  /// Inserts the scan (camera frame) and prunes the tree. Throws
-  /// Error(InvalidData) for an empty or non-finite cloud.
-  void build(const PointsView& points);
+  /// Inserts the scan (camera frame) and prunes the tree. With `ray_cast`
+  /// false only the endpoint voxels are updated (no free space is stored,
+  /// a much smaller .ot file). Throws Error(InvalidData) for an empty or
+  /// non-finite cloud.
+  void build(const PointsView& points, bool ray_cast = true);
 
   double resolution() const;
   /// Number of occupied leaves at the finest depth.

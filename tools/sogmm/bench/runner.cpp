@@ -143,7 +143,8 @@ BenchRow run_octomap(const std::string& frame, const PointsView& truth, const Ca
   row.n_points = truth.size;
   const auto t0 = Clock::now();
   OctoMapModel map(resolution);
-  map.build(truth);
+  map.build(truth, config.octomap_ray_cast);
+  if (!config.octomap_ray_cast) row.note = "no ray casting (endpoints only)";
   row.build_seconds = seconds_since(t0);
   std::vector<float> predicted(truth.size);
   for (std::size_t i = 0; i < truth.size; ++i) predicted[i] = map.gray_at(truth[i], &row.gray_fallbacks);

@@ -17,6 +17,7 @@ namespace sogmm::bench {
 /// What to run. Families: "octomap", "ndt", "fc", "sogmm".
 struct BenchConfig {
   std::vector<double> octomap_resolutions{0.02, 0.05};
+  bool octomap_ray_cast = true;  ///< false: endpoints only, no free space in the tree
   std::vector<double> ndt_resolutions{0.02, 0.05};
   std::vector<std::size_t> fc_components{75, 500, 2000};
   std::vector<double> bandwidths{0.01, 0.02, 0.03};

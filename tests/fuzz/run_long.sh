@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Runs the libFuzzer targets of tests/fuzz for a bounded time each.
+#
+# Usage: bash tests/fuzz/run_long.sh [--seconds S] [--jobs J] [--build DIR] [--no-build] [TARGET...]
+#   --seconds S  time per target (default 3600; tools/test.sh uses 60)
+#   --jobs J     targets run at the same time (default 1)
+#   --build DIR  fuzz build folder (default build-fuzz), configured here with
+#                clang, -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON unless --no-build
+#   TARGET       load_memory load_file verify fit (default: all)
+# Corpus: each format target starts from the spec/conformance .sogmm vectors,
+# fit from tests/fuzz/seeds/fit; all from tests/fuzz/regressions/<target>; what it
+# finds is kept in DIR/fuzz-corpus/<target>. A crash writes its input to
+# DIR/fuzz-artifacts/<target>/ and makes this script fail: turn it into a
+# regression (tests/fuzz/regressions/<target>/, see README.md there).
+# Prints, per target, the executions run and the outcome.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+SECONDS_PER_TARGET=3600
+JOBS=1
+BUILD=build-fuzz
+DO_BUILD=1
+TARGETS=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) SECONDS_PER_TARGET=$2; shift 2 ;;
+    --jobs) JOBS=$2; shift 2 ;;
+    --build) BUILD=$2; shift 2 ;;
+    --no-build) DO_BUILD=0; shift ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    *) TARGETS+=("$1"); shift ;;
+  esac
+done
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(load_memory load_file verify fit)
+
+if [ "$DO_BUILD" = 1 ]; then
+  CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON -DSOGMM_BUILD_TOOLS=OFF >/dev/null
+  cmake --build "$BUILD" --parallel "$(nproc)" --target "${TARGETS[@]/#/sogmm_fuzz_}"
+fi
+
+# Per-input limits: a slow input (> 25 s) or more than 2 GiB of memory is a finding too.
+max_len_for() { case "$1" in fit) echo 4200 ;; *) echo 40000 ;; esac; }
+
+# Seeds of the format targets: the .sogmm conformance vectors (not the .json dumps).
+SEEDS="$BUILD/fuzz-seeds/sogmm"
+rm -rf "$SEEDS" && mkdir -p "$SEEDS"
+cp spec/conformance/valid/*.sogmm spec/conformance/invalid/*.sogmm "$SEEDS/"
+
+run_one() {
+  local t=$1
+  local corpus="$BUILD/fuzz-corpus/$t" artifacts="$BUILD/fuzz-artifacts/$t" log="$BUILD/fuzz-logs/$t.log"
+  mkdir -p "$corpus" "$artifacts" "$(dirname "$log")"
+  local dirs=("$corpus") d
+  [ "$t" = fit ] || dirs+=("$SEEDS")
+  for d in "tests/fuzz/seeds/$t" "tests/fuzz/regressions/$t"; do
+    if [ -d "$d" ]; then dirs+=("$d"); fi
+  done
+  local status=0
+  OMP_NUM_THREADS=1 \
+  ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
+  UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    "$BUILD/tests/fuzz/sogmm_fuzz_$t" "${dirs[@]}" \
+      -max_total_time="$SECONDS_PER_TARGET" -timeout=25 -rss_limit_mb=2048 -max_len="$(max_len_for "$t")" \
+      -artifact_prefix="$artifacts/" -print_final_stats=1 >"$log" 2>&1 || status=$?
+  local execs
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+  if [ "$status" = 0 ]; then
+    echo "fuzz $t: ${execs:-?} executions in ${SECONDS_PER_TARGET} s, no crash"
+  else
+    echo "fuzz $t: FAILED (exit $status) after ${execs:-?} executions; log $log; inputs:" \
+      "$(ls "$artifacts" 2>/dev/null | tr '\n' ' ')"
+    grep -m 20 -E 'ERROR|SUMMARY|runtime error|invariant violated|==[0-9]+==' "$log" || true
+  fi
+  return "$status"
+}
+
+failed=0
+pids=()
+names=()
+for t in "${TARGETS[@]}"; do
+  run_one "$t" &
+  pids+=($!)
+  names+=("$t")
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do sleep 1; done
+done
+for i in "${!pids[@]}"; do
+  wait "${pids[$i]}" || failed=1
+done
+exit $failed

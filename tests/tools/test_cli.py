@@ -1,0 +1,443 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the `sogmm` command-line tool.
+
+Usage: test_cli.py --sogmm PATH --data SHARED_DATA_DIR --mode MODE
+Modes:
+  help       --help of the tool and of every subcommand (exit 0, an example)
+  errors     documented exit codes (2 usage, 3 invalid data, 4 I/O), one-line
+             messages naming the file, atomic writes
+  synthetic  fit / eval / render / sample on the synthetic frame written by
+             `sogmm demo --write-frame` (no external data needed)
+  sequence   fit --sequence / eval --sequence / render --trajectory on a
+             3-frame synthetic sequence; support size = sum of frame points
+  shared     the same on ../shared/data/rgbd (prints "SKIP: ..." and exits 0
+             only when that folder is absent)
+Checks parse the PNG (chunks, zlib stream, scanline filters) and PLY (header
+and binary body) outputs themselves. Exit 0 = pass, 1 = failure.
+"""
+import argparse
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+
+import numpy as np
+
+SOGMM = None
+FAILURES = []
+
+
+def check(cond, what):
+    if not cond:
+        FAILURES.append(what)
+        print("FAIL:", what)
+    return cond
+
+
+def run(args, expect=0, env=None):
+    p = subprocess.run([SOGMM] + [str(a) for a in args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True, env=env, timeout=120)
+    check(p.returncode == expect,
+          "sogmm %s: exit %d, expected %d\nstdout: %s\nstderr: %s" %
+          (" ".join(map(str, args)), p.returncode, expect, p.stdout[-2000:], p.stderr[-2000:]))
+    return p
+
+
+def run_json(args, with_stderr=False):
+    p = run(list(args) + ["--json"])
+    try:
+        j = json.loads(p.stdout)
+    except ValueError:
+        check(False, "sogmm %s: stdout is not JSON: %r" % (" ".join(map(str, args)), p.stdout[:500]))
+        j = {}
+    return (j, p.stderr) if with_stderr else j
+
+
+# ---------------------------------------------------------------- PNG / PLY
+def read_png(path):
+    """Decodes a non-interlaced 8/16-bit gray/RGB/RGBA PNG. Returns an array
+    (h, w) or (h, w, c)."""
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "%s: not a PNG" % path
+    pos, idat, ihdr = 8, b"", None
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos:pos + 4])
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + n]
+        (crc,) = struct.unpack(">I", data[pos + 8 + n:pos + 12 + n])
+        assert zlib.crc32(kind + body) & 0xFFFFFFFF == crc, "%s: bad CRC in %s" % (path, kind)
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        elif kind == b"IEND":
+            break
+        pos += 12 + n
+    w, h, bits, ctype, _, _, interlace = ihdr
+    assert interlace == 0 and bits in (8, 16)
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[ctype]
+    bpp = channels * bits // 8
+    raw = zlib.decompress(idat)
+    stride = w * bpp
+    assert len(raw) == h * (stride + 1), "%s: %d bytes of pixel data, expected %d" % (path, len(raw), h * (stride + 1))
+    out = np.zeros((h, stride), dtype=np.uint8)
+    prev = np.zeros(stride, dtype=np.int32)
+    for y in range(h):
+        f = raw[y * (stride + 1)]
+        line = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=y * (stride + 1) + 1).astype(np.int32)
+        if f == 0:
+            cur = line
+        elif f == 2:
+            cur = (line + prev) & 0xFF
+        else:
+            cur = np.zeros(stride, dtype=np.int32)
+            for x in range(stride):
+                a = cur[x - bpp] if x >= bpp else 0
+                b = prev[x]
+                c = prev[x - bpp] if x >= bpp else 0
+                if f == 1:
+                    pred = a
+                elif f == 3:
+                    pred = (a + b) // 2
+                else:
+                    p = a + b - c
+                    pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                    pred = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                cur[x] = (line[x] + pred) & 0xFF
+        out[y] = cur
+        prev = cur
+    if bits == 16:
+        img = out.reshape(h, w * channels, 2)
+        img = (img[:, :, 0].astype(np.uint16) << 8) | img[:, :, 1]
+    else:
+        img = out
+    return img.reshape(h, w, channels) if channels > 1 else img.reshape(h, w)
+
+
+def png_size(path):
+    data = open(path, "rb").read(33)
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "%s: not a PNG" % path
+    w, h, bits, ctype = struct.unpack(">IIBB", data[16:26])
+    return w, h, {0: 1, 2: 3, 4: 2, 6: 4}[ctype], bits
+
+
+def read_ply(path):
+    """Parses a binary little-endian PLY: returns (elements, comments) with
+    elements = [(name, count, properties, data)]."""
+    data = open(path, "rb").read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    lines = data[:end].decode("ascii").splitlines()
+    assert lines[0] == "ply", "%s: no ply magic" % path
+    assert lines[1] == "format binary_little_endian 1.0", "%s: %s" % (path, lines[1])
+    elements = []
+    for ln in lines[2:]:
+        t = ln.split()
+        if t[0] == "element":
+            elements.append([t[1], int(t[2]), []])
+        elif t[0] == "property":
+            elements[-1][2].append(tuple(t[1:]))
+    types = {"float": "<f4", "uchar": "u1", "int": "<i4", "uint": "<u4", "double": "<f8"}
+    pos, parsed = end, []
+    for name, count, props in elements:
+        if any(p[0] == "list" for p in props):
+            assert len(props) == 1 and props[0][:3] == ("list", "uchar", "int")
+            dt = np.dtype([("n", "u1"), ("idx", "<i4", (3,))])
+            arr = np.frombuffer(data, dtype=dt, count=count, offset=pos)
+            assert (arr["n"] == 3).all(), "%s: non-triangle face" % path
+        else:
+            dt = np.dtype([(p[1], types[p[0]]) for p in props])
+            arr = np.frombuffer(data, dtype=dt, count=count, offset=pos)
+        pos += dt.itemsize * count
+        parsed.append((name, count, props, arr))
+    assert pos == len(data), "%s: %d bytes after the body, expected none" % (path, len(data) - pos)
+    return parsed
+
+
+def no_temp_files(folder):
+    left = [f for f in os.listdir(folder) if ".tmp" in f]
+    check(not left, "temporary files left in %s: %s" % (folder, left))
+
+
+# ---------------------------------------------------------------- modes
+def mode_help(tmp):
+    p = run(["--help"])
+    check("Exit codes" in p.stdout and "Example" in p.stdout, "sogmm --help lacks exit codes or an example")
+    for sub in ["demo", "eval", "fit", "render", "sample"]:
+        p = run([sub, "--help"])
+        check("Example" in p.stdout, "sogmm %s --help has no example" % sub)
+    run(["--version"])
+
+
+def write_synthetic(tmp, frames):
+    d = os.path.join(tmp, "synth")
+    p = run(["demo", "--write-frame", d, "--frames", frames])
+    check("Wrote" in p.stdout, "demo --write-frame prints nothing")
+    depth = read_png(os.path.join(d, "depth", "00000.png"))  # full decode of the first frame only (slow in Python)
+    check(depth.shape == (480, 640) and depth.dtype == np.uint16, "synthetic depth shape %s" % (depth.shape,))
+    check(depth.min() > 500 and depth.max() < 4000, "synthetic depth range %d..%d mm" % (depth.min(), depth.max()))
+    for k in range(frames):
+        check(png_size(os.path.join(d, "depth", "%05d.png" % k)) == (640, 480, 1, 16), "synthetic depth %d" % k)
+        check(png_size(os.path.join(d, "color", "%05d.png" % k)) == (640, 480, 1, 8), "synthetic color %d" % k)
+    cam = json.load(open(os.path.join(d, "intrinsics.json")))
+    check(cam["width"] == 640 and cam["intrinsic_matrix"][0] == 525.0, "synthetic intrinsics.json")
+    return d
+
+
+def frame_args(d, k, ext):
+    return ["--depth", os.path.join(d, "depth", "%05d.png" % k), "--color", os.path.join(d, "color", "%05d.%s" % (k, ext))]
+
+
+def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h, min_psnr):
+    """fit -> eval (saved and refit) -> render (3 kinds + compare) -> sample."""
+    model = os.path.join(tmp, "m.sogmm")
+    fargs = frame_args(d, 0, ext)
+    fit, progress = run_json(["fit"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "-o", model,
+                              "--progress"], with_stderr=True)
+    check("mode count" in progress and "EM done" in progress, "fit --progress lines: %r" % progress)
+    m, n = fit.get("n_components", 0), fit.get("n_points", 0)
+    check(m >= 1 and n > m, "fit: %d components for %d points" % (m, n))
+    check(fit.get("support_size") == n, "fit: support size %s != points %s" % (fit.get("support_size"), n))
+    check(fit.get("file_bytes", 0) == os.path.getsize(model), "fit: file_bytes differs from the file size")
+    check(fit.get("seconds_total", -1) >= 0 and fit.get("em_iterations", 0) >= 1, "fit: timings/iterations")
+    # Human summary paragraph, no progress with --quiet.
+    p = run(["fit"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "-o", model, "--quiet"])
+    check(p.stdout.startswith("Fitted %d points" % n) and "bytes per component" in p.stdout,
+          "fit summary paragraph: %r" % p.stdout)
+    check(p.stderr == "", "fit --quiet wrote to stderr: %r" % p.stderr)
+    no_temp_files(tmp)
+
+    # eval of the saved model (camera and decimation from the file) == eval with a fresh fit.
+    ev = run_json(["eval", model] + fargs)
+    check(ev.get("n_points") == n and ev.get("n_components") == m, "eval MODEL: points/components %s" % ev)
+    check(ev.get("psnr", 0) > min_psnr, "eval MODEL: PSNR %.2f <= %.1f" % (ev.get("psnr", 0), min_psnr))
+    check(0 <= ev.get("fscore", -1) <= 1 and ev.get("mre", 1) < 0.05, "eval MODEL: fscore/mre %s" % ev)
+    ref = run_json(["eval"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth])
+    check(abs(ref.get("psnr", 0) - ev.get("psnr", 1)) < 1e-9 and ref.get("n_components") == m,
+          "eval MODEL (%.6f) differs from eval --bandwidth (%.6f)" % (ev.get("psnr", 0), ref.get("psnr", 0)))
+    p = run(["eval", model] + fargs)
+    check("PSNR (honest)" in p.stdout and "F-score" in p.stdout, "eval MODEL human output")
+
+    # render: expected surface, at the ground-truth depth, uncertainty, compare.
+    out = os.path.join(tmp, "r.png")
+    run(["render", model, "-o", out])
+    img = read_png(out)
+    check(img.shape == (expect_h, expect_w), "render: %s, expected %dx%d" % (img.shape, expect_w, expect_h))
+    check((img > 0).mean() > 0.6, "render: only %.2f of the pixels show the surface" % (img > 0).mean())
+    run(["render", model, "-o", out, "--scale", "2"])
+    check(png_size(out)[:2] == (2 * expect_w, 2 * expect_h), "render --scale 2 size %s" % (png_size(out),))
+    run(["render", model, "-o", out, "--depth", fargs[1]])
+    gt = read_png(out)
+    check(gt.shape == (expect_h, expect_w), "render --depth: %s" % (gt.shape,))
+    run(["render", model, "-o", out, "--uncertainty"])
+    w, h, c, _ = png_size(out)
+    check(c == 3 and w > expect_w and h > expect_h, "render --uncertainty size %dx%dx%d" % (w, h, c))
+    read_png(out)
+    p = run(["render", model, "--compare"] + fargs + ["-o", out])
+    w, h, c, _ = png_size(out)
+    scale = max(1, -(-320 // expect_w))
+    check(c == 3 and w >= 3 * expect_w * scale and h >= expect_h * scale, "render --compare size %dx%d" % (w, h))
+    check("PSNR %.2f dB" % ev.get("psnr", 0) in p.stdout, "render --compare PSNR differs from eval: %r" % p.stdout)
+    no_temp_files(tmp)
+
+    # sample + ellipsoids.
+    ply, ell = os.path.join(tmp, "s.ply"), os.path.join(tmp, "e.ply")
+    run(["sample", model, "-n", 5000, "--seed", 3, "-o", ply, "--ellipsoids", ell])
+    (name, count, props, v), = read_ply(ply)
+    check(name == "vertex" and count == 5000, "sample: %s x %d" % (name, count))
+    check([p[1] for p in props] == ["x", "y", "z", "intensity", "red", "green", "blue"] and
+          [p[0] for p in props] == ["float"] * 4 + ["uchar"] * 3, "sample: properties %s" % props)
+    xyz = np.stack([v["x"], v["y"], v["z"]], 1)
+    check(np.isfinite(xyz).all() and np.isfinite(v["intensity"]).all(), "sample: non-finite values")
+    check((v["red"] == v["green"]).all() and (v["green"] == v["blue"]).all(), "sample: color is not gray")
+    expect_red = np.clip(np.round(np.clip(v["intensity"], 0, 1) * 255), 0, 255)
+    check(np.abs(expect_red - v["red"]).max() <= 1, "sample: red != 255 * clamp(intensity)")
+    check(np.median(v["z"]) > 0.3 and np.median(v["z"]) < 3.5, "sample: median depth %.2f" % np.median(v["z"]))
+    verts, faces = read_ply(ell)
+    check(verts[1] == 42 * m and faces[1] == 80 * m, "ellipsoids: %d vertices, %d faces for %d components" %
+          (verts[1], faces[1], m))
+    check(faces[3]["idx"].min() >= 0 and faces[3]["idx"].max() < verts[1], "ellipsoids: face index out of range")
+    first = open(ply, "rb").read()
+    run(["sample", model, "-n", 5000, "--seed", 3, "-o", ply])
+    check(open(ply, "rb").read() == first, "sample: same seed, different file")
+    run(["sample", model, "-n", 5000, "--seed", 4, "-o", ply])
+    check(open(ply, "rb").read() != first, "sample: different seed, same file")
+    run(["sample", model, "-o", ply])
+    check(read_ply(ply)[0][1] == n, "sample without -n: not the support size %d" % n)
+    no_temp_files(tmp)
+    return model
+
+
+def exercise_sequence(tmp, d, ext, frames, dec, bandwidth, extra, human):
+    seq = os.path.join(tmp, "seq.sogmm")
+    traj = os.path.join(d, "trajectory.log")
+    fit, progress = run_json(["fit", "--sequence", d, "--trajectory", traj, "--frames", "0:%d" % frames, "--decimate",
+                              dec, "--bandwidth", bandwidth, "-o", seq, "--progress"] + extra, with_stderr=True)
+    check(progress.count("; map ") == frames, "fit --sequence: one progress line per frame expected: %r" % progress)
+    per = fit.get("frames", [])
+    check(len(per) == frames, "fit --sequence: %d frames reported" % len(per))
+    check(fit.get("support_size") == sum(f["n_points"] for f in per),
+          "fit --sequence: support size %s != sum of frame points %s" %
+          (fit.get("support_size"), [f["n_points"] for f in per]))
+    check(fit.get("n_components") == sum(f["n_components"] for f in per), "fit --sequence: merged M != sum of M")
+    ev = run_json(["eval", seq, "--sequence", d, "--trajectory", traj, "--frames", "0:%d" % frames])
+    rows = ev.get("frames", [])
+    check(len(rows) == frames, "eval --sequence: %d rows" % len(rows))
+    check(ev.get("support_size") == sum(r["n_points"] for r in rows),
+          "eval --sequence: support size %s != sum of frame points %s" %
+          (ev.get("support_size"), [r["n_points"] for r in rows]))
+    # Each frame scores about as well as a model fitted on that frame alone
+    # (a wrong or missing pose would put the map metres away: F-score ~ 0).
+    intr = extra if extra else ["--intrinsics", os.path.join(d, "intrinsics.json")]
+    for r in rows:
+        k = r["frame"]
+        single = run_json(["eval"] + frame_args(d, k, ext) + intr + ["--decimate", dec, "--bandwidth", bandwidth])
+        check(r["n_points"] == single.get("n_points"), "eval --sequence frame %d: %d points, single fit %s" %
+              (k, r["n_points"], single.get("n_points")))
+        check(r["psnr"] > single.get("psnr", 0) - 2.0 and r["n_samples"] > 0 and
+              r["fscore"] > 0.6 * single.get("fscore", 0) and r["fscore"] > 0.05,
+              "eval --sequence frame %d: PSNR %.2f, F %.3f vs single-frame fit PSNR %.2f, F %.3f (pose applied wrongly?)"
+              % (k, r["psnr"], r["fscore"], single.get("psnr", 0), single.get("fscore", 0)))
+    if human:
+        p = run(["eval", seq, "--sequence", d, "--trajectory", traj, "--frames", "0:%d" % frames])
+        check("mean" in p.stdout, "eval --sequence table has no mean row")
+    out = os.path.join(tmp, "view.png")
+    run(["render", seq, "--trajectory", traj, "--frame", frames - 1, "-o", out])
+    img = read_png(out)
+    check((img > 0).mean() > 0.6, "render --trajectory: only %.2f of the pixels covered" % (img > 0).mean())
+
+
+def mode_synthetic(tmp):
+    d = write_synthetic(tmp, 1)
+    intr = ["--intrinsics", os.path.join(d, "intrinsics.json")]
+    exercise_frame(tmp, d, "png", 10, 0.05, intr, 64, 48, 12.0)
+    # fixed-K fit and explicit camera flags
+    model = os.path.join(tmp, "k.sogmm")
+    fit = run_json(["fit"] + frame_args(d, 0, "png") + ["--fx", 525, "--fy", 525, "--cx", 319.5, "--cy", 239.5,
+                                                        "--decimate", 10, "--components", 20, "-o", model])
+    check(fit.get("n_components") == 20, "fit --components 20 gave %s" % fit.get("n_components"))
+
+
+def mode_sequence(tmp):
+    d = write_synthetic(tmp, 3)
+    exercise_sequence(tmp, d, "png", 3, 10, 0.05, [], False)
+
+
+def mode_errors(tmp):
+    d = write_synthetic(tmp, 1)
+    intr = ["--intrinsics", os.path.join(d, "intrinsics.json")]
+    fa = frame_args(d, 0, "png")
+    model = os.path.join(tmp, "ok.sogmm")
+    run(["fit"] + fa + intr + ["--decimate", 10, "--components", 5, "-o", model, "--quiet"])
+
+    def err(args, code, names):
+        p = run(args, expect=code)
+        lines = p.stderr.strip().splitlines()
+        check(len(lines) == 1, "sogmm %s: expected one error line, got %r" % (" ".join(map(str, args)), p.stderr))
+        if names:
+            check(names in p.stderr, "sogmm %s: error does not name %s: %r" % (" ".join(map(str, args)), names, p.stderr))
+
+    missing = os.path.join(tmp, "missing.png")
+    nodir = os.path.join(tmp, "no", "such", "out.sogmm")
+    # usage: 2
+    err([], 2, None)
+    err(["fit", "--bogus-flag"] + fa + ["-o", model], 2, None)
+    err(["fit"] + fa + intr + ["--bandwidth", 0.02, "--components", 5, "-o", model], 2, None)
+    err(["fit"] + fa + intr + ["--bandwidth", -1, "-o", model], 2, "bandwidth")
+    err(["fit"] + fa + ["-o", model], 2, "--intrinsics")
+    err(["fit", "--sequence", d, "-o", model], 2, "--trajectory")
+    err(["fit", "--sequence", d, "--trajectory", os.path.join(d, "trajectory.log"), "--frames", "3:9", "-o", model],
+        2, "--frames")
+    err(["eval", model] + fa + ["--bandwidth", 0.02], 2, "--bandwidth")
+    err(["eval", model], 2, "--depth")
+    err(["render", model, "--compare", "-o", os.path.join(tmp, "x.png")], 2, "--depth")
+    err(["sample", model], 2, "-o")
+    err(["sample", model, "-n", 0, "-o", os.path.join(tmp, "x.ply")], 2, "-n")
+    # I/O: 4
+    err(["fit", "--depth", missing, fa[2], fa[3]] + intr + ["-o", model], 4, missing)
+    err(["fit"] + fa + intr + ["--components", 5, "-o", nodir], 4, nodir)
+    err(["eval", os.path.join(tmp, "missing.sogmm")] + fa, 4, "missing.sogmm")
+    err(["render", model, "-o", os.path.join(tmp, "no", "x.png")], 4, "x.png")
+    err(["sample", model, "-n", 10, "-o", os.path.join(tmp, "no", "x.ply")], 4, "x.ply")
+    err(["fit", "--sequence", os.path.join(tmp, "nosuchdir"), "--trajectory", os.path.join(d, "trajectory.log"),
+         "-o", model], 4, "nosuchdir")
+    # invalid data: 3
+    bad = os.path.join(tmp, "bad.sogmm")
+    open(bad, "wb").write(b"this is not a model at all" * 10)
+    err(["eval", bad] + fa, 3, "bad.sogmm")
+    err(["sample", bad, "-o", os.path.join(tmp, "x.ply")], 3, "bad.sogmm")
+    err(["render", bad, "-o", os.path.join(tmp, "x.png")], 3, "bad.sogmm")
+    trunc = os.path.join(tmp, "trunc.sogmm")
+    open(trunc, "wb").write(open(model, "rb").read()[:-20])
+    err(["eval", trunc] + fa, 3, "trunc.sogmm")
+    err(["fit"] + fa + intr + ["--depth-max", 0.2, "--components", 5, "-o", model], 3, fa[1])  # no valid depth
+    cmp_png = os.path.join(tmp, "cmp.png")
+    run(["render", model, "--compare"] + fa + ["-o", cmp_png])
+    err(["fit", "--depth", cmp_png, "--color", cmp_png] + intr + ["-o", model], 3, "cmp.png")  # 3-channel depth
+    badtraj = os.path.join(tmp, "bad.log")
+    open(badtraj, "w").write("0 0 1\n1 0 0 0\n0 1 0 0\n")
+    err(["eval", model, "--sequence", d, "--trajectory", badtraj], 3, "bad.log")
+    notrigid = os.path.join(tmp, "scaled.log")
+    open(notrigid, "w").write("0 0 1\n2 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    err(["fit", "--sequence", d, "--trajectory", notrigid, "--components", 5, "-o", model], 3, "scaled.log")
+    small = os.path.join(tmp, "small.png")
+    run(["render", model, "-o", small])  # 64x48 gray PNG, not a 640x480 frame
+    err(["fit", "--depth", fa[1], "--color", small] + intr + ["-o", model], 3, "small.png")
+    # A failed run leaves the previous output untouched and no temporary file.
+    before = open(model, "rb").read()
+    run(["fit"] + fa + intr + ["--bandwidth", -1, "-o", model], expect=2)
+    run(["fit", "--depth", missing, fa[2], fa[3]] + intr + ["-o", model], expect=4)
+    check(open(model, "rb").read() == before, "a failed fit modified the existing output")
+    no_temp_files(tmp)
+
+
+def mode_shared(tmp, data):
+    room = os.path.join(data, "rgbd", "livingroom")
+    if not os.path.isdir(room):
+        print("SKIP: %s is absent (the real frames live in ../shared/data)" % room)
+        return "skip"
+    intr = ["--intrinsics", os.path.join(room, "intrinsics.json")]
+    exercise_frame(tmp, room, "jpg", 8, 0.04, intr, 80, 60, 22.0)
+    exercise_sequence(tmp, room, "jpg", 3, 10, 0.05, [], True)
+    tum = os.path.join(data, "rgbd", "tum")
+    if os.path.isdir(tum):
+        model = os.path.join(tmp, "tum.sogmm")
+        fa = ["--depth", os.path.join(tum, "depth.png"), "--color", os.path.join(tum, "color.png")]
+        fit = run_json(["fit"] + fa + ["--intrinsics", os.path.join(tum, "intrinsics.json"), "--depth-scale", 5000,
+                                       "--decimate", 10, "--bandwidth", 0.05, "-o", model])
+        ev = run_json(["eval", model] + fa)  # depth scale and decimation come from the file
+        check(ev.get("n_points") == fit.get("n_points") and ev.get("psnr", 0) > 15,
+              "tum: eval MODEL took the wrong depth scale/decimation: %s vs %s" % (ev, fit))
+
+
+def main():
+    global SOGMM
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sogmm", required=True)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "shared"])
+    a = ap.parse_args()
+    SOGMM = a.sogmm
+    with tempfile.TemporaryDirectory(prefix="sogmm_cli_test_") as tmp:
+        if a.mode == "help":
+            mode_help(tmp)
+        elif a.mode == "errors":
+            mode_errors(tmp)
+        elif a.mode == "synthetic":
+            mode_synthetic(tmp)
+        elif a.mode == "sequence":
+            mode_sequence(tmp)
+        elif mode_shared(tmp, a.data) == "skip":
+            return 0
+    if FAILURES:
+        print("%d check(s) failed" % len(FAILURES))
+        return 1
+    print("OK: %s" % a.mode)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,238 @@
+// `sogmm fit`: fit one RGB-D frame, or a posed sequence merged in the world
+// frame, and save the model as a .sogmm file.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "file_util.hpp"
+#include "model_io.hpp"
+#include "sequence.hpp"
+#include "sogmm/error.hpp"
+#include "sogmm/inference.hpp"
+
+namespace sogmm::tools {
+
+namespace {
+
+struct FitState {
+  std::string depth, color, output;
+  std::string sequence, trajectory, frames;
+  CameraFlags camera;
+  DepthOptions depth_options;
+  FitOptions fit;
+  bool json = false, progress = false, quiet = false;
+};
+
+std::string base_name(const std::string& p) { return std::filesystem::path(p).filename().string(); }
+
+std::string fit_kind(const FitOptions& o) {
+  char buf[96];
+  if (o.n_components > 0)
+    std::snprintf(buf, sizeof buf, "fixed K = %zu", o.n_components);
+  else
+    std::snprintf(buf, sizeof buf, "self-organizing, bandwidth %g", o.bandwidth);
+  return buf;
+}
+
+struct Totals {
+  std::size_t points = 0;
+  int iterations = 0;
+  double mode = 0, seed = 0, em = 0, total = 0;
+  void add(const FitResult& r) {
+    points += r.n_points;
+    iterations += r.em.iterations;
+    mode += r.seconds_mode_count;
+    seed += r.seconds_seeding;
+    em += r.seconds_em;
+    total += r.seconds_total;
+  }
+};
+
+void print_summary(const FitState& s, const Model& model, const Totals& t, std::uint64_t file_bytes,
+                   const nlohmann::json& frames_json, const std::string& what) {
+  const std::size_t m = model.gmm.size();
+  const double per_component = m > 0 ? static_cast<double>(file_bytes) / m : 0.0;
+  if (s.json) {
+    nlohmann::json j;
+    j["output"] = s.output;
+    j["n_points"] = t.points;
+    j["support_size"] = model.gmm.support_size;
+    j["n_components"] = m;
+    j["em_iterations"] = t.iterations;
+    if (frames_json.is_null()) {
+      j["converged"] = model.fit.converged;
+      j["log_likelihood"] = model.fit.log_likelihood;
+    } else {
+      j["frames"] = frames_json;
+    }
+    j["seconds_mode_count"] = t.mode;
+    j["seconds_seeding"] = t.seed;
+    j["seconds_em"] = t.em;
+    j["seconds_total"] = t.total;
+    j["file_bytes"] = file_bytes;
+    j["bytes_per_component"] = per_component;
+    j["paper_model_bytes"] = paper_model_bytes(model.gmm);
+    std::printf("%s\n", j.dump().c_str());
+    return;
+  }
+  std::printf(
+      "%s Time: mode count %.3f s, seeding %.3f s, EM %.3f s, total %.3f s. Wrote %s: %s, %.1f bytes per "
+      "component (the paper counts %zu bytes, 60 per component).\n",
+      what.c_str(), t.mode, t.seed, t.em, t.total, s.output.c_str(), human_bytes(file_bytes).c_str(), per_component,
+      paper_model_bytes(model.gmm));
+}
+
+int run_single(const FitState& s) {
+  const LoadedFrame frame = load_frame(s.depth, s.color);
+  const Camera camera = resolve_camera(s.camera, frame);
+  const PointCloud cloud = backproject(frame.view(camera), s.depth_options);
+  require(cloud.size() > 0, ErrorCode::InvalidData,
+          s.depth + ": no valid depth pixel in (" + std::to_string(s.depth_options.depth_min) + ", " +
+              std::to_string(s.depth_options.depth_max) + "] m (check --depth-scale)");
+  ProgressPrinter progress(progress_mode(s.quiet, s.progress));
+  progress.line("fit " + base_name(s.depth) + ": " + std::to_string(cloud.size()) + " points (decimated by " +
+                std::to_string(s.depth_options.decimate) + ")");
+  FitResult r = fit(cloud.view(), s.fit, progress.fit_callback("fit " + base_name(s.depth)));
+  progress.em_done("fit " + base_name(s.depth), r);
+  progress.finish();
+  const Model model = make_model(std::move(r.gmm), s.fit, r.em, camera, s.depth_options,
+                                 {{"source_depth", s.depth}, {"source_color", s.color}, {"coordinate_frame", "camera"}});
+  const std::uint64_t bytes = save_model(s.output, model);
+  Totals t;
+  t.add(r);
+  const Camera dc = decimated(camera, s.depth_options.decimate);
+  char what[512];
+  std::snprintf(what, sizeof what,
+                "Fitted %zu points from %s (decimated by %d to %dx%d) with %zu components (%s) in %d EM iterations "
+                "(%s, mean log-likelihood %.4f).",
+                r.n_points, s.depth.c_str(), s.depth_options.decimate, dc.width, dc.height, model.gmm.size(),
+                fit_kind(s.fit).c_str(), r.em.iterations, r.em.converged ? "converged" : "not converged",
+                r.em.log_likelihood);
+  print_summary(s, model, t, bytes, nlohmann::json(), what);
+  return 0;
+}
+
+int run_sequence(const FitState& s) {
+  const std::vector<SequenceFrame> frames = list_sequence(s.sequence);
+  const std::vector<Pose> poses = read_trajectory(s.trajectory);
+  const std::vector<std::size_t> selected =
+      parse_frame_range(s.frames.empty() ? std::string(":") : s.frames, frames.size());
+  require(poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
+          s.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
+              std::to_string(selected.back()) + " is selected");
+  CameraFlags camera_flags = s.camera;
+  if (!camera_flags_given(camera_flags)) {
+    const std::string guess = (std::filesystem::path(s.sequence) / "intrinsics.json").string();
+    require(std::filesystem::is_regular_file(guess), ErrorCode::InvalidArgument,
+            "no camera: give --intrinsics FILE (or put intrinsics.json in " + s.sequence + ")");
+    camera_flags.intrinsics = guess;
+  }
+  ProgressPrinter progress(progress_mode(s.quiet, s.progress));
+  Gmm merged;
+  Totals t;
+  Camera camera;
+  EmReport last_em;
+  nlohmann::json frames_json = nlohmann::json::array();
+  std::string frame_list;
+  for (std::size_t k = 0; k < selected.size(); ++k) {
+    const SequenceFrame& f = frames[selected[k]];
+    const LoadedFrame frame = load_frame(f.depth, f.color);
+    camera = resolve_camera(camera_flags, frame);
+    const PointCloud cloud = backproject(frame.view(camera), s.depth_options);
+    require(cloud.size() > 0, ErrorCode::InvalidData, f.depth + ": no valid depth pixel (check --depth-scale)");
+    const std::string label = "frame " + std::to_string(k + 1) + "/" + std::to_string(selected.size()) + " (" +
+                              base_name(f.depth) + ")";
+    FitResult r = fit(cloud.view(), s.fit, progress.fit_callback(label));
+    progress.em_done(label, r);
+    t.add(r);
+    last_em = r.em;
+    const std::size_t m = r.gmm.size();
+    const Gmm world = transform(r.gmm, poses[f.index]);
+    merged = k == 0 ? world : merge(merged, world);
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s: %zu points, %zu components, %d EM iterations, %.2f s; map %zu components",
+                  label.c_str(), r.n_points, m, r.em.iterations, r.seconds_total, merged.size());
+    progress.line(buf);
+    frames_json.push_back({{"frame", f.index},
+                           {"depth", f.depth},
+                           {"n_points", r.n_points},
+                           {"n_components", m},
+                           {"em_iterations", r.em.iterations},
+                           {"seconds_total", r.seconds_total}});
+    frame_list += (frame_list.empty() ? "" : ",") + std::to_string(f.index);
+  }
+  progress.finish();
+  FitOptions options = s.fit;
+  EmReport em = last_em;
+  em.iterations = t.iterations;  // total over frames
+  Model model = make_model(std::move(merged), options, em, camera, s.depth_options,
+                           {{"coordinate_frame", "world"},
+                            {"sequence", s.sequence},
+                            {"trajectory", s.trajectory},
+                            {"frames", frame_list}});
+  model.fit.converged = false;
+  model.fit.log_likelihood = 0.0;  // per-frame values; the merged model has no single one
+  const std::uint64_t bytes = save_model(s.output, model);
+  char what[512];
+  std::snprintf(what, sizeof what,
+                "Fitted %zu frames of %s (frames %s, decimated by %d, %s): %zu points in total, merged in the world "
+                "frame of %s into %zu components (support size %llu), %d EM iterations in total.",
+                selected.size(), s.sequence.c_str(), frame_list.c_str(), s.depth_options.decimate,
+                fit_kind(s.fit).c_str(), t.points, s.trajectory.c_str(), model.gmm.size(),
+                static_cast<unsigned long long>(model.gmm.support_size), t.iterations);
+  print_summary(s, model, t, bytes, frames_json, what);
+  return 0;
+}
+
+}  // namespace
+
+Command add_fit_command(CLI::App& root) {
+  auto s = std::make_shared<FitState>();
+  CLI::App* app = root.add_subcommand("fit", "Fit an RGB-D frame (or a posed sequence) and save the model (.sogmm)");
+  app->footer(
+      "Progress goes to stderr (a live line on a terminal, plain lines with --progress, nothing with --quiet);\n"
+      "a one-paragraph summary goes to stdout. The model is saved atomically with its metadata (fit\n"
+      "parameters, camera, decimation, depth scale and range, producer, creation time).\n"
+      "A sequence is DIR/depth/*.png + DIR/color/*.{jpg,png} (paired in name order); each frame is fitted,\n"
+      "moved to the world frame with its camera-to-world pose from the Redwood .log trajectory and merged.\n\n"
+      "Examples:\n"
+      "  sogmm fit --depth ../shared/data/rgbd/livingroom/depth/00000.png \\\n"
+      "    --color ../shared/data/rgbd/livingroom/color/00000.jpg \\\n"
+      "    --intrinsics ../shared/data/rgbd/livingroom/intrinsics.json --decimate 5 --bandwidth 0.02 -o frame0.sogmm\n"
+      "  sogmm fit --sequence ../shared/data/rgbd/livingroom \\\n"
+      "    --trajectory ../shared/data/rgbd/livingroom/trajectory.log --frames 0:3 --decimate 5 -o room.sogmm");
+  app->add_option("--depth", s->depth, "16-bit depth PNG");
+  app->add_option("--color", s->color, "color or gray image (PNG/JPEG), registered to the depth");
+  app->add_option("--sequence", s->sequence, "folder with depth/*.png and color/*.{jpg,png} (instead of --depth/--color)");
+  app->add_option("--trajectory", s->trajectory, "Redwood .log camera-to-world poses (with --sequence)");
+  app->add_option("--frames", s->frames, "frames of the sequence: I, A:B (B excluded) or A:B:STEP; default all");
+  add_camera_flags(*app, s->camera, s->depth_options);
+  add_fit_flags(*app, s->fit);
+  app->add_option("-o,--output", s->output, "output model file (.sogmm)")->required();
+  app->add_flag("--progress", s->progress, "print progress lines on stderr even when it is not a terminal");
+  app->add_flag("-q,--quiet", s->quiet, "no progress output");
+  app->add_flag("--json", s->json, "print the summary as one JSON object");
+  CLI::App* a = app;
+  return {app, [s, a]() {
+            check_output_path(s->output);
+            const bool single = !s->depth.empty() || !s->color.empty();
+            require(single != !s->sequence.empty(), ErrorCode::InvalidArgument,
+                    "fit: give --depth D --color C, or --sequence DIR --trajectory FILE");
+            if (single) {
+              require(!s->depth.empty() && !s->color.empty(), ErrorCode::InvalidArgument,
+                      "fit: --depth and --color go together");
+              require(s->trajectory.empty() && s->frames.empty(), ErrorCode::InvalidArgument,
+                      "fit: --trajectory and --frames need --sequence");
+              return run_single(*s);
+            }
+            require(!s->trajectory.empty(), ErrorCode::InvalidArgument,
+                    "fit: --sequence needs --trajectory FILE (camera-to-world poses)");
+            (void)a;
+            return run_sequence(*s);
+          }};
+}
+
+}  // namespace sogmm::tools
