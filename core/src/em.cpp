@@ -43,8 +43,8 @@ void check_options(const EmOptions& o) {
 
 // Points as four coordinate arrays (structure of arrays), padded to whole
 // blocks. With `spatial_order`, points are sorted along a Z-order curve of 5 cm
-// voxels so that each block is spatially compact (what the truncated E-step
-// needs); sums then run in that order.
+// voxels so that each block is spatially compact; sums then run in that
+// (deterministic) order.
 struct SoaPoints {
   std::vector<float> x, y, z, g;
   std::size_t n = 0;
@@ -150,7 +150,7 @@ double log_density_upper_bound(const float* q, const float* box) {
 void truncated_log_density(const detail::EmKernels& kernels, const detail::Block& block, const float* box,
                            const std::vector<float>& params, double nats, const std::vector<std::uint32_t>& warm,
                            std::vector<double>& upper, std::vector<char>& taken, std::vector<std::uint32_t>& list,
-                           float* rows, float* max_lp) {
+                           float* rows, float* row_lp_max, float* max_lp) {
   constexpr std::size_t kFirst = 32;
   const std::size_t m = params.size() / kParamStride;
   upper.resize(m);
@@ -165,7 +165,7 @@ void truncated_log_density(const detail::EmKernels& kernels, const detail::Block
     list.assign(idx.begin(), idx.begin() + first);
     std::sort(list.begin(), list.end());
   }
-  kernels.log_density(block, params.data(), list.data(), list.size(), rows, max_lp);
+  kernels.log_density(block, params.data(), list.data(), list.size(), rows, row_lp_max, max_lp);
   float worst = max_lp[0];
   for (int p = 1; p < block.count; ++p) worst = std::min(worst, max_lp[p]);
   const double cut = static_cast<double>(worst) - nats;
@@ -174,7 +174,8 @@ void truncated_log_density(const detail::EmKernels& kernels, const detail::Block
   const std::size_t first = list.size();
   for (std::size_t k = 0; k < m; ++k)
     if (!taken[k] && upper[k] >= cut) list.push_back(static_cast<std::uint32_t>(k));
-  kernels.log_density(block, params.data(), list.data() + first, list.size() - first, rows + first * kBlock, max_lp);
+  kernels.log_density(block, params.data(), list.data() + first, list.size() - first, rows + first * kBlock,
+                      row_lp_max + first, max_lp);
 }
 
 // Writes component k's packed kernel parameters from its float covariance.
@@ -244,7 +245,10 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
            EmReport* report, const EmIterationCallback& on_iteration) {
   const std::size_t n = points.size, m = gmm.size();
   const bool truncated = options.truncation_nats > 0;
-  const SoaPoints soa(points, truncated);
+  // Spatially compact blocks let whole rows of negligible components be
+  // skipped (exactly) in the exact E-step too, and tighten the truncated
+  // E-step's bounds.
+  const SoaPoints soa(points, /*spatial_order=*/true);
   const std::size_t n_blocks = soa.n_blocks;
   const std::size_t blocks_per_chunk = std::clamp<std::size_t>((n_blocks + kWave - 1) / kWave, 1, kMaxBlocksPerChunk);
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
@@ -275,7 +279,8 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
       for (std::size_t s = 0; s < wave_chunks; ++s) {
         double* st = &slot_stats[s * m * kStatStride];
         std::fill(st, st + m * kStatStride, 0.0);
-        float* scratch = &slot_scratch[s * (kBlock + 1) * m];
+        float* scratch = &slot_scratch[s * (kBlock + 1) * m];  // m rows, then m row maxima
+        float* row_max = scratch + m * kBlock;
         std::vector<std::uint32_t> list;
         std::vector<double> upper;
         std::vector<char> taken;
@@ -291,13 +296,12 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
           const std::vector<std::uint32_t>* evaluated = &all;
           if (truncated) {
             truncated_log_density(kernels, block, &soa.box[8 * b], params, options.truncation_nats, warm[b],
-                                  upper, taken, list, scratch, max_lp);
+                                  upper, taken, list, scratch, row_max, max_lp);
             evaluated = &list;
           } else {
-            kernels.log_density(block, params.data(), all.data(), m, scratch, max_lp);
+            kernels.log_density(block, params.data(), all.data(), m, scratch, row_max, max_lp);
           }
           const std::size_t ne = evaluated->size();
-          float* row_max = scratch + ne * kBlock;
           ll += kernels.finish(block, params.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
           pairs += static_cast<double>(block.count) * ne;
           if (truncated) {

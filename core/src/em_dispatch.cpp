@@ -8,7 +8,7 @@ namespace sogmm::detail {
 
 #define SOGMM_DECLARE_KERNELS(isa)                                                                            \
   namespace isa {                                                                                              \
-  void em_log_density(const Block&, const float*, const std::uint32_t*, std::size_t, float*, float*);         \
+  void em_log_density(const Block&, const float*, const std::uint32_t*, std::size_t, float*, float*, float*); \
   double em_finish(const Block&, const float*, const std::uint32_t*, std::size_t, float*, const float*, float*, \
                    double*);                                                                                   \
   }

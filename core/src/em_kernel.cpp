@@ -15,7 +15,7 @@
 namespace sogmm::detail::SOGMM_ISA {
 
 void em_log_density(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
-                    float* rows, float* max_lp) {
+                    float* rows, float* row_lp_max, float* max_lp) {
   const float* __restrict px = block.xyzg[0];
   const float* __restrict py = block.xyzg[1];
   const float* __restrict pz = block.xyzg[2];
@@ -29,7 +29,8 @@ void em_log_density(const Block& block, const float* params, const std::uint32_t
     const float u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
                 u23 = q[12], u33 = q[13], c = q[14];
     float* __restrict lp = rows + i * kBlock;
-#pragma omp simd
+    float lmax = -std::numeric_limits<float>::infinity();
+#pragma omp simd reduction(max : lmax)
     for (int p = 0; p < count; ++p) {
       const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
       const float y0 = d0 * u00;
@@ -39,12 +40,15 @@ void em_log_density(const Block& block, const float* params, const std::uint32_t
       const float l = c - 0.5f * (y0 * y0 + y1 * y1 + y2 * y2 + y3 * y3);
       lp[p] = l;
       mx[p] = l > mx[p] ? l : mx[p];  // (a ternary vectorizes where fmax on a stored array did not)
+      lmax = l > lmax ? l : lmax;
     }
+    row_lp_max[i] = lmax;
   }
 }
 
 double em_finish(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
                  float* rows, const float* max_lp, float* row_max, double* stats) {
+  // row_max holds each row's largest log-density on entry (see em_kernel.hpp).
   const float* __restrict px = block.xyzg[0];
   const float* __restrict py = block.xyzg[1];
   const float* __restrict pz = block.xyzg[2];
@@ -54,9 +58,17 @@ double em_finish(const Block& block, const float* params, const std::uint32_t* c
   alignas(64) float sum[kBlock];
   alignas(64) float inv_sum[kBlock];
 
-  // exp(lp - max) in place, and its sum per point (log-sum-exp).
+  // exp(lp - max) in place, and its sum per point (log-sum-exp). fast_exp is
+  // exactly 0 below -87, so a row below every point's maximum by more than
+  // that contributes nothing anywhere: skip it.
+  float lowest_max = mx[0];
+  for (int p = 1; p < count; ++p) lowest_max = mx[p] < lowest_max ? mx[p] : lowest_max;
   for (int p = 0; p < kBlock; ++p) sum[p] = 0.0f;
   for (std::size_t i = 0; i < n; ++i) {
+    if (row_max[i] - lowest_max < -87.5f) {
+      row_max[i] = 0.0f;
+      continue;
+    }
     float* __restrict e = rows + i * kBlock;
     float emax = 0.0f;
 #pragma omp simd reduction(max : emax)

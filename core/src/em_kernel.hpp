@@ -32,19 +32,22 @@ struct Block {
 
 /// Log-density of the block's points under the `n` components listed in
 /// `components` (indices into `params`): row i of `rows` (kBlock floats each)
-/// receives component components[i]; `max_lp` (kBlock floats) is raised to the
-/// running maximum per point. Rows for more components can be appended by
-/// further calls before em_finish.
+/// receives component components[i] and `row_lp_max[i]` its largest value;
+/// `max_lp` (kBlock floats) is raised to the running maximum per point. Rows
+/// for more components can be appended by further calls before em_finish.
 using EmLogDensityFn = void (*)(const Block& block, const float* params, const std::uint32_t* components,
-                                std::size_t n, float* rows, float* max_lp);
+                                std::size_t n, float* rows, float* row_lp_max, float* max_lp);
 
 /// Turns the `n` rows of log-densities into responsibilities (log-sum-exp per
 /// point over the rows) and adds the block's sufficient statistics
 /// (accumulated in float within the block, then in double) into `stats`
-/// (M x kStatStride, indexed by component). `row_max` is n floats of scratch.
-/// Returns the sum of the points' log-likelihoods.
+/// (M x kStatStride, indexed by component). A row whose largest log-density
+/// is more than 87 below every point's maximum has responsibilities exactly 0
+/// in float and is skipped without changing the result. On return
+/// `row_lp_max[i]` holds the largest exp(lp - max) of row i (0 for skipped
+/// rows). Returns the sum of the points' log-likelihoods.
 using EmFinishFn = double (*)(const Block& block, const float* params, const std::uint32_t* components,
-                              std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats);
+                              std::size_t n, float* rows, const float* max_lp, float* row_lp_max, double* stats);
 
 /// The kernels for this CPU (resolved once).
 struct EmKernels {

@@ -10,8 +10,10 @@
 //
 // FLOP count per point-component pair per EM iteration: 80 (log-density 30,
 // exp and log-sum-exp 16 counting exp as 15 like the prototype, and
-// sufficient statistics 34); the GFLOP/s figure is 80 * N * M * iterations /
-// EM seconds.
+// sufficient statistics 34). The GFLOP/s figure is 80 * N * M * iterations *
+// pair_fraction / EM seconds: an effective rate, since the pairs of rows that
+// the kernel skips exactly (every responsibility 0 in float) are counted too;
+// pair_fraction < 1 only for the truncated E-step.
 #include <sys/resource.h>
 
 #include <chrono>
