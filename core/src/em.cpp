@@ -250,7 +250,10 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
   // E-step's bounds.
   const SoaPoints soa(points, /*spatial_order=*/true);
   const std::size_t n_blocks = soa.n_blocks;
-  const std::size_t blocks_per_chunk = std::clamp<std::size_t>((n_blocks + kWave - 1) / kWave, 1, kMaxBlocksPerChunk);
+  // Chunks as equal as possible and a whole number of full waves, so no wave
+  // ends with a lone chunk that leaves threads idle.
+  const std::size_t n_waves = (n_blocks + kWave * kMaxBlocksPerChunk - 1) / (kWave * kMaxBlocksPerChunk);
+  const std::size_t blocks_per_chunk = std::max<std::size_t>(1, (n_blocks + kWave * n_waves - 1) / (kWave * n_waves));
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   const detail::EmKernels& kernels = detail::em_kernels();

@@ -48,11 +48,12 @@ def sklearn_ms_per_iter(dump, iters):
         n, m = np.frombuffer(f.read(16), dtype=np.uint64)
         x = np.frombuffer(f.read(int(n) * 16), dtype=np.float32).reshape(int(n), 4).astype(np.float64)
         seeds = np.frombuffer(f.read(int(m) * 8), dtype=np.uint64).astype(np.int64)
-    resp = np.zeros((x.shape[0], len(seeds)))
-    resp[seeds, np.arange(len(seeds))] = 1.0
-    gm = GaussianMixture(len(seeds), covariance_type="full", tol=0.0, reg_covar=1e-6, max_iter=iters)
-    gm._initialize(x, resp)  # same initial responsibilities as our EM
-    gm.weights_init, gm.means_init, gm.precisions_init = gm.weights_, gm.means_, gm.precisions_
+    k = len(seeds)
+    # One-hot responsibilities on the seeds give means = seed points,
+    # covariances = reg_covar I and equal weights: the same start as our EM.
+    gm = GaussianMixture(k, covariance_type="full", tol=0.0, reg_covar=1e-6, max_iter=iters,
+                         weights_init=np.full(k, 1.0 / k), means_init=x[seeds],
+                         precisions_init=np.repeat(np.eye(4)[None] / 1e-6, k, axis=0))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         t = time.perf_counter()
