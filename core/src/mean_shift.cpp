@@ -198,7 +198,6 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
   // Collapse the blurred points into modes: greedy assignment to a mode within
   // bandwidth / 2, in point order (deterministic).
   std::vector<Mode> modes;
-  std::vector<double> centers;
   for (std::size_t i = 0; i < n; ++i) {
     bool assigned = false;
     for (std::size_t m = 0; m < modes.size() && !assigned; ++m) {

@@ -16,9 +16,11 @@ namespace sogmm {
 /// lowest resulting potential). Candidates whose nearest-seed cluster lies
 /// entirely closer to its seed than half the distance to the candidate are
 /// skipped through the triangle inequality, so the cost is far below
-/// N * K * trials distance evaluations on real frames; the result is exactly
-/// that of the plain algorithm. Deterministic for a given seed, independent
-/// of thread count. Returns indices into `points`.
+/// N * K * trials distance evaluations on real frames; the seeds are those
+/// of the plain algorithm up to the rounding of the potentials (identical on
+/// the shared frames, checked against a brute-force version). Deterministic
+/// for a given seed, independent of thread count. Returns indices into
+/// `points`.
 /// Throws Error(InvalidArgument) unless 1 <= K <= N.
 std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k, std::uint64_t seed);
 
