@@ -42,19 +42,20 @@ void check_options(const EmOptions& o) {
 }
 
 // Points as four coordinate arrays (structure of arrays), padded to whole
-// blocks. With `spatial_order`, points are sorted along a Z-order curve of 5 cm
-// voxels so that each block is spatially compact; sums then run in that
-// (deterministic) order.
+// blocks. Points are sorted along a Z-order curve of 5 cm voxels so that each
+// block is spatially compact: whole rows of negligible components can then be
+// skipped exactly, and the truncated E-step's bounds are tight. Sums run in
+// that (deterministic) order.
 struct SoaPoints {
   std::vector<float> x, y, z, g;
   std::size_t n = 0;
   std::size_t n_blocks = 0;
   std::vector<float> box;  // per block: min[4], max[4]
 
-  SoaPoints(const PointsView& pts, bool spatial_order) : n(pts.size) {
+  explicit SoaPoints(const PointsView& pts) : n(pts.size) {
     std::vector<std::uint32_t> order(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-    if (spatial_order) sort_by_z_order(pts, order);
+    sort_by_z_order(pts, order);
     n_blocks = (n + kBlock - 1) / kBlock;
     const std::size_t padded = n_blocks * kBlock;
     x.assign(padded, 0.f);
@@ -245,10 +246,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
            EmReport* report, const EmIterationCallback& on_iteration) {
   const std::size_t n = points.size, m = gmm.size();
   const bool truncated = options.truncation_nats > 0;
-  // Spatially compact blocks let whole rows of negligible components be
-  // skipped (exactly) in the exact E-step too, and tighten the truncated
-  // E-step's bounds.
-  const SoaPoints soa(points, /*spatial_order=*/true);
+  const SoaPoints soa(points);
   const std::size_t n_blocks = soa.n_blocks;
   // Chunks as equal as possible and a whole number of full waves, so no wave
   // ends with a lone chunk that leaves threads idle.
