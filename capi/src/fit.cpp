@@ -21,6 +21,7 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
                        ? sogmm::ModeCounter::GaussianBlurring
                        : sogmm::ModeCounter::FlatBinned;
   f.seed = static_cast<std::uint64_t>(o.seed);
+  f.n_init = static_cast<int>(o.n_init);
   f.em.tol = o.tol;
   f.em.reg_covar = o.reg_covar;
   f.em.max_iter = static_cast<int>(o.max_iter);
@@ -62,7 +63,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   m.fit.n_iter = r.em.iterations;
   m.fit.converged = r.em.converged;
   m.fit.log_likelihood = r.em.log_likelihood;
-  m.fit.seed = static_cast<std::uint64_t>(o.seed);
+  m.fit.seed = fo.seed + static_cast<std::uint64_t>(r.run);  // the kept run's seed
   m.created_unix_ms = sogmm_capi::creation_time_now();
   handle->timings.known = true;
   handle->timings.n_points = r.n_points ? r.n_points : n;
@@ -70,6 +71,8 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   handle->timings.seconds_seeding = r.seconds_seeding;
   handle->timings.seconds_em = r.seconds_em;
   handle->timings.seconds_total = r.seconds_total;
+  handle->timings.n_init = fo.n_init;
+  handle->timings.run = r.run;
   return handle.release();
 }
 

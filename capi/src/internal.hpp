@@ -27,6 +27,7 @@ struct sogmm_options {
   std::int64_t threads = 0;
   std::int64_t mode_counter = SOGMM_MODE_COUNTER_FLAT_BINNED;
   double truncation_nats = 0.0;  // SOGMM_OPT_TRUNCATION_NATS: 0 = exact E-step
+  std::int64_t n_init = 1;       // SOGMM_OPT_N_INIT: runs, the best kept
   // RGB-D
   double depth_scale = 1000.0;
   double depth_min = 0.1;
@@ -51,6 +52,8 @@ struct sogmm_fit_timings {
   double seconds_seeding = 0.0;
   double seconds_em = 0.0;
   double seconds_total = 0.0;
+  std::int64_t n_init = 1;  // runs made
+  std::int64_t run = 0;     // the kept one
 };
 
 struct sogmm_model {

@@ -55,6 +55,8 @@ InfoType info_type(sogmm_key key) {
     case SOGMM_INFO_FIT_MAX_ITER:
     case SOGMM_INFO_FIT_SEED:
     case SOGMM_INFO_FIT_N_POINTS:
+    case SOGMM_INFO_FIT_N_INIT:
+    case SOGMM_INFO_FIT_RUN:
     case SOGMM_INFO_CAMERA_WIDTH:
     case SOGMM_INFO_CAMERA_HEIGHT:
     case SOGMM_INFO_CAMERA_DECIMATION:
@@ -122,6 +124,8 @@ std::int64_t info_i64(const sogmm_model& m, sogmm_key key) {
     case SOGMM_INFO_FIT_MAX_ITER: return fit_info(m, key).max_iter;
     case SOGMM_INFO_FIT_SEED: return static_cast<std::int64_t>(fit_info(m, key).seed);
     case SOGMM_INFO_FIT_N_POINTS: return static_cast<std::int64_t>(timings(m, key).n_points);
+    case SOGMM_INFO_FIT_N_INIT: return timings(m, key).n_init;
+    case SOGMM_INFO_FIT_RUN: return timings(m, key).run;
     case SOGMM_INFO_CAMERA_WIDTH: return camera_info(m, key).camera.width;
     case SOGMM_INFO_CAMERA_HEIGHT: return camera_info(m, key).camera.height;
     case SOGMM_INFO_CAMERA_DECIMATION: return camera_info(m, key).decimation;

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "internal.hpp"
+#include "sogmm/fit.hpp"
 
 namespace {
 
@@ -25,6 +26,7 @@ KeyType key_type(sogmm_key key) {
     case SOGMM_OPT_MAX_ITER:
     case SOGMM_OPT_SEED:
     case SOGMM_OPT_THREADS:
+    case SOGMM_OPT_N_INIT:
     case SOGMM_OPT_MODE_COUNTER:
     case SOGMM_OPT_DECIMATION:
     case SOGMM_OPT_ZSTD_LEVEL:
@@ -80,6 +82,7 @@ std::int64_t* i64_slot(sogmm_options& o, sogmm_key key) {
     case SOGMM_OPT_MAX_ITER: return &o.max_iter;
     case SOGMM_OPT_SEED: return &o.seed;
     case SOGMM_OPT_THREADS: return &o.threads;
+    case SOGMM_OPT_N_INIT: return &o.n_init;
     case SOGMM_OPT_MODE_COUNTER: return &o.mode_counter;
     case SOGMM_OPT_DECIMATION: return &o.decimation;
     case SOGMM_OPT_ZSTD_LEVEL: return &o.zstd_level;
@@ -154,6 +157,7 @@ SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_MAX_ITER: check_i64(key, v, 1, kInt32Max, "[1, 2^31-1]"); break;
       case SOGMM_OPT_SEED: break;
       case SOGMM_OPT_THREADS: check_i64(key, v, 0, 4096, "[0, 4096]"); break;
+      case SOGMM_OPT_N_INIT: check_i64(key, v, 1, sogmm::kMaxRuns, "[1, 1000]"); break;
       case SOGMM_OPT_MODE_COUNTER: check_i64(key, v, 0, 1, "a SOGMM_MODE_COUNTER_* value"); break;
       case SOGMM_OPT_DECIMATION: check_i64(key, v, 1, 1024, "[1, 1024]"); break;
       case SOGMM_OPT_ZSTD_LEVEL: check_i64(key, v, 1, 22, "[1, 22]"); break;

@@ -49,6 +49,9 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
                 std::to_string(kMaxComponents) + " components per fit");
   }
   require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
+  require(options.n_init >= 1 && options.n_init <= kMaxRuns, ErrorCode::InvalidArgument,
+          "n_init (number of runs) must be in [1, " + std::to_string(kMaxRuns) + "], got " +
+              std::to_string(options.n_init));
   const int threads = options.em.threads > 0 ? options.em.threads : omp_get_max_threads();
   const ScopedOmpThreads scoped_threads(threads);
 
@@ -70,19 +73,32 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
     result.seconds_mode_count = seconds_since(t);
   }
 
-  if (progress) progress(FitStage::Seeding, static_cast<int>(k), 0.0);
-  auto t = std::chrono::steady_clock::now();
-  const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed);
-  result.seconds_seeding = seconds_since(t);
-
-  if (progress) progress(FitStage::Em, 0, 0.0);
-  t = std::chrono::steady_clock::now();
   EmOptions em = options.em;
   em.threads = threads;
   EmIterationCallback on_iteration;
   if (progress) on_iteration = [&progress](int iteration, double ll) { progress(FitStage::Em, iteration, ll); };
-  result.gmm = fit_em(points, seeds, em, &result.em, on_iteration);
-  result.seconds_em = seconds_since(t);
+  // Runs are sequential, each using every thread, so the kept model is the
+  // same for any thread count.
+  for (int run = 0; run < options.n_init; ++run) {
+    if (progress && options.n_init > 1)
+      progress(FitStage::Run, run + 1, run == 0 ? 0.0 : result.em.log_likelihood);
+    if (progress) progress(FitStage::Seeding, static_cast<int>(k), 0.0);
+    auto t = std::chrono::steady_clock::now();
+    const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed + static_cast<std::uint64_t>(run));
+    result.seconds_seeding += seconds_since(t);
+
+    if (progress) progress(FitStage::Em, 0, 0.0);
+    t = std::chrono::steady_clock::now();
+    EmReport report;
+    Gmm gmm = fit_em(points, seeds, em, &report, on_iteration);
+    result.seconds_em += seconds_since(t);
+    result.run_log_likelihoods.push_back(report.log_likelihood);
+    if (run == 0 || report.log_likelihood > result.em.log_likelihood) {
+      result.gmm = std::move(gmm);
+      result.em = report;
+      result.run = run;
+    }
+  }
 
   validate(result.gmm);
   result.seconds_total = seconds_since(t0);

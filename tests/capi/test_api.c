@@ -68,6 +68,8 @@ static void test_options(void) {
   EXPECT_TRUE(i == 0);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_THREADS, &i));
   EXPECT_TRUE(i == 0);
+  EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_N_INIT, &i));
+  EXPECT_TRUE(i == 1);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_MODE_COUNTER, &i));
   EXPECT_TRUE(i == SOGMM_MODE_COUNTER_FLAT_BINNED);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_DECIMATION, &i));
@@ -219,6 +221,39 @@ static void test_fit_points(void) {
     REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
     EXPECT_TRUE(check_model(m) == 5);
     sogmm_model_free(m);
+    /* N_INIT runs: the kept run is the best, its seed is recorded, and a
+     * single fit with that seed reproduces the model */
+    {
+      sogmm_model* one = NULL;
+      int64_t runs = 0, run = -1, seed = -1;
+      double ll_best = 0, ll_one = 0, ll_first = 0;
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 9));
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 10));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_first));
+      EXPECT_OK(sogmm_model_get_info_i64(one, SOGMM_INFO_FIT_N_INIT, &runs));
+      EXPECT_TRUE(runs == 1);
+      sogmm_model_free(one);
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 3));
+      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+      EXPECT_TRUE(check_model(m) == 9);
+      EXPECT_OK(sogmm_model_get_info_i64(m, SOGMM_INFO_FIT_N_INIT, &runs));
+      EXPECT_TRUE(runs == 3);
+      EXPECT_OK(sogmm_model_get_info_i64(m, SOGMM_INFO_FIT_RUN, &run));
+      EXPECT_TRUE(run >= 0 && run < 3);
+      EXPECT_OK(sogmm_model_get_info_i64(m, SOGMM_INFO_FIT_SEED, &seed));
+      EXPECT_TRUE(seed == 10 + run);
+      EXPECT_OK(sogmm_model_get_info_f64(m, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_best));
+      EXPECT_TRUE(ll_best >= ll_first);
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, seed));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_one));
+      EXPECT_TRUE(ll_one == ll_best);
+      sogmm_model_free(one);
+      sogmm_model_free(m);
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 0));
+    }
     /* NULL options = defaults (bandwidth 0.02) */
     REQUIRE_OK(sogmm_fit_points_f32(&m, pts, 300, NULL));
     check_model(m);

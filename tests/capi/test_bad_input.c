@@ -125,6 +125,8 @@ int main(int argc, char** argv) {
   ROW("O38", sogmm_options_get_i64(NULL, SOGMM_OPT_SEED, &i64), SOGMM_E_NULL_ARG);
   ROW("O39", sogmm_options_get_i64(o, SOGMM_OPT_SEED, NULL), SOGMM_E_NULL_ARG);
   ROW("O40", sogmm_options_get_i64(o, 0, &i64), SOGMM_E_INVALID_ARG);
+  ROW("O41", sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 0), SOGMM_E_INVALID_ARG);
+  ROW("O42", sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1001), SOGMM_E_INVALID_ARG);
   /* a rejected value leaves the option unchanged */
   REQUIRE_OK(sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &f64));
   EXPECT_TRUE(f64 == 0.02);

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "sogmm/em.hpp"
+#include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"
 #include "test_util.hpp"
@@ -296,6 +299,67 @@ TEST(Determinism, SameSeedBitIdenticalAcrossThreadsAndCalls) {
     differing += !sogmm_test::bit_identical(a.gmm, d.gmm);
   }
   EXPECT_GE(differing, 1) << "seed has no effect";
+}
+
+// n_init runs: run r is exactly the single fit with seed + r, the kept one is
+// the earliest with the highest final log-likelihood, and the choice does not
+// depend on the thread count.
+TEST(Runs, KeepTheBestOfSingleFitsWithConsecutiveSeeds) {
+  const std::vector<float> pts = scene_points();
+  const sogmm::PointsView v{pts.data(), pts.size() / 4};
+  sogmm::FitOptions o;
+  o.n_components = 12;  // more components than clusters: optima differ by seed
+  o.seed = 40;
+  o.n_init = 4;
+  o.em.threads = 2;
+  std::vector<int> runs_reported;
+  const sogmm::FitResult best = sogmm::fit(v, o, [&](sogmm::FitStage s, int i, double) {
+    if (s == sogmm::FitStage::Run) runs_reported.push_back(i);
+  });
+  EXPECT_EQ(runs_reported, std::vector<int>({1, 2, 3, 4}));
+  ASSERT_EQ(best.run_log_likelihoods.size(), 4u);
+  EXPECT_TRUE(sogmm_test::model_is_valid(best.gmm));
+
+  std::vector<sogmm::FitResult> singles;
+  for (int r = 0; r < 4; ++r) {
+    sogmm::FitOptions one = o;
+    one.n_init = 1;
+    one.seed = o.seed + r;
+    singles.push_back(sogmm::fit(v, one));
+    EXPECT_EQ(singles.back().run_log_likelihoods, std::vector<double>({singles.back().em.log_likelihood}));
+    EXPECT_EQ(best.run_log_likelihoods[r], singles.back().em.log_likelihood) << "run " << r;
+  }
+  int expected = 0;
+  for (int r = 1; r < 4; ++r)
+    if (singles[r].em.log_likelihood > singles[expected].em.log_likelihood) expected = r;
+  EXPECT_EQ(best.run, expected);
+  EXPECT_TRUE(sogmm_test::bit_identical(best.gmm, singles[expected].gmm));
+  EXPECT_EQ(best.em.iterations, singles[expected].em.iterations);
+  // The seeds give different optima here, so keeping the best is not vacuous.
+  const auto [lo, hi] = std::minmax_element(best.run_log_likelihoods.begin(), best.run_log_likelihoods.end());
+  EXPECT_LT(*lo, *hi);
+  EXPECT_EQ(best.em.log_likelihood, *hi);
+
+  o.em.threads = 1;
+  const sogmm::FitResult serial = sogmm::fit(v, o);
+  EXPECT_EQ(serial.run, best.run);
+  EXPECT_TRUE(sogmm_test::bit_identical(serial.gmm, best.gmm));
+}
+
+TEST(Runs, OutOfRangeRunCountIsRefused) {
+  const std::vector<float> pts = scene_points();
+  const sogmm::PointsView v{pts.data(), pts.size() / 4};
+  for (int n : {0, -1, sogmm::kMaxRuns + 1}) {
+    sogmm::FitOptions o;
+    o.n_init = n;
+    try {
+      sogmm::fit(v, o);
+      ADD_FAILURE() << "n_init " << n << " accepted";
+    } catch (const sogmm::Error& e) {
+      EXPECT_EQ(e.code(), sogmm::ErrorCode::InvalidArgument);
+      EXPECT_NE(std::string(e.what()).find("n_init"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Determinism, FitEmThreadsBitIdentical) {

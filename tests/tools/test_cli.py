@@ -220,6 +220,17 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
           "eval MODEL (%.6f) differs from eval --bandwidth (%.6f)" % (ev.get("psnr", 0), ref.get("psnr", 0)))
     p = run(["eval", model] + fargs)
     check("PSNR (honest)" in p.stdout and "F-score" in p.stdout, "eval MODEL human output")
+    # --n-init: the kept run is the best, and a single fit with its seed is the same model.
+    best = run_json(["eval"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "--seed", 5,
+                                                       "--n-init", 3])
+    lls, kept = best.get("run_log_likelihoods", []), best.get("run", -1)
+    check(best.get("n_init") == 3 and len(lls) == 3 and 0 <= kept < 3, "eval --n-init 3: %s" % best)
+    if check(len(lls) == 3 and 0 <= kept < 3, "eval --n-init 3 runs"):
+        check(best.get("log_likelihood") == max(lls) and lls.index(max(lls)) == kept, "eval --n-init kept %s" % best)
+        one = run_json(["eval"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "--seed",
+                                                          5 + kept])
+        check(one.get("log_likelihood") == best.get("log_likelihood") and one.get("psnr") == best.get("psnr"),
+              "eval --seed %d differs from the kept run of --n-init 3" % (5 + kept))
 
     # render: expected surface, at the ground-truth depth, uncertainty, compare.
     out = os.path.join(tmp, "r.png")
@@ -352,6 +363,7 @@ def mode_errors(tmp):
     err(["fit", "--sequence", d, "--trajectory", os.path.join(d, "trajectory.log"), "--frames", "3:9", "-o", model],
         2, "--frames")
     err(["eval", model] + fa + ["--bandwidth", 0.02], 2, "--bandwidth")
+    err(["eval", model] + fa + ["--n-init", 3], 2, "--n-init")
     err(["eval", model], 2, "--depth")
     err(["render", model, "--compare", "-o", os.path.join(tmp, "x.png")], 2, "--depth")
     err(["sample", model], 2, "-o")
@@ -389,6 +401,7 @@ def mode_errors(tmp):
     # A failed run leaves the previous output untouched and no temporary file.
     before = open(model, "rb").read()
     run(["fit"] + fa + intr + ["--bandwidth", -1, "-o", model], expect=2)
+    run(["fit"] + fa + intr + ["--n-init", 0, "-o", model], expect=2)
     run(["fit", "--depth", missing, fa[2], fa[3]] + intr + ["-o", model], expect=4)
     check(open(model, "rb").read() == before, "a failed fit modified the existing output")
     no_temp_files(tmp)

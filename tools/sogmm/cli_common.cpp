@@ -49,6 +49,10 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
   auto* k = app.add_option("--components", o.n_components, "fixed number of components K (FC baseline)");
   bw->excludes(k);
   app.add_option("--seed", o.seed, "random seed (k-means++ and sampling)")->capture_default_str();
+  app.add_option("--n-init", o.n_init,
+                 "runs of k-means++ + EM with seeds seed, seed+1, ...; the highest log-likelihood is kept")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxRuns));
   app.add_option("--threads", o.em.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();
@@ -160,6 +164,13 @@ FitProgress ProgressPrinter::fit_callback(const std::string& label) {
       return;
     }
     close_stage();
+    if (stage == FitStage::Run) {  // a new run of k-means++ + EM starts
+      c->current = nullptr;
+      if (iteration > 1) std::snprintf(buf, sizeof buf, "run %d (best mean log-likelihood so far %.4f)", iteration, ll);
+      else std::snprintf(buf, sizeof buf, "run %d", iteration);
+      show(label + ": " + buf, mode_ == ProgressMode::Lines);
+      return;
+    }
     c->current = stage == FitStage::ModeCount ? "mode count" : stage == FitStage::Seeding ? "seeding" : "EM";
     c->start = now;
     const std::string what = stage == FitStage::ModeCount ? "mode count (mean shift)..."
@@ -226,6 +237,9 @@ void print_evaluation(const Evaluation& e, bool json) {
     j["em_iterations"] = f.em.iterations;
     j["converged"] = f.em.converged;
     j["log_likelihood"] = f.em.log_likelihood;
+    j["n_init"] = f.run_log_likelihoods.size();
+    j["run"] = f.run;
+    j["run_log_likelihoods"] = f.run_log_likelihoods;
     j["seconds_mode_count"] = f.seconds_mode_count;
     j["seconds_seeding"] = f.seconds_seeding;
     j["seconds_em"] = f.seconds_em;
@@ -237,6 +251,8 @@ void print_evaluation(const Evaluation& e, bool json) {
   std::printf("components M        %zu\n", f.gmm.size());
   std::printf("EM iterations       %d (%s)\n", f.em.iterations, f.em.converged ? "converged" : "not converged");
   std::printf("mean log-likelihood %.4f\n", f.em.log_likelihood);
+  if (f.run_log_likelihoods.size() > 1)
+    std::printf("runs                %zu, kept run %d (seed + %d)\n", f.run_log_likelihoods.size(), f.run, f.run);
   std::printf("time mode count     %.3f s\n", f.seconds_mode_count);
   std::printf("time seeding        %.3f s\n", f.seconds_seeding);
   std::printf("time EM             %.3f s\n", f.seconds_em);

@@ -258,9 +258,11 @@ Command add_eval_command(CLI::App& root) {
                       "eval: give MODEL, or --depth D --color C to fit and evaluate the frame");
               return run_fit_and_eval(*s);
             }
-            require(!any_given(*a, {"--bandwidth", "--components", "--tol", "--max-iter", "--reg-covar"}),
+            require(!any_given(*a, {"--bandwidth", "--components", "--tol", "--max-iter", "--reg-covar", "--n-init",
+                                     "--truncate"}),
                     ErrorCode::InvalidArgument,
-                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar apply only without MODEL");
+                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate apply only "
+                    "without MODEL");
             if (!s->sequence.empty()) {
               require(!s->trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");
               require(s->depth.empty() && s->color.empty(), ErrorCode::InvalidArgument,

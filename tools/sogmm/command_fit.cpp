@@ -98,19 +98,28 @@ int run_single(const FitState& s) {
   FitResult r = fit(cloud.view(), s.fit, progress.fit_callback("fit " + base_name(s.depth)));
   progress.em_done("fit " + base_name(s.depth), r);
   progress.finish();
-  const Model model = make_model(std::move(r.gmm), s.fit, r.em, camera, s.depth_options,
-                                 {{"source_depth", s.depth}, {"source_color", s.color}, {"coordinate_frame", "camera"}});
+  // The file records the kept run's seed: refitting with it and one run
+  // reproduces the model.
+  FitOptions kept = s.fit;
+  kept.seed += static_cast<std::uint64_t>(r.run);
+  std::vector<std::pair<std::string, std::string>> key_values{
+      {"source_depth", s.depth}, {"source_color", s.color}, {"coordinate_frame", "camera"}};
+  if (s.fit.n_init > 1) key_values.emplace_back("n_init", std::to_string(s.fit.n_init));
+  const Model model = make_model(std::move(r.gmm), kept, r.em, camera, s.depth_options, std::move(key_values));
   const std::uint64_t bytes = save_model(s.output, model);
   Totals t;
   t.add(r);
   const Camera dc = decimated(camera, s.depth_options.decimate);
-  char what[512];
+  const std::string runs = s.fit.n_init > 1 ? "; best of " + std::to_string(s.fit.n_init) + " runs, seed " +
+                                                    std::to_string(kept.seed)
+                                              : "";
+  char what[640];
   std::snprintf(what, sizeof what,
                 "Fitted %zu points from %s (decimated by %d to %dx%d) with %zu components (%s) in %d EM iterations "
-                "(%s, mean log-likelihood %.4f).",
+                "(%s, mean log-likelihood %.4f%s).",
                 r.n_points, s.depth.c_str(), s.depth_options.decimate, dc.width, dc.height, model.gmm.size(),
                 fit_kind(s.fit).c_str(), r.em.iterations, r.em.converged ? "converged" : "not converged",
-                r.em.log_likelihood);
+                r.em.log_likelihood, runs.c_str());
   print_summary(s, model, t, bytes, nlohmann::json(), what);
   return 0;
 }

@@ -76,6 +76,23 @@ def test_fixed_k(points):
     np.testing.assert_allclose(np.sort(m.weights_), 0.25, atol=0.01)
 
 
+def test_n_init_keeps_the_best_run(points):
+    single = [sogmm.SOGMM(n_components=9, seed=20 + r).fit(points) for r in range(3)]
+    best = sogmm.SOGMM(n_components=9, seed=20, n_init=3).fit(points)
+    info = best.info()
+    assert info["fit_n_init"] == 3
+    lls = [m.lower_bound_ for m in single]
+    assert info["fit_run"] == int(np.argmax(lls))  # first of equal maxima, as np.argmax
+    assert info["fit_seed"] == 20 + info["fit_run"]
+    assert best.lower_bound_ == max(lls)
+    kept = single[info["fit_run"]]
+    for name in ("weights_", "means_", "covariances_"):
+        np.testing.assert_array_equal(getattr(best, name), getattr(kept, name))
+    for bad in (0, 1001, 2.0, True):
+        with pytest.raises(sogmm.InvalidArgumentError):
+            sogmm.SOGMM(n_components=3, n_init=bad).fit(points)
+
+
 def test_not_fitted():
     est = sogmm.SOGMM()
     assert not hasattr(est, "weights_")

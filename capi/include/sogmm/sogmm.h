@@ -143,6 +143,9 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_TRUNCATION_NATS 108 /* f64, >= 0, finite; default 0 = exact E-step. > 0: truncated E-step
                                        * that skips components provably more than this many nats below
                                        * every point's best in a block (25: each skipped term < 1.4e-11) */
+#define SOGMM_OPT_N_INIT 109       /* i64, [1, 1000]; default 1: runs of k-means++ + EM. Run r (from 0)
+                                    * is seeded with SEED + r; the run with the highest final mean
+                                    * log-likelihood is kept (ties: the earliest). Cost grows linearly. */
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
@@ -250,13 +253,17 @@ SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model,
 #define SOGMM_INFO_FIT_TOL 105            /* f64 */
 #define SOGMM_INFO_FIT_REG_COVAR 106      /* f64 */
 #define SOGMM_INFO_FIT_MAX_ITER 107       /* i64 */
-#define SOGMM_INFO_FIT_SEED 108           /* i64: the uint64 seed's bits */
+#define SOGMM_INFO_FIT_SEED 108           /* i64: the uint64 seed's bits: the k-means++ seed of the kept
+                                           * run (SEED + run), so a fit with this seed and N_INIT 1
+                                           * reproduces the model */
 /* Timings: present only for a model fitted in this process (not stored in files). */
 #define SOGMM_INFO_FIT_N_POINTS 150              /* i64: points given to the fit */
 #define SOGMM_INFO_FIT_SECONDS_MODE_COUNT 151    /* f64 */
 #define SOGMM_INFO_FIT_SECONDS_SEEDING 152       /* f64 */
 #define SOGMM_INFO_FIT_SECONDS_EM 153            /* f64 */
 #define SOGMM_INFO_FIT_SECONDS_TOTAL 154         /* f64 */
+#define SOGMM_INFO_FIT_N_INIT 155                /* i64: runs made (SOGMM_OPT_N_INIT) */
+#define SOGMM_INFO_FIT_RUN 156                   /* i64: which run was kept, from 0 */
 /* Camera the points came from: present for sogmm_fit_rgbd models and files that store it. */
 #define SOGMM_INFO_CAMERA_WIDTH 200       /* i64: full-size image width, pixels */
 #define SOGMM_INFO_CAMERA_HEIGHT 201      /* i64 */

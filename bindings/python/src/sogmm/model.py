@@ -246,6 +246,8 @@ class GMM:
         "fit_seconds_seeding": (_ffi.INFO_FIT_SECONDS_SEEDING, "f"),
         "fit_seconds_em": (_ffi.INFO_FIT_SECONDS_EM, "f"),
         "fit_seconds_total": (_ffi.INFO_FIT_SECONDS_TOTAL, "f"),
+        "fit_n_init": (_ffi.INFO_FIT_N_INIT, "i"),
+        "fit_run": (_ffi.INFO_FIT_RUN, "i"),
         "camera_width": (_ffi.INFO_CAMERA_WIDTH, "i"),
         "camera_height": (_ffi.INFO_CAMERA_HEIGHT, "i"),
         "camera_fx": (_ffi.INFO_CAMERA_FX, "f"),
@@ -481,13 +483,16 @@ class SOGMM(GMM):
         truncation_nats: 0 (default) = exact E-step; > 0 = truncated E-step that
             skips components provably more than this many nats below every
             point's best in a block (25 is a good value for full frames).
+        n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
+            the highest final mean log-likelihood is kept (as scikit-learn's
+            GaussianMixture(n_init)). 1 (default) = the paper's single run.
 
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
 
     def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float = 1e-6,
                  max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
-                 mode_counter: str = "flat_binned", truncation_nats: float = 0.0):
+                 mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -497,12 +502,13 @@ class SOGMM(GMM):
         self.n_threads = n_threads
         self.mode_counter = mode_counter
         self.truncation_nats = truncation_nats
+        self.n_init = n_init
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats")
+               "truncation_nats", "n_init")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -522,7 +528,7 @@ class SOGMM(GMM):
             k = 0
         elif isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
             raise InvalidArgumentError(f"n_components must be None or an int >= 1, got {k!r}")
-        for name in ("seed", "max_iter", "n_threads"):
+        for name in ("seed", "max_iter", "n_threads", "n_init"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
                 raise InvalidArgumentError(f"{name} must be an int, got {v!r}")
@@ -536,6 +542,7 @@ class SOGMM(GMM):
             _ffi.OPT_MAX_ITER: int(self.max_iter),
             _ffi.OPT_SEED: seed,
             _ffi.OPT_THREADS: int(self.n_threads),
+            _ffi.OPT_N_INIT: int(self.n_init),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
         }
         f64.update(extra_f64 or {})
