@@ -5,6 +5,7 @@
 #include <pthread.h>
 
 #include "test_util.h"
+#include "worker_check.h"
 
 #define N_THREADS 4
 #define N_POINTS 500
@@ -16,20 +17,6 @@ static double g_ref_score[N_POINTS];
 static float g_ref_gray[N_POINTS], g_ref_var[N_POINTS];
 static float g_ref_samples[N_POINTS * 4];
 static float g_xyz[N_POINTS * 3];
-
-typedef struct {
-  int index;
-  int failures;
-} worker_arg;
-
-#define WCHECK(cond)                                                                  \
-  do {                                                                                \
-    if (!(cond)) {                                                                    \
-      ++arg->failures;                                                                \
-      fprintf(stderr, "thread %d: %s:%d: %s (last error: %s)\n", arg->index, __FILE__, \
-              __LINE__, #cond, sogmm_last_error());                                   \
-    }                                                                                 \
-  } while (0)
 
 static void* worker(void* p) {
   worker_arg* arg = (worker_arg*)p;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "test_util.h"
+#include "worker_check.h"
 
 #define N_THREADS 4
 #define N_POINTS 400
@@ -26,20 +27,6 @@ static float* g_points[N_THREADS];
 static float g_ref_weights[N_THREADS][4];
 static float g_ref_samples[N_THREADS][64 * 4];
 static size_t g_ref_M[N_THREADS];
-
-typedef struct {
-  int index;
-  int failures;
-} worker_arg;
-
-#define WCHECK(cond)                                                                  \
-  do {                                                                                \
-    if (!(cond)) {                                                                    \
-      ++arg->failures;                                                                \
-      fprintf(stderr, "thread %d: %s:%d: %s (last error: %s)\n", arg->index, __FILE__, \
-              __LINE__, #cond, sogmm_last_error());                                   \
-    }                                                                                 \
-  } while (0)
 
 static sogmm_options* one_thread_options(void) {
   sogmm_options* o = NULL;

@@ -4,11 +4,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <dirent.h>
 
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <string>
 
 #include "internal.hpp"
@@ -22,31 +20,13 @@ using format::detail::SaveStage;
 
 class Save : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char templ[] = "/tmp/sogmm-format-test-XXXXXX";
-    ASSERT_NE(::mkdtemp(templ), nullptr);
-    dir_ = templ;
-  }
+  void SetUp() override { dir_ = test::make_scratch_dir("sogmm-format-test"); }
   void TearDown() override {
     format::detail::set_save_fault_hook(nullptr);
-    for (const std::string& f : files()) std::remove((dir_ + "/" + f).c_str());
-    ::rmdir(dir_.c_str());
+    test::remove_scratch_dir(dir_);
   }
-  std::vector<std::string> files() const {
-    std::vector<std::string> out;
-    if (DIR* d = ::opendir(dir_.c_str())) {
-      while (dirent* e = ::readdir(d)) {
-        const std::string n = e->d_name;
-        if (n != "." && n != "..") out.push_back(n);
-      }
-      ::closedir(d);
-    }
-    return out;
-  }
-  static std::vector<char> slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  std::vector<std::string> files() const { return test::list_dir(dir_); }
+  static std::vector<std::uint8_t> slurp(const std::string& path) { return test::read_file_bytes(path); }
   std::string dir_;
 };
 
@@ -61,7 +41,7 @@ TEST_F(Save, SaveLoadRoundTrip) {
   EXPECT_EQ(info.file_length, slurp(path).size());
   // The file is the to_bytes() output.
   const auto bytes = format::to_bytes(m);
-  EXPECT_EQ(slurp(path), std::vector<char>(bytes.begin(), bytes.end()));
+  EXPECT_EQ(slurp(path), std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
 }
 
 SaveStage g_fail_at;
@@ -72,7 +52,7 @@ TEST_F(Save, InjectedFailuresLeaveThePreviousFileAndNoTemporary) {
   const Model old_model = test::synthetic_model(3, 1);
   format::save(path, old_model);
   ::chmod(path.c_str(), 0640);
-  const std::vector<char> before = slurp(path);
+  const std::vector<std::uint8_t> before = slurp(path);
   const Model new_model = test::synthetic_model(40, 2);
   for (SaveStage stage : {SaveStage::Open, SaveStage::WriteHalf, SaveStage::Fsync, SaveStage::Rename}) {
     g_fail_at = stage;
@@ -124,9 +104,10 @@ TEST_F(Save, IoErrors) {
 TEST_F(Save, TruncatedFileOnDiskIsRejectedByLoadAndReadInfo) {
   const std::string path = dir_ + "/model.sogmm";
   format::save(path, test::synthetic_model(12, 4));
-  const std::vector<char> full = slurp(path);
+  const std::vector<std::uint8_t> full = slurp(path);
   for (std::size_t n : {std::size_t{0}, std::size_t{5}, std::size_t{31}, std::size_t{100}, full.size() - 1}) {
-    std::ofstream(path, std::ios::binary | std::ios::trunc).write(full.data(), static_cast<std::streamsize>(n));
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(full.data()), static_cast<std::streamsize>(n));
     for (int which = 0; which < 2; ++which) {
       try {
         if (which == 0) format::load(path);

@@ -1,5 +1,14 @@
 #include "test_support.hpp"
 
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
 #include <cmath>
 #include <random>
 
@@ -80,6 +89,35 @@ bool bit_equal(const Model& a, const Model& b) {
          ca.depth_min == cb.depth_min && ca.depth_max == cb.depth_max && a.pose == b.pose &&
          a.producer_name == b.producer_name && a.producer_version == b.producer_version &&
          a.created_unix_ms == b.created_unix_ms && a.key_values == b.key_values;
+}
+
+std::string make_scratch_dir(const std::string& prefix) {
+  std::string templ = "/tmp/" + prefix + "-XXXXXX";
+  if (::mkdtemp(templ.data()) == nullptr) throw std::runtime_error("cannot create a scratch directory " + templ);
+  return templ;
+}
+
+std::vector<std::string> list_dir(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n != "." && n != "..") out.push_back(n);
+    }
+    ::closedir(d);
+  }
+  return out;
+}
+
+void remove_scratch_dir(const std::string& dir) {
+  ::chmod(dir.c_str(), 0700);
+  for (const std::string& f : list_dir(dir)) std::remove((dir + "/" + f).c_str());
+  ::rmdir(dir.c_str());
+}
+
+std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 }  // namespace sogmm::test

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "sogmm/model.hpp"
@@ -28,5 +29,15 @@ T le(const std::vector<std::uint8_t>& b, std::size_t off) {
 
 /// True when both models hold bit-identical arrays and equal metadata.
 bool bit_equal(const Model& a, const Model& b);
+
+/// A fresh empty directory /tmp/PREFIX-XXXXXX for files a test writes.
+/// Throws std::runtime_error when it cannot be made.
+std::string make_scratch_dir(const std::string& prefix);
+/// Names of the entries of a directory (without "." and "..").
+std::vector<std::string> list_dir(const std::string& dir);
+/// Makes `dir` writable again, removes its files, then the directory itself.
+void remove_scratch_dir(const std::string& dir);
+/// The whole content of a file (empty if it cannot be read).
+std::vector<std::uint8_t> read_file_bytes(const std::string& path);
 
 }  // namespace sogmm::test

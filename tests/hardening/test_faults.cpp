@@ -5,7 +5,6 @@
 // every truncated prefix of a file through the C API, and loads racing with a
 // writer that rewrites the file in place.
 #include <gtest/gtest.h>
-#include <dirent.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -15,7 +14,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,31 +29,10 @@ namespace fmt = sogmm::format;
 
 class Faults : public ::testing::Test {
  protected:
-  void SetUp() override {
-    char templ[] = "/tmp/sogmm-hardening-XXXXXX";
-    ASSERT_NE(::mkdtemp(templ), nullptr);
-    dir_ = templ;
-  }
-  void TearDown() override {
-    ::chmod(dir_.c_str(), 0700);
-    for (const std::string& f : files()) std::remove((dir_ + "/" + f).c_str());
-    ::rmdir(dir_.c_str());
-  }
-  std::vector<std::string> files() const {
-    std::vector<std::string> out;
-    if (DIR* d = ::opendir(dir_.c_str())) {
-      while (dirent* e = ::readdir(d)) {
-        const std::string n = e->d_name;
-        if (n != "." && n != "..") out.push_back(n);
-      }
-      ::closedir(d);
-    }
-    return out;
-  }
-  static std::vector<std::uint8_t> slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  void SetUp() override { dir_ = sogmm::test::make_scratch_dir("sogmm-hardening"); }
+  void TearDown() override { sogmm::test::remove_scratch_dir(dir_); }
+  std::vector<std::string> files() const { return sogmm::test::list_dir(dir_); }
+  static std::vector<std::uint8_t> slurp(const std::string& path) { return sogmm::test::read_file_bytes(path); }
   static sogmm_model* capi_model(std::size_t m, std::uint32_t seed) {
     const sogmm::Model src = sogmm::test::synthetic_model(m, seed, false);
     sogmm_model* h = nullptr;

@@ -63,6 +63,24 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
       ->capture_default_str();
 }
 
+PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, const DepthOptions& depth,
+                                const std::string& depth_path) {
+  PointCloud cloud = backproject(frame.view(camera), depth);
+  require(cloud.size() > 0, ErrorCode::InvalidData,
+          depth_path + ": no valid depth pixel in (" + std::to_string(depth.depth_min) + ", " +
+              std::to_string(depth.depth_max) + "] m (check --depth-scale)");
+  return cloud;
+}
+
+void add_frame_source_flags(CLI::App& app, FrameSource& f, const std::string& sequence_use) {
+  app.add_option("--depth", f.depth, "16-bit depth PNG");
+  app.add_option("--color", f.color, "color or gray image (PNG/JPEG), registered to the depth");
+  app.add_option("--sequence", f.sequence,
+                 sequence_use + "folder with depth/*.png and color/*.{jpg,png} (instead of --depth/--color)");
+  app.add_option("--trajectory", f.trajectory, "with --sequence: Redwood .log camera-to-world poses");
+  app.add_option("--frames", f.frames, "with --sequence: I, A:B (B excluded) or A:B:STEP; default all");
+}
+
 Evaluation evaluate(FitResult fit, const PointsView& truth, const Camera& decimated_camera, std::uint64_t seed) {
   Evaluation e;
   e.psnr = psnr(fit.gmm, truth, decimated_camera);

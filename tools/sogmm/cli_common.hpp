@@ -29,8 +29,24 @@ void add_camera_flags(CLI::App& app, CameraFlags& camera, DepthOptions& depth);
 /// The camera from the flags; checks that it matches the frame size.
 Camera resolve_camera(const CameraFlags& flags, const LoadedFrame& frame);
 
-/// Model-selection flags: --bandwidth S | --components K, --seed, --threads.
+/// Back-projects the valid pixels of a loaded frame; throws Error(InvalidData)
+/// naming `depth_path` and the valid depth range when there is none.
+PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, const DepthOptions& depth,
+                                const std::string& depth_path);
+
+/// Fit flags: --bandwidth S | --components K, --seed, --n-init, --threads,
+/// --tol, --max-iter, --reg-covar, --truncate.
 void add_fit_flags(CLI::App& app, FitOptions& options);
+
+/// Where frames come from: one pair (--depth D --color C) or a posed sequence
+/// (--sequence DIR --trajectory FILE [--frames RANGE]).
+struct FrameSource {
+  std::string depth, color;
+  std::string sequence, trajectory, frames;
+};
+/// Adds the five flags. `sequence_use` is prefixed to the help of the
+/// sequence flags (e.g. "with MODEL: "), where a command restricts them.
+void add_frame_source_flags(CLI::App& app, FrameSource& source, const std::string& sequence_use = "");
 
 /// Everything `sogmm eval` reports about one fit.
 struct Evaluation {
@@ -51,8 +67,9 @@ int run_guarded(const std::function<int()>& body);
 namespace sogmm::tools {
 /// Prints an evaluation as a human table, or with `json` as one JSON object
 /// with keys n_points, n_components, psnr, psnr_paper, mre, precision, recall,
-/// fscore, model_bytes, em_iterations, converged, log_likelihood,
-/// seconds_mode_count, seconds_seeding, seconds_em, seconds_total.
+/// fscore, model_bytes, em_iterations, converged, log_likelihood, n_init,
+/// run, run_log_likelihoods, seconds_mode_count, seconds_seeding, seconds_em,
+/// seconds_total.
 void print_evaluation(const Evaluation& e, bool json);
 
 /// A subcommand: its CLI11 parser and what to run when it is chosen.

@@ -159,9 +159,7 @@ Command add_bench_command(CLI::App& root) {
             for (const FramePaths& f : frames) {
               const LoadedFrame frame = load_frame(f.depth, f.color);
               const Camera camera = resolve_camera(camera_flags, frame);
-              const PointCloud cloud = backproject(frame.view(camera), s->depth_options);
-              require(cloud.size() > 0, ErrorCode::InvalidData,
-                      f.depth + ": no valid depth pixel (check --depth-scale)");
+              const PointCloud cloud = backproject_nonempty(frame, camera, s->depth_options, f.depth);
               bench::BenchConfig config = s->config;
               config.camera_info.known = true;
               config.camera_info.camera = camera;

@@ -20,8 +20,7 @@ namespace {
 
 struct EvalState {
   std::string model;
-  std::string depth, color;
-  std::string sequence, trajectory, frames;
+  FrameSource src;
   CameraFlags camera;
   DepthOptions depth_options;
   FitOptions fit;
@@ -82,12 +81,9 @@ void describe_model(const std::string& path, const Model& m, bool json, nlohmann
 }
 
 int run_fit_and_eval(const EvalState& s) {
-  const LoadedFrame frame = load_frame(s.depth, s.color);
+  const LoadedFrame frame = load_frame(s.src.depth, s.src.color);
   const Camera camera = resolve_camera(s.camera, frame);
-  const PointCloud cloud = backproject(frame.view(camera), s.depth_options);
-  require(cloud.size() > 0, ErrorCode::InvalidData,
-          s.depth + ": no valid depth pixel in (" + std::to_string(s.depth_options.depth_min) + ", " +
-              std::to_string(s.depth_options.depth_max) + "] m (check --depth-scale)");
+  const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, s.src.depth);
   FitResult fitted = fit(cloud.view(), s.fit);
   const Evaluation e =
       evaluate(std::move(fitted), cloud.view(), decimated(camera, s.depth_options.decimate), s.fit.seed);
@@ -102,23 +98,22 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
                  "sogmm: note: %s is in world coordinates (a sequence model); evaluate it with --sequence DIR "
                  "--trajectory FILE to move it into each frame's camera\n",
                  s.model.c_str());
-  const LoadedFrame frame = load_frame(s.depth, s.color);
+  const LoadedFrame frame = load_frame(s.src.depth, s.src.color);
   Camera camera;
   if (camera_flags_given(s.camera)) {
     camera = resolve_camera(s.camera, frame);
   } else {
     camera = camera_for(s.camera, model, s.model);
     require(camera.width == frame.width && camera.height == frame.height, ErrorCode::InvalidData,
-            s.depth + ": image is " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+            s.src.depth + ": image is " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
                 " but the camera stored in " + s.model + " is " + std::to_string(camera.width) + "x" +
                 std::to_string(camera.height) + " (give --intrinsics)");
   }
   const DepthOptions d = depth_options_for(app, s.depth_options, model);
-  const PointCloud cloud = backproject(frame.view(camera), d);
-  require(cloud.size() > 0, ErrorCode::InvalidData, s.depth + ": no valid depth pixel (check --depth-scale)");
+  const PointCloud cloud = backproject_nonempty(frame, camera, d, s.src.depth);
   const Camera dc = decimated(camera, d.decimate);
   FrameScore f;
-  f.depth = s.depth;
+  f.depth = s.src.depth;
   f.n_points = cloud.size();
   f.psnr = psnr(model.gmm, cloud.view(), dc);
   f.rec = reconstruction_metrics(model.gmm, cloud.view(), 0.01, s.fit.seed);
@@ -130,7 +125,7 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
-  std::printf("frame               %s, decimated by %d -> %zu points\n", s.depth.c_str(), d.decimate, f.n_points);
+  std::printf("frame               %s, decimated by %d -> %zu points\n", s.src.depth.c_str(), d.decimate, f.n_points);
   std::printf("PSNR (honest)       %.2f dB\n", f.psnr.psnr);
   std::printf("PSNR (paper-compat) %.2f dB (+13.98 dB for the paper's 640x480 canvas)\n", f.psnr.psnr_paper);
   std::printf("MRE                 %.4f m\n", f.rec.mre);
@@ -141,18 +136,18 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
 
 int run_model_sequence(const EvalState& s, const CLI::App& app) {
   const Model model = load_model(s.model);
-  const std::vector<SequenceFrame> frames = list_sequence(s.sequence);
-  const std::vector<Pose> poses = read_trajectory(s.trajectory);
+  const std::vector<SequenceFrame> frames = list_sequence(s.src.sequence);
+  const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
   const std::vector<std::size_t> selected =
-      parse_frame_range(s.frames.empty() ? std::string(":") : s.frames, frames.size());
+      parse_frame_range(s.src.frames.empty() ? std::string(":") : s.src.frames, frames.size());
   require(poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
-          s.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
+          s.src.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
               std::to_string(selected.back()) + " is selected");
   if (key_value(model, "coordinate_frame") == "camera")
     std::fprintf(stderr, "sogmm: note: %s is a single-frame model in its camera's coordinates; it is moved with "
                  "the inverse of each frame's pose as if it were in world coordinates\n", s.model.c_str());
   CameraFlags flags = s.camera;
-  const std::string guess = (std::filesystem::path(s.sequence) / "intrinsics.json").string();
+  const std::string guess = (std::filesystem::path(s.src.sequence) / "intrinsics.json").string();
   if (!camera_flags_given(flags) && !model.camera.known && std::filesystem::is_regular_file(guess))
     flags.intrinsics = guess;
   const DepthOptions d = depth_options_for(app, s.depth_options, model);
@@ -163,8 +158,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     const Camera camera = camera_flags_given(flags) ? resolve_camera(flags, frame) : camera_for(flags, model, s.model);
     require(camera.width == frame.width && camera.height == frame.height, ErrorCode::InvalidData,
             f.depth + ": image size differs from the camera (give --intrinsics)");
-    const PointCloud cloud = backproject(frame.view(camera), d);
-    require(cloud.size() > 0, ErrorCode::InvalidData, f.depth + ": no valid depth pixel (check --depth-scale)");
+    const PointCloud cloud = backproject_nonempty(frame, camera, d, f.depth);
     const Camera dc = decimated(camera, d.decimate);
     const Gmm local = transform(model.gmm, inverse_rigid(poses[i]));
     FrameScore sc;
@@ -209,7 +203,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
   }
   std::printf("frames of %s, decimated by %d; model moved into each camera with the inverse pose;\n"
               "MRE/F-score use samples inside each camera's view (n_samples)\n",
-              s.sequence.c_str(), d.decimate);
+              s.src.sequence.c_str(), d.decimate);
   std::printf("%-6s %-12s %8s %9s %9s %8s %7s %9s\n", "frame", "file", "points", "PSNR dB", "paper dB", "MRE m",
               "F@1cm", "samples");
   for (const FrameScore& f : scores)
@@ -241,20 +235,16 @@ Command add_eval_command(CLI::App& root) {
       "  sogmm eval room.sogmm --sequence ../shared/data/rgbd/livingroom \\\n"
       "    --trajectory ../shared/data/rgbd/livingroom/trajectory.log --frames 0:3");
   app->add_option("model", s->model, "saved model (.sogmm) to evaluate; omit to fit the frame first");
-  app->add_option("--depth", s->depth, "16-bit depth PNG");
-  app->add_option("--color", s->color, "color or gray image (PNG/JPEG), registered to the depth");
-  app->add_option("--sequence", s->sequence, "with MODEL: folder with depth/*.png and color/*.{jpg,png}");
-  app->add_option("--trajectory", s->trajectory, "with --sequence: Redwood .log camera-to-world poses");
-  app->add_option("--frames", s->frames, "with --sequence: I, A:B (B excluded) or A:B:STEP; default all");
+  add_frame_source_flags(*app, s->src, "with MODEL: ");
   add_camera_flags(*app, s->camera, s->depth_options);
   add_fit_flags(*app, s->fit);
   app->add_flag("--json", s->json, "print one JSON object");
   CLI::App* a = app;
   return {app, [s, a]() {
             if (s->model.empty()) {
-              require(s->sequence.empty() && s->trajectory.empty() && s->frames.empty(), ErrorCode::InvalidArgument,
+              require(s->src.sequence.empty() && s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
                       "eval: --sequence needs a MODEL (fit one with: sogmm fit --sequence DIR --trajectory FILE -o M)");
-              require(!s->depth.empty() && !s->color.empty(), ErrorCode::InvalidArgument,
+              require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                       "eval: give MODEL, or --depth D --color C to fit and evaluate the frame");
               return run_fit_and_eval(*s);
             }
@@ -263,15 +253,15 @@ Command add_eval_command(CLI::App& root) {
                     ErrorCode::InvalidArgument,
                     "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate apply only "
                     "without MODEL");
-            if (!s->sequence.empty()) {
-              require(!s->trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");
-              require(s->depth.empty() && s->color.empty(), ErrorCode::InvalidArgument,
+            if (!s->src.sequence.empty()) {
+              require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");
+              require(s->src.depth.empty() && s->src.color.empty(), ErrorCode::InvalidArgument,
                       "eval: give --sequence or --depth/--color, not both");
               return run_model_sequence(*s, *a);
             }
-            require(s->trajectory.empty() && s->frames.empty(), ErrorCode::InvalidArgument,
+            require(s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
                     "eval: --trajectory and --frames need --sequence");
-            require(!s->depth.empty() && !s->color.empty(), ErrorCode::InvalidArgument,
+            require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                     "eval: give --depth D --color C (or --sequence DIR --trajectory FILE) to evaluate " + s->model);
             return run_model_frame(*s, *a);
           }};

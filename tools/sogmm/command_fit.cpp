@@ -18,8 +18,8 @@ namespace sogmm::tools {
 namespace {
 
 struct FitState {
-  std::string depth, color, output;
-  std::string sequence, trajectory, frames;
+  FrameSource src;
+  std::string output;
   CameraFlags camera;
   DepthOptions depth_options;
   FitOptions fit;
@@ -86,24 +86,21 @@ void print_summary(const FitState& s, const Model& model, const Totals& t, std::
 }
 
 int run_single(const FitState& s) {
-  const LoadedFrame frame = load_frame(s.depth, s.color);
+  const LoadedFrame frame = load_frame(s.src.depth, s.src.color);
   const Camera camera = resolve_camera(s.camera, frame);
-  const PointCloud cloud = backproject(frame.view(camera), s.depth_options);
-  require(cloud.size() > 0, ErrorCode::InvalidData,
-          s.depth + ": no valid depth pixel in (" + std::to_string(s.depth_options.depth_min) + ", " +
-              std::to_string(s.depth_options.depth_max) + "] m (check --depth-scale)");
+  const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, s.src.depth);
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
-  progress.line("fit " + base_name(s.depth) + ": " + std::to_string(cloud.size()) + " points (decimated by " +
+  progress.line("fit " + base_name(s.src.depth) + ": " + std::to_string(cloud.size()) + " points (decimated by " +
                 std::to_string(s.depth_options.decimate) + ")");
-  FitResult r = fit(cloud.view(), s.fit, progress.fit_callback("fit " + base_name(s.depth)));
-  progress.em_done("fit " + base_name(s.depth), r);
+  FitResult r = fit(cloud.view(), s.fit, progress.fit_callback("fit " + base_name(s.src.depth)));
+  progress.em_done("fit " + base_name(s.src.depth), r);
   progress.finish();
   // The file records the kept run's seed: refitting with it and one run
   // reproduces the model.
   FitOptions kept = s.fit;
   kept.seed += static_cast<std::uint64_t>(r.run);
   std::vector<std::pair<std::string, std::string>> key_values{
-      {"source_depth", s.depth}, {"source_color", s.color}, {"coordinate_frame", "camera"}};
+      {"source_depth", s.src.depth}, {"source_color", s.src.color}, {"coordinate_frame", "camera"}};
   if (s.fit.n_init > 1) key_values.emplace_back("n_init", std::to_string(s.fit.n_init));
   const Model model = make_model(std::move(r.gmm), kept, r.em, camera, s.depth_options, std::move(key_values));
   const std::uint64_t bytes = save_model(s.output, model);
@@ -117,7 +114,7 @@ int run_single(const FitState& s) {
   std::snprintf(what, sizeof what,
                 "Fitted %zu points from %s (decimated by %d to %dx%d) with %zu components (%s) in %d EM iterations "
                 "(%s, mean log-likelihood %.4f%s).",
-                r.n_points, s.depth.c_str(), s.depth_options.decimate, dc.width, dc.height, model.gmm.size(),
+                r.n_points, s.src.depth.c_str(), s.depth_options.decimate, dc.width, dc.height, model.gmm.size(),
                 fit_kind(s.fit).c_str(), r.em.iterations, r.em.converged ? "converged" : "not converged",
                 r.em.log_likelihood, runs.c_str());
   print_summary(s, model, t, bytes, nlohmann::json(), what);
@@ -125,18 +122,18 @@ int run_single(const FitState& s) {
 }
 
 int run_sequence(const FitState& s) {
-  const std::vector<SequenceFrame> frames = list_sequence(s.sequence);
-  const std::vector<Pose> poses = read_trajectory(s.trajectory);
+  const std::vector<SequenceFrame> frames = list_sequence(s.src.sequence);
+  const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
   const std::vector<std::size_t> selected =
-      parse_frame_range(s.frames.empty() ? std::string(":") : s.frames, frames.size());
+      parse_frame_range(s.src.frames.empty() ? std::string(":") : s.src.frames, frames.size());
   require(poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
-          s.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
+          s.src.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
               std::to_string(selected.back()) + " is selected");
   CameraFlags camera_flags = s.camera;
   if (!camera_flags_given(camera_flags)) {
-    const std::string guess = (std::filesystem::path(s.sequence) / "intrinsics.json").string();
+    const std::string guess = (std::filesystem::path(s.src.sequence) / "intrinsics.json").string();
     require(std::filesystem::is_regular_file(guess), ErrorCode::InvalidArgument,
-            "no camera: give --intrinsics FILE (or put intrinsics.json in " + s.sequence + ")");
+            "no camera: give --intrinsics FILE (or put intrinsics.json in " + s.src.sequence + ")");
     camera_flags.intrinsics = guess;
   }
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
@@ -150,8 +147,7 @@ int run_sequence(const FitState& s) {
     const SequenceFrame& f = frames[selected[k]];
     const LoadedFrame frame = load_frame(f.depth, f.color);
     camera = resolve_camera(camera_flags, frame);
-    const PointCloud cloud = backproject(frame.view(camera), s.depth_options);
-    require(cloud.size() > 0, ErrorCode::InvalidData, f.depth + ": no valid depth pixel (check --depth-scale)");
+    const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, f.depth);
     const std::string label = "frame " + std::to_string(k + 1) + "/" + std::to_string(selected.size()) + " (" +
                               base_name(f.depth) + ")";
     FitResult r = fit(cloud.view(), s.fit, progress.fit_callback(label));
@@ -179,8 +175,8 @@ int run_sequence(const FitState& s) {
   em.iterations = t.iterations;  // total over frames
   Model model = make_model(std::move(merged), options, em, camera, s.depth_options,
                            {{"coordinate_frame", "world"},
-                            {"sequence", s.sequence},
-                            {"trajectory", s.trajectory},
+                            {"sequence", s.src.sequence},
+                            {"trajectory", s.src.trajectory},
                             {"frames", frame_list}});
   model.fit.converged = false;
   model.fit.log_likelihood = 0.0;  // per-frame values; the merged model has no single one
@@ -189,8 +185,8 @@ int run_sequence(const FitState& s) {
   std::snprintf(what, sizeof what,
                 "Fitted %zu frames of %s (frames %s, decimated by %d, %s): %zu points in total, merged in the world "
                 "frame of %s into %zu components (support size %llu), %d EM iterations in total.",
-                selected.size(), s.sequence.c_str(), frame_list.c_str(), s.depth_options.decimate,
-                fit_kind(s.fit).c_str(), t.points, s.trajectory.c_str(), model.gmm.size(),
+                selected.size(), s.src.sequence.c_str(), frame_list.c_str(), s.depth_options.decimate,
+                fit_kind(s.fit).c_str(), t.points, s.src.trajectory.c_str(), model.gmm.size(),
                 static_cast<unsigned long long>(model.gmm.support_size), t.iterations);
   print_summary(s, model, t, bytes, frames_json, what);
   return 0;
@@ -213,11 +209,7 @@ Command add_fit_command(CLI::App& root) {
       "    --intrinsics ../shared/data/rgbd/livingroom/intrinsics.json --decimate 5 --bandwidth 0.02 -o frame0.sogmm\n"
       "  sogmm fit --sequence ../shared/data/rgbd/livingroom \\\n"
       "    --trajectory ../shared/data/rgbd/livingroom/trajectory.log --frames 0:3 --decimate 5 -o room.sogmm");
-  app->add_option("--depth", s->depth, "16-bit depth PNG");
-  app->add_option("--color", s->color, "color or gray image (PNG/JPEG), registered to the depth");
-  app->add_option("--sequence", s->sequence, "folder with depth/*.png and color/*.{jpg,png} (instead of --depth/--color)");
-  app->add_option("--trajectory", s->trajectory, "Redwood .log camera-to-world poses (with --sequence)");
-  app->add_option("--frames", s->frames, "frames of the sequence: I, A:B (B excluded) or A:B:STEP; default all");
+  add_frame_source_flags(*app, s->src);
   add_camera_flags(*app, s->camera, s->depth_options);
   add_fit_flags(*app, s->fit);
   app->add_option("-o,--output", s->output, "output model file (.sogmm)")->required();
@@ -227,17 +219,17 @@ Command add_fit_command(CLI::App& root) {
   CLI::App* a = app;
   return {app, [s, a]() {
             check_output_path(s->output);
-            const bool single = !s->depth.empty() || !s->color.empty();
-            require(single != !s->sequence.empty(), ErrorCode::InvalidArgument,
+            const bool single = !s->src.depth.empty() || !s->src.color.empty();
+            require(single != !s->src.sequence.empty(), ErrorCode::InvalidArgument,
                     "fit: give --depth D --color C, or --sequence DIR --trajectory FILE");
             if (single) {
-              require(!s->depth.empty() && !s->color.empty(), ErrorCode::InvalidArgument,
+              require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                       "fit: --depth and --color go together");
-              require(s->trajectory.empty() && s->frames.empty(), ErrorCode::InvalidArgument,
+              require(s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
                       "fit: --trajectory and --frames need --sequence");
               return run_single(*s);
             }
-            require(!s->trajectory.empty(), ErrorCode::InvalidArgument,
+            require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument,
                     "fit: --sequence needs --trajectory FILE (camera-to-world poses)");
             (void)a;
             return run_sequence(*s);

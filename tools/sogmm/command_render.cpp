@@ -86,8 +86,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
   const Camera dc = decimated(camera, d.decimate);
 
   if (s.compare) {
-    const PointCloud cloud = backproject(frame.view(camera), d);
-    require(cloud.size() > 0, ErrorCode::InvalidData, s.depth + ": no valid depth pixel (check --depth-scale)");
+    const PointCloud cloud = backproject_nonempty(frame, camera, d, s.depth);
     std::vector<float> gray_truth(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) gray_truth[i] = cloud.xyzg[4 * i + 3];
     const std::vector<float> truth = project_to_image(cloud.view(), gray_truth.data(), dc, -1.f);
@@ -110,8 +109,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
   RenderedView view;
   std::string where;
   if (have_depth) {
-    const PointCloud cloud = backproject(frame.view(camera), d);
-    require(cloud.size() > 0, ErrorCode::InvalidData, s.depth + ": no valid depth pixel (check --depth-scale)");
+    const PointCloud cloud = backproject_nonempty(frame, camera, d, s.depth);
     view = render_at_points(gmm, cloud.xyzg, dc);
     where = "at the depth of " + s.depth;
   } else {
