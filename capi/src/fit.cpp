@@ -76,11 +76,6 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   return handle.release();
 }
 
-void require_intrinsic(double v, bool positive, const char* name) {
-  if (!std::isfinite(v) || (positive && !(v > 0)))
-    fail(SOGMM_E_INVALID_ARG, std::string(name) + " = " + std::to_string(v) + " is invalid (" +
-                                  (positive ? "must be finite and > 0)" : "must be finite)"));
-}
 
 }  // namespace
 
@@ -116,61 +111,17 @@ SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, 
   SOGMM_TRY {
     sogmm_capi::reset_out(out);
     require_nonnull(out, "out");
-    require_nonnull(depth, "depth");
-    require_nonnull(color, "color");
-    if (color_format != SOGMM_COLOR_GRAY8 && color_format != SOGMM_COLOR_RGB8)
-      fail(SOGMM_E_INVALID_ARG, "unknown color_format " + std::to_string(color_format));
-    const std::uint32_t kMax = static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max());
-    if (width == 0 || height == 0 || width > kMax || height > kMax)
-      fail(SOGMM_E_INVALID_ARG, "image size " + std::to_string(width) + " x " + std::to_string(height) +
-                                    " is invalid (each side in [1, 2^31-1])");
-    const std::size_t pixels = sogmm_capi::checked_mul(width, height, "image");
-    sogmm_capi::checked_mul(pixels, 3, "color image");
-    require_intrinsic(fx, true, "fx");
-    require_intrinsic(fy, true, "fy");
-    require_intrinsic(cx, false, "cx");
-    require_intrinsic(cy, false, "cy");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-
-    sogmm::Camera camera;
-    camera.width = static_cast<int>(width);
-    camera.height = static_cast<int>(height);
-    camera.fx = fx;
-    camera.fy = fy;
-    camera.cx = cx;
-    camera.cy = cy;
-    sogmm::DepthOptions depth_options;
-    depth_options.depth_scale = o.depth_scale;
-    depth_options.depth_min = o.depth_min;
-    depth_options.depth_max = o.depth_max;
-    depth_options.decimate = static_cast<int>(o.decimation);
-    if (!(o.depth_min < o.depth_max))
-      fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + std::to_string(o.depth_min) +
-                                    " must be < SOGMM_OPT_DEPTH_MAX = " + std::to_string(o.depth_max));
-    if (o.decimation > static_cast<std::int64_t>(width) || o.decimation > static_cast<std::int64_t>(height))
-      fail(SOGMM_E_INVALID_ARG, "decimation " + std::to_string(o.decimation) +
-                                    " leaves no pixel of a " + std::to_string(width) + " x " +
-                                    std::to_string(height) + " image");
-    sogmm::validate(camera);
-    sogmm::validate(depth_options);
-
-    const sogmm::GrayImage gray =
-        color_format == SOGMM_COLOR_RGB8
-            ? sogmm::gray_from_rgb_image(color, camera.width, camera.height)
-            : sogmm::gray_from_u8_image(color, camera.width, camera.height);
-    sogmm::RgbdView frame;
-    frame.depth = depth;
-    frame.gray = gray.pixels.data();
-    frame.camera = camera;
-    const sogmm::PointCloud cloud = sogmm::backproject(frame, depth_options);
-    if (cloud.size() == 0)
+    const sogmm_capi::RgbdPoints r =
+        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, o);
+    if (r.cloud.size() == 0)
       fail(SOGMM_E_INVALID_DATA, "no pixel has a depth in the valid range after decimation");
 
     std::unique_ptr<sogmm_model> handle(
-        fit_to_handle(cloud.xyzg.data(), cloud.size(), static_cast<std::size_t>(o.n_components), o));
+        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), static_cast<std::size_t>(o.n_components), o));
     sogmm::CameraInfo& ci = handle->model.camera;
     ci.known = true;
-    ci.camera = camera;
+    ci.camera = r.camera;
     ci.decimation = static_cast<std::int32_t>(o.decimation);
     ci.depth_scale = o.depth_scale;
     ci.depth_min = o.depth_min;

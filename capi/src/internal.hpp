@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "sogmm/camera.hpp"
 #include "sogmm/model.hpp"
+#include "sogmm/point_cloud.hpp"
 #include "sogmm/sogmm.h"
 
 // ---- handles -----------------------------------------------------------
@@ -109,6 +111,19 @@ void require_finite(const float* values, std::size_t count, const char* what);
 
 /// SOGMM_E_INVALID_ARG unless the 16 doubles are a finite rigid transform.
 void require_rigid(const double* pose, const char* what);
+
+/// An RGB-D frame checked and back-projected as sogmm_fit_rgbd and
+/// sogmm_rgbd_to_points_f32 take it.
+struct RgbdPoints {
+  sogmm::Camera camera;             // full-size intrinsics
+  sogmm::DepthOptions depth;        // scale, range, decimation from the options
+  sogmm::PointCloud cloud;          // valid pixels of the decimated frame, row by row
+};
+/// Checks every argument (SOGMM_E_NULL_ARG / INVALID_ARG / INVALID_DATA for
+/// non-finite float gray) and back-projects; the cloud may be empty.
+RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* color, std::int32_t color_format,
+                            std::uint32_t width, std::uint32_t height, double fx, double fy, double cx, double cy,
+                            const sogmm_options& options);
 
 /// Stores NULL into a handle out-pointer if it is not NULL (on failure).
 template <typename T>

@@ -317,6 +317,49 @@ static void test_fit_rgbd(void) {
     }
     free(mu);
   }
+  /* The points behind the fit: sogmm_rgbd_to_points_f32 gives N = 39 x 30,
+   * a hand-computed first point, and fitting them as points reproduces the
+   * RGB-D model bit for bit. Float gray (GRAY_F32) equal to g / 255 gives
+   * the same model as GRAY8. */
+  {
+    size_t n_pts = 0, k;
+    float *xyzg, *mu_g, *mu_p, *grayf;
+    sogmm_model *mp = NULL, *mf = NULL;
+    REQUIRE_OK(sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5,
+                                        29.5, o));
+    EXPECT_TRUE(n_pts == 39 * 30);
+    xyzg = (float*)malloc(4 * n_pts * sizeof(float));
+    grayf = (float*)malloc((size_t)w * h * sizeof(float));
+    mu_g = (float*)malloc(4 * Mg * sizeof(float));
+    mu_p = (float*)malloc(4 * Mg * sizeof(float));
+    REQUIRE_OK(sogmm_rgbd_to_points_f32(xyzg, 4 * n_pts, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0,
+                                        39.5, 29.5, o));
+    /* decimated pixel (u, v) = (1, 0) <- source (2, 0): depth 1000 + 600 * 2 / 80 = 1015 mm;
+     * intrinsics / 2: fx = fy = 35, cx = 19.75, cy = 14.75; gray 40 / 255 */
+    EXPECT_NEAR(xyzg[2], 1.015, 1e-6);
+    EXPECT_NEAR(xyzg[0], (1 - 19.75) * 1.015 / 35.0, 1e-6);
+    EXPECT_NEAR(xyzg[1], (0 - 14.75) * 1.015 / 35.0, 1e-6);
+    EXPECT_NEAR(xyzg[3], 40.0 / 255.0, 1e-7);
+    REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, o));
+    EXPECT_TRUE(check_model(mp) == Mg);
+    EXPECT_OK(sogmm_model_get_means_f32(mg, mu_g, 4 * Mg));
+    EXPECT_OK(sogmm_model_get_means_f32(mp, mu_p, 4 * Mg));
+    EXPECT_TRUE(memcmp(mu_g, mu_p, 4 * Mg * sizeof(float)) == 0);
+    for (k = 0; k < (size_t)w * h; ++k) grayf[k] = gray[k] / 255.0f;
+    REQUIRE_OK(sogmm_fit_rgbd(&mf, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, w, h, 70.0, 70.0, 39.5, 29.5,
+                              o));
+    EXPECT_TRUE(check_model(mf) == Mg);
+    EXPECT_OK(sogmm_model_get_means_f32(mf, mu_p, 4 * Mg));
+    EXPECT_TRUE(memcmp(mu_g, mu_p, 4 * Mg * sizeof(float)) == 0);
+    EXPECT_OK(sogmm_model_get_info_i64(mf, SOGMM_INFO_CAMERA_DECIMATION, &i));
+    EXPECT_TRUE(i == 2);
+    sogmm_model_free(mp);
+    sogmm_model_free(mf);
+    free(xyzg);
+    free(grayf);
+    free(mu_g);
+    free(mu_p);
+  }
   sogmm_model_free(mg);
   sogmm_model_free(mc);
   sogmm_options_free(o);

@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   ROW_OUT("R6", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, 0x80000000u, 1, 35, 35, 20, 15, NULL),
           SOGMM_E_INVALID_ARG);
   ROW_OUT("R7", out, FRAME(depth, gray, 0, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R8", out, FRAME(depth, gray, 3, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R8", out, FRAME(depth, gray, 4, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R9", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 0, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R10", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, -35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R11", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, nan_, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
@@ -184,6 +184,33 @@ int main(int argc, char** argv) {
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, (int64_t)W * H + 1));
   ROW_OUT("R18", out, FRAME(depth, rgb, SOGMM_COLOR_RGB8, W, H, 35, 35, 20, 15, o), SOGMM_E_INVALID_ARG);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
+  {
+    float grayf[16], xyzg[4 * 16];
+    size_t n_pts = 99;
+    int k;
+    for (k = 0; k < 16; ++k) grayf[k] = 0.5f;
+    grayf[9] = (float)nan_;
+    ROW_OUT("R19", out, FRAME(depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3, 3, 2, 2, NULL),
+            SOGMM_E_INVALID_DATA);
+    /* back-projection only */
+    ROW("R20", sogmm_rgbd_to_points_f32(xyzg, 64, NULL, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+        SOGMM_E_NULL_ARG);
+    ROW("R21", sogmm_rgbd_to_points_f32(NULL, 4, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+        SOGMM_E_NULL_ARG);
+    ROW("R22", sogmm_rgbd_to_points_f32(xyzg, 59, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+        SOGMM_E_BUFFER_TOO_SMALL);
+    EXPECT_TRUE(n_pts == 15); /* the size is reported with the error (pixel 0 has no depth) */
+    ROW("R23", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
+                                        3, 2, 2, NULL),
+        SOGMM_E_INVALID_DATA);
+    ROW("R24", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
+        SOGMM_E_INVALID_ARG);
+    /* no valid pixel is not an error here: N = 0 */
+    ROW("R25", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
+                                        2, NULL),
+        SOGMM_OK);
+    EXPECT_TRUE(n_pts == 0);
+  }
 
   /* ---- models from arrays, clone ---- */
   ROW("A1", sogmm_model_from_arrays_f32(NULL, 2, w, mu, cov, 0), SOGMM_E_NULL_ARG);

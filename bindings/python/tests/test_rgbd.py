@@ -75,8 +75,8 @@ def test_rgbd_to_points_formula():
 
 @pytest.mark.parametrize("decimate", [1, 2, 3, 7])
 def test_rgbd_to_points_is_what_the_c_library_fits(decimate):
-    """Fitting rgbd_to_points' output gives bit for bit the model that
-    sogmm_fit_rgbd fits (the C library's own back-projection)."""
+    """Fitting rgbd_to_points' output (sogmm_rgbd_to_points_f32) gives bit
+    for bit the model that sogmm_fit_rgbd fits."""
     depth, color, cam = synthetic_rgbd()
     kw = dict(depth_scale=1000.0, depth_min=0.1, depth_trunc=3.0, decimate=decimate)
     pts = sogmm.rgbd_to_points(depth, color, cam, **kw)
@@ -98,9 +98,18 @@ def test_fit_rgbd_records_the_camera():
     assert m.camera_ == cam
     info = m.info()
     assert info["camera_decimation"] == 2 and info["camera_depth_max"] == 2.5
-    # Float gray goes through Python's back-projection: same points, no camera record.
-    g = sogmm.SOGMM(bandwidth=0.05).fit_rgbd(depth, color[:, :, 1] / 255.0, cam, decimate=2)
-    assert g.camera_ is None and g.support_size_ > 0
+    # Float gray (e.g. a normalised thermal image) goes to the C library too and
+    # records the camera; gray8 / 255 in float32 is the same model as gray8.
+    gray8 = np.ascontiguousarray(color[:, :, 1])
+    g = sogmm.SOGMM(bandwidth=0.05, seed=2).fit_rgbd(depth, gray8.astype(np.float32) / np.float32(255), cam, decimate=2)
+    assert g.camera_ == cam and g.support_size_ > 0
+    _same_model(g, sogmm.SOGMM(bandwidth=0.05, seed=2).fit_rgbd(depth, gray8, cam, decimate=2))
+    bad = gray8.astype(np.float32) / 255
+    bad[3, 4] = np.nan
+    with pytest.raises(sogmm.InvalidDataError, match="not finite"):
+        sogmm.SOGMM().fit_rgbd(depth, bad, cam)
+    with pytest.raises(sogmm.InvalidDataError, match="not finite"):
+        sogmm.rgbd_to_points(depth, bad, cam)
 
 
 # ---- real frames -------------------------------------------------------------

@@ -149,7 +149,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
-/* RGB-D back-projection (sogmm_fit_rgbd only). */
+/* RGB-D back-projection (sogmm_fit_rgbd, sogmm_rgbd_to_points_f32). */
 #define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite; default 1000: raw depth units per metre */
 #define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
 #define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
@@ -195,9 +195,12 @@ SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* poin
 SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
                                                     size_t k, const sogmm_options* options);
 
-/* Layout of the color image given to sogmm_fit_rgbd. */
-#define SOGMM_COLOR_GRAY8 1 /* width * height bytes, gray 0..255 */
-#define SOGMM_COLOR_RGB8 2  /* width * height * 3 bytes, interleaved R, G, B */
+/* Layout of the color image given to sogmm_fit_rgbd and sogmm_rgbd_to_points_f32. */
+#define SOGMM_COLOR_GRAY8 1    /* width * height bytes, gray 0..255 */
+#define SOGMM_COLOR_RGB8 2     /* width * height * 3 bytes, interleaved R, G, B */
+#define SOGMM_COLOR_GRAY_F32 3 /* width * height native floats, gray used as given (meant to be in
+                                * [0, 1], e.g. a normalised thermal image); pass the float array
+                                * cast to const uint8_t*; any alignment. Non-finite -> INVALID_DATA */
 
 /* Fits a model to one RGB-D frame. `depth` holds width * height uint16
  * values (raw units, SOGMM_OPT_DEPTH_SCALE per metre, 0 = no reading),
@@ -206,11 +209,25 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
  * Decimation and the valid depth range come from `options` (NULL =
  * defaults). The model records the camera (SOGMM_INFO_CAMERA_*).
  * Errors: width/height 0 or > INT32_MAX, bad intrinsics, unknown color
- * format, bad depth range -> SOGMM_E_INVALID_ARG; no valid pixel ->
- * SOGMM_E_INVALID_DATA. */
+ * format, bad depth range -> SOGMM_E_INVALID_ARG; no valid pixel or a
+ * non-finite float gray -> SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
                                       int32_t color_format, uint32_t width, uint32_t height, double fx,
                                       double fy, double cx, double cy, const sogmm_options* options);
+
+/* The points sogmm_fit_rgbd fits, without fitting: the valid pixels of the
+ * decimated frame, row by row, as N rows (x, y, z, gray) of float32 in the
+ * camera frame (x right, y down, z forward, metres): z = depth / scale,
+ * x = (u - cx/d) z / (fx/d), y = (v - cy/d) z / (fy/d) on the decimated
+ * pixel grid. Arguments and errors as sogmm_fit_rgbd, except that a frame
+ * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
+ * receives N. `out` has room for `capacity` floats and must hold 4 N, else
+ * SOGMM_E_BUFFER_TOO_SMALL (with *n_points set); out = NULL with capacity 0
+ * only queries N. At most (width / d) * (height / d) points (integer division). */
+SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, size_t* n_points,
+                                                const uint16_t* depth, const uint8_t* color, int32_t color_format,
+                                                uint32_t width, uint32_t height, double fx, double fy, double cx,
+                                                double cy, const sogmm_options* options);
 
 /* ---- models from arrays, copies, release ------------------------------ */
 /* Builds a model from m components: `weights` (m floats, >= 0, summing to 1

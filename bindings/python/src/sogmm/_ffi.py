@@ -56,6 +56,7 @@ OPT_SAMPLE_TRUNCATION = 500
 
 COLOR_GRAY8 = 1
 COLOR_RGB8 = 2
+COLOR_GRAY_F32 = 3
 
 INFO_SUPPORT_SIZE = 1
 INFO_CREATED_UNIX_MS = 2
@@ -119,6 +120,11 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_fit_rgbd": (
         STATUS,
         [HANDLE_OUT, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, HANDLE],
+    ),
+    "sogmm_rgbd_to_points_f32": (
+        STATUS,
+        [F32_OUT, c_size_t, POINTER(c_size_t), U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double,
+         c_double, c_double, HANDLE],
     ),
     "sogmm_model_from_arrays_f32": (STATUS, [HANDLE_OUT, c_size_t, F32_IN, F32_IN, F32_IN, c_uint64]),
     "sogmm_model_clone": (STATUS, [HANDLE_OUT, HANDLE]),

@@ -1,12 +1,9 @@
 """Pinhole camera intrinsics and RGB-D back-projection.
 
-The C API fits RGB-D frames directly (``sogmm_fit_rgbd``) but exports no
-back-projection of its own, so :func:`rgbd_to_points` restates the core's
-few lines here (core/src/camera.cpp: nearest-neighbour decimation with
-source index floor(i * src / dst), intrinsics divided by the factor, valid
-depth in (depth_min, depth_trunc], gray = (0.299 R + 0.587 G + 0.114 B) / 255
-in float32). The tests check that fitting its output gives bit for bit the
-model that ``sogmm_fit_rgbd`` gives.
+:func:`rgbd_to_points` returns the points the C library fits for a frame
+(``sogmm_rgbd_to_points_f32``: nearest-neighbour decimation, intrinsics
+divided by the factor, valid depth in (depth_min, depth_trunc], gray from
+uint8 gray, uint8 RGB or float gray).
 """
 
 from __future__ import annotations
@@ -18,12 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ctypes import byref, c_size_t
+
+from . import _ffi
 from .errors import FormatError, InvalidArgumentError
 
 __all__ = ["Camera", "rgbd_to_points"]
-
-COLOR_GRAY8 = 1
-COLOR_RGB8 = 2
 
 
 @dataclass(frozen=True)
@@ -149,18 +146,6 @@ def prepare_color(color, camera: Camera) -> tuple[str, np.ndarray]:
     raise InvalidArgumentError(f"color must be (H, W) gray or (H, W, 3) RGB, got shape {c.shape}")
 
 
-def gray_image(kind: str, color: np.ndarray) -> np.ndarray:
-    """Gray in [0, 1] as float32, computed as the core does (float arithmetic)."""
-    if kind == "gray8":
-        return color.astype(np.float32) / np.float32(255.0)
-    if kind == "rgb8":
-        r = color[:, :, 0].astype(np.float32)
-        g = color[:, :, 1].astype(np.float32)
-        b = color[:, :, 2].astype(np.float32)
-        return (np.float32(0.299) * r + np.float32(0.587) * g + np.float32(0.114) * b) / np.float32(255.0)
-    return color
-
-
 def check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera: Camera) -> tuple[float, float, float, int]:
     depth_scale, depth_min, depth_trunc = float(depth_scale), float(depth_min), float(depth_trunc)
     if not (math.isfinite(depth_scale) and depth_scale > 0):
@@ -204,29 +189,32 @@ def rgbd_to_points(
     by row, identical to what ``SOGMM.fit_rgbd`` fits.
     """
     camera = _as_camera(camera)
-    d_raw = prepare_depth(depth, camera)
+    d = prepare_depth(depth, camera)
     kind, c = prepare_color(color, camera)
-    depth_scale, depth_min, depth_trunc, d = check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera)
+    depth_scale, depth_min, depth_trunc, dec = check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera)
+    capacity = 4 * (camera.width // dec) * (camera.height // dec)  # every decimated pixel valid
+    out = np.empty(capacity, dtype=np.float32)
+    n = c_size_t(0)
+    with depth_options(depth_scale, depth_min, depth_trunc, dec) as o:
+        _ffi.check(_ffi.lib.sogmm_rgbd_to_points_f32(out, capacity, byref(n), d, color_bytes(c), color_format(kind),
+                                                     camera.width, camera.height, camera.fx, camera.fy, camera.cx,
+                                                     camera.cy, o.ptr))
+    return out[: 4 * n.value].reshape(n.value, 4).copy()
 
-    W, H = camera.width, camera.height
-    dw, dh = W // d, H // d
-    su = np.minimum((np.arange(dw, dtype=np.int64) * W) // dw, W - 1)
-    sv = np.minimum((np.arange(dh, dtype=np.int64) * H) // dh, H - 1)
-    fx, fy, cx, cy = camera.fx / d, camera.fy / d, camera.cx / d, camera.cy / d
 
-    z = d_raw[np.ix_(sv, su)].astype(np.float64) * (1.0 / depth_scale)
-    valid = (z > depth_min) & (z <= depth_trunc)
-    vv, uu = np.nonzero(valid)  # row-major order
-    zz = z[vv, uu]
-    if kind == "grayf":
-        gray = c[np.ix_(sv, su)][vv, uu]
-    else:
-        # Convert only the pixels that are used (same float arithmetic per pixel).
-        picked = c[np.ix_(sv, su)][vv, uu]
-        gray = gray_image(kind, picked[None, ...])[0]
-    out = np.empty((zz.size, 4), dtype=np.float32)
-    out[:, 0] = (uu.astype(np.float64) - cx) * zz / fx
-    out[:, 1] = (vv.astype(np.float64) - cy) * zz / fy
-    out[:, 2] = zz
-    out[:, 3] = gray
-    return out
+def color_format(kind: str) -> int:
+    """The C library's SOGMM_COLOR_* value of a prepare_color kind."""
+    return {"gray8": _ffi.COLOR_GRAY8, "rgb8": _ffi.COLOR_RGB8, "grayf": _ffi.COLOR_GRAY_F32}[kind]
+
+
+def color_bytes(color: np.ndarray) -> np.ndarray:
+    """A prepared color image as the flat bytes the C library reads."""
+    return color.reshape(-1).view(np.uint8)
+
+
+def depth_options(depth_scale: float, depth_min: float, depth_trunc: float, decimate: int) -> "_ffi.Options":
+    """Options handle with the back-projection keys (checked values)."""
+    return _ffi.Options(
+        f64={_ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc},
+        i64={_ffi.OPT_DECIMATION: decimate},
+    )

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _ffi
 from ._ffi import check, lib
-from .camera import Camera, check_depth_options, prepare_color, prepare_depth, rgbd_to_points
+from .camera import Camera, check_depth_options, color_bytes, color_format, prepare_color, prepare_depth
 from .errors import InvalidArgumentError, NotFittedError, NotFoundError
 
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
@@ -565,9 +565,8 @@ class SOGMM(GMM):
                  depth_trunc: float = 3.0, decimate: int = 1) -> "SOGMM":
         """Fits the model to one RGB-D frame (arguments as :func:`sogmm.rgbd_to_points`).
 
-        uint8 gray or RGB color goes straight to the C library, which records
-        the camera in the model (``camera_``). Float gray is back-projected in
-        Python and fitted as points (no camera record). Returns self."""
+        The C library back-projects the frame (uint8 gray, uint8 RGB or float
+        gray) and records the camera in the model (``camera_``). Returns self."""
         if not isinstance(camera, Camera):
             raise InvalidArgumentError(f"camera must be a sogmm.Camera, got {type(camera).__name__}")
         d = prepare_depth(depth, camera)
@@ -575,13 +574,10 @@ class SOGMM(GMM):
         depth_scale, depth_min, depth_trunc, decimate = check_depth_options(
             depth_scale, depth_min, depth_trunc, decimate, camera
         )
-        if kind == "grayf":
-            return self.fit(rgbd_to_points(d, c, camera, depth_scale, depth_min, depth_trunc, decimate))
-        fmt = _ffi.COLOR_GRAY8 if kind == "gray8" else _ffi.COLOR_RGB8
         out = c_void_p()
         extra_f64 = {_ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         with self._fit_options(extra_f64, {_ffi.OPT_DECIMATION: decimate}) as o:
-            check(lib.sogmm_fit_rgbd(byref(out), d, c.reshape(-1), fmt, camera.width, camera.height,
+            check(lib.sogmm_fit_rgbd(byref(out), d, color_bytes(c), color_format(kind), camera.width, camera.height,
                                      camera.fx, camera.fy, camera.cx, camera.cy, o.ptr))
         self._attach(out)
         return self
