@@ -58,11 +58,18 @@ struct DensityCache {
   }
 };
 
+// exp(x) is exactly 0 in double for x below about -745.13; terms further
+// than this below the largest are skipped without changing any sum.
+constexpr double kExpUnderflow = -746.0;
+
 double log_sum_exp(const double* v, std::size_t n) {
   const double mx = *std::max_element(v, v + n);
   if (!std::isfinite(mx)) return mx;
   double s = 0.0;
-  for (std::size_t i = 0; i < n; ++i) s += std::exp(v[i] - mx);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = v[i] - mx;
+    if (d >= kExpUnderflow) s += std::exp(d);
+  }
   return mx + std::log(s);
 }
 
@@ -165,16 +172,22 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3f>(xyz + 3 * i).cast<double>();
-      for (std::size_t k = 0; k < m; ++k) lw[k] = cache.log_component(k, x);
-      const double lse = log_sum_exp(lw.data(), m);
-      double mu = 0.0, second = 0.0;
+      double mx = -std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < m; ++k) mx = std::max(mx, lw[k] = cache.log_component(k, x));
+      // One exp per component that does not underflow: unnormalised weights
+      // e_k = exp(lw_k - max), normalised by their sum at the end.
+      double sum = 0.0, mu = 0.0, second = 0.0;
       for (std::size_t k = 0; k < m; ++k) {
-        const double w = std::exp(lw[k] - lse);
-        if (w == 0.0) continue;
+        const double d = lw[k] - mx;
+        if (!(d >= kExpUnderflow)) continue;
+        const double e = std::exp(d);
         const double lambda = mean_g[k] + gain[k].dot(x - cache.mean[k]);
-        mu += w * lambda;
-        second += w * (cond_var[k] + lambda * lambda);
+        sum += e;
+        mu += e * lambda;
+        second += e * (cond_var[k] + lambda * lambda);
       }
+      mu /= sum;
+      second /= sum;
       mean_out[i] = static_cast<float>(mu);
       if (variance_out) variance_out[i] = static_cast<float>(std::max(0.0, second - mu * mu));
     }
