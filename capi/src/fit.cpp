@@ -1,11 +1,9 @@
 // Fitting: from an N x 4 point array (self-organizing or fixed K) and from a
 // raw RGB-D frame.
-#include <cmath>
-#include <limits>
+#include <memory>
 #include <string>
 
 #include "internal.hpp"
-#include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 
 namespace {
@@ -75,7 +73,6 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   handle->timings.run = r.run;
   return handle.release();
 }
-
 
 }  // namespace
 

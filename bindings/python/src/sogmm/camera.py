@@ -188,33 +188,47 @@ def rgbd_to_points(
     Points are in the camera frame (x right, y down, z forward), ordered row
     by row, identical to what ``SOGMM.fit_rgbd`` fits.
     """
+    f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
+    d = f.i64[_ffi.OPT_DECIMATION]
+    capacity = 4 * (f.camera.width // d) * (f.camera.height // d)  # every decimated pixel valid
+    out = np.empty(capacity, dtype=np.float32)
+    n = c_size_t(0)
+    with _ffi.Options(f64=f.f64, i64=f.i64) as o:
+        _ffi.check(_ffi.lib.sogmm_rgbd_to_points_f32(out, capacity, byref(n), *f.frame_args(), o.ptr))
+    return out[: 4 * n.value].reshape(n.value, 4).copy()
+
+
+_COLOR_FORMATS = {"gray8": _ffi.COLOR_GRAY8, "rgb8": _ffi.COLOR_RGB8, "grayf": _ffi.COLOR_GRAY_F32}
+
+
+@dataclass(frozen=True)
+class PreparedFrame:
+    """An RGB-D frame checked and laid out as the C library's RGB-D calls take it."""
+
+    camera: Camera
+    depth: np.ndarray  # (H, W) C-contiguous uint16
+    color: np.ndarray  # the color image's bytes, flat
+    color_format: int  # SOGMM_COLOR_*
+    f64: dict  # back-projection options (depth scale and range)
+    i64: dict  # (decimation)
+
+    def frame_args(self) -> tuple:
+        """depth, color, color_format, width, height, fx, fy, cx, cy."""
+        c = self.camera
+        return (self.depth, self.color, self.color_format, c.width, c.height, c.fx, c.fy, c.cx, c.cy)
+
+
+def prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate) -> PreparedFrame:
+    """Checks a frame and its back-projection options (InvalidArgumentError)."""
     camera = _as_camera(camera)
     d = prepare_depth(depth, camera)
     kind, c = prepare_color(color, camera)
     depth_scale, depth_min, depth_trunc, dec = check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera)
-    capacity = 4 * (camera.width // dec) * (camera.height // dec)  # every decimated pixel valid
-    out = np.empty(capacity, dtype=np.float32)
-    n = c_size_t(0)
-    with depth_options(depth_scale, depth_min, depth_trunc, dec) as o:
-        _ffi.check(_ffi.lib.sogmm_rgbd_to_points_f32(out, capacity, byref(n), d, color_bytes(c), color_format(kind),
-                                                     camera.width, camera.height, camera.fx, camera.fy, camera.cx,
-                                                     camera.cy, o.ptr))
-    return out[: 4 * n.value].reshape(n.value, 4).copy()
-
-
-def color_format(kind: str) -> int:
-    """The C library's SOGMM_COLOR_* value of a prepare_color kind."""
-    return {"gray8": _ffi.COLOR_GRAY8, "rgb8": _ffi.COLOR_RGB8, "grayf": _ffi.COLOR_GRAY_F32}[kind]
-
-
-def color_bytes(color: np.ndarray) -> np.ndarray:
-    """A prepared color image as the flat bytes the C library reads."""
-    return color.reshape(-1).view(np.uint8)
-
-
-def depth_options(depth_scale: float, depth_min: float, depth_trunc: float, decimate: int) -> "_ffi.Options":
-    """Options handle with the back-projection keys (checked values)."""
-    return _ffi.Options(
+    return PreparedFrame(
+        camera=camera,
+        depth=d,
+        color=c.reshape(-1).view(np.uint8),
+        color_format=_COLOR_FORMATS[kind],
         f64={_ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc},
-        i64={_ffi.OPT_DECIMATION: decimate},
+        i64={_ffi.OPT_DECIMATION: dec},
     )

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _ffi
 from ._ffi import check, lib
-from .camera import Camera, check_depth_options, color_bytes, color_format, prepare_color, prepare_depth
+from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, NotFittedError, NotFoundError
 
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
@@ -567,18 +567,10 @@ class SOGMM(GMM):
 
         The C library back-projects the frame (uint8 gray, uint8 RGB or float
         gray) and records the camera in the model (``camera_``). Returns self."""
-        if not isinstance(camera, Camera):
-            raise InvalidArgumentError(f"camera must be a sogmm.Camera, got {type(camera).__name__}")
-        d = prepare_depth(depth, camera)
-        kind, c = prepare_color(color, camera)
-        depth_scale, depth_min, depth_trunc, decimate = check_depth_options(
-            depth_scale, depth_min, depth_trunc, decimate, camera
-        )
+        f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
         out = c_void_p()
-        extra_f64 = {_ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
-        with self._fit_options(extra_f64, {_ffi.OPT_DECIMATION: decimate}) as o:
-            check(lib.sogmm_fit_rgbd(byref(out), d, color_bytes(c), color_format(kind), camera.width, camera.height,
-                                     camera.fx, camera.fy, camera.cx, camera.cy, o.ptr))
+        with self._fit_options(f.f64, f.i64) as o:
+            check(lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr))
         self._attach(out)
         return self
 
