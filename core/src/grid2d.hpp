@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm::detail {
@@ -28,13 +29,17 @@ class Grid2d {
       max_x = std::max(max_x, xy[2 * i]);
       max_y = std::max(max_y, xy[2 * i + 1]);
     }
-    nx_ = static_cast<std::int64_t>((max_x - min_x_) / cell) + 1;
-    ny_ = static_cast<std::int64_t>((max_y - min_y_) / cell) + 1;
-    // A dense grid is fastest; refuse sizes that would exhaust memory.
-    const double cells = static_cast<double>(nx_) * static_cast<double>(ny_);
-    require(cells <= kMaxCells, ErrorCode::Limit,
-            "bandwidth " + std::to_string(cell) + " is too small for the extent of the data (" +
-                std::to_string(cells) + " grid cells, limit " + std::to_string(kMaxCells) + ")");
+    require(n > 0 && std::isfinite(min_x_) && std::isfinite(min_y_) && std::isfinite(max_x) &&
+                std::isfinite(max_y) && cell > 0,
+            ErrorCode::InvalidData, "neighbour grid: points or cell size are not finite");
+    // A dense grid is fastest; refuse sizes that would exhaust memory. The
+    // per-axis counts are bounded before they are converted to integers.
+    const double fx = std::floor((max_x - min_x_) / cell) + 1, fy = std::floor((max_y - min_y_) / cell) + 1;
+    require(fx * fy <= kMaxCells, ErrorCode::Limit,
+            "cell size " + checked::exact(cell) + " is too small for the extent of the data (" +
+                checked::exact(fx * fy) + " grid cells, limit " + checked::exact(kMaxCells) + ")");
+    nx_ = checked::to_int<std::int64_t>(fx, "grid cells along x");
+    ny_ = checked::to_int<std::int64_t>(fy, "grid cells along y");
     // Counting sort of points by cell: cell c holds order_[start_[c], start_[c+1]).
     start_.assign(static_cast<std::size_t>(nx_ * ny_ + 1), 0);
     std::vector<std::int64_t> cell_of(n);
@@ -66,8 +71,15 @@ class Grid2d {
   }
 
  private:
-  std::int64_t cx(double x) const { return static_cast<std::int64_t>(std::floor((x - min_x_) / cell_)); }
-  std::int64_t cy(double y) const { return static_cast<std::int64_t>(std::floor((y - min_y_) / cell_)); }
+  // Cell index of a coordinate, clamped to [-1, n] before the conversion so
+  // that it is defined for any query (NaN maps to -1: no cell is visited).
+  static std::int64_t clamped_cell(double t, std::int64_t n) {
+    if (!(t >= -1.0)) t = -1.0;
+    if (t > static_cast<double>(n)) t = static_cast<double>(n);
+    return static_cast<std::int64_t>(std::floor(t));
+  }
+  std::int64_t cx(double x) const { return clamped_cell((x - min_x_) / cell_, nx_); }
+  std::int64_t cy(double y) const { return clamped_cell((y - min_y_) / cell_, ny_); }
   std::int64_t cell_index(std::int64_t gx, std::int64_t gy) const { return gy * nx_ + gx; }
 
   const double* xy_;

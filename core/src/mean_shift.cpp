@@ -8,14 +8,25 @@
 #include <utility>
 
 #include "grid2d.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm {
+
+bool bandwidth_is_usable(double bandwidth) {
+  if (!(std::isfinite(bandwidth) && bandwidth > 0)) return false;
+  const double b2 = bandwidth * bandwidth;
+  const double inv = 1.0 / (2.0 * b2);
+  // 9 b^2: the blurring kernel's radius is 3 bandwidths.
+  return b2 > 0 && std::isfinite(9.0 * b2) && std::isfinite(inv) && inv > 0;
+}
+
 namespace {
 
 void check_inputs(const std::vector<double>& points2d, double bandwidth) {
-  require(std::isfinite(bandwidth) && bandwidth > 0, ErrorCode::InvalidArgument,
-          "bandwidth must be positive and finite, got " + std::to_string(bandwidth));
+  require(bandwidth_is_usable(bandwidth), ErrorCode::InvalidArgument,
+          "bandwidth must be a finite positive value whose square and inverse square are finite (about "
+          "1e-150 to 1e150), got " + checked::exact(bandwidth));
   require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
           "mean shift needs a non-empty N x 2 array");
   for (double v : points2d)
@@ -35,9 +46,9 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
     const double extent = (hi - lo) / bandwidth;
     const double magnitude = std::max(std::fabs(lo), std::fabs(hi)) / bandwidth;
     require(extent <= kMaxCellsPerAxis && magnitude <= kMaxBinIndex, ErrorCode::Limit,
-            std::string("bandwidth ") + std::to_string(bandwidth) + " is too small for the " +
-                (axis == 0 ? "range" : "gray") + " values of the data (from " + std::to_string(lo) + " to " +
-                std::to_string(hi) + "): use a larger bandwidth");
+            std::string("bandwidth ") + checked::exact(bandwidth) + " is too small for the " +
+                (axis == 0 ? "range" : "gray") + " values of the data (from " + checked::exact(lo) + " to " +
+                checked::exact(hi) + "): use a larger bandwidth");
   }
 }
 
@@ -72,8 +83,9 @@ std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, B
   }
   auto cell = [&](double v, double lo) {
     // Zero anchor: numpy's round (half to even) as scikit-learn's get_bin_seeds.
-    return anchor == BinAnchor::Zero ? static_cast<std::int64_t>(std::nearbyint(v / bandwidth))
-                                     : static_cast<std::int64_t>(std::floor((v - lo) / bandwidth + 0.5));
+    // check_inputs bounds |v| / bandwidth by 1e15, so these never throw on checked input.
+    return anchor == BinAnchor::Zero ? checked::to_int<std::int64_t>(std::nearbyint(v / bandwidth), "bin index")
+                                     : checked::floor_to_int<std::int64_t>((v - lo) / bandwidth + 0.5, "bin index");
   };
   std::map<std::pair<std::int64_t, std::int64_t>, int> occupied;  // ordered: seeds in a fixed order
   for (std::size_t i = 0; i < xy.size(); i += 2) occupied[{cell(xy[i], min_x), cell(xy[i + 1], min_y)}] = 1;

@@ -13,9 +13,14 @@
 
 namespace {
 
+// Per process, and of a fixed length (the pid zero-padded), so that the
+// length of the path in error messages is the same in every run: a seeded
+// run must execute the same code whatever the pid.
 std::string temp_path() {
   const char* dir = std::getenv("TMPDIR");
-  return std::string(dir && *dir ? dir : "/tmp") + "/sogmm-fuzz-load-file-" + std::to_string(::getpid()) + ".sogmm";
+  char pid[24];
+  std::snprintf(pid, sizeof pid, "%010ld", static_cast<long>(::getpid()));
+  return std::string(dir && *dir ? dir : "/tmp") + "/sogmm-fuzz-load-file-" + pid + ".sogmm";
 }
 
 }  // namespace

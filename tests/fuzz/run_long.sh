@@ -1,12 +1,22 @@
 #!/usr/bin/env bash
-# Runs the libFuzzer targets of tests/fuzz for a bounded time each.
+# Runs the libFuzzer targets of tests/fuzz, either for a bounded time each
+# (a random search: the long campaign) or for a fixed number of runs from a
+# fixed seed (deterministic: what tools/test.sh and CI run).
 #
-# Usage: bash tests/fuzz/run_long.sh [--seconds S] [--jobs J] [--build DIR] [--no-build] [TARGET...]
-#   --seconds S  time per target (default 3600; tools/test.sh uses 60)
+# Usage: bash tests/fuzz/run_long.sh [--seconds S | --runs N [--seed X]] [--jobs J] [--build DIR]
+#                                    [--no-build] [TARGET[=RUNS]...]
+#   --seconds S  time per target (default 3600), random seed, corpus kept and
+#                grown in DIR/fuzz-corpus/<target> across runs
+#   --runs N     exactly N inputs per target from seed X (default 1), starting
+#                from the committed seeds and regressions only (a fresh corpus
+#                each time), no time limit: the same commit gives the same
+#                inputs and so the same verdict on every run
 #   --jobs J     targets run at the same time (default 1)
 #   --build DIR  fuzz build folder (default build-fuzz), configured here with
 #                clang, -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON unless --no-build
-#   TARGET       load_memory load_file verify fit (default: all)
+#   TARGET       load_memory load_file verify fit api (default: all); with
+#                --runs, TARGET=RUNS gives that target its own run count
+#                (the targets' speeds differ by 100x)
 # Corpus: each format target starts from the spec/conformance .sogmm vectors,
 # fit from tests/fuzz/seeds/fit; all from tests/fuzz/regressions/<target>; what it
 # finds is kept in DIR/fuzz-corpus/<target>. A crash writes its input to
@@ -17,6 +27,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 SECONDS_PER_TARGET=3600
+RUNS=""
+FUZZ_SEED=1
 JOBS=1
 BUILD=build-fuzz
 DO_BUILD=1
@@ -24,14 +36,23 @@ TARGETS=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) SECONDS_PER_TARGET=$2; shift 2 ;;
+    --runs) RUNS=$2; shift 2 ;;
+    --seed) FUZZ_SEED=$2; shift 2 ;;
     --jobs) JOBS=$2; shift 2 ;;
     --build) BUILD=$2; shift 2 ;;
     --no-build) DO_BUILD=0; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) TARGETS+=("$1"); shift ;;
   esac
 done
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(load_memory load_file verify fit)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(load_memory load_file verify fit api)
+# TARGET=RUNS: split into the target names and their run counts.
+declare -A RUNS_OF=()
+for i in "${!TARGETS[@]}"; do
+  case "${TARGETS[$i]}" in
+    *=*) RUNS_OF[${TARGETS[$i]%%=*}]=${TARGETS[$i]#*=}; TARGETS[$i]=${TARGETS[$i]%%=*} ;;
+  esac
+done
 
 if [ "$DO_BUILD" = 1 ]; then
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -47,26 +68,42 @@ SEEDS="$BUILD/fuzz-seeds/sogmm"
 rm -rf "$SEEDS" && mkdir -p "$SEEDS"
 cp spec/conformance/valid/*.sogmm spec/conformance/invalid/*.sogmm "$SEEDS/"
 
+# What bounds a run: wall time and a random seed, or a run count and a fixed
+# seed (then the corpus starts empty so that earlier runs cannot change it).
+budget_flags() {
+  if [ -n "$RUNS" ]; then echo "-runs=${RUNS_OF[$1]:-$RUNS} -seed=$FUZZ_SEED -reload=0"; else echo "-max_total_time=$SECONDS_PER_TARGET"; fi
+}
+budget_words() {
+  if [ -n "$RUNS" ]; then echo "from seed $FUZZ_SEED"; else echo "in ${SECONDS_PER_TARGET} s"; fi
+}
+
 run_one() {
   local t=$1
   local corpus="$BUILD/fuzz-corpus/$t" artifacts="$BUILD/fuzz-artifacts/$t" log="$BUILD/fuzz-logs/$t.log"
+  if [ -n "$RUNS" ]; then corpus="$BUILD/fuzz-corpus-seeded/$t"; rm -rf "$corpus" "$artifacts"; fi
   mkdir -p "$corpus" "$artifacts" "$(dirname "$log")"
   local dirs=("$corpus") d
-  [ "$t" = fit ] || dirs+=("$SEEDS")
+  case "$t" in fit|api) ;; *) dirs+=("$SEEDS") ;; esac
   for d in "tests/fuzz/seeds/$t" "tests/fuzz/regressions/$t"; do
     if [ -d "$d" ]; then dirs+=("$d"); fi
   done
   local status=0
+  # A seeded run must execute the same code on every machine and every run:
+  # a fixed environment (libFuzzer's coverage shifted with the caller's
+  # variables) and no address randomisation (it shifted with the addresses).
+  local launch=(env)
+  if [ -n "$RUNS" ]; then launch=(env -i PATH=/usr/bin:/bin LANG=C.UTF-8 TMPDIR=/tmp setarch "$(uname -m)" -R env); fi
+  "${launch[@]}" \
   OMP_NUM_THREADS=1 \
   ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
   UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
     "$BUILD/tests/fuzz/sogmm_fuzz_$t" "${dirs[@]}" \
-      -max_total_time="$SECONDS_PER_TARGET" -timeout=25 -rss_limit_mb=2048 -max_len="$(max_len_for "$t")" \
+      $(budget_flags "$t") -timeout=25 -rss_limit_mb=2048 -max_len="$(max_len_for "$t")" \
       -artifact_prefix="$artifacts/" -print_final_stats=1 >"$log" 2>&1 || status=$?
   local execs
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
   if [ "$status" = 0 ]; then
-    echo "fuzz $t: ${execs:-?} executions in ${SECONDS_PER_TARGET} s, no crash"
+    echo "fuzz $t: ${execs:-?} executions $(budget_words), no crash"
   else
     echo "fuzz $t: FAILED (exit $status) after ${execs:-?} executions; log $log; inputs:" \
       "$(ls "$artifacts" 2>/dev/null | tr '\n' ' ')"

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "internal.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/format.hpp"
@@ -200,6 +201,35 @@ TEST(CoreLimits, CoordinatesTooLargeForTheBandwidthAreRefused) {
   sogmm::FitOptions o;
   o.bandwidth = 1e20;
   EXPECT_NO_THROW(sogmm::fit(sogmm::PointsView{near_far.data(), 2}, o));
+}
+
+// A bandwidth whose square or inverse square is not a finite non-zero double
+// is refused up front with its exact value in the message (4e-314 made the
+// blurring kernel 0 * inf = NaN and the grid cast NaN to an integer:
+// regressions/fit/blurring_bandwidth_denormal). The boundary is where
+// 1 / (2 bw^2) overflows: about 5.3e-155.
+TEST(CoreLimits, BandwidthWhoseInverseSquareOverflowsIsRefused) {
+  const std::vector<float> cloud = {0, 0, 1, 0.5f, 0, 0, 1, 0.5f, 0.01f, 0, 1, 0.5f};
+  for (double bw : {4e-314, 1e-160, 5e-155, 1e155, 1e300}) {
+    EXPECT_FALSE(sogmm::bandwidth_is_usable(bw)) << bw;
+    for (auto counter : {sogmm::ModeCounter::FlatBinned, sogmm::ModeCounter::GaussianBlurring}) {
+      sogmm::FitOptions o;
+      o.mode_counter = counter;
+      o.bandwidth = bw;
+      try {
+        sogmm::fit(sogmm::PointsView{cloud.data(), cloud.size() / 4}, o);
+        ADD_FAILURE() << "fit accepted bandwidth " << bw;
+      } catch (const sogmm::Error& e) {
+        EXPECT_EQ(e.code(), sogmm::ErrorCode::InvalidArgument) << e.what();
+        EXPECT_NE(std::string(e.what()).find(sogmm::checked::exact(bw)), std::string::npos) << e.what();
+      }
+    }
+  }
+  for (double bw : {6e-155, 1e-100, 0.02, 1e100, 1e150}) EXPECT_TRUE(sogmm::bandwidth_is_usable(bw)) << bw;
+  // Both mean shifts refuse it directly too.
+  const std::vector<double> xy = {1.0, 0.5, 1.0, 0.5};
+  EXPECT_THROW(sogmm::mean_shift_gaussian_blurring(xy, 4e-314), sogmm::Error);
+  EXPECT_THROW(sogmm::mean_shift_flat(xy, 4e-314), sogmm::Error);
 }
 
 // ---- reader memory bound ----------------------------------------------------

@@ -28,6 +28,12 @@ struct MeanShiftResult {
   std::size_t size() const { return strengths.size(); }
 };
 
+/// True when `bandwidth` can be used as a mean-shift (and Gaussian kernel)
+/// scale: finite, > 0, and both bandwidth^2 and 1 / (2 bandwidth^2) finite and
+/// non-zero, i.e. roughly 1e-150 < bandwidth < 1e150. Outside that the kernel
+/// weights are 0 * inf = NaN. The C API's option setter applies the same rule.
+bool bandwidth_is_usable(double bandwidth);
+
 /// Flat-kernel mean shift with bin seeding on 2-D data (N x 2, row-major), as
 /// scikit-learn's MeanShift(bin_seeding=True, min_bin_freq=1, cluster_all):
 /// seeds are the centres of occupied grid cells of size `bandwidth`; each moves
@@ -36,8 +42,8 @@ struct MeanShiftResult {
 /// number of points within bandwidth (most first) and a seed within bandwidth
 /// of an already kept one is dropped. Radius queries use a uniform grid of cell
 /// size `bandwidth`. Runs in parallel over seeds; the result does not depend
-/// on the thread count. Throws Error(InvalidArgument) for bandwidth <= 0 or
-/// non-finite, Error(InvalidData) for empty or non-finite data.
+/// on the thread count. Throws Error(InvalidArgument) for a bandwidth that is
+/// not bandwidth_is_usable, Error(InvalidData) for empty or non-finite data.
 MeanShiftResult mean_shift_flat(const std::vector<double>& points2d, double bandwidth,
                                 const MeanShiftOptions& options = {});
 
