@@ -11,6 +11,10 @@
 #                from the committed seeds and regressions only (a fresh corpus
 #                each time), no time limit: the same commit gives the same
 #                inputs and so the same verdict on every run
+#   --keep-going with --seconds: a crash does not end the target (libFuzzer
+#                -fork=1 -ignore_crashes ...): every finding of the campaign is
+#                kept in DIR/fuzz-artifacts/<target>/, and the script fails if
+#                there is any
 #   --jobs J     targets run at the same time (default 1)
 #   --build DIR  fuzz build folder (default build-fuzz), configured here with
 #                clang, -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON unless --no-build
@@ -29,6 +33,7 @@ cd "$(dirname "$0")/../.."
 SECONDS_PER_TARGET=3600
 RUNS=""
 FUZZ_SEED=1
+KEEP_GOING=0
 JOBS=1
 BUILD=build-fuzz
 DO_BUILD=1
@@ -38,10 +43,11 @@ while [ $# -gt 0 ]; do
     --seconds) SECONDS_PER_TARGET=$2; shift 2 ;;
     --runs) RUNS=$2; shift 2 ;;
     --seed) FUZZ_SEED=$2; shift 2 ;;
+    --keep-going) KEEP_GOING=1; shift ;;
     --jobs) JOBS=$2; shift 2 ;;
     --build) BUILD=$2; shift 2 ;;
     --no-build) DO_BUILD=0; shift ;;
-    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,32p' "$0"; exit 0 ;;
     *) TARGETS+=("$1"); shift ;;
   esac
 done
@@ -71,7 +77,9 @@ cp spec/conformance/valid/*.sogmm spec/conformance/invalid/*.sogmm "$SEEDS/"
 # What bounds a run: wall time and a random seed, or a run count and a fixed
 # seed (then the corpus starts empty so that earlier runs cannot change it).
 budget_flags() {
-  if [ -n "$RUNS" ]; then echo "-runs=${RUNS_OF[$1]:-$RUNS} -seed=$FUZZ_SEED -reload=0"; else echo "-max_total_time=$SECONDS_PER_TARGET"; fi
+  if [ -n "$RUNS" ]; then echo "-runs=${RUNS_OF[$1]:-$RUNS} -seed=$FUZZ_SEED -reload=0"; return; fi
+  echo "-max_total_time=$SECONDS_PER_TARGET"
+  if [ "$KEEP_GOING" = 1 ]; then echo "-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"; fi
 }
 budget_words() {
   if [ -n "$RUNS" ]; then echo "from seed $FUZZ_SEED"; else echo "in ${SECONDS_PER_TARGET} s"; fi
@@ -87,23 +95,31 @@ run_one() {
   for d in "tests/fuzz/seeds/$t" "tests/fuzz/regressions/$t"; do
     if [ -d "$d" ]; then dirs+=("$d"); fi
   done
-  local status=0
+  local status=0 cpu
   # A seeded run must execute the same code on every machine and every run:
   # a fixed environment (libFuzzer's coverage shifted with the caller's
   # variables) and no address randomisation (it shifted with the addresses).
   local launch=(env)
   if [ -n "$RUNS" ]; then launch=(env -i PATH=/usr/bin:/bin LANG=C.UTF-8 TMPDIR=/tmp setarch "$(uname -m)" -R env); fi
-  "${launch[@]}" \
+  local TIMEFORMAT="%U %S"  # CPU seconds (user, system) of the target and its forks
+  { time "${launch[@]}" \
   OMP_NUM_THREADS=1 \
   ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
   UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
     "$BUILD/tests/fuzz/sogmm_fuzz_$t" "${dirs[@]}" \
       $(budget_flags "$t") -timeout=25 -rss_limit_mb=2048 -max_len="$(max_len_for "$t")" \
-      -artifact_prefix="$artifacts/" -print_final_stats=1 >"$log" 2>&1 || status=$?
-  local execs
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+      -artifact_prefix="$artifacts/" -print_final_stats=1 >"$log" 2>&1; } 2>"$log.cpu" || status=$?
+  local execs findings
+  execs=$(grep -ao 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+  # Fork mode prints running totals as '#N: cov: ...' instead.
+  [ -n "$execs" ] || execs=$(grep -aoE '^#[0-9]+:' "$log" | tr -d '#:' | tail -1)
+  findings=$(find "$artifacts" -type f | wc -l)
+  cpu=$(awk '{printf "%.0f", $1 + $2}' "$log.cpu" 2>/dev/null || echo "?")
+  if [ "$KEEP_GOING" = 1 ] && [ "$findings" -gt 0 ]; then status=1; fi
   if [ "$status" = 0 ]; then
-    echo "fuzz $t: ${execs:-?} executions $(budget_words), no crash"
+    echo "fuzz $t: ${execs:-?} executions $(budget_words) (${cpu} CPU s), no crash"
+  elif [ "$KEEP_GOING" = 1 ]; then
+    echo "fuzz $t: ${execs:-?} executions $(budget_words) (${cpu} CPU s), $findings findings in $artifacts"
   else
     echo "fuzz $t: FAILED (exit $status) after ${execs:-?} executions; log $log; inputs:" \
       "$(ls "$artifacts" 2>/dev/null | tr '\n' ' ')"
