@@ -22,6 +22,7 @@ DEBIAN_PACKAGES=(
   libcli11-dev nlohmann-json3-dev                 # CLI parsing, JSON
   liboctomap-dev                                  # optional OctoMap baseline in `sogmm bench`
   clang libclang-rt-14-dev libomp-14-dev          # fuzzing and sanitizers (clang's OpenMP)
+  abigail-tools                                   # abidw/abidiff: ABI baseline check (tools/abi, ctest abi_*)
   python3 python3-pip python3-venv
 )
 need_install=()

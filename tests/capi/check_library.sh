@@ -1,6 +1,7 @@
 #!/bin/sh
-# Checks the shipped shared library: exports only sogmm_* symbols, exports
-# every function the public header declares, has SONAME libsogmm.so.<ABI>,
+# Checks the shipped shared library: exports only sogmm_* symbols, each in
+# the version node SOGMM_<ABI> (sogmm_x@@SOGMM_<ABI> in readelf --dyn-syms),
+# exports every function the public header declares, has SONAME libsogmm.so.<ABI>,
 # and depends dynamically only on the C/C++ runtime (no zstd, flatbuffers,
 # OpenCV: they must be linked privately and statically).
 # Usage: check_library.sh <libsogmm.so> <sogmm.h> <abi-version>
@@ -10,11 +11,20 @@ header=$2
 abi=$3
 fail=0
 
-exports=$(nm -D --defined-only "$lib" | awk '{print $NF}' | sed 's/@.*//' | sort -u)
+# Defined dynamic symbols as name@@version (readelf, as the spec states the
+# rule). The version node itself appears as an absolute symbol SOGMM_<ABI>.
+node="SOGMM_$abi"
+dynsyms=$(readelf -W --dyn-syms "$lib" | awk '$1 ~ /^[0-9]+:$/ && $7 != "UND" && $5 != "LOCAL" && $8 != "" {print $8}')
+exports=$(printf '%s\n' "$dynsyms" | grep -vx "$node" | sed 's/@.*//' | sort -u)
 if [ -z "$exports" ]; then echo "no exported symbols in $lib"; exit 1; fi
 bad=$(printf '%s\n' "$exports" | grep -v '^sogmm_' || true)
 if [ -n "$bad" ]; then
   echo "FAIL: symbols exported outside the sogmm_ prefix:"; printf '%s\n' "$bad" | head -50; fail=1
+fi
+# Every sogmm_ symbol is in the version node SOGMM_<ABI> as its default version.
+unversioned=$(printf '%s\n' "$dynsyms" | grep '^sogmm_' | grep -v "@@$node\$" || true)
+if [ -n "$unversioned" ]; then
+  echo "FAIL: sogmm_ symbols without the version node $node:"; printf '%s\n' "$unversioned" | head -50; fail=1
 fi
 
 # Every SOGMM_API function of the header is exported, and nothing else.
@@ -43,6 +53,6 @@ done
 
 count=$(printf '%s\n' "$exports" | wc -l)
 if [ $fail -eq 0 ]; then
-  echo "OK: $count sogmm_* symbols exported (all declared), SONAME $soname, NEEDED: $(echo $needed)"
+  echo "OK: $count sogmm_* symbols exported (all declared, all @@$node), SONAME $soname, NEEDED: $(echo $needed)"
 fi
 exit $fail
