@@ -355,9 +355,15 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
                                              const double* pose);
 
 /* ---- .sogmm files and memory ------------------------------------------ */
-/* Writes `model` to `path` atomically (a temporary file renamed into place:
- * on failure the previous file, if any, is untouched). Write keys of
- * `options` apply. Errors: cannot write -> SOGMM_E_IO. */
+/* Writes `model` to `path` atomically (a temporary file in the same
+ * directory renamed into place: on failure the previous file, if any, is
+ * untouched). A symbolic link is written through: its final target is
+ * replaced and the link kept. The file gets the permission bits of the file
+ * it replaces (never set-user-ID, set-group-ID or sticky bits), or 0666 minus
+ * the umask. Write keys of `options` apply. Errors: metadata too large for a
+ * .sogmm file (2^31 - 1 bytes; 100 000 tables: 99 994 to 99 996 key/value pairs)
+ * -> SOGMM_E_LIMIT, checked before anything is written; cannot write, or the
+ * path names something other than a regular file -> SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* path,
                                         const sogmm_options* options);
 /* Reads a model from `path`. Read keys of `options` apply. Errors: cannot
@@ -365,7 +371,8 @@ SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* pa
  * content invalid -> SOGMM_E_FORMAT / SOGMM_E_INVALID_DATA / SOGMM_E_NUMERIC;
  * decoded size above the cap -> SOGMM_E_LIMIT. */
 SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, const sogmm_options* options);
-/* Serialises `model` into a new buffer (the bytes of a .sogmm file). */
+/* Serialises `model` into a new buffer (the bytes of a .sogmm file).
+ * Errors as sogmm_model_save without SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogmm_model* model,
                                                   const sogmm_options* options);
 /* Reads a model from `size` bytes at `data` (copied as needed). Errors as
