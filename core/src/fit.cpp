@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
 
@@ -39,7 +40,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
   const bool fixed_k = options.n_components > 0;
   if (!fixed_k) {
     require(std::isfinite(options.bandwidth) && options.bandwidth > 0, ErrorCode::InvalidArgument,
-            "bandwidth must be positive and finite, got " + std::to_string(options.bandwidth));
+            "bandwidth must be positive and finite, got " + checked::exact(options.bandwidth));
   } else {
     require(options.n_components <= points.size, ErrorCode::InvalidArgument,
             "number of components K = " + std::to_string(options.n_components) +
@@ -68,7 +69,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
     k = std::min<std::size_t>(std::max<std::size_t>(modes.size(), 1), points.size);
     require(k <= kMaxComponents, ErrorCode::Limit,
             "the mode count found " + std::to_string(k) + " components with bandwidth " +
-                std::to_string(options.bandwidth) + ", over the limit of " + std::to_string(kMaxComponents) +
+                checked::exact(options.bandwidth) + ", over the limit of " + std::to_string(kMaxComponents) +
                 " components per fit: use a larger bandwidth");
     result.seconds_mode_count = seconds_since(t);
   }

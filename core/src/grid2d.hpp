@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm::detail {
@@ -33,8 +34,8 @@ class Grid2d {
     // A dense grid is fastest; refuse sizes that would exhaust memory.
     const double cells = static_cast<double>(nx_) * static_cast<double>(ny_);
     require(cells <= kMaxCells, ErrorCode::Limit,
-            "bandwidth " + std::to_string(cell) + " is too small for the extent of the data (" +
-                std::to_string(cells) + " grid cells, limit " + std::to_string(kMaxCells) + ")");
+            "bandwidth " + checked::exact(cell) + " is too small for the extent of the data (" +
+                checked::exact(cells) + " grid cells, limit " + std::to_string(kMaxCells) + ")");
     // Counting sort of points by cell: cell c holds order_[start_[c], start_[c+1]).
     start_.assign(static_cast<std::size_t>(nx_ * ny_ + 1), 0);
     std::vector<std::int64_t> cell_of(n);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "grid2d.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm {
@@ -15,7 +16,7 @@ namespace {
 
 void check_inputs(const std::vector<double>& points2d, double bandwidth) {
   require(std::isfinite(bandwidth) && bandwidth > 0, ErrorCode::InvalidArgument,
-          "bandwidth must be positive and finite, got " + std::to_string(bandwidth));
+          "bandwidth must be positive and finite, got " + checked::exact(bandwidth));
   require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
           "mean shift needs a non-empty N x 2 array");
   for (double v : points2d)
@@ -35,9 +36,9 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
     const double extent = (hi - lo) / bandwidth;
     const double magnitude = std::max(std::fabs(lo), std::fabs(hi)) / bandwidth;
     require(extent <= kMaxCellsPerAxis && magnitude <= kMaxBinIndex, ErrorCode::Limit,
-            std::string("bandwidth ") + std::to_string(bandwidth) + " is too small for the " +
-                (axis == 0 ? "range" : "gray") + " values of the data (from " + std::to_string(lo) + " to " +
-                std::to_string(hi) + "): use a larger bandwidth");
+            std::string("bandwidth ") + checked::exact(bandwidth) + " is too small for the " +
+                (axis == 0 ? "range" : "gray") + " values of the data (from " + checked::exact(lo) + " to " +
+                checked::exact(hi) + "): use a larger bandwidth");
   }
 }
 
