@@ -106,12 +106,16 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
     require_nonnull(out, "out");
     require_nonnull(model, "model");
     require_nonnull(pose, "pose");
-    sogmm_capi::require_rigid(pose, "pose");
-    std::array<double, 16> t;
-    for (int i = 0; i < 16; ++i) t[i] = pose[i];
+    const std::array<double, 16> t = sogmm_capi::require_rigid(pose, "pose");
     auto handle = std::make_unique<sogmm_model>(*model);
     handle->model.gmm = sogmm::transform(model->model.gmm, t);
-    if (handle->model.pose) handle->model.pose = mul4(*handle->model.pose, rigid_inverse(t));
+    if (handle->model.pose) {
+      // P * pose^-1 of two valid poses is finite unless a translation overflows.
+      const std::array<double, 16> moved = mul4(*handle->model.pose, rigid_inverse(t));
+      const std::string problem = sogmm::rigid_pose_error(moved);
+      if (!problem.empty()) fail(SOGMM_E_INVALID_ARG, "the model's pose moved by pose: " + problem);
+      handle->model.pose = moved;
+    }
     *out = handle.release();
   }
   SOGMM_CATCH

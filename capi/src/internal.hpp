@@ -3,6 +3,7 @@
 // argument checks. Never installed.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -109,8 +110,9 @@ inline std::size_t checked_mul(std::size_t n, std::size_t k, const char* what) {
 /// SOGMM_E_INVALID_DATA unless all `count` floats are finite.
 void require_finite(const float* values, std::size_t count, const char* what);
 
-/// SOGMM_E_INVALID_ARG unless the 16 doubles are a finite rigid transform.
-void require_rigid(const double* pose, const char* what);
+/// The 16 doubles as a pose; SOGMM_E_INVALID_ARG naming the problem unless
+/// sogmm::rigid_pose_error accepts them (the one pose rule of the library).
+std::array<double, 16> require_rigid(const double* pose, const char* what);
 
 /// An RGB-D frame checked and back-projected as sogmm_fit_rgbd and
 /// sogmm_rgbd_to_points_f32 take it.

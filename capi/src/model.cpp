@@ -8,6 +8,8 @@
 #include <string>
 
 #include "internal.hpp"
+#include "keys.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/gmm.hpp"
 
 namespace {
@@ -27,56 +29,8 @@ void copy_out(const std::vector<float>& src, float* out, std::size_t capacity, c
   if (!src.empty()) std::memcpy(out, src.data(), src.size() * sizeof(float));
 }
 
-enum class InfoType { None, F64, I64 };
-
-InfoType info_type(sogmm_key key) {
-  switch (key) {
-    case SOGMM_INFO_FIT_LOG_LIKELIHOOD:
-    case SOGMM_INFO_FIT_BANDWIDTH:
-    case SOGMM_INFO_FIT_TOL:
-    case SOGMM_INFO_FIT_REG_COVAR:
-    case SOGMM_INFO_FIT_SECONDS_MODE_COUNT:
-    case SOGMM_INFO_FIT_SECONDS_SEEDING:
-    case SOGMM_INFO_FIT_SECONDS_EM:
-    case SOGMM_INFO_FIT_SECONDS_TOTAL:
-    case SOGMM_INFO_CAMERA_FX:
-    case SOGMM_INFO_CAMERA_FY:
-    case SOGMM_INFO_CAMERA_CX:
-    case SOGMM_INFO_CAMERA_CY:
-    case SOGMM_INFO_CAMERA_DEPTH_SCALE:
-    case SOGMM_INFO_CAMERA_DEPTH_MIN:
-    case SOGMM_INFO_CAMERA_DEPTH_MAX:
-      return InfoType::F64;
-    case SOGMM_INFO_SUPPORT_SIZE:
-    case SOGMM_INFO_CREATED_UNIX_MS:
-    case SOGMM_INFO_FIT_ITERATIONS:
-    case SOGMM_INFO_FIT_CONVERGED:
-    case SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED:
-    case SOGMM_INFO_FIT_MAX_ITER:
-    case SOGMM_INFO_FIT_SEED:
-    case SOGMM_INFO_FIT_N_POINTS:
-    case SOGMM_INFO_FIT_N_INIT:
-    case SOGMM_INFO_FIT_RUN:
-    case SOGMM_INFO_CAMERA_WIDTH:
-    case SOGMM_INFO_CAMERA_HEIGHT:
-    case SOGMM_INFO_CAMERA_DECIMATION:
-      return InfoType::I64;
-    default:
-      return InfoType::None;
-  }
-}
-
-void require_info_type(sogmm_key key, InfoType wanted) {
-  const InfoType t = info_type(key);
-  if (t == InfoType::None) fail(SOGMM_E_INVALID_ARG, "unknown info key " + std::to_string(key));
-  if (t != wanted)
-    fail(SOGMM_E_INVALID_ARG, "info key " + std::to_string(key) + " is " +
-                                  (t == InfoType::F64 ? "f64: use sogmm_model_get_info_f64"
-                                                      : "i64: use sogmm_model_get_info_i64"));
-}
-
 [[noreturn]] void absent(sogmm_key key, const char* what) {
-  fail(SOGMM_E_NOT_FOUND, "info key " + std::to_string(key) + ": the model has no " + what);
+  fail(SOGMM_E_NOT_FOUND, "info key " + sogmm_capi::key_label(key) + ": the model has no " + what);
 }
 
 const sogmm::FitInfo& fit_info(const sogmm_model& m, sogmm_key key) {
@@ -143,11 +97,11 @@ void require_weights_and_symmetry(const sogmm::Gmm& g) {
   for (std::size_t k = 0; k < g.size(); ++k) {
     if (!(g.weights[k] >= 0.0f))
       fail(SOGMM_E_INVALID_DATA, "weights: component " + std::to_string(k) + " has a negative weight " +
-                                     std::to_string(g.weights[k]));
+                                     sogmm::checked::exact(g.weights[k]));
     sum += g.weights[k];
   }
   if (std::fabs(sum - 1.0) > 1e-4)
-    fail(SOGMM_E_INVALID_DATA, "weights sum to " + std::to_string(sum) + ", not 1 (tolerance 1e-4)");
+    fail(SOGMM_E_INVALID_DATA, "weights sum to " + sogmm::checked::exact(sum) + ", not 1 (tolerance 1e-4)");
   for (std::size_t k = 0; k < g.size(); ++k) {
     const float* c = g.covariance(k);
     double scale = 0.0, asym = 0.0;
@@ -250,7 +204,7 @@ SOGMM_API sogmm_status sogmm_model_get_info_f64(const sogmm_model* model, sogmm_
   SOGMM_TRY {
     require_nonnull(model, "model");
     require_nonnull(out, "out");
-    require_info_type(key, InfoType::F64);
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::Info, sogmm_capi::KeyType::F64, "get");
     *out = info_f64(*model, key);
   }
   SOGMM_CATCH
@@ -260,7 +214,7 @@ SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_
   SOGMM_TRY {
     require_nonnull(model, "model");
     require_nonnull(out, "out");
-    require_info_type(key, InfoType::I64);
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::Info, sogmm_capi::KeyType::I64, "get");
     *out = info_i64(*model, key);
   }
   SOGMM_CATCH
@@ -280,10 +234,7 @@ SOGMM_API sogmm_status sogmm_model_set_pose(sogmm_model* model, const double* po
   SOGMM_TRY {
     require_nonnull(model, "model");
     require_nonnull(pose, "pose");
-    sogmm_capi::require_rigid(pose, "pose");
-    std::array<double, 16> p;
-    std::copy(pose, pose + 16, p.begin());
-    model->model.pose = p;
+    model->model.pose = sogmm_capi::require_rigid(pose, "pose");
   }
   SOGMM_CATCH
 }

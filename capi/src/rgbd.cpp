@@ -6,13 +6,14 @@
 #include <string>
 
 #include "internal.hpp"
+#include "sogmm/checked.hpp"
 
 namespace sogmm_capi {
 namespace {
 
 void require_intrinsic(double v, bool positive, const char* name) {
   if (!std::isfinite(v) || (positive && !(v > 0)))
-    fail(SOGMM_E_INVALID_ARG, std::string(name) + " = " + std::to_string(v) + " is invalid (" +
+    fail(SOGMM_E_INVALID_ARG, std::string(name) + " = " + sogmm::checked::exact(v) + " is invalid (" +
                                   (positive ? "must be finite and > 0)" : "must be finite)"));
 }
 
@@ -44,8 +45,8 @@ RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* colo
   if (width == 0 || height == 0 || width > kMax || height > kMax)
     fail(SOGMM_E_INVALID_ARG, "image size " + std::to_string(width) + " x " + std::to_string(height) +
                                   " is invalid (each side in [1, 2^31-1])");
-  const std::size_t pixels = checked_mul(width, height, "image");
-  checked_mul(pixels, 4, "color image");
+  const std::size_t pixels = sogmm::checked::mul<std::size_t>(width, height, "image pixels");
+  sogmm::checked::bytes(pixels, sizeof(float), "color image bytes");
   require_intrinsic(fx, true, "fx");
   require_intrinsic(fy, true, "fy");
   require_intrinsic(cx, false, "cx");
@@ -63,13 +64,14 @@ RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* colo
   r.depth.depth_max = o.depth_max;
   r.depth.decimate = static_cast<int>(o.decimation);
   if (!(o.depth_min < o.depth_max))
-    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + std::to_string(o.depth_min) +
-                                  " must be < SOGMM_OPT_DEPTH_MAX = " + std::to_string(o.depth_max));
+    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + sogmm::checked::exact(o.depth_min) +
+                                  " must be < SOGMM_OPT_DEPTH_MAX = " + sogmm::checked::exact(o.depth_max));
   if (o.decimation > static_cast<std::int64_t>(width) || o.decimation > static_cast<std::int64_t>(height))
     fail(SOGMM_E_INVALID_ARG, "decimation " + std::to_string(o.decimation) + " leaves no pixel of a " +
                                   std::to_string(width) + " x " + std::to_string(height) + " image");
-  sogmm::validate(r.camera);
-  sogmm::validate(r.depth);
+  // Before the color image is converted: the size limit and the finiteness of
+  // the back-projection depend on the image size and parameters only.
+  sogmm::check_backprojection(r.camera, r.depth);
 
   const sogmm::GrayImage gray =
       color_format == SOGMM_COLOR_RGB8     ? sogmm::gray_from_rgb_image(color, r.camera.width, r.camera.height)
@@ -93,18 +95,18 @@ SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, siz
                                                 const sogmm_options* options) {
   SOGMM_TRY {
     sogmm_capi::require_nonnull(n_points, "n_points");
-    *n_points = 0;
     if (out == nullptr && capacity != 0) sogmm_capi::fail(SOGMM_E_NULL_ARG, "out is NULL but capacity is not 0");
     const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_rgbd(
         depth, color, color_format, width, height, fx, fy, cx, cy, sogmm_capi::opts_or_default(options));
     const std::size_t n = r.cloud.size();
-    *n_points = n;
-    if (out == nullptr) return SOGMM_OK;  // size query
-    if (capacity < 4 * n)
+    if (out != nullptr && capacity < r.cloud.xyzg.size()) {
+      *n_points = n;  // the documented exception: the size to allocate comes with the error
       sogmm_capi::fail(SOGMM_E_BUFFER_TOO_SMALL, "out has room for " + std::to_string(capacity) +
                                                      " floats but the frame has " + std::to_string(n) +
-                                                     " points (" + std::to_string(4 * n) + " floats)");
-    std::memcpy(out, r.cloud.xyzg.data(), 4 * n * sizeof(float));
+                                                     " points (" + std::to_string(r.cloud.xyzg.size()) + " floats)");
+    }
+    if (out != nullptr && n > 0) std::memcpy(out, r.cloud.xyzg.data(), r.cloud.xyzg.size() * sizeof(float));
+    *n_points = n;
   }
   SOGMM_CATCH
 }

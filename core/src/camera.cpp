@@ -1,11 +1,14 @@
 // Pinhole camera, decimation and back-projection.
 #include "sogmm/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/fit.hpp"
 
 namespace sogmm {
 
@@ -20,13 +23,56 @@ void validate(const Camera& c) {
 
 void validate(const DepthOptions& o) {
   require(std::isfinite(o.depth_scale) && o.depth_scale > 0, ErrorCode::InvalidArgument,
-          "depth scale must be positive, got " + std::to_string(o.depth_scale));
+          "depth scale must be positive, got " + checked::exact(o.depth_scale));
   require(std::isfinite(o.depth_min) && std::isfinite(o.depth_max) && o.depth_min >= 0 && o.depth_min < o.depth_max,
           ErrorCode::InvalidArgument,
-          "depth range must satisfy 0 <= min < max, got (" + std::to_string(o.depth_min) + ", " +
-              std::to_string(o.depth_max) + "]");
+          "depth range must satisfy 0 <= min < max, got (" + checked::exact(o.depth_min) + ", " +
+              checked::exact(o.depth_max) + "]");
   require(o.decimate >= 1, ErrorCode::InvalidArgument,
           "decimation factor must be >= 1, got " + std::to_string(o.decimate));
+}
+
+namespace {
+
+bool fits_float(double v) { return std::isfinite(static_cast<float>(v)); }
+
+// Largest |(p - c) z / f| over the pixel coordinates p in [0, size) and depths
+// z in [0, z_max], computed as backproject() computes each coordinate: IEEE
+// rounding is monotonic, so no pixel gives a larger magnitude.
+double largest_coordinate(int size, double c, double f, double z_max) {
+  const double span = std::max(std::fabs(0.0 - c), std::fabs(static_cast<double>(size - 1) - c));
+  return span * z_max / f;
+}
+
+}  // namespace
+
+void check_backprojection(const Camera& camera, const DepthOptions& options) {
+  validate(camera);
+  validate(options);
+  const Camera cam = decimated(camera, options.decimate);
+  const auto pixels = checked::mul<std::uint64_t>(static_cast<std::uint64_t>(cam.width),
+                                                  static_cast<std::uint64_t>(cam.height), "decimated image pixels");
+  require(pixels <= kMaxPoints, ErrorCode::Limit,
+          "the decimated image has " + std::to_string(cam.width) + " x " + std::to_string(cam.height) + " = " +
+              std::to_string(pixels) + " pixels, over the limit of " + std::to_string(kMaxPoints) +
+              " points per fit: use a larger decimation");
+  // A pixel is valid when depth_min < raw / depth_scale <= depth_max, raw <= 65535.
+  const double z_raw_max = 65535.0 * (1.0 / options.depth_scale);
+  if (!(z_raw_max > options.depth_min)) return;  // no pixel can be valid
+  const double z_max = std::min(z_raw_max, options.depth_max);
+  require(fits_float(z_max), ErrorCode::InvalidArgument,
+          "depth scale " + checked::exact(options.depth_scale) + " and depth_max " + checked::exact(options.depth_max) +
+              " let z reach " + checked::exact(z_max) + " m, beyond the float32 range");
+  const double x_max = largest_coordinate(cam.width, cam.cx, cam.fx, z_max);
+  require(fits_float(x_max), ErrorCode::InvalidArgument,
+          "fx = " + checked::exact(camera.fx) + " and cx = " + checked::exact(camera.cx) + " let x reach " +
+              checked::exact(x_max) + " m (depth up to " + checked::exact(z_max) +
+              " m), beyond the float32 range: the intrinsics are invalid");
+  const double y_max = largest_coordinate(cam.height, cam.cy, cam.fy, z_max);
+  require(fits_float(y_max), ErrorCode::InvalidArgument,
+          "fy = " + checked::exact(camera.fy) + " and cy = " + checked::exact(camera.cy) + " let y reach " +
+              checked::exact(y_max) + " m (depth up to " + checked::exact(z_max) +
+              " m), beyond the float32 range: the intrinsics are invalid");
 }
 
 Camera decimated(const Camera& camera, int d) {
@@ -74,8 +120,7 @@ namespace {
 // Visits the valid pixels of the decimated frame in row-major order.
 template <typename Visit>
 void for_each_valid_pixel(const RgbdView& frame, const DepthOptions& options, Visit&& visit) {
-  validate(frame.camera);
-  validate(options);
+  check_backprojection(frame.camera, options);
   require(frame.depth != nullptr, ErrorCode::InvalidData, "depth image is empty");
   require(frame.gray != nullptr, ErrorCode::InvalidData, "gray image is empty");
   const Camera cam = decimated(frame.camera, options.decimate);

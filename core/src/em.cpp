@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "em_kernel.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm {
@@ -32,13 +33,13 @@ constexpr std::size_t kMaxBlocksPerChunk = 32;
 
 void check_options(const EmOptions& o) {
   require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
-          "EM tol must be finite and >= 0, got " + std::to_string(o.tol));
+          "EM tol must be finite and >= 0, got " + checked::exact(o.tol));
   require(std::isfinite(o.reg_covar) && o.reg_covar >= 0, ErrorCode::InvalidArgument,
-          "EM reg_covar must be finite and >= 0, got " + std::to_string(o.reg_covar));
+          "EM reg_covar must be finite and >= 0, got " + checked::exact(o.reg_covar));
   require(o.max_iter >= 1, ErrorCode::InvalidArgument, "EM max_iter must be >= 1, got " + std::to_string(o.max_iter));
   require(o.threads >= 0, ErrorCode::InvalidArgument, "EM threads must be >= 0, got " + std::to_string(o.threads));
   require(std::isfinite(o.truncation_nats) && o.truncation_nats >= 0, ErrorCode::InvalidArgument,
-          "EM truncation_nats must be finite and >= 0 (0 = exact), got " + std::to_string(o.truncation_nats));
+          "EM truncation_nats must be finite and >= 0 (0 = exact), got " + checked::exact(o.truncation_nats));
 }
 
 // Points as four coordinate arrays (structure of arrays), padded to whole

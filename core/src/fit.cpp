@@ -70,7 +70,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
     k = std::min<std::size_t>(std::max<std::size_t>(modes.size(), 1), points.size);
     require(k <= kMaxComponents, ErrorCode::Limit,
             "the mode count found " + std::to_string(k) + " components with bandwidth " +
-                std::to_string(options.bandwidth) + ", over the limit of " + std::to_string(kMaxComponents) +
+                checked::exact(options.bandwidth) + ", over the limit of " + std::to_string(kMaxComponents) +
                 " components per fit: use a larger bandwidth");
     result.seconds_mode_count = seconds_since(t);
   }

@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm {
@@ -24,13 +25,13 @@ std::string validation_error(const Gmm& gmm, double weight_tolerance) {
   for (std::size_t k = 0; k < m; ++k) {
     const float w = gmm.weights[k];
     if (!std::isfinite(w) || w < 0.0f) {
-      msg << "component " << k << " has an invalid weight " << w;
+      msg << "component " << k << " has an invalid weight " << checked::exact(w);
       return msg.str();
     }
     sum += w;
   }
   if (std::fabs(sum - 1.0) > weight_tolerance) {
-    msg << "weights sum to " << sum << ", not 1";
+    msg << "weights sum to " << checked::exact(sum) << ", not 1";
     return msg.str();
   }
   for (std::size_t k = 0; k < m; ++k) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "container.hpp"
+#include "sogmm/model.hpp"
 
 namespace sogmm::format::detail {
 namespace {
@@ -98,24 +99,10 @@ void check_values(const ArraysView& a) {
 }
 
 void check_pose(const std::array<double, 16>& p) {
-  for (double v : p) {
-    if (!std::isfinite(v)) fail(ErrorCode::InvalidData, "bad_pose", "pose has a non-finite entry");
-  }
-  if (p[12] != 0.0 || p[13] != 0.0 || p[14] != 0.0 || p[15] != 1.0) {
-    fail(ErrorCode::InvalidData, "bad_pose", "pose's last row is not (0, 0, 0, 1)");
-  }
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      double dot = 0.0;
-      for (int k = 0; k < 3; ++k) dot += p[k * 4 + i] * p[k * 4 + j];
-      if (std::fabs(dot - (i == j ? 1.0 : 0.0)) > kPoseTolerance) {
-        fail(ErrorCode::InvalidData, "bad_pose", "pose's rotation block is not orthonormal");
-      }
-    }
-  }
-  const double det = p[0] * (p[5] * p[10] - p[6] * p[9]) - p[1] * (p[4] * p[10] - p[6] * p[8]) +
-                     p[2] * (p[4] * p[9] - p[5] * p[8]);
-  if (!(det > 0.0)) fail(ErrorCode::InvalidData, "bad_pose", "pose's rotation block is a reflection");
+  // The library's one pose rule (sogmm/model.hpp), so that every pose that
+  // sogmm_model_set_pose accepts can be saved and loaded again.
+  const std::string problem = rigid_pose_error(p);
+  if (!problem.empty()) fail(ErrorCode::InvalidData, "bad_pose", "pose: " + problem);
 }
 
 }  // namespace sogmm::format::detail

@@ -11,7 +11,6 @@ namespace sogmm::format::detail {
 /// Tolerances of the value checks (normative, spec/format.md section 9).
 inline constexpr double kWeightSumTolerance = 1e-4;
 inline constexpr double kSymmetryTolerance = 1e-5;
-inline constexpr double kPoseTolerance = 1e-3;
 
 /// Model arrays widened to double. `cov` holds 10 values per component when
 /// `packed`, else 16 (row-major).
@@ -27,9 +26,9 @@ struct ArraysView {
 /// reason non_finite, bad_weights, not_symmetric or not_spd (ErrorCode::Numeric).
 void check_values(const ArraysView& a);
 
-/// Throws FormatError("bad_pose", InvalidData) unless the pose is finite,
-/// has last row (0, 0, 0, 1) and a rotation block R with |R^T R - I| <= 1e-3
-/// entrywise and det(R) > 0.
+/// Throws FormatError("bad_pose", InvalidData) unless sogmm::rigid_pose_error
+/// accepts the pose: finite, last row (0, 0, 0, 1) and a rotation block R with
+/// |R^T R - I| <= sogmm::kPoseTolerance (1e-3) entrywise and det(R) > 0.
 void check_pose(const std::array<double, 16>& pose);
 
 /// Full symmetric 4x4 from the 10 upper-triangle values (row by row).

@@ -20,6 +20,9 @@ inline constexpr std::array<std::uint8_t, 4> kEndMagic = {'S', 'G', 'M', 'M'};
 inline constexpr std::size_t kHeaderSize = 32;
 inline constexpr std::size_t kTrailerSize = 4;
 inline constexpr std::size_t kMinFileSize = kHeaderSize + kTrailerSize;
+/// Metadata blocks must be smaller than this: FlatBuffers' limit (offsets are
+/// 32-bit signed), FLATBUFFERS_MAX_BUFFER_SIZE, exclusive.
+inline constexpr std::uint64_t kMetadataLengthLimit = (std::uint64_t{1} << 31) - 1;
 /// Feature bits this reader knows (format 1.0 defines none).
 inline constexpr std::uint64_t kKnownFeatures = 0;
 

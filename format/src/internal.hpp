@@ -2,7 +2,9 @@
 // generator only. Not installed, not part of the public API.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,7 +45,17 @@ enum class SaveStage { Open, WriteHalf, Fsync, Rename };
 using SaveFaultHook = bool (*)(SaveStage stage);
 void set_save_fault_hook(SaveFaultHook hook);
 
-/// Writes `bytes` to `path` atomically (what save() uses).
-void atomic_write(const std::string& path, const std::vector<std::uint8_t>& bytes);
+/// Receives the bytes of a file in order, a chunk at a time.
+using ByteSink = std::function<void(const std::uint8_t* data, std::size_t size)>;
+
+/// Writes a file of `size` bytes atomically (what save() uses): `produce`
+/// hands the bytes, in order, to the sink it is given, which writes them to a
+/// temporary file in the directory of the final target of `path` (symbolic
+/// links are followed, so a link keeps pointing at the new model), created
+/// with the target's permission bits (set-user-ID, set-group-ID and sticky
+/// bits dropped) and a name that fits NAME_MAX; the temporary file is fsync'ed
+/// and renamed over the target. Throws Error(Io) and leaves the previous file
+/// and no temporary file on failure, also when `produce` throws.
+void atomic_write(const std::string& path, std::uint64_t size, const std::function<void(const ByteSink&)>& produce);
 
 }  // namespace sogmm::format::detail

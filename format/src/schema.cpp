@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "checks.hpp"
@@ -82,9 +83,9 @@ const char* const kArrayNames[3] = {"weights", "means", "covariances"};
 
 }  // namespace
 
-std::vector<std::uint8_t> build_metadata(const Model& model, const ArrayRecord (&arrays)[3], std::uint64_t n_declared,
-                                         bool packed, const Tweaks& t) {
-  flatbuffers::FlatBufferBuilder b(1024);
+flatbuffers::DetachedBuffer build_metadata(const Model& model, const ArrayRecord (&arrays)[3], std::uint64_t n_declared,
+                                           bool packed, const Tweaks& t, std::size_t size_hint) {
+  flatbuffers::FlatBufferBuilder b(size_hint);
   // Children first (FlatBuffers builds bottom-up).
   const auto weights = build_array(b, arrays[kWeights]);
   const auto means = build_array(b, arrays[kMeans]);
@@ -151,7 +152,17 @@ std::vector<std::uint8_t> build_metadata(const Model& model, const ArrayRecord (
     root.fbb_.AddOffset(flatbuffers::FieldIndexToOffset(21), unknown_string);
   }
   b.Finish(root.Finish(), fb::SogmmFileIdentifier());
-  return std::vector<std::uint8_t>(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+  return b.Release();
+}
+
+void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3], const bool (&patch)[3]) {
+  fb::SogmmFile* root = fb::GetMutableSogmmFile(metadata);
+  fb::Array* const arrays[3] = {root->mutable_weights(), root->mutable_means(), root->mutable_covariances()};
+  for (int i = 0; i < 3; ++i) {
+    if (patch[i] && !arrays[i]->mutate_offset(offsets[i])) {
+      throw std::logic_error(std::string(kArrayNames[i]) + ": the metadata has no offset field to patch");
+    }
+  }
 }
 
 ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, const ReadOptions& options) {
@@ -164,7 +175,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, con
   if (!flatbuffers::BufferHasIdentifier(buf, fb::SogmmFileIdentifier())) {
     fail(F, "bad_metadata", "metadata file identifier is not \"SGMM\"");
   }
-  flatbuffers::Verifier verifier(buf, h.metadata_length, /*max_depth=*/64, /*max_tables=*/100000);
+  flatbuffers::Verifier verifier(buf, h.metadata_length, /*max_depth=*/64, kMaxMetadataTables);
   if (!fb::VerifySogmmFileBuffer(verifier)) fail(F, "bad_metadata", "metadata fails FlatBuffers verification");
   const fb::SogmmFile* root = fb::GetSogmmFile(buf);
 

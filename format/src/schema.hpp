@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <flatbuffers/detached_buffer.h>
+
 #include "container.hpp"
 #include "internal.hpp"
 
@@ -20,10 +22,22 @@ struct ArrayRecord {
 /// Index of the arrays in the records below.
 enum { kWeights = 0, kMeans = 1, kCovariances = 2 };
 
+/// Most tables a reader verifies in one metadata block (spec/format.md
+/// section 4.3); a writer never emits more.
+inline constexpr std::uint32_t kMaxMetadataTables = 100000;
+
 /// Builds the metadata FlatBuffer of `model` (arrays excluded) with the given
-/// array records, declared M and covariance layout.
-std::vector<std::uint8_t> build_metadata(const Model& model, const ArrayRecord (&arrays)[3], std::uint64_t n_declared,
-                                         bool packed, const Tweaks& tweaks);
+/// array records, declared M and covariance layout. Every array's offset field
+/// is written (a record's offset is never 0), so set_array_offsets() can fill
+/// in the real offsets once the block's length is known. `size_hint` (an upper
+/// bound of the result) sizes the builder so that it never grows by copying.
+flatbuffers::DetachedBuffer build_metadata(const Model& model, const ArrayRecord (&arrays)[3], std::uint64_t n_declared,
+                                           bool packed, const Tweaks& tweaks, std::size_t size_hint);
+
+/// Overwrites the offset of array i (0: weights, 1: means, 2: covariances)
+/// with offsets[i] in a block from build_metadata(), for each i with
+/// patch[i] set.
+void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3], const bool (&patch)[3]);
 
 /// The metadata once verified.
 struct ParsedMetadata {

@@ -127,6 +127,13 @@ int main(int argc, char** argv) {
   ROW("O40", sogmm_options_get_i64(o, 0, &i64), SOGMM_E_INVALID_ARG);
   ROW("O41", sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 0), SOGMM_E_INVALID_ARG);
   ROW("O42", sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1001), SOGMM_E_INVALID_ARG);
+  ROW("O43", sogmm_options_set_f64(o, SOGMM_INFO_FIT_LOG_LIKELIHOOD, 0.5), SOGMM_E_INVALID_ARG);
+  ROW("O44", sogmm_options_set_i64(o, SOGMM_INFO_FIT_ITERATIONS, 5), SOGMM_E_INVALID_ARG);
+  ROW("O45", sogmm_options_get_f64(o, SOGMM_INFO_FIT_TOL, &f64), SOGMM_E_INVALID_ARG);
+  ROW("O46", sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 4e-314), SOGMM_E_INVALID_ARG);
+  ROW("O47", sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 1e154), SOGMM_E_INVALID_ARG);
+  ROW("O48", sogmm_options_set_f64(o, SOGMM_OPT_REG_COVAR, 1e39), SOGMM_E_INVALID_ARG);
+  ROW("O49", sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_SCALE, 1e-310), SOGMM_E_INVALID_ARG);
   /* a rejected value leaves the option unchanged */
   REQUIRE_OK(sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &f64));
   EXPECT_TRUE(f64 == 0.02);
@@ -203,13 +210,36 @@ int main(int argc, char** argv) {
     ROW("R23", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
                                         3, 2, 2, NULL),
         SOGMM_E_INVALID_DATA);
+    n_pts = 99;
     ROW("R24", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
         SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(n_pts == 99); /* an error other than BUFFER_TOO_SMALL writes no out-parameter */
     /* no valid pixel is not an error here: N = 0 */
     ROW("R25", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
                                         2, NULL),
         SOGMM_OK);
     EXPECT_TRUE(n_pts == 0);
+    ROW_OUT("R26", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 1e-300, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
+    n_pts = 99;
+    ROW("R27", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, NULL),
+        SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(n_pts == 99);
+  }
+  {
+    /* 8200 x 8200 zero pixels (calloc: untouched pages), over 2^26 points: refused from the size */
+    const uint32_t big = 8200;
+    uint16_t* big_depth = (uint16_t*)calloc((size_t)big * big, sizeof(uint16_t));
+    uint8_t* big_gray = (uint8_t*)calloc((size_t)big * big, 1);
+    size_t n_pts = 99;
+    REQUIRE_OK(big_depth && big_gray ? SOGMM_OK : SOGMM_E_NOMEM);
+    ROW_OUT("R28", out, FRAME(big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000, 4100, 4100, NULL),
+            SOGMM_E_LIMIT);
+    ROW("R29", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000,
+                                        4100, 4100, NULL),
+        SOGMM_E_LIMIT);
+    EXPECT_TRUE(n_pts == 99);
+    free(big_depth);
+    free(big_gray);
   }
 
   /* ---- models from arrays, clone ---- */
@@ -305,6 +335,10 @@ int main(int argc, char** argv) {
   ROW("M37", sogmm_model_value_at(m, 0, NULL, &s2), SOGMM_E_NULL_ARG);
   ROW("M38", sogmm_model_value_at(m, 0, &s1, NULL), SOGMM_E_NULL_ARG);
   ROW("M39", sogmm_model_value_at(m, 0, &s1, &s2), SOGMM_E_INVALID_ARG); /* no pairs yet */
+  ROW("M40", sogmm_model_get_info_f64(m, SOGMM_OPT_BANDWIDTH, &f64), SOGMM_E_INVALID_ARG);
+  memcpy(pose_bad, pose_ok, sizeof pose_ok);
+  pose_bad[15] = 1.0 + 1e-6; /* the last row is exactly (0, 0, 0, 1) */
+  ROW("M41", sogmm_model_set_pose(m, pose_bad), SOGMM_E_INVALID_ARG);
 
   /* ---- inference ---- */
   ROW("I1", sogmm_model_sample_f32(NULL, 4, 0, 4, NULL, f1), SOGMM_E_NULL_ARG);
@@ -345,6 +379,18 @@ int main(int argc, char** argv) {
   memcpy(pose_bad, pose_ok, sizeof pose_ok);
   pose_bad[5] = 0.5;
   ROW_OUT("I29", out, sogmm_model_transform(&out, m, pose_bad), SOGMM_E_INVALID_ARG);
+  {
+    sogmm_model *zero = NULL, *huge_support = NULL;
+    REQUIRE_OK(sogmm_model_from_arrays_f32(&zero, 2, w, mu, cov, 0));
+    REQUIRE_OK(sogmm_model_from_arrays_f32(&huge_support, 2, w, mu, cov, ((uint64_t)1 << 63) + 1));
+    ROW_OUT("I30", out, sogmm_model_merge(&out, a, zero), SOGMM_E_INVALID_ARG); /* support 10 against 0 */
+    ROW_OUT("I31", out, sogmm_model_merge(&out, huge_support, huge_support), SOGMM_E_LIMIT);
+    sogmm_model_free(zero);
+    sogmm_model_free(huge_support);
+  }
+  memcpy(pose_bad, pose_ok, sizeof pose_ok);
+  pose_bad[3] = 1e39; /* moves the means beyond float32 */
+  ROW_OUT("I32", out, sogmm_model_transform(&out, m, pose_bad), SOGMM_E_INVALID_ARG);
 
   /* ---- files and memory ---- */
 #ifdef SOGMM_CAPI_HAVE_FORMAT

@@ -97,14 +97,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double u = std::isfinite(bw_raw) ? std::fabs(std::fmod(bw_raw, 1.0)) : 0.5;
     bw = 1e-3 * std::pow(1e4, u);  // [1e-3, 10)
   }
-  const bool bw_valid = std::isfinite(bw) && bw > 0;
+  // The setter's rule (spec/api.md): finite, > 0, and bw^2 and 1 / (2 bw^2)
+  // finite and nonzero, so the mode counter never sees an infinite kernel.
+  auto finite_nonzero = [](double v) { return std::isfinite(v) && v != 0.0; };
+  const bool bw_valid =
+      std::isfinite(bw) && bw > 0 && finite_nonzero(bw * bw) && finite_nonzero(1.0 / (2.0 * bw * bw));
   FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, bw) == (bw_valid ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   if (flags & 8) {
     const bool ok = std::isfinite(tol) && tol > 0;
     FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_TOL, tol) == (ok ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   }
   if (flags & 16) {
-    const bool ok = std::isfinite(reg) && reg >= 0;
+    const bool ok = std::isfinite(reg) && reg >= 0 && std::isfinite(static_cast<float>(reg));  // float32 covariances
     FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_REG_COVAR, reg) == (ok ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <new>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include <memory>
@@ -67,8 +68,8 @@ PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, 
                                 const std::string& depth_path) {
   PointCloud cloud = backproject(frame.view(camera), depth);
   require(cloud.size() > 0, ErrorCode::InvalidData,
-          depth_path + ": no valid depth pixel in (" + std::to_string(depth.depth_min) + ", " +
-              std::to_string(depth.depth_max) + "] m (check --depth-scale)");
+          depth_path + ": no valid depth pixel in (" + checked::exact(depth.depth_min) + ", " +
+              checked::exact(depth.depth_max) + "] m (check --depth-scale)");
   return cloud;
 }
 

@@ -9,6 +9,7 @@
 
 #include "file_util.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/model.hpp"
 
 namespace sogmm::tools {
 
@@ -116,18 +117,11 @@ std::vector<Pose> read_trajectory(const std::string& path) {
         require(static_cast<bool>(row >> p[4 * r + c]) && std::isfinite(p[4 * r + c]), ErrorCode::InvalidData,
                 path + ":" + std::to_string(line_no) + ": expected 4 finite numbers");
     }
-    // Rigid: last row (0 0 0 1) and R^T R = I.
-    bool rigid = std::abs(p[12]) < 1e-9 && std::abs(p[13]) < 1e-9 && std::abs(p[14]) < 1e-9 &&
-                 std::abs(p[15] - 1) < 1e-9;
-    for (int i = 0; i < 3 && rigid; ++i)
-      for (int j = 0; j < 3; ++j) {
-        double d = 0;
-        for (int k = 0; k < 3; ++k) d += p[4 * k + i] * p[4 * k + j];
-        if (std::abs(d - (i == j ? 1.0 : 0.0)) > 1e-4) rigid = false;
-      }
-    require(rigid, ErrorCode::InvalidData,
+    // Rigid by the rule every pose in the library follows (kPoseTolerance).
+    const std::string problem = rigid_pose_error(p);
+    require(problem.empty(), ErrorCode::InvalidData,
             path + ":" + std::to_string(line_no) + ": pose " + std::to_string(poses.size()) +
-                " is not a rigid transform (rotation block not orthonormal or last row not 0 0 0 1)");
+                " is not a rigid transform: " + problem);
     poses.push_back(p);
   }
   require(!poses.empty(), ErrorCode::InvalidData, path + ": no pose in the trajectory");

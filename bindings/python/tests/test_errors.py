@@ -46,6 +46,9 @@ def test_empty_points():
     (dict(bandwidth=-0.1), "bandwidth"),
     (dict(bandwidth=0.0), "bandwidth"),
     (dict(bandwidth=float("nan")), "bandwidth"),
+    (dict(bandwidth=4e-314), "bandwidth"),  # 1 / (2 bw^2) overflows
+    (dict(bandwidth=1e154), "bandwidth"),  # 2 bw^2 overflows
+    (dict(reg_covar=1e39), "reg"),  # not finite in float32
     (dict(tol=0.0), "tol"),
     (dict(reg_covar=-1.0), "reg"),
     (dict(max_iter=0), "iter"),
@@ -146,3 +149,14 @@ def test_option_errors_carry_c_messages():
     assert e.value.message  # the C library names the key
     with pytest.raises(sogmm.InvalidArgumentError):
         _ffi.Options(f64={_ffi.OPT_MAX_ITER: 1.0})  # i64 key through the f64 setter
+
+
+def test_info_keys_are_not_option_keys():
+    # Info keys (10000 and up) never alias an option: the C library names the key.
+    for key in (_ffi.INFO_FIT_ITERATIONS, _ffi.INFO_SUPPORT_SIZE, _ffi.INFO_CAMERA_FX):
+        assert key >= 10000
+        with pytest.raises(sogmm.InvalidArgumentError) as e:
+            _ffi.Options(f64={key: 0.5})
+        assert "SOGMM_INFO_" in e.value.message and "info key" in e.value.message
+    assert all(k < 10000 for k in _ffi.OPTION_NAMES)
+

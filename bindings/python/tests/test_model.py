@@ -168,6 +168,26 @@ def test_merge(points):
         a.merge("not a model")
 
 
+def test_merge_support_rules(points):
+    a = sogmm.SOGMM(bandwidth=0.08).fit(points[:500])
+    unknown = sogmm.GMM.from_arrays(a.weights_, a.means_, a.covariances_)  # support 0 = unknown
+    with pytest.raises(sogmm.InvalidArgumentError, match="support size 0"):
+        a.merge(unknown)  # a known size against an unknown one would be a guess
+    both = unknown.merge(unknown)  # two unknowns count equally
+    np.testing.assert_allclose(both.weights_, np.concatenate([a.weights_, a.weights_]) / 2, rtol=1e-6)
+    huge = sogmm.GMM.from_arrays(a.weights_, a.means_, a.covariances_, support_size=2**63 + 1)
+    assert huge.support_size_ == 2**63 + 1
+    with pytest.raises(sogmm.LimitError):
+        huge.merge(huge)  # 2^64 + 2 does not fit
+
+
+def test_transform_beyond_float32_is_an_error(fitted):
+    pose = np.eye(4)
+    pose[0, 3] = 1e39
+    with pytest.raises(sogmm.InvalidArgumentError, match="float32"):
+        fitted.transform(pose)
+
+
 def _rotation(ax, ay, az):
     cx, sx, cy, sy, cz, sz = np.cos(ax), np.sin(ax), np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
     rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])

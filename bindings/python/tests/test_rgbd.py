@@ -156,3 +156,22 @@ def test_livingroom_agrees_with_the_cpp_cli(livingroom):
     assert m.n_components_ == pytest.approx(ref["n_components"], rel=0.02)
     assert m.lower_bound_ == pytest.approx(ref["log_likelihood"], abs=0.02)
     assert m.converged_ == ref["converged"]
+
+
+def test_frame_over_the_point_limit_is_refused_from_its_size():
+    # 8200 x 8200 > 2^26 pixels: refused before the frame is read (np.zeros
+    # pages stay untouched), with the size in the message.
+    depth = np.zeros((8200, 8200), np.uint16)
+    color = np.zeros((8200, 8200), np.uint8)
+    cam = sogmm.Camera(8200, 8200, 7000.0, 7000.0, 4100.0, 4100.0)
+    with pytest.raises(sogmm.LimitError, match="67240000"):
+        sogmm.SOGMM().fit_rgbd(depth, color, cam)
+    with pytest.raises(sogmm.LimitError, match="67240000"):
+        sogmm.rgbd_to_points(depth, color, cam)
+
+
+def test_intrinsics_that_back_project_to_infinity_are_refused():
+    depth = np.full((4, 4), 1000, np.uint16)
+    color = np.full((4, 4), 128, np.uint8)
+    with pytest.raises(sogmm.InvalidArgumentError, match="fx"):
+        sogmm.rgbd_to_points(depth, color, sogmm.Camera(4, 4, 1e-300, 3.0, 2.0, 2.0))

@@ -14,8 +14,12 @@
  *   every created handle and releases it with the matching *_free function.
  *   Every *_free function accepts NULL and then does nothing.
  * - Fallible functions return sogmm_status: SOGMM_OK (0) or a negative
- *   SOGMM_E_* code. Out-parameters are written only on success (except the
- *   NULL stored into a handle out-pointer on failure).
+ *   SOGMM_E_* code. Out-parameters and output arrays are written only on
+ *   success, with two documented exceptions: the NULL stored into a handle
+ *   out-pointer on failure, and the count that sogmm_rgbd_to_points_f32
+ *   reports with SOGMM_E_BUFFER_TOO_SMALL.
+ * - A call whose result would not be finite (a transform moving a mean beyond
+ *   float32, intrinsics that back-project to infinity) fails at that call.
  * - Input arrays and strings belong to the caller. They are read only during
  *   the call and copied if kept (nothing the caller passes is retained).
  * - Output arrays are allocated by the caller, row-major, with the element
@@ -123,19 +127,24 @@ typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, sa
 typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
 
 /* ---- options ---------------------------------------------------------- */
-/* Key of a parameter. Each key has one type: set/get it with the _f64 or
- * _i64 function named in its comment; the other one returns
- * SOGMM_E_INVALID_ARG. Values outside the stated range are rejected by the
+/* Key of a parameter (SOGMM_OPT_*, below 10000) or of a model's information
+ * (SOGMM_INFO_*, 10000 and up): the two ranges are disjoint, so no number is
+ * both. Each key has one type: set/get an option with the _f64 or _i64
+ * function named in its comment; the other one, an info key or an unknown
+ * key returns SOGMM_E_INVALID_ARG with a message naming the key (and the
+ * function to use). Values outside the stated range are rejected by the
  * setter with SOGMM_E_INVALID_ARG and leave the handle unchanged. Functions
  * ignore keys that do not concern them. Passing NULL where a
  * `const sogmm_options*` is expected means "all defaults". */
 typedef int32_t sogmm_key;
 
 /* Fit (mode count + k-means++ + EM). */
-#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite; default 0.02: mean-shift bandwidth */
+#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite, with bw^2 and 1 / (2 bw^2) finite and nonzero
+                                    * (about 5.3e-155 to 9.5e153); default 0.02: mean-shift bandwidth */
 #define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
 #define SOGMM_OPT_TOL 102          /* f64, > 0, finite; default 1e-3: EM stop tolerance */
-#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite; default 1e-6: added to covariance diagonals */
+#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32);
+                                    * default 1e-6: added to covariance diagonals */
 #define SOGMM_OPT_MAX_ITER 104     /* i64, [1, 2^31-1]; default 100: EM iterations at most */
 #define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
 #define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores */
@@ -150,7 +159,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
 /* RGB-D back-projection (sogmm_fit_rgbd, sogmm_rgbd_to_points_f32). */
-#define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite; default 1000: raw depth units per metre */
+#define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite, 1 / value finite; default 1000: raw depth units per metre */
 #define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
 #define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
 #define SOGMM_OPT_DECIMATION 203  /* i64, [1, 1024]; default 1: integer decimation factor */
@@ -167,7 +176,7 @@ typedef int32_t sogmm_key;
 /* Sampling (sogmm_model_sample_f32). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
 
-/* Keys >= 1000 are experimental and may change in any release. */
+/* Option keys 1000 to 9999 are experimental and may change in any release. */
 
 /* Creates an options handle holding every default. Caller frees it. */
 SOGMM_API sogmm_status sogmm_options_create(sogmm_options** out);
@@ -208,9 +217,13 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
  * Intrinsics are those of the full-size images (fx, fy > 0, all finite).
  * Decimation and the valid depth range come from `options` (NULL =
  * defaults). The model records the camera (SOGMM_INFO_CAMERA_*).
- * Errors: width/height 0 or > INT32_MAX, bad intrinsics, unknown color
- * format, bad depth range -> SOGMM_E_INVALID_ARG; no valid pixel or a
- * non-finite float gray -> SOGMM_E_INVALID_DATA. */
+ * Errors: width/height 0 or > INT32_MAX, bad intrinsics (including fx, fy,
+ * cx, cy, depth scale and range that would back-project a pixel beyond the
+ * float32 range), unknown color format, bad depth range ->
+ * SOGMM_E_INVALID_ARG; a decimated image of more than 2^26 pixels
+ * ((width / d) * (height / d), checked before anything is allocated) ->
+ * SOGMM_E_LIMIT; no valid pixel or a non-finite float gray ->
+ * SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
                                       int32_t color_format, uint32_t width, uint32_t height, double fx,
                                       double fy, double cx, double cy, const sogmm_options* options);
@@ -222,8 +235,10 @@ SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, 
  * pixel grid. Arguments and errors as sogmm_fit_rgbd, except that a frame
  * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
  * receives N. `out` has room for `capacity` floats and must hold 4 N, else
- * SOGMM_E_BUFFER_TOO_SMALL (with *n_points set); out = NULL with capacity 0
- * only queries N. At most (width / d) * (height / d) points (integer division). */
+ * SOGMM_E_BUFFER_TOO_SMALL, which still sets *n_points to N (the size to
+ * allocate); on any other error neither *n_points nor `out` is written.
+ * out = NULL with capacity 0 only queries N. At most (width / d) * (height / d)
+ * points (integer division), which must be at most 2^26 as for a fit. */
 SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, size_t* n_points,
                                                 const uint16_t* depth, const uint8_t* color, int32_t color_format,
                                                 uint32_t width, uint32_t height, double fx, double fy, double cx,
@@ -256,42 +271,45 @@ SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model,
                                                        size_t capacity);
 
 /* ---- fit report and metadata ------------------------------------------ */
-/* Read-only information keys; types as with options. A value that the
- * model does not have returns SOGMM_E_NOT_FOUND (e.g. the fit report of a
- * model built from arrays, or the timings of a loaded model). */
-#define SOGMM_INFO_SUPPORT_SIZE 1    /* i64: points the model stands for (always present) */
-#define SOGMM_INFO_CREATED_UNIX_MS 2 /* i64: creation time, ms since 1970 UTC (0 = unknown) */
+/* Read-only information keys (10000 and up, disjoint from the option keys);
+ * types as with options: the getter of the other type, an option key or an
+ * unknown key -> SOGMM_E_INVALID_ARG naming the key. A value that the model
+ * does not have returns SOGMM_E_NOT_FOUND (e.g. the fit report of a model
+ * built from arrays, or the timings of a loaded model). */
+#define SOGMM_INFO_SUPPORT_SIZE 10001    /* i64: points the model stands for (always present): the uint64's
+                                          * bits (cast), as for the seed */
+#define SOGMM_INFO_CREATED_UNIX_MS 10002 /* i64: creation time, ms since 1970 UTC (0 = unknown) */
 /* Fit report and parameters: present for fitted models and files that store them. */
-#define SOGMM_INFO_FIT_ITERATIONS 100     /* i64: EM iterations run */
-#define SOGMM_INFO_FIT_CONVERGED 101      /* i64: 1 if EM stopped on the tolerance */
-#define SOGMM_INFO_FIT_LOG_LIKELIHOOD 102 /* f64: final mean log-likelihood per point */
-#define SOGMM_INFO_FIT_BANDWIDTH 103      /* f64: bandwidth (0 for a fixed-K fit) */
-#define SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED 104 /* i64: K of a fixed-K fit, 0 = self-organizing */
-#define SOGMM_INFO_FIT_TOL 105            /* f64 */
-#define SOGMM_INFO_FIT_REG_COVAR 106      /* f64 */
-#define SOGMM_INFO_FIT_MAX_ITER 107       /* i64 */
-#define SOGMM_INFO_FIT_SEED 108           /* i64: the uint64 seed's bits: the k-means++ seed of the kept
+#define SOGMM_INFO_FIT_ITERATIONS 10100     /* i64: EM iterations run */
+#define SOGMM_INFO_FIT_CONVERGED 10101      /* i64: 1 if EM stopped on the tolerance */
+#define SOGMM_INFO_FIT_LOG_LIKELIHOOD 10102 /* f64: final mean log-likelihood per point */
+#define SOGMM_INFO_FIT_BANDWIDTH 10103      /* f64: bandwidth (0 for a fixed-K fit) */
+#define SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED 10104 /* i64: K of a fixed-K fit, 0 = self-organizing */
+#define SOGMM_INFO_FIT_TOL 10105            /* f64 */
+#define SOGMM_INFO_FIT_REG_COVAR 10106      /* f64 */
+#define SOGMM_INFO_FIT_MAX_ITER 10107       /* i64 */
+#define SOGMM_INFO_FIT_SEED 10108           /* i64: the uint64 seed's bits: the k-means++ seed of the kept
                                            * run (SEED + run), so a fit with this seed and N_INIT 1
                                            * reproduces the model */
 /* Timings: present only for a model fitted in this process (not stored in files). */
-#define SOGMM_INFO_FIT_N_POINTS 150              /* i64: points given to the fit */
-#define SOGMM_INFO_FIT_SECONDS_MODE_COUNT 151    /* f64 */
-#define SOGMM_INFO_FIT_SECONDS_SEEDING 152       /* f64 */
-#define SOGMM_INFO_FIT_SECONDS_EM 153            /* f64 */
-#define SOGMM_INFO_FIT_SECONDS_TOTAL 154         /* f64 */
-#define SOGMM_INFO_FIT_N_INIT 155                /* i64: runs made (SOGMM_OPT_N_INIT) */
-#define SOGMM_INFO_FIT_RUN 156                   /* i64: which run was kept, from 0 */
+#define SOGMM_INFO_FIT_N_POINTS 10150              /* i64: points given to the fit */
+#define SOGMM_INFO_FIT_SECONDS_MODE_COUNT 10151    /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_SEEDING 10152       /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_EM 10153            /* f64 */
+#define SOGMM_INFO_FIT_SECONDS_TOTAL 10154         /* f64 */
+#define SOGMM_INFO_FIT_N_INIT 10155                /* i64: runs made (SOGMM_OPT_N_INIT) */
+#define SOGMM_INFO_FIT_RUN 10156                   /* i64: which run was kept, from 0 */
 /* Camera the points came from: present for sogmm_fit_rgbd models and files that store it. */
-#define SOGMM_INFO_CAMERA_WIDTH 200       /* i64: full-size image width, pixels */
-#define SOGMM_INFO_CAMERA_HEIGHT 201      /* i64 */
-#define SOGMM_INFO_CAMERA_FX 202          /* f64 */
-#define SOGMM_INFO_CAMERA_FY 203          /* f64 */
-#define SOGMM_INFO_CAMERA_CX 204          /* f64 */
-#define SOGMM_INFO_CAMERA_CY 205          /* f64 */
-#define SOGMM_INFO_CAMERA_DECIMATION 206  /* i64 */
-#define SOGMM_INFO_CAMERA_DEPTH_SCALE 207 /* f64 */
-#define SOGMM_INFO_CAMERA_DEPTH_MIN 208   /* f64 */
-#define SOGMM_INFO_CAMERA_DEPTH_MAX 209   /* f64 */
+#define SOGMM_INFO_CAMERA_WIDTH 10200       /* i64: full-size image width, pixels */
+#define SOGMM_INFO_CAMERA_HEIGHT 10201      /* i64 */
+#define SOGMM_INFO_CAMERA_FX 10202          /* f64 */
+#define SOGMM_INFO_CAMERA_FY 10203          /* f64 */
+#define SOGMM_INFO_CAMERA_CX 10204          /* f64 */
+#define SOGMM_INFO_CAMERA_CY 10205          /* f64 */
+#define SOGMM_INFO_CAMERA_DECIMATION 10206  /* i64 */
+#define SOGMM_INFO_CAMERA_DEPTH_SCALE 10207 /* f64 */
+#define SOGMM_INFO_CAMERA_DEPTH_MIN 10208   /* f64 */
+#define SOGMM_INFO_CAMERA_DEPTH_MAX 10209   /* f64 */
 
 SOGMM_API sogmm_status sogmm_model_get_info_f64(const sogmm_model* model, sogmm_key key, double* out);
 SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_key key, int64_t* out);
@@ -299,7 +317,8 @@ SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_
 /* Pose of the model's frame in the world: 16 doubles, row-major 4 x 4 rigid
  * transform [R t; 0 0 0 1] (camera-to-world for a fitted frame).
  * get: SOGMM_E_NOT_FOUND if no pose is set. set: copies `pose`; it must be
- * finite and rigid (R^T R = I and det R = 1 within 1e-4, last row 0 0 0 1),
+ * finite and rigid (every entry of R^T R within 1e-3 of I, det R > 0, last
+ * row exactly 0 0 0 1: the rule of sogmm_model_transform and of .sogmm files),
  * else SOGMM_E_INVALID_ARG. clear: removes the pose. */
 SOGMM_API sogmm_status sogmm_model_get_pose(const sogmm_model* model, double* pose_out);
 SOGMM_API sogmm_status sogmm_model_set_pose(sogmm_model* model, const double* pose);
@@ -342,22 +361,33 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
                                                      size_t n, int32_t dims, double* out);
 
 /* New model with the components of a and b, weights re-weighted by support
- * size (equal if both are 0); support size a + b. Both must be in the same
- * frame. The result has no fit report, camera, pose or key/values. a may
- * equal b. */
+ * size; support size a + b. Both must be in the same frame. The result has
+ * no fit report, camera, pose or key/values. a may equal b. Support size 0
+ * means unknown: if both are 0 the models count equally; if only one is 0 ->
+ * SOGMM_E_INVALID_ARG (weighing a known count against an unknown one would be
+ * a guess; rebuild that model with its support size). a + b overflowing
+ * uint64 -> SOGMM_E_LIMIT. */
 SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b);
 
 /* New model = `model` moved by the rigid transform `pose` (16 doubles,
  * row-major [R t; 0 1], rules as sogmm_model_set_pose): means -> R mu + t,
  * spatial covariance blocks rotated. Metadata is copied; a stored pose P
- * becomes P * pose^-1 so that the result still maps to the same world. */
+ * becomes P * pose^-1 so that the result still maps to the same world. A
+ * moved mean or covariance (or the new pose) that is not finite ->
+ * SOGMM_E_INVALID_ARG. */
 SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_model* model,
                                              const double* pose);
 
 /* ---- .sogmm files and memory ------------------------------------------ */
-/* Writes `model` to `path` atomically (a temporary file renamed into place:
- * on failure the previous file, if any, is untouched). Write keys of
- * `options` apply. Errors: cannot write -> SOGMM_E_IO. */
+/* Writes `model` to `path` atomically (a temporary file in the same
+ * directory renamed into place: on failure the previous file, if any, is
+ * untouched). A symbolic link is written through: its final target is
+ * replaced and the link kept. The file gets the permission bits of the file
+ * it replaces (never set-user-ID, set-group-ID or sticky bits), or 0666 minus
+ * the umask. Write keys of `options` apply. Errors: metadata too large for a
+ * .sogmm file (2^31 - 1 bytes; 100 000 tables: 99 994 to 99 996 key/value pairs)
+ * -> SOGMM_E_LIMIT, checked before anything is written; cannot write, or the
+ * path names something other than a regular file -> SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* path,
                                         const sogmm_options* options);
 /* Reads a model from `path`. Read keys of `options` apply. Errors: cannot
@@ -365,7 +395,8 @@ SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* pa
  * content invalid -> SOGMM_E_FORMAT / SOGMM_E_INVALID_DATA / SOGMM_E_NUMERIC;
  * decoded size above the cap -> SOGMM_E_LIMIT. */
 SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, const sogmm_options* options);
-/* Serialises `model` into a new buffer (the bytes of a .sogmm file). */
+/* Serialises `model` into a new buffer (the bytes of a .sogmm file).
+ * Errors as sogmm_model_save without SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogmm_model* model,
                                                   const sogmm_options* options);
 /* Reads a model from `size` bytes at `data` (copied as needed). Errors as

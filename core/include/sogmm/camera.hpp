@@ -38,6 +38,15 @@ void validate(const Camera& camera);
 /// Throws Error(InvalidArgument) unless depth_scale > 0, 0 <= min < max, d >= 1.
 void validate(const DepthOptions& options);
 
+/// Checks a frame's geometry before anything is allocated for it (backproject()
+/// starts with this): validate(camera) and validate(options), a decimation that
+/// leaves at least one pixel, at most kMaxPoints (sogmm/fit.hpp) pixels in the
+/// decimated image (Error(Limit): no fit could take more points, and the
+/// check needs only the image size), and intrinsics and depth options for which
+/// every back-projected coordinate is finite in float32 (Error(InvalidArgument)
+/// naming the values: e.g. fx = 1e-300 would give x = -inf).
+void check_backprojection(const Camera& camera, const DepthOptions& options);
+
 /// The camera of the image decimated by d: size (W/d, H/d) (integer division,
 /// as nearest-neighbour resizing to that size) and intrinsics divided by d.
 Camera decimated(const Camera& camera, int d);
@@ -74,7 +83,8 @@ struct RgbdView {
 /// Back-projects the valid pixels of a frame, after decimation, into (x, y, z,
 /// gray) points in the camera frame (x right, y down, z forward; metres). A
 /// pixel is valid when depth_min < depth / depth_scale <= depth_max. Points are
-/// ordered row by row. Throws Error(InvalidArgument) for bad options/camera.
+/// ordered row by row. Throws as check_backprojection() for a bad camera,
+/// options or image size.
 PointCloud backproject(const RgbdView& frame, const DepthOptions& options);
 
 /// Pixel index (row-major) in the decimated image of every point that

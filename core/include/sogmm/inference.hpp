@@ -43,13 +43,17 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, 
 
 /// Merges two models into one: components are concatenated and weights
 /// re-weighted by support size (w = w_a S_a / (S_a + S_b) for a's
-/// components). If both support sizes are 0 the models count equally.
-/// The support size of the result is S_a + S_b.
+/// components). Support size 0 means unknown: if both are 0 the models count
+/// equally; if only one is 0, Error(InvalidArgument) (any weighting would be a
+/// guess). The support size of the result is S_a + S_b; Error(Limit) when that
+/// overflows uint64.
 Gmm merge(const Gmm& a, const Gmm& b);
 
 /// Applies a rigid transform (row-major 4x4, [R t; 0 1]) to the spatial part:
 /// mu_xyz -> R mu_xyz + t, Sigma_xx -> R Sigma_xx R^T, Sigma_gx -> Sigma_gx R^T.
-/// Throws Error(InvalidArgument) unless R is a rotation within 1e-4.
+/// Throws Error(InvalidArgument) unless rigid_pose_error(pose) is empty
+/// (sogmm/model.hpp), or when a moved mean or covariance is not finite in
+/// float32 (e.g. a translation of 1e39).
 Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose);
 
 /// Bytes of the model as the paper counts them: 4 M (1 + 10 + 4).

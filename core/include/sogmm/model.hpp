@@ -51,6 +51,21 @@ struct Model {
   std::vector<std::pair<std::string, std::string>> key_values;  ///< free-form metadata
 };
 
+/// Tolerance of every check that a pose is a rigid transform: the C API's
+/// sogmm_model_set_pose and sogmm_model_transform, transform() below, the
+/// .sogmm writer and reader (normative in spec/format.md section 9) and the
+/// tools' trajectories all use rigid_pose_error(), so a pose accepted by one is
+/// accepted by all. 1e-3 is the file format's value: loose enough for rotations
+/// printed with a few digits or stored as float32, tight enough that R is a
+/// rotation to within a 0.1 % scale.
+inline constexpr double kPoseTolerance = 1e-3;
+
+/// Empty when `pose` (row-major 4x4, [R t; 0 0 0 1]) is a rigid transform:
+/// every entry finite, last row exactly (0, 0, 0, 1), |R^T R - I| <=
+/// kPoseTolerance entrywise and det R > 0. Otherwise what is wrong, with the
+/// offending value at round-trip precision.
+std::string rigid_pose_error(const std::array<double, 16>& pose);
+
 /// Library version, "MAJOR.MINOR.PATCH".
 const char* version_string();
 

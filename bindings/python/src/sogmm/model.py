@@ -195,8 +195,8 @@ class GMM:
 
     @property
     def support_size_(self) -> int:
-        """Number of points the model stands for."""
-        return self._info_i64(_ffi.INFO_SUPPORT_SIZE)
+        """Number of points the model stands for (0 = unknown; merges refuse an unknown size against a known one)."""
+        return self._info_i64(_ffi.INFO_SUPPORT_SIZE) % (1 << 64)  # the C API returns the uint64's bits
 
     @property
     def converged_(self) -> bool | None:
@@ -353,7 +353,12 @@ class GMM:
         return mean, var
 
     def merge(self, other: "GMM") -> "GMM":
-        """A new model with the components of both, weighted by support size."""
+        """A new model with the components of both, weighted by support size.
+
+        A support size of 0 means unknown: two unknowns count equally, and an
+        unknown against a known size raises InvalidArgumentError (any share
+        would be a guess; build the model with its ``support_size``). Sizes
+        whose sum exceeds 2**64 - 1 raise LimitError."""
         if not isinstance(other, GMM):
             raise InvalidArgumentError(f"merge needs a GMM, got {type(other).__name__}")
         out = c_void_p()
@@ -361,7 +366,10 @@ class GMM:
         return GMM._wrap(out)
 
     def transform(self, pose) -> "GMM":
-        """A new model moved by the 4 x 4 rigid transform ``pose``: means -> R mu + t."""
+        """A new model moved by the 4 x 4 rigid transform ``pose``: means -> R mu + t.
+
+        InvalidArgumentError when a moved mean or covariance would not be
+        finite in float32 (e.g. a translation of 1e39)."""
         p = _pose(pose)
         out = c_void_p()
         check(lib.sogmm_model_transform(byref(out), self._h(), p))

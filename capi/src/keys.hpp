@@ -1,0 +1,37 @@
+// The option and info keys of the C API: number, name, kind and type of each,
+// and the argument check every keyed function starts with. Never installed.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "internal.hpp"
+
+namespace sogmm_capi {
+
+/// Whether a key names a parameter (sogmm_options_*) or a model's information
+/// (sogmm_model_get_info_*). The numbers are disjoint: options are below
+/// 10000, info keys 10000 and up.
+enum class KeyKind { Option, Info };
+/// The value type of a key.
+enum class KeyType { F64, I64 };
+
+struct KeySpec {
+  sogmm_key key;
+  const char* name;  ///< the macro, e.g. "SOGMM_OPT_BANDWIDTH"
+  KeyKind kind;
+  KeyType type;
+  double sogmm_options::*f64;        ///< the option's storage (F64 options only)
+  std::int64_t sogmm_options::*i64;  ///< the option's storage (I64 options only)
+};
+
+/// The spec of `key` of `kind` and `type`. Otherwise SOGMM_E_INVALID_ARG with
+/// a message naming the key and, for a known key of the wrong kind or type,
+/// the function that takes it. `verb` is "set" or "get" for options (it names
+/// the function to use instead); ignored for info keys.
+const KeySpec& require_key(sogmm_key key, KeyKind kind, KeyType type, const char* verb);
+
+/// "100 (SOGMM_OPT_BANDWIDTH)", or the bare number of an unknown key.
+std::string key_label(sogmm_key key);
+
+}  // namespace sogmm_capi

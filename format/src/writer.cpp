@@ -1,0 +1,283 @@
+// The writer: to_bytes() and save(). A model is checked against everything a
+// reader would reject, every limit included, before any byte is produced; the
+// encoded file is then held as its parts (header, metadata block, arrays) and
+// streamed to disk or copied once into memory, so a save needs little more
+// memory than the file it writes.
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "checks.hpp"
+#include "codec.hpp"
+#include "container.hpp"
+#include "crc32c.hpp"
+#include "internal.hpp"
+#include "schema.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/format.hpp"
+
+namespace sogmm::format {
+namespace detail {
+namespace {
+
+// Canonical little-endian bytes of float values, as f32 or (exactly widened) f64.
+std::vector<std::uint8_t> canonical_bytes(const std::vector<float>& v, bool f64) {
+  std::vector<std::uint8_t> out(checked::bytes(v.size(), f64 ? 8 : 4, "array bytes"));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (f64) {
+      std::uint64_t bits;
+      const double d = v[i];
+      std::memcpy(&bits, &d, 8);
+      store_le<std::uint64_t>(&out[i * 8], bits);
+    } else {
+      std::uint32_t bits;
+      std::memcpy(&bits, &v[i], 4);
+      store_le<std::uint32_t>(&out[i * 4], bits);
+    }
+  }
+  return out;
+}
+
+std::vector<double> widen(const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); }
+
+bool bit_symmetric(const std::vector<float>& cov, std::size_t m) {
+  for (std::size_t k = 0; k < m; ++k) {
+    const float* c = cov.data() + 16 * k;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        if (std::memcmp(&c[i * 4 + j], &c[j * 4 + i], sizeof(float)) != 0) return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::vector<float> pack_upper(const std::vector<float>& cov, std::size_t m) {
+  std::vector<float> out;
+  out.reserve(10 * m);
+  for (std::size_t k = 0; k < m; ++k) {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i; j < 4; ++j) out.push_back(cov[16 * k + 4 * i + j]);
+    }
+  }
+  return out;
+}
+
+// The writer's checks: what a reader would reject, a writer refuses.
+void validate_for_write(const Model& model) {
+  const Gmm& g = model.gmm;
+  const std::size_t m = g.weights.size();
+  if (m == 0) fail(ErrorCode::InvalidData, "empty", "model has no components (M = 0)");
+  if (g.means.size() != 4 * m || g.covariances.size() != 16 * m) {
+    fail(ErrorCode::InvalidData, "length_mismatch",
+         "array lengths disagree with M = " + std::to_string(m) + ": " + std::to_string(g.means.size()) +
+             " mean values, " + std::to_string(g.covariances.size()) + " covariance values");
+  }
+  const std::vector<double> w = widen(g.weights), mu = widen(g.means), cov = widen(g.covariances);
+  ArraysView view{m, &w, &mu, &cov, /*packed=*/false};
+  check_values(view);
+  if (model.pose) check_pose(*model.pose);
+}
+
+// The producer version a file records: the model's, or this library's.
+std::string producer_version(const Model& model) {
+  return model.producer_version.empty() ? std::string(sogmm::version_string()) : model.producer_version;
+}
+
+// Bytes a FlatBuffers string of n bytes takes at most (length, NUL,
+// alignment) and at least (length and NUL).
+constexpr std::uint64_t kStringMaxOverhead = 8;
+constexpr std::uint64_t kStringMinOverhead = 5;
+// A KeyValue table with its vtable, padding and vector slot, at most / at least.
+constexpr std::uint64_t kKeyValueMaxBytes = 36;
+constexpr std::uint64_t kKeyValueMinBytes = 16;
+// Everything else of a block (root, array, fit and camera tables, pose, axis
+// vectors, the builder's scratch space), at most.
+constexpr std::uint64_t kFixedMaxBytes = 4096;
+
+// Metadata-size bounds computed from the strings alone.
+struct MetadataBounds {
+  std::uint64_t lower = 0;  ///< the block has at least this many bytes
+  std::uint64_t upper = 0;  ///< and at most this many
+};
+
+MetadataBounds metadata_bounds(const Model& model) {
+  std::uint64_t text = model.producer_name.size() + producer_version(model).size();
+  for (const auto& kv : model.key_values) text += kv.first.size() + kv.second.size();
+  const std::uint64_t strings = 2 + 2 * static_cast<std::uint64_t>(model.key_values.size());
+  const std::uint64_t n_kv = model.key_values.size();
+  // No overflow: sizes of strings held in memory and a count of at most
+  // kMaxMetadataTables (checked before) are far below 2^63.
+  return {text + strings * kStringMinOverhead + n_kv * kKeyValueMinBytes,
+          text + strings * kStringMaxOverhead + n_kv * kKeyValueMaxBytes + kFixedMaxBytes};
+}
+
+// The limits a reader enforces on the metadata block (spec/format.md section
+// 4.3): at most kMaxMetadataTables tables and fewer than kMetadataLengthLimit
+// bytes. Checked from the counts and string sizes, before anything is built.
+MetadataBounds check_metadata_limits(const Model& model) {
+  const std::uint64_t tables = 4 + (model.fit.known ? 1 : 0) + (model.camera.known ? 1 : 0) +
+                               static_cast<std::uint64_t>(model.key_values.size());
+  if (tables > kMaxMetadataTables) {
+    fail(ErrorCode::Limit, "limit",
+         "the model has " + std::to_string(model.key_values.size()) + " key/value pairs: its metadata would hold " +
+             std::to_string(tables) + " tables, more than the " + std::to_string(kMaxMetadataTables) +
+             " a reader verifies");
+  }
+  const MetadataBounds bounds = metadata_bounds(model);
+  if (bounds.lower >= kMetadataLengthLimit) {
+    fail(ErrorCode::Limit, "limit",
+         "the metadata (producer strings and key/value pairs) needs at least " + std::to_string(bounds.lower) +
+             " bytes; a metadata block must be smaller than 2^31 - 1 bytes");
+  }
+  return bounds;
+}
+
+struct EncodedArray {
+  ArrayRecord record;
+  std::vector<std::uint8_t> stored;
+};
+
+EncodedArray encode_one(const std::vector<float>& values, std::uint64_t cols, const WriteOptions& options) {
+  EncodedArray out;
+  const bool f64 = options.float64;
+  std::vector<std::uint8_t> canonical = canonical_bytes(values, f64);
+  const Shape shape{values.size() / cols, cols, f64 ? 8u : 4u};
+  out.record.dtype = f64 ? kDTypeF64 : kDTypeF32;
+  out.record.decoded_length = canonical.size();
+  out.record.crc32c = crc32c(canonical.data(), canonical.size());
+  if (options.compress) {
+    const Encoding packed{kOrderColumnMajor, kFilterByteStreamSplit, kCodecZstd};
+    std::vector<std::uint8_t> z = encode_array(canonical, shape, packed, options.zstd_level);
+    if (z.size() < canonical.size()) {
+      out.stored = std::move(z);
+      out.record.order = packed.order;
+      out.record.filter = packed.filter;
+      out.record.codec = packed.codec;
+    }
+  }
+  // Otherwise raw: component-major, no filter, no codec.
+  if (out.record.codec == kCodecNone) out.stored = std::move(canonical);
+  out.record.stored_length = out.stored.size();
+  return out;
+}
+
+// An encoded file held as its parts, in file order: header, metadata block,
+// zero padding to 8, then the arrays, each at a multiple of 8 and without
+// padding after the last, then the end marker.
+class EncodedFile {
+ public:
+  EncodedFile(const Model& model, const WriteOptions& options, const Tweaks& t) {
+    MetadataBounds bounds;
+    if (t.validate) {
+      validate_for_write(model);
+      bounds = check_metadata_limits(model);
+    } else {
+      bounds = metadata_bounds(model);
+    }
+    const Gmm& g = model.gmm;
+    const std::size_t m = g.weights.size();
+    const bool packed = !t.force_full_layout && g.covariances.size() == 16 * m && bit_symmetric(g.covariances, m);
+    arrays_[kWeights] = encode_one(g.weights, 1, options);
+    arrays_[kMeans] = encode_one(g.means, 4, options);
+    arrays_[kCovariances] = encode_one(packed ? pack_upper(g.covariances, m) : g.covariances, packed ? 10 : 16, options);
+    const std::uint64_t n_declared = t.n_components ? *t.n_components : m;
+    ArrayRecord records[3];
+    for (int i = 0; i < 3; ++i) {
+      records[i] = arrays_[i].record;
+      if (t.lengths_follow_declared_m) records[i].decoded_length = n_declared * columns(i, packed) * (options.float64 ? 8 : 4);
+      // A placeholder until the block's length is known: any non-zero value
+      // makes the field present, so the block's length does not depend on it.
+      records[i].offset = std::uint64_t{1} << 40;
+    }
+    records[kCovariances].crc32c ^= t.covariance_crc_xor;
+    if (t.means_codec) records[kMeans].codec = *t.means_codec;
+    if (t.means_offset) records[kMeans].offset = *t.means_offset;
+
+    const std::size_t hint = static_cast<std::size_t>(std::min<std::uint64_t>(bounds.upper, kMetadataLengthLimit));
+    metadata_ = build_metadata(model, records, n_declared, packed, t, hint);
+    if (t.validate && metadata_.size() >= kMetadataLengthLimit) {
+      fail(ErrorCode::Limit, "limit",
+           "the metadata block would have " + std::to_string(metadata_.size()) +
+               " bytes; it must be smaller than 2^31 - 1 bytes");
+    }
+
+    std::uint64_t offsets[3];
+    std::uint64_t end = kHeaderSize + pad8(metadata_.size());
+    for (int i = 0; i < 3; ++i) {
+      offsets[i] = end;
+      end += arrays_[i].stored.size();
+      if (i < 2) end = pad8(end);
+    }
+    const bool patch[3] = {true, !t.means_offset, true};
+    set_array_offsets(metadata_.data(), offsets, patch);
+
+    header_.major = t.major;
+    header_.minor = t.minor;
+    header_.metadata_length = static_cast<std::uint32_t>(metadata_.size());  // < 2^31 (checked) or a test's tweak
+    header_.metadata_crc32c = crc32c(metadata_.data(), metadata_.size());
+    header_.file_length = end + kTrailerSize;
+  }
+
+  std::uint64_t size() const { return header_.file_length; }
+
+  // Hands the file's bytes, in order, to `sink`.
+  void emit(const ByteSink& sink) const {
+    static const std::uint8_t kZeros[8] = {};
+    std::uint8_t header[kHeaderSize];
+    write_header(header, header_);
+    sink(header, kHeaderSize);
+    sink(metadata_.data(), metadata_.size());
+    std::uint64_t at = kHeaderSize + metadata_.size();
+    for (int i = 0; i < 3; ++i) {
+      sink(kZeros, static_cast<std::size_t>(pad8(at) - at));
+      at = pad8(at);
+      sink(arrays_[i].stored.data(), arrays_[i].stored.size());
+      at += arrays_[i].stored.size();
+    }
+    sink(kEndMagic.data(), kEndMagic.size());
+  }
+
+  std::vector<std::uint8_t> to_vector() const {
+    if (size() > std::numeric_limits<std::size_t>::max()) fail(ErrorCode::Limit, "limit", "the file is too large for memory");
+    std::vector<std::uint8_t> file(static_cast<std::size_t>(size()));
+    std::size_t at = 0;
+    emit([&](const std::uint8_t* p, std::size_t n) {
+      if (n > 0) std::memcpy(&file[at], p, n);
+      at += n;
+    });
+    return file;
+  }
+
+ private:
+  Header header_;
+  flatbuffers::DetachedBuffer metadata_;
+  EncodedArray arrays_[3];
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> encode(const Model& model, const WriteOptions& options, const Tweaks& t) {
+  return EncodedFile(model, options, t).to_vector();
+}
+
+void refresh_metadata_crc(std::vector<std::uint8_t>& file) {
+  const std::uint32_t len = load_le<std::uint32_t>(&file[24]);
+  store_le<std::uint32_t>(&file[28], crc32c(&file[kHeaderSize], len));
+}
+
+}  // namespace detail
+
+std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options) {
+  return detail::encode(model, options, detail::Tweaks{});
+}
+
+void save(const std::string& path, const Model& model, const WriteOptions& options) {
+  const detail::EncodedFile file(model, options, detail::Tweaks{});
+  detail::atomic_write(path, file.size(), [&file](const detail::ByteSink& sink) { file.emit(sink); });
+}
+
+}  // namespace sogmm::format
