@@ -26,7 +26,6 @@ void check_f64(sogmm_key key, double v, bool ok, const char* range) {
   if (std::isnan(v) || !ok) out_of_range(key, sogmm::checked::exact(v), range);
 }
 
-
 }  // namespace
 
 namespace sogmm_capi {
