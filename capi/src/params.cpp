@@ -64,7 +64,7 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
     const sogmm_capi::KeySpec& spec = sogmm_capi::require_key(key, KeyKind::Option, KeyType::F64, "set");
     switch (key) {
       case SOGMM_OPT_BANDWIDTH:
-        check_f64(key, v, sogmm::bandwidth_is_usable(v), "> 0, finite, with bw^2 and 1 / (2 bw^2) finite and nonzero");
+        check_f64(key, v, sogmm::bandwidth_is_usable(v), "> 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero");
         break;
       case SOGMM_OPT_TOL: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       case SOGMM_OPT_REG_COVAR:

@@ -39,9 +39,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
   require_finite_points(points, "point cloud");
   const bool fixed_k = options.n_components > 0;
   if (!fixed_k) {
-    require(bandwidth_is_usable(options.bandwidth), ErrorCode::InvalidArgument,
-            "bandwidth must be a finite positive value whose square and inverse square are finite (about "
-            "1e-150 to 1e150), got " + checked::exact(options.bandwidth));
+    require_usable_bandwidth(options.bandwidth);
   } else {
     require(options.n_components <= points.size, ErrorCode::InvalidArgument,
             "number of components K = " + std::to_string(options.n_components) +

@@ -21,12 +21,16 @@ bool bandwidth_is_usable(double bandwidth) {
   return b2 > 0 && std::isfinite(9.0 * b2) && std::isfinite(inv) && inv > 0;
 }
 
+void require_usable_bandwidth(double bandwidth) {
+  require(bandwidth_is_usable(bandwidth), ErrorCode::InvalidArgument,
+          "bandwidth must be a finite positive value whose square and inverse square are finite (about "
+          "5.3e-155 to 4.4e153), got " + checked::exact(bandwidth));
+}
+
 namespace {
 
 void check_inputs(const std::vector<double>& points2d, double bandwidth) {
-  require(bandwidth_is_usable(bandwidth), ErrorCode::InvalidArgument,
-          "bandwidth must be a finite positive value whose square and inverse square are finite (about "
-          "1e-150 to 1e150), got " + checked::exact(bandwidth));
+  require_usable_bandwidth(bandwidth);
   require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
           "mean shift needs a non-empty N x 2 array");
   for (double v : points2d)

@@ -100,8 +100,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // The setter's rule (spec/api.md): finite, > 0, and bw^2 and 1 / (2 bw^2)
   // finite and nonzero, so the mode counter never sees an infinite kernel.
   auto finite_nonzero = [](double v) { return std::isfinite(v) && v != 0.0; };
-  const bool bw_valid =
-      std::isfinite(bw) && bw > 0 && finite_nonzero(bw * bw) && finite_nonzero(1.0 / (2.0 * bw * bw));
+  // The documented rule: bw, bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and non-zero.
+  const bool bw_valid = std::isfinite(bw) && bw > 0 && finite_nonzero(bw * bw) && std::isfinite(9.0 * bw * bw) &&
+                        finite_nonzero(1.0 / (2.0 * bw * bw));
   FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, bw) == (bw_valid ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   if (flags & 8) {
     const bool ok = std::isfinite(tol) && tol > 0;

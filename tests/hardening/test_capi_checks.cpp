@@ -179,13 +179,13 @@ TEST(CapiKeys, WrongTypeNamesTheKeyAndTheFunctionToUse) {
 
 // Values with a known verdict under "finite, > 0, bw^2 and 1 / (2 bw^2)
 // finite and nonzero": bw^2 underflows to 0 below ~1.5e-162, 1 / (2 bw^2)
-// overflows below ~5.3e-155, 2 bw^2 overflows (so 1 / (2 bw^2) is 0) above ~9.5e153.
+// overflows below ~5.3e-155, (3 bw)^2, the blurring kernel radius squared, overflows above ~4.4e153.
 TEST(CapiOptions, BandwidthWhoseSquareOrInverseOverflowsIsRefused) {
   sogmm_options* o = nullptr;
   ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
   const std::pair<double, bool> cases[] = {
       {4e-314, false}, {1e-200, false}, {1e-160, false}, {1e-155, false}, {1e-154, true}, {1e-3, true},
-      {1e100, true},   {9e153, true},   {1e154, false},  {1e200, false},  {DBL_MAX, false},
+      {1e100, true},   {4e153, true},   {5e153, false}, {1e154, false},  {1e200, false},  {DBL_MAX, false},
   };
   for (const auto& c : cases) {
     const sogmm_status s = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, c.first);

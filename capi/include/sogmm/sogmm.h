@@ -139,8 +139,8 @@ typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
 typedef int32_t sogmm_key;
 
 /* Fit (mode count + k-means++ + EM). */
-#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite, with bw^2 and 1 / (2 bw^2) finite and nonzero
-                                    * (about 5.3e-155 to 9.5e153); default 0.02: mean-shift bandwidth */
+#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero
+                                    * (about 5.3e-155 to 4.4e153); default 0.02: mean-shift bandwidth */
 #define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
 #define SOGMM_OPT_TOL 102          /* f64, > 0, finite; default 1e-3: EM stop tolerance */
 #define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32);

@@ -29,10 +29,14 @@ struct MeanShiftResult {
 };
 
 /// True when `bandwidth` can be used as a mean-shift (and Gaussian kernel)
-/// scale: finite, > 0, and both bandwidth^2 and 1 / (2 bandwidth^2) finite and
-/// non-zero, i.e. roughly 1e-150 < bandwidth < 1e150. Outside that the kernel
+/// scale: finite, > 0, and bandwidth^2, (3 bandwidth)^2 (the blurring kernel's
+/// radius) and 1 / (2 bandwidth^2) finite and non-zero, i.e. roughly
+/// 5.3e-155 < bandwidth < 4.4e153. Outside that the kernel
 /// weights are 0 * inf = NaN. The C API's option setter applies the same rule.
 bool bandwidth_is_usable(double bandwidth);
+
+/// Throws Error(InvalidArgument) naming the exact value unless bandwidth_is_usable.
+void require_usable_bandwidth(double bandwidth);
 
 /// Flat-kernel mean shift with bin seeding on 2-D data (N x 2, row-major), as
 /// scikit-learn's MeanShift(bin_seeding=True, min_bin_freq=1, cluster_all):
