@@ -154,6 +154,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
     const std::size_t k = std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin();
     ++counts[std::min(k, m - 1)];
   }
+  const TruncatedNormal truncated(truncation);
   std::size_t row = 0;
   for (std::size_t k = 0; k < m; ++k) {
     if (counts[k] == 0) continue;
@@ -161,7 +162,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
     const Eigen::Vector4d mu = mean_of(gmm, k);
     for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
       Eigen::Vector4d z;
-      for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : rng.truncated_normal(truncation);
+      for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : truncated(rng);
       const Eigen::Vector4d x = mu + l * z;
       for (int i = 0; i < dims; ++i) out[dims * row + i] = static_cast<float>(x[i]);
     }
