@@ -1,8 +1,6 @@
 // EM driver: blocked, fused E+M passes with a fixed reduction order.
 #include "sogmm/em.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -12,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "em_kernel.hpp"
+#include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
@@ -254,7 +253,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
   const std::size_t n_waves = (n_blocks + kWave * kMaxBlocksPerChunk - 1) / (kWave * kMaxBlocksPerChunk);
   const std::size_t blocks_per_chunk = std::max<std::size_t>(1, (n_blocks + kWave * n_waves - 1) / (kWave * n_waves));
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const int threads = detail::team_size(options.threads);
   const detail::EmKernels& kernels = detail::em_kernels();
 
   std::vector<float> params;
@@ -277,8 +276,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
     double total_ll = 0.0;
     for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
       const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-      for (std::size_t s = 0; s < wave_chunks; ++s) {
+      detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int) {
         double* st = &slot_stats[s * m * kStatStride];
         std::fill(st, st + m * kStatStride, 0.0);
         float* scratch = &slot_scratch[s * (kBlock + 1) * m];  // m rows, then m row maxima
@@ -318,7 +316,7 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
         }
         slot_ll[s] = ll;
         slot_pairs[s] = pairs;
-      }
+      });
       // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
       for (std::size_t s = 0; s < wave_chunks; ++s) {
         const double* st = &slot_stats[s * m * kStatStride];

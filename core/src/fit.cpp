@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
@@ -52,7 +53,8 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
   require(options.n_init >= 1 && options.n_init <= kMaxRuns, ErrorCode::InvalidArgument,
           "n_init (number of runs) must be in [1, " + std::to_string(kMaxRuns) + "], got " +
               std::to_string(options.n_init));
-  const int threads = options.em.threads > 0 ? options.em.threads : omp_get_max_threads();
+  // Every parallel loop of the fit (mode count, seeding, EM) uses this many.
+  const int threads = detail::team_size(options.em.threads);
   const ScopedOmpThreads scoped_threads(threads);
 
   FitResult result;

@@ -10,6 +10,8 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "parallel.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
 #include "sogmm/checked.hpp"
@@ -75,26 +77,43 @@ double log_sum_exp(const double* v, std::size_t n) {
   return mx + std::log(s);
 }
 
-void require_finite(const float* v, std::size_t count, const char* what) {
+// Rows of `width` floats; the message (built only on failure) names the row.
+void require_finite(const float* v, std::size_t rows, int width, const char* what) {
+  const std::size_t count = checked::mul<std::size_t>(rows, static_cast<std::size_t>(width), "input size");
   for (std::size_t i = 0; i < count; ++i)
-    require(std::isfinite(v[i]), ErrorCode::InvalidData,
-            std::string(what) + " has a non-finite value (NaN or Inf) at row " + std::to_string(i / 3));
+    if (!std::isfinite(v[i]))
+      throw Error(ErrorCode::InvalidData, std::string(what) + " has a non-finite value (NaN or Inf) at row " +
+                                              std::to_string(i / static_cast<std::size_t>(width)));
 }
+
+// Points handed to a thread at a time: each costs O(M), so scheduling is cheap.
+constexpr std::size_t kPointsPerChunk = 64;
+
+// `m` doubles per thread of OpenMP's default team, allocated before the
+// parallel loop so that running out of memory is an ordinary exception. Rows
+// are 64 bytes apart, so no two threads write to one cache line.
+struct PerThreadScratch {
+  explicit PerThreadScratch(std::size_t m)
+      : threads(detail::team_size(0)),
+        stride(checked::add<std::size_t>(m, 8, "scratch row")),
+        values(checked::mul<std::size_t>(static_cast<std::size_t>(threads), stride, "scratch size")) {}
+  double* of(int thread) { return values.data() + static_cast<std::size_t>(thread) * stride; }
+  int threads;
+  std::size_t stride;
+  std::vector<double> values;
+};
 
 template <int D>
 void score_dims(const Gmm& gmm, const float* points, std::size_t n, double* out) {
   const DensityCache<D> cache(gmm);
   const std::size_t m = gmm.size();
-#pragma omp parallel
-  {
-    std::vector<double> lp(m);
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Matrix<double, D, 1> x = Eigen::Map<const Eigen::Matrix<float, D, 1>>(points + D * i).template cast<double>();
-      for (std::size_t k = 0; k < m; ++k) lp[k] = cache.log_component(k, x);
-      out[i] = log_sum_exp(lp.data(), m);
-    }
-  }
+  PerThreadScratch scratch(m);
+  detail::parallel_for(n, scratch.threads, kPointsPerChunk, [&](std::size_t i, int thread) {
+    double* lp = scratch.of(thread);
+    const Eigen::Matrix<double, D, 1> x = Eigen::Map<const Eigen::Matrix<float, D, 1>>(points + D * i).template cast<double>();
+    for (std::size_t k = 0; k < m; ++k) lp[k] = cache.log_component(k, x);
+    out[i] = log_sum_exp(lp, m);
+  });
 }
 
 }  // namespace
@@ -103,7 +122,7 @@ void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims,
   require(dims == 3 || dims == 4, ErrorCode::InvalidArgument, "dims must be 3 or 4, got " + std::to_string(dims));
   if (n == 0) return;
   require(points != nullptr && out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
-  require_finite(points, n * dims, "points to score");
+  require_finite(points, n, dims, "points to score");
   if (dims == 4)
     score_dims<4>(gmm, points, n, out);
   else
@@ -137,6 +156,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
     const std::size_t k = std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin();
     ++counts[std::min(k, m - 1)];
   }
+  const TruncatedNormal truncated(truncation);
   std::size_t row = 0;
   for (std::size_t k = 0; k < m; ++k) {
     if (counts[k] == 0) continue;
@@ -144,7 +164,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
     const Eigen::Vector4d mu = mean_of(gmm, k);
     for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
       Eigen::Vector4d z;
-      for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : rng.truncated_normal(truncation);
+      for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : truncated(rng);
       const Eigen::Vector4d x = mu + l * z;
       for (int i = 0; i < dims; ++i) out[dims * row + i] = static_cast<float>(x[i]);
     }
@@ -154,7 +174,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
 void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_out, float* variance_out) {
   if (n == 0) return;
   require(xyz != nullptr && mean_out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
-  require_finite(xyz, 3 * n, "points to regress");
+  require_finite(xyz, n, 3, "points to regress");
   const DensityCache<3> cache(gmm);
   const std::size_t m = gmm.size();
   // Per component: gain A = Sigma_gx Sigma_xx^-1 and conditional variance.
@@ -168,32 +188,29 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
     cond_var[k] = std::max(0.0, c(3, 3) - gain[k].dot(sxg));
     mean_g[k] = gmm.mean(k)[3];
   }
-#pragma omp parallel
-  {
-    std::vector<double> lw(m);
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3f>(xyz + 3 * i).cast<double>();
-      double mx = -std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < m; ++k) mx = std::max(mx, lw[k] = cache.log_component(k, x));
-      // One exp per component that does not underflow: unnormalised weights
-      // e_k = exp(lw_k - max), normalised by their sum at the end.
-      double sum = 0.0, mu = 0.0, second = 0.0;
-      for (std::size_t k = 0; k < m; ++k) {
-        const double d = lw[k] - mx;
-        if (!(d >= kExpUnderflow)) continue;
-        const double e = std::exp(d);
-        const double lambda = mean_g[k] + gain[k].dot(x - cache.mean[k]);
-        sum += e;
-        mu += e * lambda;
-        second += e * (cond_var[k] + lambda * lambda);
-      }
-      mu /= sum;
-      second /= sum;
-      mean_out[i] = static_cast<float>(mu);
-      if (variance_out) variance_out[i] = static_cast<float>(std::max(0.0, second - mu * mu));
+  PerThreadScratch scratch(m);
+  detail::parallel_for(n, scratch.threads, kPointsPerChunk, [&](std::size_t i, int thread) {
+    double* lw = scratch.of(thread);
+    const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3f>(xyz + 3 * i).cast<double>();
+    double mx = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < m; ++k) mx = std::max(mx, lw[k] = cache.log_component(k, x));
+    // One exp per component that does not underflow: unnormalised weights
+    // e_k = exp(lw_k - max), normalised by their sum at the end.
+    double sum = 0.0, mu = 0.0, second = 0.0;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double d = lw[k] - mx;
+      if (!(d >= kExpUnderflow)) continue;
+      const double e = std::exp(d);
+      const double lambda = mean_g[k] + gain[k].dot(x - cache.mean[k]);
+      sum += e;
+      mu += e * lambda;
+      second += e * (cond_var[k] + lambda * lambda);
     }
-  }
+    mu /= sum;
+    second /= sum;
+    mean_out[i] = static_cast<float>(mu);
+    if (variance_out) variance_out[i] = static_cast<float>(std::max(0.0, second - mu * mu));
+  });
 }
 
 Gmm merge(const Gmm& a, const Gmm& b) {

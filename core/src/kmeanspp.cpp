@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "parallel.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
 
@@ -39,6 +40,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
   require_finite_points(points, "k-means++ input");
   Rng rng(seed);
   const int trials = 2 + static_cast<int>(std::log(static_cast<double>(k)));
+  const int threads = detail::team_size(0);
 
   std::vector<std::size_t> centers;
   centers.reserve(k);
@@ -71,8 +73,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
     // per step is tiny and thousands of parallel regions cost more than they
     // save. Each gain is summed serially, so the result does not depend on
     // the thread count.
-#pragma omp parallel for schedule(dynamic, 1) if (n >= 65536)
-    for (int t = 0; t < trials; ++t) {
+    detail::parallel_for(candidates.size(), n >= 65536 ? threads : 1, 1, [&](std::size_t t, int) {
       const float* cand = points[candidates[t]];
       double g = 0.0;
       for (std::size_t a = 0; a < clusters.members.size(); ++a) {
@@ -84,7 +85,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
         }
       }
       gain[t] = g;
-    }
+    });
     int best = 0;
     for (int t = 1; t < trials; ++t)
       if (gain[t] > gain[best]) best = t;  // lowest potential; ties keep the first

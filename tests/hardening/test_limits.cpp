@@ -6,17 +6,16 @@
 #include <sys/mman.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
 #include <dirent.h>
 #include <fstream>
 #include <iterator>
-#include <new>
 #include <string>
 #include <vector>
 
+#include "heap_hook.hpp"
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
@@ -26,39 +25,8 @@
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
-// ---- heap accounting: every operator new of this process ------------------
-namespace {
-std::atomic<long long> g_live{0}, g_peak{0};
-constexpr std::size_t kHeader = 16;  // keeps max_align_t alignment
-void* counted_alloc(std::size_t n) {
-  void* p = std::malloc(n + kHeader);
-  if (!p) throw std::bad_alloc();
-  *static_cast<std::size_t*>(p) = n;
-  const long long live = g_live.fetch_add(static_cast<long long>(n)) + static_cast<long long>(n);
-  long long peak = g_peak.load();
-  while (live > peak && !g_peak.compare_exchange_weak(peak, live)) {
-  }
-  return static_cast<char*>(p) + kHeader;
-}
-void counted_free(void* q) noexcept {
-  if (!q) return;
-  void* p = static_cast<char*>(q) - kHeader;
-  g_live.fetch_sub(static_cast<long long>(*static_cast<std::size_t*>(p)));
-  std::free(p);
-}
-}  // namespace
-void* operator new(std::size_t n) { return counted_alloc(n); }
-void* operator new[](std::size_t n) { return counted_alloc(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_alloc(n); } catch (...) { return nullptr; }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_alloc(n); } catch (...) { return nullptr; }
-}
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
+// Heap accounting: heap_hook.cpp replaces operator new for this executable.
+namespace heap = sogmm::test::heap;
 
 namespace {
 
@@ -167,11 +135,11 @@ TEST(CoreLimits, ModeCountMemoryDoesNotGrowWithTheExtent) {
     sogmm::FitOptions o;
     o.mode_counter = counter;
     o.em.threads = 1;
-    const long long base = g_live.load();
-    g_peak.store(base);
+    const long long base = heap::live_bytes();
+    heap::reset_peak();
     const sogmm::FitResult r = sogmm::fit(view, o);
     EXPECT_EQ(r.gmm.size(), 64u);  // every point is its own mode
-    EXPECT_LT(g_peak.load() - base, 64 << 20) << "the mode count allocated " << (g_peak.load() - base) << " bytes";
+    EXPECT_LT(heap::peak_bytes() - base, 64 << 20) << "the mode count allocated " << (heap::peak_bytes() - base) << " bytes";
   }
 }
 
@@ -239,15 +207,15 @@ TEST(CoreLimits, BandwidthWhoseInverseSquareOverflowsIsRefused) {
 long long peak_during_read(const std::vector<std::uint8_t>& file, std::uint64_t cap, bool* ok) {
   fmt::ReadOptions r;
   r.max_decoded_bytes = cap;
-  const long long base = g_live.load();
-  g_peak.store(base);
+  const long long base = heap::live_bytes();
+  heap::reset_peak();
   try {
     const sogmm::Model m = fmt::from_bytes(file.data(), file.size(), r);
     *ok = true;
   } catch (const sogmm::Error&) {
     *ok = false;
   }
-  return g_peak.load() - base;
+  return heap::peak_bytes() - base;
 }
 
 // The bound that the reader keeps (spec/format.md section 8's cap on decoded

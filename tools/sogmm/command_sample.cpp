@@ -36,7 +36,7 @@ Command add_sample_command(CLI::App& root) {
   app->add_option("-o,--output", s->output, "output point cloud (.ply)");
   app->add_option("-n,--count", s->n, "number of samples (default: the model's support size)");
   app->add_option("--seed", s->seed, "random seed")->capture_default_str();
-  app->add_option("--truncation", s->truncation, "redraw standard-normal coordinates beyond this (0 = none)")
+  app->add_option("--truncation", s->truncation, "truncate each standard-normal coordinate to (-t, t) (0 = none)")
       ->capture_default_str();
   app->add_option("--ellipsoids", s->ellipsoids, "also write the components' ellipsoids as a mesh (.ply)");
   app->add_option("--sigmas", s->sigmas, "ellipsoid radius in standard deviations")->capture_default_str();

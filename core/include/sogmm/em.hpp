@@ -16,7 +16,7 @@ struct EmOptions {
   double tol = 1e-3;        ///< stop when |change of mean log-likelihood| < tol
   double reg_covar = 1e-6;  ///< added to every covariance diagonal in every M-step
   int max_iter = 100;       ///< at most this many E+M iterations
-  int threads = 0;          ///< worker threads; 0 = all available cores
+  int threads = 0;          ///< worker threads; 0 = all available cores; at most 4 x omp_get_num_procs()
   /// 0 (default): exact E-step, every point against every component.
   /// > 0: truncated E-step (opt-in). Points are grouped into spatially compact
   /// blocks; for each block, a component is skipped when a bound proves that

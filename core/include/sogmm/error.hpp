@@ -36,5 +36,10 @@ class Error : public std::runtime_error {
 inline void require(bool condition, ErrorCode code, const std::string& message) {
   if (!condition) throw Error(code, message);
 }
+/// The same for a literal message, which then costs no allocation unless it
+/// is thrown (checks inside loops over every input value use this one).
+inline void require(bool condition, ErrorCode code, const char* message) {
+  if (!condition) throw Error(code, message);
+}
 
 }  // namespace sogmm

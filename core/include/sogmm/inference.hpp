@@ -23,8 +23,10 @@ double mean_log_likelihood(const Gmm& gmm, const float* points, std::size_t n, i
 
 /// Draws `n` points from the model: per-component counts are multinomial in
 /// the weights; each draw is mu + L z with L the Cholesky factor of the
-/// covariance and each coordinate of z standard normal redrawn until
-/// |z_i| < `truncation` (2.5, the authors' choice; infinity = untruncated).
+/// covariance and each coordinate of z drawn independently from the standard
+/// normal truncated to (-`truncation`, `truncation`) (2.5, the authors'
+/// choice; infinity = untruncated). The truncated draws invert the CDF
+/// exactly, so the cost does not depend on `truncation`.
 /// Rows of 4 floats (x, y, z, gray) are written to `out` grouped by component.
 /// The same seed gives the same samples. `dims` = 3 writes only (x, y, z),
 /// which is the 3-D marginal sampled the same way.

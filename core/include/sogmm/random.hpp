@@ -5,8 +5,11 @@
 // libraries. Everything random in SOGMM goes through this header instead.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+
+#include "sogmm/normal_quantile.hpp"
 
 namespace sogmm {
 
@@ -38,14 +41,6 @@ class Rng {
     const double u2 = uniform();
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586476925 * u2);
   }
-  /// Standard normal truncated to (-bound, bound) by redrawing.
-  double truncated_normal(double bound) {
-    for (;;) {
-      const double z = normal();
-      if (std::fabs(z) < bound) return z;
-    }
-  }
-
  private:
   static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
   static std::uint64_t splitmix64(std::uint64_t& x) {
@@ -55,6 +50,37 @@ class Rng {
     return z ^ (z >> 31);
   }
   std::uint64_t state_[4];
+};
+
+/// The standard normal truncated to (-bound, bound), drawn exactly by
+/// inverting its CDF: one Rng::next() per value, whatever the bound. (Redrawing
+/// until |z| < bound would cost 1 / P(|Z| < bound) draws: 1.3e8 per value at
+/// bound 1e-8.) bound > 0; +infinity is allowed and gives the plain normal.
+class TruncatedNormal {
+ public:
+  explicit TruncatedNormal(double bound)
+      : below_bound_(std::nextafter(bound, 0.0)),
+        half_mass_(0.5 * std::erf(bound * 0.70710678118654752440)),
+        tail_(0.5 * std::erfc(bound * 0.70710678118654752440)) {}
+
+  /// One value. The top 53 bits of a draw give u in [0, 1), its lowest bit
+  /// the sign; |z| is the quantile with P(0 <= Z < |z|) = u P(0 <= Z < bound).
+  double operator()(Rng& rng) const {
+    const std::uint64_t bits = rng.next();
+    const double u = static_cast<double>(bits >> 11) * 0x1.0p-53;
+    const double c = u * half_mass_;
+    // Far from the median, the quantile is read from the upper-tail
+    // probability 1/2 - c, formed without cancellation (1 - u is exact).
+    double z = c <= kNormalCentralLimit ? normal_quantile_central(c)
+                                        : normal_quantile_upper_tail(0.5 * (1.0 - u) + u * tail_);
+    z = std::min(z, below_bound_);  // rounding never leaves the interval
+    return (bits & 1) ? -z : z;
+  }
+
+ private:
+  double below_bound_;  // largest double below bound
+  double half_mass_;    // P(0 <= Z < bound)
+  double tail_;         // P(Z >= bound)
 };
 
 }  // namespace sogmm

@@ -1,0 +1,62 @@
+// OpenMP in the core (private): how many threads a parallel loop may start,
+// and a parallel loop that carries exceptions out of the parallel region.
+//
+// Why: an exception that leaves an OpenMP structured block calls
+// std::terminate, so a std::bad_alloc in one worker used to abort the whole
+// process instead of becoming an out-of-memory error; and libgomp ends the
+// process when it cannot create a thread, so a large thread request under a
+// memory limit (each thread needs a stack) did the same.
+#pragma once
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <exception>
+#include <mutex>
+
+namespace sogmm::detail {
+
+/// Threads per processor above which no team grows (see team_size).
+inline constexpr int kThreadsPerProcessor = 4;
+
+/// The number of threads the core starts for a request of `requested`
+/// threads (0 = OpenMP's default, omp_get_max_threads(), e.g. from
+/// OMP_NUM_THREADS): the request clamped to [1, kThreadsPerProcessor x
+/// omp_get_num_procs()]. More threads than processors cannot speed up these
+/// compute-bound loops, and each one costs a stack (the RLIMIT_STACK size,
+/// 8 MiB by default); results never depend on the team size.
+inline int team_size(int requested) {
+  const int cap = kThreadsPerProcessor * std::max(1, omp_get_num_procs());
+  const int wanted = requested > 0 ? requested : omp_get_max_threads();
+  return std::clamp(wanted, 1, cap);
+}
+
+/// Calls body(i, thread) for every i in [0, n) on a team of `threads`
+/// threads, handing out `chunk` consecutive indices at a time (OpenMP
+/// schedule(dynamic, chunk)); `thread` is the caller's omp_get_thread_num(),
+/// below `threads`, for indexing per-thread scratch allocated beforehand. If
+/// a call throws, the calls not yet started are skipped and the first
+/// exception is rethrown on the calling thread once the team has finished.
+template <class Body>
+void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& body) {
+  std::atomic<bool> failed{false};
+  std::exception_ptr first_error;
+  std::mutex error_mutex;
+  const std::size_t step = std::max<std::size_t>(chunk, 1);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, step)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (failed.load(std::memory_order_relaxed)) continue;
+    try {
+      body(i, omp_get_thread_num());
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!first_error) first_error = std::current_exception();
+      failed.store(true, std::memory_order_relaxed);
+    }
+  }
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace sogmm::detail
