@@ -152,13 +152,16 @@ void atomic_write(const std::string& path, std::uint64_t size, const std::functi
   if (path.empty()) throw Error(ErrorCode::InvalidArgument, "save: empty path");
   const std::string target = final_target(path);
   const mode_t mode = mode_for(target);
-  std::string name = temp_template(target);
-  const int fd = inject(SaveStage::Open) ? -1 : ::mkstemp(&name[0]);
-  if (fd < 0) io_error("cannot create a temporary file next to", target, errno);
+  // The guard owns the name before mkstemp() creates the file: nothing that
+  // can throw (allocation) stands between creating the file and guarding it.
   TempFile tmp;
-  tmp.path = name;
-  tmp.fd = fd;
-  ::fchmod(fd, mode);  // best effort: the file keeps mkstemp's 0600 otherwise
+  tmp.path = temp_template(target);
+  tmp.fd = inject(SaveStage::Open) ? -1 : ::mkstemp(&tmp.path[0]);
+  if (tmp.fd < 0) {
+    tmp.keep = true;  // no file was created: nothing to remove
+    io_error("cannot create a temporary file next to", target, errno);
+  }
+  ::fchmod(tmp.fd, mode);  // best effort: the file keeps mkstemp's 0600 otherwise
 
   // The fault hook's WriteHalf stage fires once the first half is written,
   // so that tests can make the write fail midway.

@@ -249,7 +249,7 @@ TEST_F(OutOfMemory, SaveAndLoadReportNomemForEveryFailedAllocation) {
 // the file with mkstemp and only then copies the name into the std::string of
 // its cleanup guard, so a std::bad_alloc there leaves "model.sogmm.tmp-XXXXXX"
 // and its descriptor behind (found by this sweep at the 44th allocation).
-TEST_F(OutOfMemory, DISABLED_FailedSaveLeavesNoTemporaryFile) {
+TEST_F(OutOfMemory, FailedSaveLeavesNoTemporaryFile) {
   const std::string path = dir_ + "/model.sogmm";
   ASSERT_EQ(sogmm_model_save(model_, path.c_str(), nullptr), SOGMM_OK) << sogmm_last_error();
   sweep("save", [&] {
