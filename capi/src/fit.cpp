@@ -4,6 +4,7 @@
 #include <string>
 
 #include "internal.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
 
 namespace {
@@ -32,7 +33,7 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
 /// parameters, timings) in a new handle.
 sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o) {
   if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: nothing to fit");
-  const std::size_t count = sogmm_capi::checked_mul(n, 4, "points");
+  const std::size_t count = sogmm::checked::mul<std::size_t>(n, 4, "points");
   // The size limit first, so an oversized input is refused before it is read.
   if (n > sogmm::kMaxPoints)
     fail(SOGMM_E_LIMIT, "n = " + std::to_string(n) + " points exceeds the limit of " +

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "internal.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/inference.hpp"
 
 namespace {
@@ -50,7 +51,7 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
     require_dims(dims);
     if (n == 0) return SOGMM_OK;
     require_nonnull(out, "out");
-    sogmm_capi::checked_mul(n, static_cast<std::size_t>(dims), "samples");
+    sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "samples");
     const double truncation = sogmm_capi::opts_or_default(options).sample_truncation;
     sogmm::sample(model->model.gmm, n, seed, dims, out, truncation);
   }
@@ -64,7 +65,7 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, co
     if (n == 0) return SOGMM_OK;
     require_nonnull(xyz, "xyz");
     require_nonnull(mean_out, "mean_out");
-    sogmm_capi::require_finite(xyz, sogmm_capi::checked_mul(n, 3, "xyz"), "xyz");
+    sogmm_capi::require_finite(xyz, sogmm::checked::mul<std::size_t>(n, 3, "xyz"), "xyz");
     sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out);
   }
   SOGMM_CATCH
@@ -78,7 +79,7 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
     if (n == 0) return SOGMM_OK;
     require_nonnull(points, "points");
     require_nonnull(out, "out");
-    sogmm_capi::require_finite(points, sogmm_capi::checked_mul(n, static_cast<std::size_t>(dims), "points"),
+    sogmm_capi::require_finite(points, sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "points"),
                                "points");
     sogmm::score_samples(model->model.gmm, points, n, dims, out);
   }

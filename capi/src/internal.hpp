@@ -100,13 +100,6 @@ inline void require_nonnull(const void* p, const char* name) {
   if (!p) fail(SOGMM_E_NULL_ARG, std::string(name) + " is NULL");
 }
 
-/// n * k in size_t, SOGMM_E_LIMIT on overflow.
-inline std::size_t checked_mul(std::size_t n, std::size_t k, const char* what) {
-  if (k != 0 && n > std::numeric_limits<std::size_t>::max() / k)
-    fail(SOGMM_E_LIMIT, std::string(what) + ": size overflows");
-  return n * k;
-}
-
 /// SOGMM_E_INVALID_DATA unless all `count` floats are finite.
 void require_finite(const float* values, std::size_t count, const char* what);
 

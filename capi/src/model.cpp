@@ -133,7 +133,7 @@ SOGMM_API sogmm_status sogmm_model_from_arrays_f32(sogmm_model** out, size_t m, 
     require_nonnull(means, "means");
     require_nonnull(covariances, "covariances");
     if (m == 0) fail(SOGMM_E_INVALID_DATA, "m is 0: a model needs at least one component");
-    const std::size_t n_cov = sogmm_capi::checked_mul(m, 16, "covariances");
+    const std::size_t n_cov = sogmm::checked::mul<std::size_t>(m, 16, "covariances");
     sogmm_capi::require_finite(weights, m, "weights");
     sogmm_capi::require_finite(means, 4 * m, "means");
     sogmm_capi::require_finite(covariances, n_cov, "covariances");

@@ -23,7 +23,7 @@ sogmm::GrayImage gray_from_f32_image(const std::uint8_t* bytes, int width, int h
   sogmm::GrayImage g;
   g.width = width;
   g.height = height;
-  g.pixels.resize(static_cast<std::size_t>(width) * height);
+  g.pixels.resize(sogmm::checked::mul<std::size_t>(width, height, "float gray pixels"));
   std::memcpy(g.pixels.data(), bytes, g.pixels.size() * sizeof(float));  // the caller's floats, any alignment
   for (std::size_t i = 0; i < g.pixels.size(); ++i)
     if (!std::isfinite(g.pixels[i]))

@@ -103,14 +103,14 @@ float gray_from_rgb(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
 
 GrayImage gray_from_rgb_image(const std::uint8_t* rgb, int width, int height) {
   require(rgb != nullptr && width > 0 && height > 0, ErrorCode::InvalidData, "color image is empty");
-  GrayImage out{width, height, std::vector<float>(static_cast<std::size_t>(width) * height)};
+  GrayImage out{width, height, std::vector<float>(checked::mul<std::size_t>(static_cast<std::size_t>(width), static_cast<std::size_t>(height), "gray image pixels"))};
   for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = gray_from_rgb(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
   return out;
 }
 
 GrayImage gray_from_u8_image(const std::uint8_t* gray, int width, int height) {
   require(gray != nullptr && width > 0 && height > 0, ErrorCode::InvalidData, "gray image is empty");
-  GrayImage out{width, height, std::vector<float>(static_cast<std::size_t>(width) * height)};
+  GrayImage out{width, height, std::vector<float>(checked::mul<std::size_t>(static_cast<std::size_t>(width), static_cast<std::size_t>(height), "gray image pixels"))};
   for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = gray[i] / 255.0f;
   return out;
 }
@@ -160,7 +160,7 @@ std::vector<std::int32_t> valid_pixel_indices(const RgbdView& frame, const Depth
 
 std::vector<float> project_to_image(const PointsView& points, const float* values, const Camera& camera, float empty) {
   validate(camera);
-  const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+  const std::size_t pixels = checked::mul<std::size_t>(static_cast<std::size_t>(camera.width), static_cast<std::size_t>(camera.height), "image pixels");
   std::vector<float> image(pixels, empty);
   std::vector<float> zbuf(pixels, std::numeric_limits<float>::infinity());
   for (std::size_t i = 0; i < points.size; ++i) {

@@ -104,7 +104,7 @@ struct SoaPoints {
     for (std::size_t i = 0; i < pts.size; ++i) {
       std::uint64_t c[3];
       for (int j = 0; j < 3; ++j)
-        c[j] = static_cast<std::uint64_t>(std::min(2097151.0, std::floor((pts[i][j] - lo[j]) / 0.05)));
+        c[j] = checked::to_int<std::uint64_t>(std::min(2097151.0, std::floor((pts[i][j] - lo[j]) / 0.05)), "EM block cell");
       key[i] = spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2;
     }
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });

@@ -12,7 +12,11 @@ namespace sogmm::detail {
 /// (std::exp would be a library call per element). Cephes-style: x = n ln2 + r,
 /// |r| <= ln2 / 2, exp(r) by a degree-6 polynomial, 2^n built in the exponent.
 inline float fast_exp(float x) {
-  const float xc = x > -87.0f ? x : -87.0f;  // ternary, not fmax: fmax may become a libm call
+  // Clamped to [-87, 88] (ternaries, not fmin/fmax, which may become libm
+  // calls): the integer conversion of n below is then always defined (NaN
+  // maps to -87), and callers' x <= 0 is unchanged.
+  float xc = x > -87.0f ? x : -87.0f;
+  xc = xc < 88.0f ? xc : 88.0f;
   // Round to nearest with the 1.5 * 2^23 trick (no library call).
   const float n = (xc * 1.44269504088896341f + 12582912.0f) - 12582912.0f;
   float r = xc - n * 0.693359375f;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "parallel.hpp"
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
 
@@ -39,7 +40,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
           "number of components must be in [1, N = " + std::to_string(n) + "], got " + std::to_string(k));
   require_finite_points(points, "k-means++ input");
   Rng rng(seed);
-  const int trials = 2 + static_cast<int>(std::log(static_cast<double>(k)));
+  const int trials = 2 + checked::to_int<int>(std::log(static_cast<double>(k)), "k-means++ trials");
   const int threads = detail::team_size(0);
 
   std::vector<std::size_t> centers;
