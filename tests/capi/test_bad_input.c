@@ -305,6 +305,8 @@ int main(int argc, char** argv) {
   ROW("M37", sogmm_model_value_at(m, 0, NULL, &s2), SOGMM_E_NULL_ARG);
   ROW("M38", sogmm_model_value_at(m, 0, &s1, NULL), SOGMM_E_NULL_ARG);
   ROW("M39", sogmm_model_value_at(m, 0, &s1, &s2), SOGMM_E_INVALID_ARG); /* no pairs yet */
+  ROW("M40", sogmm_model_set_value(m, "k\xff", "v"), SOGMM_E_INVALID_ARG);
+  ROW("M41", sogmm_model_set_value(m, "k", "\xed\xa0\x80"), SOGMM_E_INVALID_ARG); /* a UTF-16 surrogate */
 
   /* ---- inference ---- */
   ROW("I1", sogmm_model_sample_f32(NULL, 4, 0, 4, NULL, f1), SOGMM_E_NULL_ARG);
