@@ -47,7 +47,9 @@ void check_values(const Gmm& g) {
   const std::size_t m = g.size();
   // 19a. finite (an F64 value too large for float32 is infinite here)
   std::size_t i = first_non_finite(g.weights);
-  if (i < g.weights.size()) numeric("non_finite", "weight of component " + std::to_string(i) + " is not finite in float32");
+  if (i < g.weights.size()) {
+    numeric("non_finite", "weight of component " + std::to_string(i) + " is not finite in float32");
+  }
   if ((i = first_non_finite(g.means)) < g.means.size()) {
     numeric("non_finite", "mean of component " + std::to_string(i / 4) + " is not finite in float32");
   }
@@ -58,7 +60,9 @@ void check_values(const Gmm& g) {
   double sum = 0.0;
   for (std::size_t k = 0; k < m; ++k) {
     const double w = g.weights[k];
-    if (w < 0.0) numeric("bad_weights", "weight of component " + std::to_string(k) + " is negative (" + checked::exact(w) + ")");
+    if (w < 0.0) {
+      numeric("bad_weights", "weight of component " + std::to_string(k) + " is negative (" + checked::exact(w) + ")");
+    }
     sum += w;
   }
   if (std::fabs(sum - 1.0) > kWeightSumTolerance) {

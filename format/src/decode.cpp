@@ -33,6 +33,7 @@ class StoredBytes {
       next_ = end_;
     } else {
       buffer_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(length, kChunk)));
+      data_ = buffer_.data();  // never null when there is something to read
     }
   }
   /// Makes at least min(want, left()) bytes available at data(); returns how many are.
@@ -86,7 +87,7 @@ class Scatter {
     const std::uint64_t at = written_;
     placed(n);
     if (identity()) {
-      std::memcpy(out_ + at, p, n);
+      if (n > 0) std::memcpy(out_ + at, p, n);
       return;
     }
     while (n > 0) {

@@ -82,7 +82,9 @@ void expand_upper_in_place(float* cov, std::uint64_t m) {
     float packed[10];
     std::memcpy(packed, cov + 10 * k, sizeof packed);
     float* full = cov + 16 * k;
-    for (int t = 0; t < 10; ++t) full[kUpper[t][0] * 4 + kUpper[t][1]] = full[kUpper[t][1] * 4 + kUpper[t][0]] = packed[t];
+    for (int t = 0; t < 10; ++t) {
+      full[kUpper[t][0] * 4 + kUpper[t][1]] = full[kUpper[t][1] * 4 + kUpper[t][0]] = packed[t];
+    }
   }
 }
 

@@ -96,8 +96,8 @@ void check_metadata_strings(const fb::SogmmFile* root, std::uint64_t block_lengt
   }
   if (total > block_length) {
     fail(F, "bad_metadata",
-         "metadata strings total " + std::to_string(total) + " bytes (shared strings counted once per use), more than the " +
-             std::to_string(block_length) + " bytes of the metadata block");
+         "metadata strings total " + std::to_string(total) + " bytes (shared strings counted once per use), " +
+             "more than the " + std::to_string(block_length) + " bytes of the metadata block");
   }
 }
 

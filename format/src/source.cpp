@@ -28,7 +28,7 @@ const char* kind_of(mode_t mode) {
 }  // namespace
 
 void MemorySource::read(std::uint64_t offset, std::uint8_t* out, std::size_t n) const {
-  if (n != 0) std::memcpy(out, data_ + offset, n);
+  if (data_ != nullptr && n != 0) std::memcpy(out, data_ + offset, n);  // from_bytes(nullptr, 0) reads nothing
 }
 
 const std::uint8_t* MemorySource::view(std::uint64_t offset, std::size_t) const { return data_ + offset; }

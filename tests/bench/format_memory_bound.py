@@ -70,25 +70,17 @@ def _gf2_square(mat):
 
 
 def crc32c_combine(crc1, crc2, len2):
-    """CRC of A + B from CRC(A), CRC(B) and len(B) (zlib's crc32_combine, Castagnoli polynomial)."""
-    if len2 == 0:
-        return crc1
-    odd = [POLY] + [1 << n for n in range(31)]  # one zero bit
-    even = _gf2_square(odd)
-    odd = _gf2_square(even)
-    while True:
-        even = _gf2_square(odd)
+    """CRC of A + B from CRC(A), CRC(B) and len(B): crc1 is run through len2
+    zero bytes (a linear map over GF(2), applied by repeated squaring)."""
+    op = [POLY] + [1 << n for n in range(31)]  # one zero bit
+    for _ in range(3):
+        op = _gf2_square(op)  # one zero byte
+    while len2:
         if len2 & 1:
-            crc1 = _gf2_times(even, crc1)
+            crc1 = _gf2_times(op, crc1)
         len2 >>= 1
-        if not len2:
-            break
-        odd = _gf2_square(even)
-        if len2 & 1:
-            crc1 = _gf2_times(odd, crc1)
-        len2 >>= 1
-        if not len2:
-            break
+        if len2:
+            op = _gf2_square(op)
     return crc1 ^ crc2
 
 

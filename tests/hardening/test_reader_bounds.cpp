@@ -277,14 +277,14 @@ TEST_F(ReaderBounds, DecodingStaysWithinTheBoundOfTheSpec) {
         SCOPED_TRACE(std::string(f64 ? "f64" : "f32") + (compress ? " zstd" : " raw") + (full ? " full" : " packed"));
         sogmm::Model variant = model;
         if (full) variant.gmm.covariances[1] = std::nextafter(variant.gmm.covariances[1], 1.0f);  // not bit-symmetric
-        det::Tweaks t;
-        const std::vector<std::uint8_t> file = det::encode(variant, fmt::WriteOptions{1, f64, compress}, t);
+        const std::vector<std::uint8_t> file = fmt::to_bytes(variant, fmt::WriteOptions{1, f64, compress});
         const fmt::FileInfo info = fmt::read_info(file.data(), file.size());
         ASSERT_EQ(info.covariance_layout, full ? "full" : "upper_packed");
         const std::uint64_t decoded =
             info.weights.decoded_length + info.means.decoded_length + info.covariances.decoded_length;
         const double allowed = allowed_peak(info, 1);
-        long long peak = heap_peak_of([&] { EXPECT_TRUE(sogmm::test::bit_equal(fmt::from_bytes(file.data(), file.size()), variant)); });
+        long long peak = heap_peak_of(
+            [&] { EXPECT_TRUE(sogmm::test::bit_equal(fmt::from_bytes(file.data(), file.size()), variant)); });
         EXPECT_LE(peak, allowed) << "from_bytes: " << decoded << " decoded bytes from " << file.size();
         const std::string path = write("bomb.sogmm", file);
         peak = heap_peak_of([&] { EXPECT_TRUE(sogmm::test::bit_equal(fmt::load(path), variant)); });
@@ -331,7 +331,8 @@ TEST_F(ReaderBounds, AFrameThatPromisesMoreThanDeclaredIsRejectedBeforeDecoding)
   fmt::ReadOptions unchecked;
   unchecked.verify_checksums = false;
   std::string got;
-  const long long peak = heap_peak_of([&] { got = reason_of([&] { fmt::from_bytes(file.data(), file.size(), unchecked); }); });
+  const long long peak =
+      heap_peak_of([&] { got = reason_of([&] { fmt::from_bytes(file.data(), file.size(), unchecked); }); });
   EXPECT_EQ(got, "decompression_failed");
   EXPECT_LE(peak, allowed_peak(info, 0) - static_cast<double>(info.covariances.decoded_length));
 }
@@ -467,9 +468,15 @@ TEST(MetadataStrings, TheRuleIsExactlyUtf8WithoutNul) {
   // each lead byte's limits.
   long long checked = 0;
   auto check = [&](std::vector<unsigned char> s) {
-    const bool ours = sogmm::metadata_string_problem(reinterpret_cast<const char*>(s.data()), s.size()).empty();
+    const std::string text(s.begin(), s.end());
+    const bool ours = sogmm::metadata_string_problem(text).empty();
     if (ours != utf8_by_reencoding(s)) {
       ADD_FAILURE() << "disagree on " << std::hex << int(s[0]) << " " << (s.size() > 1 ? int(s[1]) : -1);
+    }
+    // Repairing (file names stored by `sogmm fit`) keeps valid text and always follows the rule.
+    const std::string repaired = sogmm::to_metadata_string(text);
+    if (!sogmm::metadata_string_problem(repaired).empty() || (ours && repaired != text)) {
+      ADD_FAILURE() << "to_metadata_string on " << std::hex << int(s[0]) << " " << (s.size() > 1 ? int(s[1]) : -1);
     }
     ++checked;
   };

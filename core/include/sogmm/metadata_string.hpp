@@ -62,4 +62,24 @@ inline std::string metadata_string_problem(const char* s, std::size_t n) {
 
 inline std::string metadata_string_problem(const std::string& s) { return metadata_string_problem(s.data(), s.size()); }
 
+/// `s` made to follow the rule: each byte that does not (a NUL, or a byte of
+/// no valid UTF-8 sequence) becomes U+FFFD. For text from outside that is to
+/// become metadata, such as file names, which POSIX does not require to be UTF-8.
+inline std::string to_metadata_string(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const std::size_t len = p[i] == 0 ? 0 : metadata_string_detail::sequence_length(p, i, s.size());
+    if (len == 0) {
+      out += "\xef\xbf\xbd";
+      ++i;
+    } else {
+      out.append(s, i, len);
+      i += len;
+    }
+  }
+  return out;
+}
+
 }  // namespace sogmm
