@@ -346,9 +346,9 @@ def main():
                 ratio = used / allowed
                 worst = max(worst, ratio)
                 print(f"{name:48} {reader:8} {facts['file']:>11} {facts['D']:>11} {facts['E']:>7} {verdict:>16} "
-                      f"{used / MIB:>9.1f} {allowed / MIB:>9.1f} {ratio:>6.2f}", flush=True)
+                      f"{used / MIB:>9.1f} {allowed / MIB:>9.1f} {ratio:>6.3f}", flush=True)
             os.unlink(path)
-    print(f"largest measured/allowed: {worst:.2f}")
+    print(f"largest measured/allowed: {worst:.3f}")
     return 1 if a.check and worst > 1.0 else 0
 
 
