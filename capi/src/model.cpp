@@ -11,6 +11,7 @@
 #include "keys.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/gmm.hpp"
+#include "sogmm/metadata_string.hpp"
 
 namespace {
 
@@ -270,6 +271,12 @@ SOGMM_API sogmm_status sogmm_model_set_value(sogmm_model* model, const char* key
     require_nonnull(key, "key");
     require_nonnull(value, "value");
     if (*key == '\0') fail(SOGMM_E_INVALID_ARG, "metadata key is empty");
+    // What no reader accepts, no setter stores (spec/format.md section 4.4).
+    for (const char* s : {key, value}) {
+      const std::string problem = sogmm::metadata_string_problem(s, std::strlen(s));
+      if (!problem.empty())
+        fail(SOGMM_E_INVALID_ARG, std::string("metadata ") + (s == key ? "key" : "value") + ": " + problem);
+    }
     for (auto& kv : model->model.key_values) {
       if (kv.first == key) {
         kv.second = value;

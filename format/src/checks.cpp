@@ -8,24 +8,20 @@
 
 #include "container.hpp"
 #include "sogmm/model.hpp"
+#include "sogmm/checked.hpp"
 
 namespace sogmm::format::detail {
 namespace {
-
-constexpr int kUpper[10][2] = {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1}, {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}};
 
 [[noreturn]] void numeric(const char* reason, const std::string& detail) {
   fail(ErrorCode::Numeric, reason, detail);
 }
 
-bool all_finite(const std::vector<double>& v, std::size_t* index) {
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!std::isfinite(v[i])) {
-      *index = i;
-      return false;
-    }
-  }
-  return true;
+// Index of the first value that is not finite, or n.
+std::size_t first_non_finite(const std::vector<float>& v) {
+  std::size_t i = 0;
+  while (i < v.size() && std::isfinite(v[i])) ++i;
+  return i;
 }
 
 // Cholesky-Banachiewicz on the lower triangle, in double, ascending sums;
@@ -48,54 +44,53 @@ bool cholesky_ok(const double* a) {
 
 }  // namespace
 
-void unpack_upper(const double* packed, double* full) {
-  for (int t = 0; t < 10; ++t) {
-    full[kUpper[t][0] * 4 + kUpper[t][1]] = packed[t];
-    full[kUpper[t][1] * 4 + kUpper[t][0]] = packed[t];
+void check_values(const Gmm& g) {
+  const std::size_t m = g.size();
+  // 19a. finite (an F64 value too large for float32 is infinite here)
+  std::size_t i = first_non_finite(g.weights);
+  if (i < g.weights.size()) {
+    numeric("non_finite", "weight of component " + std::to_string(i) + " is not finite in float32");
   }
-}
-
-void check_values(const ArraysView& a) {
-  std::size_t i = 0;
-  if (!all_finite(*a.weights, &i)) numeric("non_finite", "weight of component " + std::to_string(i) + " is not finite");
-  if (!all_finite(*a.means, &i)) numeric("non_finite", "mean of component " + std::to_string(i / 4) + " is not finite");
-  const std::size_t c = a.packed ? 10 : 16;
-  if (!all_finite(*a.cov, &i)) {
-    numeric("non_finite", "covariance of component " + std::to_string(i / c) + " is not finite");
+  if ((i = first_non_finite(g.means)) < g.means.size()) {
+    numeric("non_finite", "mean of component " + std::to_string(i / 4) + " is not finite in float32");
   }
+  if ((i = first_non_finite(g.covariances)) < g.covariances.size()) {
+    numeric("non_finite", "covariance of component " + std::to_string(i / 16) + " is not finite in float32");
+  }
+  // 19b. weights
   double sum = 0.0;
-  for (std::size_t k = 0; k < a.m; ++k) {
-    const double w = (*a.weights)[k];
-    if (w < 0.0) numeric("bad_weights", "weight of component " + std::to_string(k) + " is negative");
+  for (std::size_t k = 0; k < m; ++k) {
+    const double w = g.weights[k];
+    if (w < 0.0) {
+      numeric("bad_weights", "weight of component " + std::to_string(k) + " is negative (" + checked::exact(w) + ")");
+    }
     sum += w;
   }
   if (std::fabs(sum - 1.0) > kWeightSumTolerance) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", sum);
-    numeric("bad_weights", std::string("weights sum to ") + buf + ", not 1 (tolerance 1e-4)");
+    numeric("bad_weights", "weights sum to " + checked::exact(sum) + ", not 1 (tolerance 1e-4)");
   }
-  double full[16];
-  for (std::size_t k = 0; k < a.m; ++k) {
-    const double* src = a.cov->data() + k * c;
-    if (a.packed) {
-      unpack_upper(src, full);
-    } else {
-      std::copy(src, src + 16, full);
-      double scale = 0.0, asym = 0.0;
-      for (int r = 0; r < 4; ++r) {
-        for (int q = 0; q < 4; ++q) {
-          scale = std::max(scale, std::fabs(full[r * 4 + q]));
-          asym = std::max(asym, std::fabs(full[r * 4 + q] - full[q * 4 + r]));
-        }
-      }
-      if (asym > kSymmetryTolerance * scale) {
-        numeric("not_symmetric", "covariance of component " + std::to_string(k) + " is not symmetric");
+  // 19c-d. per component: symmetric (exactly so when stored packed), positive definite
+  double a[16];
+  for (std::size_t k = 0; k < m; ++k) {
+    std::copy(g.covariance(k), g.covariance(k) + 16, a);
+    double scale = 0.0, asym = 0.0;
+    for (int r = 0; r < 4; ++r) {
+      for (int q = 0; q < 4; ++q) {
+        scale = std::max(scale, std::fabs(a[r * 4 + q]));
+        asym = std::max(asym, std::fabs(a[r * 4 + q] - a[q * 4 + r]));
       }
     }
-    if (!cholesky_ok(full)) {
+    if (asym > kSymmetryTolerance * scale) {
+      numeric("not_symmetric", "covariance of component " + std::to_string(k) + " is not symmetric");
+    }
+    if (!cholesky_ok(a)) {
       numeric("not_spd", "covariance of component " + std::to_string(k) + " is not positive definite");
     }
   }
+  // The checks above and sogmm::validate agree except for the rounding of the
+  // Cholesky sums of a nearly singular matrix; what remains is such a matrix.
+  const std::string residual = validation_error(g, kWeightSumTolerance);
+  if (!residual.empty()) numeric("not_spd", residual);
 }
 
 void check_pose(const std::array<double, 16>& p) {

@@ -1,11 +1,10 @@
-// Element order, byte-stream split and zstd framing.
+// Element order, byte-stream split and zstd framing, encoding side.
 #include "codec.hpp"
 
 #include <memory>
 #include <string>
 
 #include <zstd.h>
-#include <zstd_errors.h>
 
 #include "container.hpp"
 
@@ -34,22 +33,9 @@ std::vector<std::uint8_t> split_streams(const std::vector<std::uint8_t>& in, std
   return out;
 }
 
-std::vector<std::uint8_t> join_streams(const std::vector<std::uint8_t>& in, std::uint64_t w) {
-  const std::uint64_t n = in.size() / w;
-  std::vector<std::uint8_t> out(in.size());
-  for (std::uint64_t i = 0; i < n; ++i) {
-    for (std::uint64_t k = 0; k < w; ++k) out[i * w + k] = in[k * n + i];
-  }
-  return out;
-}
-
 struct CCtxDeleter {
   void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
 };
-struct DCtxDeleter {
-  void operator()(ZSTD_DCtx* d) const { ZSTD_freeDCtx(d); }
-};
-
 void append_frame(std::vector<std::uint8_t>& out, ZSTD_CCtx* cctx, const std::uint8_t* src, std::size_t size) {
   const std::size_t pos = out.size();
   out.resize(pos + ZSTD_compressBound(size));
@@ -79,50 +65,6 @@ std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonica
   const std::size_t stream_size = bytes.size() / streams;
   for (std::size_t k = 0; k < streams; ++k) append_frame(out, cctx.get(), bytes.data() + k * stream_size, stream_size);
   return out;
-}
-
-std::vector<std::uint8_t> decode_array(const std::uint8_t* stored, std::size_t stored_length, const Shape& shape,
-                                       const Encoding& e) {
-  const std::uint64_t expected = shape.bytes();
-  std::vector<std::uint8_t> bytes;
-  if (e.codec == kCodecNone) {
-    bytes.assign(stored, stored + stored_length);  // length checked by the caller (bad_layout)
-  } else {
-    bytes.resize(expected);
-    std::unique_ptr<ZSTD_DCtx, DCtxDeleter> dctx(ZSTD_createDCtx());
-    if (!dctx) throw std::bad_alloc();
-    std::size_t in = 0, out = 0;
-    int frame = 0;
-    while (in < stored_length) {
-      const std::uint8_t* src = stored + in;
-      const std::size_t avail = stored_length - in;
-      if (avail < 4 || load_le<std::uint32_t>(src) != ZSTD_MAGICNUMBER) {
-        fail(ErrorCode::Format, "decompression_failed",
-             "frame " + std::to_string(frame) + " does not start with the zstd magic number");
-      }
-      const std::size_t frame_size = ZSTD_findFrameCompressedSize(src, avail);
-      if (ZSTD_isError(frame_size)) {
-        fail(ErrorCode::Format, "decompression_failed",
-             "frame " + std::to_string(frame) + ": " + ZSTD_getErrorName(frame_size));
-      }
-      const std::size_t n = ZSTD_decompressDCtx(dctx.get(), bytes.data() + out, expected - out, src, frame_size);
-      if (ZSTD_isError(n)) {
-        fail(ErrorCode::Format, "decompression_failed",
-             "frame " + std::to_string(frame) + ": " + ZSTD_getErrorName(n) +
-                 (ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall ? " (decodes to more than declared)" : ""));
-      }
-      in += frame_size;
-      out += n;
-      ++frame;
-    }
-    if (out != expected) {
-      fail(ErrorCode::Format, "decompression_failed",
-           "data decodes to " + std::to_string(out) + " bytes, " + std::to_string(expected) + " declared");
-    }
-  }
-  if (e.filter == kFilterByteStreamSplit) bytes = join_streams(bytes, shape.width);
-  if (e.order == kOrderColumnMajor) bytes = transpose(bytes, shape.cols, shape.rows, shape.width);
-  return bytes;
 }
 
 }  // namespace sogmm::format::detail

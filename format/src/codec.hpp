@@ -1,5 +1,5 @@
 // Array encoding pipeline (spec/format.md section 5): element order,
-// byte-stream split and zstd framing, in both directions.
+// byte-stream split and zstd framing (decoding: decode.hpp).
 #pragma once
 
 #include <cstddef>
@@ -35,11 +35,5 @@ struct Shape {
 /// streams becomes its own zstd frame (frames are concatenated).
 std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonical, const Shape& shape,
                                        const Encoding& encoding, int zstd_level);
-
-/// Stored bytes -> canonical bytes (exactly shape.bytes() of them). Throws
-/// FormatError("decompression_failed") when the zstd data is bad or does not
-/// decode to exactly shape.bytes() bytes; never allocates more than that.
-std::vector<std::uint8_t> decode_array(const std::uint8_t* stored, std::size_t stored_length, const Shape& shape,
-                                       const Encoding& encoding);
 
 }  // namespace sogmm::format::detail

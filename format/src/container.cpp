@@ -19,8 +19,8 @@ void write_header(std::uint8_t* out, const Header& h) {
   store_le<std::uint32_t>(out + 28, h.metadata_crc32c);
 }
 
-Header check_container(const std::uint8_t* p, std::size_t prefix_size, std::uint64_t file_size,
-                       const std::uint8_t* trailer, bool verify_checksums) {
+Header check_header(const std::uint8_t* p, std::size_t prefix_size, std::uint64_t file_size,
+                    const std::uint8_t* trailer) {
   const ErrorCode F = ErrorCode::Format;
   // 1. magic (on the bytes there are, so a short non-.sogmm file is "bad_magic")
   const std::size_t n_magic = prefix_size < kMagic.size() ? prefix_size : kMagic.size();
@@ -61,16 +61,21 @@ Header check_container(const std::uint8_t* p, std::size_t prefix_size, std::uint
   if (std::memcmp(trailer, kEndMagic.data(), kEndMagic.size()) != 0) {
     fail(F, "bad_trailer", "end marker \"SGMM\" missing (truncated or corrupted file)");
   }
-  // 7. metadata bounds
-  if (h.metadata_length < 8 || kHeaderSize + pad8(h.metadata_length) + kTrailerSize > h.file_length) {
-    fail(F, "bad_header", "metadata length " + std::to_string(h.metadata_length) + " does not fit the file");
-  }
-  // 8. metadata checksum
-  if (verify_checksums && prefix_size >= kHeaderSize + h.metadata_length) {
-    const std::uint32_t crc = crc32c(p + kHeaderSize, h.metadata_length);
-    if (crc != h.metadata_crc32c) fail(F, "checksum_mismatch", "metadata CRC-32C does not match");
+  // 7. metadata bounds (pad8 and the sum in 64 bits: L may be up to 2^32 - 1)
+  if (h.metadata_length < 8 || h.metadata_length >= kMetadataLengthLimit ||
+      kHeaderSize + pad8(h.metadata_length) + kTrailerSize > h.file_length) {
+    fail(F, "bad_header",
+         "metadata length " + std::to_string(h.metadata_length) +
+             (h.metadata_length >= kMetadataLengthLimit ? " is not below the FlatBuffers limit of 2^31 - 1 bytes"
+                                                        : " does not fit the file"));
   }
   return h;
+}
+
+void check_metadata_crc(const std::uint8_t* metadata, const Header& h) {
+  if (crc32c(metadata, h.metadata_length) != h.metadata_crc32c) {
+    fail(ErrorCode::Format, "checksum_mismatch", "metadata CRC-32C does not match");
+  }
 }
 
 }  // namespace sogmm::format::detail

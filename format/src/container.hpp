@@ -56,13 +56,16 @@ void store_le(std::uint8_t* p, T v) {
 /// Serialises a header into 32 bytes.
 void write_header(std::uint8_t* out, const Header& header);
 
-/// Steps 1-8 of the reading procedure (spec/format.md section 9) on the
-/// first `prefix_size` bytes of a file of `file_size` bytes whose last 4
-/// bytes are `trailer`: magic, size, version, flags, length, trailer,
-/// metadata bounds and the metadata checksum (when `prefix_size` covers the
-/// metadata). Returns the header.
-Header check_container(const std::uint8_t* prefix, std::size_t prefix_size, std::uint64_t file_size,
-                       const std::uint8_t* trailer, bool verify_checksums);
+/// Steps 1-7 of the reading procedure (spec/format.md section 9) on the
+/// first `prefix_size` (at most 32) bytes of a file of `file_size` bytes whose
+/// last 4 bytes are `trailer`: magic, size, version, flags, length, trailer
+/// and the metadata bounds. Uses nothing but those bytes, so a caller reads
+/// the metadata block only once its length is known to fit. Returns the header.
+Header check_header(const std::uint8_t* prefix, std::size_t prefix_size, std::uint64_t file_size,
+                    const std::uint8_t* trailer);
+
+/// Step 8: the CRC-32C of the metadata block against the header.
+void check_metadata_crc(const std::uint8_t* metadata, const Header& header);
 
 /// Offset of the body: header + metadata padded to 8.
 inline std::uint64_t body_start(const Header& h) { return kHeaderSize + pad8(h.metadata_length); }

@@ -31,6 +31,7 @@ struct Tweaks {
   std::optional<std::vector<std::string>> axis_units;  ///< overrides the axis units
   std::optional<std::vector<double>> raw_pose;         ///< pose vector written as is (any length)
   bool unknown_optional_fields = false;  ///< appends fields with ids unknown to format 1.0
+  bool share_strings = false;  ///< key/value strings stored once and shared (FlatBuffers CreateSharedString)
 };
 
 /// to_bytes() with tweaks.
@@ -38,6 +39,13 @@ std::vector<std::uint8_t> encode(const Model& model, const WriteOptions& options
 
 /// Recomputes the metadata CRC in the header after the metadata was patched.
 void refresh_metadata_crc(std::vector<std::uint8_t>& file);
+
+/// In a file written with float64 = true, compress = false: sets element
+/// `index` of array `which` (kWeights, kMeans, kCovariances of schema.hpp,
+/// canonical order) to `value` and updates that array's CRC-32C and the
+/// metadata CRC, so the file holds a binary64 value no float32 model has.
+/// Throws std::logic_error for any other file.
+void patch_f64_value(std::vector<std::uint8_t>& file, int which, std::uint64_t index, double value);
 
 /// Fault injection for save(): when set, called at each stage of the atomic
 /// write; returning true makes that stage fail as if the system call had.

@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sogmm/format.hpp"
+#include "strings.hpp"
 
 namespace sogmm::format {
 namespace {
@@ -24,6 +25,7 @@ ojson array_json(const ArrayInfo& a) {
 }  // namespace
 
 std::string to_canonical_json(const Model& model, const FileInfo* info) {
+  detail::check_strings(model, ErrorCode::InvalidData);
   ojson j;
   if (info != nullptr) {
     ojson f;
@@ -94,9 +96,7 @@ std::string to_canonical_json(const Model& model, const FileInfo* info) {
     j["means"] = mu;
     j["covariances"] = cov;
   }
-  // Strings from a file are not guaranteed to be valid UTF-8: invalid bytes
-  // become U+FFFD instead of an exception (the dump is for reading).
-  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  return j.dump(2) + "\n";  // strings checked above: valid UTF-8, so dump() cannot throw
 }
 
 }  // namespace sogmm::format

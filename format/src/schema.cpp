@@ -8,6 +8,8 @@
 
 #include "checks.hpp"
 #include "codec.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/metadata_string.hpp"
 #include "sogmm_generated.h"
 
 namespace sogmm::format::detail {
@@ -72,14 +74,34 @@ bool strings_equal(const flatbuffers::Vector<flatbuffers::Offset<flatbuffers::St
   return true;
 }
 
-// a * b, or nullopt-like max on overflow.
-bool mul_overflows(std::uint64_t a, std::uint64_t b, std::uint64_t* out) {
-  if (a != 0 && b > std::numeric_limits<std::uint64_t>::max() / a) return true;
-  *out = a * b;
-  return false;
-}
-
 const char* const kArrayNames[3] = {"weights", "means", "covariances"};
+
+// Step 11, strings (spec/format.md section 4.4): every string the reader
+// decodes is valid UTF-8 without NUL, and together they are no longer than the
+// block. FlatBuffers lets many fields point at one string, so without the
+// total a small block could decode to gigabytes; every reference counts.
+void check_metadata_strings(const fb::SogmmFile* root, std::uint64_t block_length) {
+  std::uint64_t total = 0;
+  auto check = [&](const flatbuffers::String* s, const auto& what) {
+    if (s == nullptr) return;
+    total += s->size();  // at most 100 000 tables x 2 strings of < 2^31 bytes: no overflow
+    const std::string problem = metadata_string_problem(s->c_str(), s->size());
+    if (!problem.empty()) fail(F, "bad_metadata", what() + ": " + problem);
+  };
+  check(root->producer_name(), [] { return std::string("producer name"); });
+  check(root->producer_version(), [] { return std::string("producer version"); });
+  if (const auto* kvs = root->key_values()) {
+    for (flatbuffers::uoffset_t i = 0; i < kvs->size(); ++i) {
+      check(kvs->Get(i)->key(), [i] { return "key of key/value pair " + std::to_string(i); });
+      check(kvs->Get(i)->value(), [i] { return "value of key/value pair " + std::to_string(i); });
+    }
+  }
+  if (total > block_length) {
+    fail(F, "bad_metadata",
+         "metadata strings total " + std::to_string(total) + " bytes (shared strings counted once per use), " +
+             "more than the " + std::to_string(block_length) + " bytes of the metadata block");
+  }
+}
 
 }  // namespace
 
@@ -118,8 +140,8 @@ flatbuffers::DetachedBuffer build_metadata(const Model& model, const ArrayRecord
   if (!model.key_values.empty()) {
     std::vector<flatbuffers::Offset<fb::KeyValue>> items;
     for (const auto& kv : model.key_values) {
-      const auto k = b.CreateString(kv.first);
-      const auto v = b.CreateString(kv.second);
+      const auto k = t.share_strings ? b.CreateSharedString(kv.first) : b.CreateString(kv.first);
+      const auto v = t.share_strings ? b.CreateSharedString(kv.second) : b.CreateString(kv.second);
       items.push_back(fb::CreateKeyValue(b, k, v));
     }
     kvs = b.CreateVector(items);
@@ -165,12 +187,7 @@ void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3]
   }
 }
 
-ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, const ReadOptions& options) {
-  // Copy into 8-aligned storage so every FlatBuffers scalar read is aligned.
-  std::vector<std::uint64_t> storage((h.metadata_length + 7) / 8);
-  std::memcpy(storage.data(), metadata, h.metadata_length);
-  const auto* buf = reinterpret_cast<const std::uint8_t*>(storage.data());
-
+ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const ReadOptions& options) {
   // 9. FlatBuffers verification (identifier, offsets, sizes, required fields).
   if (!flatbuffers::BufferHasIdentifier(buf, fb::SogmmFileIdentifier())) {
     fail(F, "bad_metadata", "metadata file identifier is not \"SGMM\"");
@@ -198,6 +215,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, con
     fail(F, "bad_metadata", "axis units are not (m, m, m, 1)");
   }
   if (root->gray_min() != 0.0 || root->gray_max() != 1.0) fail(F, "bad_metadata", "gray range is not [0, 1]");
+  check_metadata_strings(root, h.metadata_length);
   ParsedMetadata out;
   Model& model = out.info.metadata;
   if (root->pose()) {
@@ -235,15 +253,14 @@ ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, con
   for (int i = 0; i < 3; ++i) {
     const ArrayRecord& r = out.arrays[i];
     std::uint64_t expected = 0, mc = 0;
-    const bool overflow = mul_overflows(m, columns(i, out.packed), &mc) ||
-                          mul_overflows(mc, r.dtype == kDTypeF64 ? 8 : 4, &expected);
+    const bool overflow = !checked::try_mul<std::uint64_t>(m, columns(i, out.packed), &mc) ||
+                          !checked::try_mul<std::uint64_t>(mc, r.dtype == kDTypeF64 ? 8 : 4, &expected);
     if (overflow || r.decoded_length != expected) {
       fail(ErrorCode::InvalidData, "length_mismatch",
            std::string(kArrayNames[i]) + " declare " + std::to_string(r.decoded_length) +
                " decoded bytes, which disagrees with M = " + std::to_string(m));
     }
-    if (total > std::numeric_limits<std::uint64_t>::max() - expected) total_overflow = true;
-    total += expected;
+    if (!checked::try_add(total, expected, &total)) total_overflow = true;
   }
 
   // 15. size cap
@@ -317,6 +334,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& h, con
   model.producer_version = str(root->producer_version());
   model.created_unix_ms = root->created_unix_ms();
   if (root->key_values()) {
+    model.key_values.reserve(root->key_values()->size());
     for (const fb::KeyValue* kv : *root->key_values()) model.key_values.emplace_back(str(kv->key()), str(kv->value()));
   }
   return out;

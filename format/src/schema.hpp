@@ -46,8 +46,11 @@ struct ParsedMetadata {
   bool packed = true;
 };
 
-/// Steps 9-16: verifies the FlatBuffer, the features, the metadata values,
-/// the encodings, M, the declared lengths, the size cap and the buffer layout.
+/// Steps 9-16: verifies the FlatBuffer, the features, the metadata values
+/// (strings included), the encodings, M, the declared lengths, the size cap
+/// and the buffer layout; then decodes the metadata. `metadata` holds the
+/// header.metadata_length bytes of the block and is 8-byte aligned (so every
+/// FlatBuffers scalar read is aligned).
 ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& header, const ReadOptions& options);
 
 /// Number of columns C of array `which` (1, 4, 10 or 16).

@@ -16,6 +16,7 @@
 #include "crc32c.hpp"
 #include "internal.hpp"
 #include "schema.hpp"
+#include "strings.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/format.hpp"
 
@@ -41,7 +42,6 @@ std::vector<std::uint8_t> canonical_bytes(const std::vector<float>& v, bool f64)
   return out;
 }
 
-std::vector<double> widen(const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); }
 
 bool bit_symmetric(const std::vector<float>& cov, std::size_t m) {
   for (std::size_t k = 0; k < m; ++k) {
@@ -76,10 +76,9 @@ void validate_for_write(const Model& model) {
          "array lengths disagree with M = " + std::to_string(m) + ": " + std::to_string(g.means.size()) +
              " mean values, " + std::to_string(g.covariances.size()) + " covariance values");
   }
-  const std::vector<double> w = widen(g.weights), mu = widen(g.means), cov = widen(g.covariances);
-  ArraysView view{m, &w, &mu, &cov, /*packed=*/false};
-  check_values(view);
+  check_strings(model, ErrorCode::InvalidData);
   if (model.pose) check_pose(*model.pose);
+  check_values(g);
 }
 
 // The producer version a file records: the model's, or this library's.

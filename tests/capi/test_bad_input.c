@@ -339,6 +339,8 @@ int main(int argc, char** argv) {
   memcpy(pose_bad, pose_ok, sizeof pose_ok);
   pose_bad[15] = 1.0 + 1e-6; /* the last row is exactly (0, 0, 0, 1) */
   ROW("M41", sogmm_model_set_pose(m, pose_bad), SOGMM_E_INVALID_ARG);
+  ROW("M42", sogmm_model_set_value(m, "k\xff", "v"), SOGMM_E_INVALID_ARG);
+  ROW("M43", sogmm_model_set_value(m, "k", "\xed\xa0\x80"), SOGMM_E_INVALID_ARG); /* a UTF-16 surrogate */
 
   /* ---- inference ---- */
   ROW("I1", sogmm_model_sample_f32(NULL, 4, 0, 4, NULL, f1), SOGMM_E_NULL_ARG);

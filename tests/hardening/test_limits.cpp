@@ -220,9 +220,9 @@ long long peak_during_read(const std::vector<std::uint8_t>& file, std::uint64_t 
 
 // The bound that the reader keeps (spec/format.md section 8's cap on decoded
 // bytes D): peak heap <= file size + kReadFactor * min(D, cap) + kSlack.
-// Decoding keeps the stored bytes, one decoded copy and its double-precision
-// values per array, and the float32 model: 5 x D covers every layout.
-constexpr double kReadFactor = 5.0;
+// Decoding keeps the float32 model and one array's staging at a time: at most
+// 2.45 x D for any mix of dtypes (section 8.1).
+constexpr double kReadFactor = 2.45;
 constexpr long long kSlack = 256 << 10;
 
 TEST(ReaderCap, PeakHeapIsBoundedByTheDecodedCap) {

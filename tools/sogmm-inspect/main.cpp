@@ -68,16 +68,50 @@ Stats stats(std::vector<double> v) {
   return s;
 }
 
+// A metadata string as printed: the backslash and every control or
+// direction-changing code point (C0, DEL, C1, line/paragraph separators, bidi
+// embeddings, overrides and isolates) escaped as \xNN or \uNNNN, so that a file
+// cannot drive the terminal (escape sequences), reorder what is shown or fake
+// lines of this output. Strings read from a file are valid UTF-8 (the reader
+// checks), so code points can be decoded without further checks.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    const std::size_t len = b < 0x80 ? 1 : b < 0xE0 ? 2 : b < 0xF0 ? 3 : 4;
+    std::uint32_t cp = len == 1 ? b : b & (0x7F >> len);
+    for (std::size_t k = 1; k < len && i + k < s.size(); ++k) cp = (cp << 6) | (s[i + k] & 0x3F);
+    const bool escape = cp < 0x20 || (cp >= 0x7F && cp <= 0x9F) || (cp >= 0x2028 && cp <= 0x202E) ||
+                        (cp >= 0x2066 && cp <= 0x2069);
+    char buf[16];
+    if (cp == '\\') {
+      out += "\\\\";
+    } else if (escape) {
+      if (cp < 0x80) {
+        std::snprintf(buf, sizeof buf, "\\x%02x", static_cast<unsigned>(cp));
+      } else {
+        std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(cp));
+      }
+      out += buf;
+    } else {
+      out.append(s, i, len);
+    }
+    i += len;
+  }
+  return out;
+}
+
 void print_array(const char* name, const fmt::ArrayInfo& a) {
   std::printf("  %-12s %s %s %s %s  stored %llu B, decoded %llu B, crc32c %08x\n", name, a.dtype.c_str(),
               a.order.c_str(), a.filter.c_str(), a.codec.c_str(), static_cast<unsigned long long>(a.stored_length),
               static_cast<unsigned long long>(a.decoded_length), a.crc32c);
 }
 
-void print_metadata(const fmt::FileInfo& info) {
-  const sogmm::Model& m = info.metadata;
+// `m` holds the metadata (info.metadata after read_info_file, the model after load).
+void print_metadata(const fmt::FileInfo& info, const sogmm::Model& m) {
   std::printf("format version      %u.%u\n", info.format_major, info.format_minor);
-  std::printf("producer            %s %s\n", m.producer_name.c_str(), m.producer_version.c_str());
+  std::printf("producer            %s %s\n", printable(m.producer_name).c_str(),
+              printable(m.producer_version).c_str());
   std::printf("created             %s\n", iso_time(m.created_unix_ms).c_str());
   std::printf("components (M)      %llu\n", static_cast<unsigned long long>(info.n_components));
   std::printf("support size        %llu points\n", static_cast<unsigned long long>(m.gmm.support_size));
@@ -121,7 +155,9 @@ void print_metadata(const fmt::FileInfo& info) {
   } else {
     std::printf("pose                unknown\n");
   }
-  for (const auto& kv : m.key_values) std::printf("key/value           %s = %s\n", kv.first.c_str(), kv.second.c_str());
+  for (const auto& kv : m.key_values) {
+    std::printf("key/value           %s = %s\n", printable(kv.first).c_str(), printable(kv.second).c_str());
+  }
 }
 
 void print_statistics(const sogmm::Model& model) {
@@ -197,12 +233,13 @@ int main(int argc, char** argv) {
 
   try {
     if (mode == "metadata") {
-      print_metadata(fmt::read_info_file(path));
+      const fmt::FileInfo info = fmt::read_info_file(path);
+      print_metadata(info, info.metadata);
       std::printf("checksums           metadata verified; arrays not read\n");
       return 0;
     }
-    const sogmm::Model model = fmt::load(path);  // full verification, checksums included
-    const fmt::FileInfo info = fmt::read_info_file(path);
+    fmt::FileInfo info;
+    const sogmm::Model model = fmt::load(path, {}, &info);  // full verification, checksums included
     if (mode == "verify") {
       std::printf("ok\n");
       return 0;
@@ -228,7 +265,7 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    print_metadata(info);
+    print_metadata(info, model);
     print_statistics(model);
     std::printf("checksums           all verified (metadata and %d arrays)\n", 3);
     return 0;

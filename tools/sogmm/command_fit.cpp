@@ -12,6 +12,7 @@
 #include "sequence.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
+#include "sogmm/metadata_string.hpp"
 
 namespace sogmm::tools {
 
@@ -99,8 +100,10 @@ int run_single(const FitState& s) {
   // reproduces the model.
   FitOptions kept = s.fit;
   kept.seed += static_cast<std::uint64_t>(r.run);
-  std::vector<std::pair<std::string, std::string>> key_values{
-      {"source_depth", s.src.depth}, {"source_color", s.src.color}, {"coordinate_frame", "camera"}};
+  // File names need not be UTF-8; metadata strings must be (spec/format.md 4.4).
+  std::vector<std::pair<std::string, std::string>> key_values{{"source_depth", to_metadata_string(s.src.depth)},
+                                                              {"source_color", to_metadata_string(s.src.color)},
+                                                              {"coordinate_frame", "camera"}};
   if (s.fit.n_init > 1) key_values.emplace_back("n_init", std::to_string(s.fit.n_init));
   const Model model = make_model(std::move(r.gmm), kept, r.em, camera, s.depth_options, std::move(key_values));
   const std::uint64_t bytes = save_model(s.output, model);

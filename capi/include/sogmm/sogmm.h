@@ -326,10 +326,12 @@ SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);
 
 /* Free-form key/value metadata (UTF-8 strings, NUL-terminated, stored in
  * .sogmm files). get: *value_out points to the library-owned value, valid
- * until `model` is next modified or freed; SOGMM_E_NOT_FOUND if absent.
- * set: adds the pair or replaces the value of an existing key; an empty key
- * is SOGMM_E_INVALID_ARG. count / at: enumerate pairs in insertion order;
- * index >= count is SOGMM_E_INVALID_ARG; pointers as for get. */
+ * until `model` is next modified or freed; SOGMM_E_NOT_FOUND if absent; a
+ * key that repeats (files may hold repeated keys) gives its first pair.
+ * set: adds the pair or replaces the value of the first pair with that key;
+ * an empty key or a key or value that is not valid UTF-8 is
+ * SOGMM_E_INVALID_ARG. count / at: enumerate all pairs in order; index >=
+ * count is SOGMM_E_INVALID_ARG; pointers as for get. */
 SOGMM_API sogmm_status sogmm_model_get_value(const sogmm_model* model, const char* key,
                                              const char** value_out);
 SOGMM_API sogmm_status sogmm_model_set_value(sogmm_model* model, const char* key, const char* value);
@@ -391,9 +393,11 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
 SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* path,
                                         const sogmm_options* options);
 /* Reads a model from `path`. Read keys of `options` apply. Errors: cannot
- * open/read -> SOGMM_E_IO; not a valid .sogmm -> SOGMM_E_FORMAT; checksum or
- * content invalid -> SOGMM_E_FORMAT / SOGMM_E_INVALID_DATA / SOGMM_E_NUMERIC;
- * decoded size above the cap -> SOGMM_E_LIMIT. */
+ * open/read, or not a regular file (a FIFO, device or directory is refused
+ * at once, never waited on) -> SOGMM_E_IO; not a valid .sogmm ->
+ * SOGMM_E_FORMAT; checksum or content invalid -> SOGMM_E_FORMAT /
+ * SOGMM_E_INVALID_DATA / SOGMM_E_NUMERIC; decoded size above the cap ->
+ * SOGMM_E_LIMIT. */
 SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, const sogmm_options* options);
 /* Serialises `model` into a new buffer (the bytes of a .sogmm file).
  * Errors as sogmm_model_save without SOGMM_E_IO. */

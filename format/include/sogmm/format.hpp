@@ -64,7 +64,8 @@ class FormatError : public Error {
 
 /// Encodes a model into the bytes of a .sogmm file. Refuses (throws
 /// Error(InvalidData/Numeric), nothing written) a model that a reader would
-/// reject. An empty producer_version is written as sogmm::version_string().
+/// reject, metadata strings that are not valid UTF-8 or contain NUL included.
+/// An empty producer_version is written as sogmm::version_string().
 /// Covariances are stored packed (upper triangle) when every matrix is
 /// bit-exactly symmetric, else in full, so the round trip is always bit-exact.
 std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options = {});
@@ -77,7 +78,10 @@ Model from_bytes(const void* data, std::size_t size, const ReadOptions& options 
 /// any) is untouched and no temporary file is left; throws Error(Io).
 void save(const std::string& path, const Model& model, const WriteOptions& options = {});
 
-/// Reads and fully verifies a .sogmm file. Throws Error(Io) when it cannot be read.
+/// Reads and fully verifies a .sogmm file. Throws Error(Io) when it cannot be
+/// read or is not a regular file (a FIFO, a device or a directory is refused
+/// at once, never waited on). The file is read piecewise: header first, then
+/// the metadata block, then each array; memory as in spec/format.md section 8.
 Model load(const std::string& path, const ReadOptions& options = {});
 
 /// How one array is encoded in a file.
@@ -117,9 +121,16 @@ FileInfo read_info(const void* data, std::size_t size, const ReadOptions& option
 /// bytes. Throws Error(Io) when the file cannot be read.
 FileInfo read_info_file(const std::string& path, const ReadOptions& options = {});
 
+/// load() that also returns the file information in *info (not null), whose
+/// `metadata` member is left default-constructed: the returned model holds
+/// the metadata. One read, for tools that show both.
+Model load(const std::string& path, const ReadOptions& options, FileInfo* info);
+
 /// Canonical JSON dump of a model and its file information (spec/format.md
 /// section 10): fixed key order, 2-space indentation, numbers written so that
 /// parsing them gives back the exact value. `info` may be null (model only).
+/// Throws Error(InvalidData) for a string that breaks the metadata string
+/// rule of sogmm/metadata_string.hpp (a model read from a file never has one).
 std::string to_canonical_json(const Model& model, const FileInfo* info = nullptr);
 
 }  // namespace sogmm::format

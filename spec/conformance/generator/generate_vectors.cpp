@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "internal.hpp"
+#include "schema.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/format.hpp"
@@ -331,6 +332,49 @@ int main(int argc, char** argv) {
     bad = base;
     bad.pose = std::array<double, 16>{2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     invalid("pose_not_rigid", det::encode(bad, {}, nv), "invalid_data", "bad_pose", "pose scales x by 2");
+
+    // --- appended with issue 13 (metadata strings, F64 values rounded to float32)
+    det::Tweaks share;
+    share.share_strings = true;
+    Model shared = synthetic(3, 11);
+    shared.key_values = {{"camera", "kinect v1"}, {"rig", "kinect v1"}, {"spare", "kinect v1"}};
+    valid("shared_strings", det::encode(shared, {}, share),
+          "three values share one string; the strings total fewer bytes than the block");
+    Model controls = synthetic(3, 12);
+    controls.producer_name = "sogmm\x1b]0;title\x07";
+    controls.key_values = {{"note", "\x1b[2J\x1b[31mred\r\nforged: line\xe2\x80\xae\xc2\x9b"}};
+    valid("control_characters", fmt::to_bytes(controls),
+          "terminal escape sequences, CR LF, U+202E and U+009B in strings: valid UTF-8 (tools escape them)");
+    bad = base;
+    bad.key_values = {{"note", "caf\xe9"}};
+    invalid("string_not_utf8", det::encode(bad, {}, nv), "format", "bad_metadata",
+            "a key/value value in Latin-1 (byte 0xE9), not UTF-8");
+    bad = base;
+    bad.key_values = {{"\xed\xa0\x80", "v"}};
+    invalid("string_surrogate", det::encode(bad, {}, nv), "format", "bad_metadata",
+            "a key holding the UTF-16 surrogate U+D800 (CESU-8), not UTF-8");
+    bad = base;
+    bad.producer_name = "sogmm\xc0\xaf";
+    invalid("string_overlong", det::encode(bad, {}, nv), "format", "bad_metadata",
+            "producer name with an overlong encoding of '/'");
+    bad = base;
+    bad.key_values = {{"note", std::string("visible\0hidden", 14)}};
+    invalid("string_nul", det::encode(bad, {}, nv), "format", "bad_metadata", "a key/value value with an embedded NUL");
+    bad = base;
+    bad.key_values.assign(64, {"k", std::string(1000, 'x')});
+    det::Tweaks share_nv = share;
+    share_nv.validate = false;
+    invalid("shared_strings_over_block", det::encode(bad, {}, share_nv), "format", "bad_metadata",
+            "64 pairs sharing one key and one 1000-byte value: 64 KB of strings from a 2 KB block");
+    fmt::WriteOptions raw64;
+    raw64.float64 = true;
+    raw64.compress = false;
+    b = fmt::to_bytes(synthetic(2, 13), raw64);
+    const double tiny_diagonal[10] = {1e-50, 0, 0, 0, 1e-3, 0, 0, 1e-3, 0, 1e-3};  // packed, component 0
+    for (int t = 0; t < 10; ++t) det::patch_f64_value(b, det::kCovariances, static_cast<std::uint64_t>(t), tiny_diagonal[t]);
+    invalid("f64_underflows_float32", b, "numeric", "not_spd",
+            "float64 covariance diag(1e-50, 1e-3, 1e-3, 1e-3): positive definite in binary64, singular once rounded to "
+            "binary32");
 
     std::ofstream manifest(g_out + "/manifest.json");
     manifest << "{\n  \"format\": \"sogmm-conformance\",\n  \"manifest_version\": 1,\n"

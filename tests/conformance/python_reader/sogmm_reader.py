@@ -24,6 +24,7 @@ KNOWN_FEATURES = 0
 DEFAULT_MAX_DECODED_BYTES = 1 << 30
 MAX_DEPTH = 64
 MAX_TABLES = 100000
+METADATA_LENGTH_LIMIT = (1 << 31) - 1  # FlatBuffers' maximum buffer size, exclusive
 
 
 class SogmmError(Exception):
@@ -146,11 +147,12 @@ class _Table:
         return t + 4, n
 
     def string_at(self, t):
+        """The raw bytes of a string (its UTF-8 is checked in step 11)."""
         n = self.v.u32(t)
         self.v.check(t + 4, n + 1)
         if self.v.buf[t + 4 + n] != 0:
             raise _Bad("string not NUL-terminated")
-        return bytes(self.v.buf[t + 4:t + 4 + n]).decode("utf-8")
+        return bytes(self.v.buf[t + 4:t + 4 + n])
 
     def string(self, fid):
         t = self._target(fid)
@@ -229,12 +231,39 @@ def _read_all_metadata(root):
         "decimation": c.scalar(6, "i", 1), "depth_scale": c.scalar(7, "d", 1000.0),
         "depth_min": c.scalar(8, "d", 0.1), "depth_max": c.scalar(9, "d", 3.0)}
     m["pose"] = root.doubles(15)
-    m["producer_name"] = root.string(16) or ""
-    m["producer_version"] = root.string(17) or ""
+    m["producer_name"] = root.string(16) or b""
+    m["producer_version"] = root.string(17) or b""
     m["created_unix_ms"] = root.scalar(18, "q", 0)
     kvs = root.tables_(19) or []
-    m["key_values"] = [[kv.string(0) or "", kv.string(1) or ""] for kv in kvs]
+    m["key_values"] = [[kv.string(0) or b"", kv.string(1) or b""] for kv in kvs]
     return m
+
+
+def _decode_strings(md, block_length):
+    """Step 11, strings (spec section 4.4): valid UTF-8 without NUL, and no
+    more bytes in total (a shared string once per use) than the block."""
+    raw = [md["producer_name"], md["producer_version"]] + [b for kv in md["key_values"] for b in kv]
+    if sum(len(b) for b in raw) > block_length:
+        _format("bad_metadata", "strings total more bytes than the metadata block")
+    for b in raw:
+        if b"\0" in b:
+            _format("bad_metadata", "a string contains NUL")
+        try:
+            b.decode("utf-8")  # strict: no overlong forms, surrogates or code points above U+10FFFF
+        except UnicodeDecodeError as e:
+            _format("bad_metadata", f"a string is not valid UTF-8: {e}")
+    md["producer_name"] = md["producer_name"].decode("utf-8")
+    md["producer_version"] = md["producer_version"].decode("utf-8")
+    md["key_values"] = [[k.decode("utf-8"), v.decode("utf-8")] for k, v in md["key_values"]]
+
+
+def _round_f32(x):
+    """Nearest binary32 value of a binary64 value (ties to even), as spec
+    section 5.6 defines the values of F64 arrays; beyond the range: infinity."""
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return math.copysign(math.inf, x)
 
 
 # ---------------------------------------------------------------- checks and decoding
@@ -342,7 +371,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     if data[-4:] != END_MAGIC:
         _format("bad_trailer", "end marker missing")
     body_start = HEADER_SIZE + (meta_len + 7) // 8 * 8
-    if meta_len < 8 or body_start + TRAILER_SIZE > file_length:
+    if meta_len < 8 or meta_len >= METADATA_LENGTH_LIMIT or body_start + TRAILER_SIZE > file_length:
         _format("bad_header", "metadata length out of range")
     meta = data[HEADER_SIZE:HEADER_SIZE + meta_len]
     # 8
@@ -355,7 +384,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         v = _Verifier(meta)
         root = _Table(v, v.u32(0), 1)
         md = _read_all_metadata(root)
-    except (_Bad, UnicodeDecodeError, struct.error) as e:
+    except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
     # 10
     if md["features_required"] & ~KNOWN_FEATURES:
@@ -363,12 +392,13 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     # 11
     if md["dims"] != 4:
         _format("bad_metadata", "dims != 4")
-    if md["axis_labels"] is not None and md["axis_labels"] != ["x", "y", "z", "gray"]:
+    if md["axis_labels"] is not None and md["axis_labels"] != [b"x", b"y", b"z", b"gray"]:
         _format("bad_metadata", "axis labels")
-    if md["axis_units"] is not None and md["axis_units"] != ["m", "m", "m", "1"]:
+    if md["axis_units"] is not None and md["axis_units"] != [b"m", b"m", b"m", b"1"]:
         _format("bad_metadata", "axis units")
     if md["gray_min"] != 0.0 or md["gray_max"] != 1.0:
         _format("bad_metadata", "gray range")
+    _decode_strings(md, meta_len)
     if md["pose"] is not None:
         if len(md["pose"]) != 16:
             _format("bad_metadata", "pose length")
@@ -434,9 +464,10 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         if verify_checksums and crc32c(raw) != rec["crc32c"]:
             _format("checksum_mismatch", f"{name} CRC-32C")
         _, w, code = DTYPES[rec["dtype"]]
-        values.append(list(struct.unpack(f"<{m * c}{code}", raw)))
+        v = struct.unpack(f"<{m * c}{code}", raw)
+        values.append([_round_f32(x) for x in v] if code == "d" else list(v))
     weights, means, cov = values
-    # 19
+    # 19 (on the values as float32, section 5.6)
     if not all(math.isfinite(x) for arr in values for x in arr):
         _fail("numeric", "non_finite", "NaN or infinity in the arrays")
     if any(x < 0 for x in weights):

@@ -291,7 +291,11 @@ class GMM:
 
     @property
     def metadata(self) -> dict[str, str]:
-        """Copy of the free-form key/value strings (stored in .sogmm files)."""
+        """Copy of the free-form key/value strings (stored in .sogmm files).
+
+        A file may repeat a key; like the C API's lookup, the first pair with
+        that key gives its value. Strings are valid UTF-8 without NUL: the
+        library's reader rejects files whose strings are not."""
         h = self._h()
         n = c_size_t()
         check(lib.sogmm_model_value_count(h, byref(n)))
@@ -299,16 +303,20 @@ class GMM:
         for i in range(n.value):
             k, v = c_char_p(), c_char_p()
             check(lib.sogmm_model_value_at(h, i, byref(k), byref(v)))
-            out[k.value.decode("utf-8")] = v.value.decode("utf-8")
+            out.setdefault(k.value.decode("utf-8"), v.value.decode("utf-8"))
         return out
 
     def set_metadata(self, key: str, value: str) -> None:
-        """Adds or replaces one key/value string."""
+        """Adds one key/value string, or replaces the value of the first pair with that key."""
         if not isinstance(key, str) or not isinstance(value, str):
             raise InvalidArgumentError("metadata keys and values must be str")
         if "\0" in key or "\0" in value:
             raise InvalidArgumentError("metadata keys and values must not contain NUL characters")
-        check(lib.sogmm_model_set_value(self._h(), key.encode("utf-8"), value.encode("utf-8")))
+        try:
+            k, v = key.encode("utf-8"), value.encode("utf-8")
+        except UnicodeEncodeError as e:  # a lone surrogate has no UTF-8 form
+            raise InvalidArgumentError(f"metadata keys and values must be valid Unicode text: {e}") from None
+        check(lib.sogmm_model_set_value(self._h(), k, v))
 
     # ---- inference -------------------------------------------------------
     def score_samples(self, X) -> np.ndarray:

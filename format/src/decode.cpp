@@ -1,0 +1,253 @@
+// Streaming decoder of one array: zstd frames (or raw bytes) -> byte-stream
+// join and transpose -> canonical bytes, without intermediate copies.
+#include "decode.hpp"
+
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_d_stableOutBuffer: decode into our buffer, no window copy
+#include <zstd.h>
+#include <zstd_errors.h>
+
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "container.hpp"
+
+namespace sogmm::format::detail {
+namespace {
+
+constexpr std::size_t kChunk = 64 << 10;  // bytes read from a file at a time
+
+[[noreturn]] void bad(const std::string& detail) { fail(ErrorCode::Format, "decompression_failed", detail); }
+
+// The stored bytes of one array, consumed front to back: the whole range when
+// the source is in memory, else a chunk at a time.
+class StoredBytes {
+ public:
+  StoredBytes(const Source& src, std::uint64_t offset, std::uint64_t length)
+      : src_(src), next_(offset), end_(offset + length) {
+    if (const std::uint8_t* all = src.view(offset, static_cast<std::size_t>(length))) {
+      data_ = all;
+      avail_ = static_cast<std::size_t>(length);
+      next_ = end_;
+    } else {
+      buffer_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(length, kChunk)));
+      data_ = buffer_.data();  // never null when there is something to read
+    }
+  }
+  /// Makes at least min(want, left()) bytes available at data(); returns how many are.
+  std::size_t fill(std::size_t want) {
+    if (avail_ >= want || next_ == end_) return avail_;
+    std::memmove(buffer_.data(), data_, avail_);
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(buffer_.size() - avail_, end_ - next_));
+    src_.read(next_, buffer_.data() + avail_, n);
+    next_ += n;
+    avail_ += n;
+    data_ = buffer_.data();
+    return avail_;
+  }
+  const std::uint8_t* data() const { return data_; }
+  std::size_t available() const { return avail_; }
+  void consume(std::size_t n) {
+    data_ += n;
+    avail_ -= n;
+  }
+  /// Bytes not yet consumed.
+  std::uint64_t left() const { return avail_ + (end_ - next_); }
+
+ private:
+  const Source& src_;
+  std::uint64_t next_, end_;  // file range not yet read
+  std::vector<std::uint8_t> buffer_;
+  const std::uint8_t* data_ = nullptr;
+  std::size_t avail_ = 0;
+};
+
+// Writes filtered bytes, in stored order, to their canonical positions.
+// Stored order: BYTE_STREAM_SPLIT gives byte k of element i at k * n + i,
+// else element after element; COLUMN_MAJOR orders the elements as column c
+// of component r at c * M + r, else component after component.
+class Scatter {
+ public:
+  Scatter(const Shape& s, const Encoding& e, std::uint8_t* out)
+      : out_(out), total_(s.bytes()), rows_(s.rows), cols_(s.cols), width_(s.width), n_(s.rows * s.cols),
+        split_(e.filter == kFilterByteStreamSplit), column_major_(e.order == kOrderColumnMajor) {}
+
+  bool identity() const { return !split_ && !column_major_; }
+  std::uint64_t written() const { return written_; }
+
+  /// Records n bytes that the caller wrote itself at out + written() (identity layout only).
+  void placed(std::size_t n) {
+    if (n > total_ - written_) bad("data decodes to more than the declared " + std::to_string(total_) + " bytes");
+    written_ += n;
+  }
+
+  void put(const std::uint8_t* p, std::size_t n) {
+    const std::uint64_t at = written_;
+    placed(n);
+    if (identity()) {
+      if (n > 0) std::memcpy(out_ + at, p, n);
+      return;
+    }
+    while (n > 0) {
+      const std::uint64_t element = column_major_ ? row_ * cols_ + col_ : index_;
+      if (split_) {
+        // A run of byte k of successive elements, up to the end of the column or stream.
+        const std::uint64_t run = std::min<std::uint64_t>(n, column_major_ ? rows_ - row_ : n_ - index_);
+        const std::uint64_t stride = column_major_ ? cols_ * width_ : width_;
+        std::uint8_t* dst = out_ + element * width_ + byte_;
+        for (std::uint64_t t = 0; t < run; ++t) dst[t * stride] = p[t];
+        advance_elements(run);
+        if (index_ == n_) {
+          index_ = row_ = col_ = 0;
+          ++byte_;
+        }
+        p += run;
+        n -= static_cast<std::size_t>(run);
+      } else {
+        // Whole elements in column-major order: the rest of the current one.
+        const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(n, width_ - byte_));
+        std::memcpy(out_ + element * width_ + byte_, p, take);
+        byte_ += take;
+        if (byte_ == width_) {
+          byte_ = 0;
+          advance_elements(1);
+        }
+        p += take;
+        n -= take;
+      }
+    }
+  }
+
+ private:
+  void advance_elements(std::uint64_t count) {
+    index_ += count;
+    if (column_major_) {
+      row_ += count;  // runs never cross a column
+      if (row_ == rows_) {
+        row_ = 0;
+        ++col_;
+      }
+    }
+  }
+
+  std::uint8_t* out_;
+  std::uint64_t total_, rows_, cols_, width_, n_;
+  bool split_, column_major_;
+  std::uint64_t written_ = 0;
+  std::uint64_t index_ = 0, row_ = 0, col_ = 0, byte_ = 0;  // position of the next stored byte
+};
+
+struct DCtxDeleter {
+  void operator()(ZSTD_DCtx* d) const { ZSTD_freeDCtx(d); }
+};
+
+std::string zstd_error(int frame, std::size_t code) {
+  return "frame " + std::to_string(frame) + ": " + ZSTD_getErrorName(code) +
+         (ZSTD_getErrorCode(code) == ZSTD_error_dstSize_tooSmall ? " (decodes to more than declared)" : "");
+}
+
+// Feeds one frame's input to zstd until the frame ends; `flush` sees the
+// output after every step (a streamed frame empties it there).
+template <typename Flush>
+void decode_frame(ZSTD_DCtx* dctx, StoredBytes& in, ZSTD_outBuffer& ob, int frame, Flush&& flush) {
+  std::size_t hint = 1;
+  while (hint != 0) {
+    if (in.available() == 0 && in.fill(kChunk) == 0) bad("frame " + std::to_string(frame) + " is truncated");
+    ZSTD_inBuffer ib{in.data(), in.available(), 0};
+    const std::size_t before = ob.pos;
+    hint = ZSTD_decompressStream(dctx, &ob, &ib);
+    if (ZSTD_isError(hint)) bad(zstd_error(frame, hint));
+    in.consume(ib.pos);
+    const bool progress = ib.pos > 0 || ob.pos > before;
+    flush(ob);
+    if (hint != 0 && !progress) bad("frame " + std::to_string(frame) + " decodes to more than declared");
+  }
+}
+
+void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint64_t expected) {
+  std::unique_ptr<ZSTD_DCtx, DCtxDeleter> dctx(ZSTD_createDCtx());
+  if (!dctx) throw std::bad_alloc();
+  // Frames are decoded either into a buffer that holds the whole frame and
+  // serves as its window (stable output), or, when the layout needs staging
+  // and the frame's window is smaller than its content, streamed through a
+  // small chunk (zstd then keeps only the window). Either way a frame costs
+  // at most its content, which is checked against what is left first, so the
+  // largest window a frame may ask for is accepted.
+  ZSTD_DCtx_setParameter(dctx.get(), ZSTD_d_windowLogMax, ZSTD_WINDOWLOG_MAX);
+  // One frame's content when staged; not zero-filled, so only the pages a
+  // frame writes become resident.
+  std::unique_ptr<std::uint8_t[]> staging;
+  std::size_t staging_size = 0;
+  std::vector<std::uint8_t> chunk;  // output of streamed frames
+  for (int frame = 0; in.left() > 0; ++frame) {
+    in.fill(ZSTD_FRAMEHEADERSIZE_MAX);
+    if (in.available() < 4 || load_le<std::uint32_t>(in.data()) != ZSTD_MAGICNUMBER) {
+      bad("frame " + std::to_string(frame) + " does not start with the zstd magic number");
+    }
+    ZSTD_frameHeader fh{};
+    const std::size_t need = ZSTD_getFrameHeader(&fh, in.data(), in.available());
+    if (ZSTD_isError(need)) bad(zstd_error(frame, need));
+    if (need > 0) bad("frame " + std::to_string(frame) + ": truncated frame header");
+    // Checked before anything is allocated: a frame may not promise more than is left.
+    const std::uint64_t left = expected - scatter.written();
+    const bool known = fh.frameContentSize != ZSTD_CONTENTSIZE_UNKNOWN;
+    if (known && fh.frameContentSize > left) {
+      bad("frame " + std::to_string(frame) + " declares " + std::to_string(fh.frameContentSize) +
+          " bytes, more than the " + std::to_string(left) + " left of the declared length");
+    }
+    const std::size_t cap = static_cast<std::size_t>(known ? fh.frameContentSize : left);
+    const bool streamed = !scatter.identity() && fh.windowSize < cap;
+    ZSTD_DCtx_reset(dctx.get(), ZSTD_reset_session_only);  // a new output buffer per frame
+    ZSTD_DCtx_setParameter(dctx.get(), ZSTD_d_stableOutBuffer, streamed ? 0 : 1);
+    if (streamed) {
+      chunk.resize(ZSTD_DStreamOutSize());
+      ZSTD_outBuffer ob{chunk.data(), chunk.size(), 0};
+      decode_frame(dctx.get(), in, ob, frame, [&](ZSTD_outBuffer& o) {
+        scatter.put(chunk.data(), o.pos);
+        o.pos = 0;
+      });
+      continue;
+    }
+    std::uint8_t* dst = out + scatter.written();
+    if (!scatter.identity()) {
+      if (staging_size < cap) {
+        staging.reset();
+        staging.reset(new std::uint8_t[cap]);
+        staging_size = cap;
+      }
+      dst = staging.get();
+    }
+    ZSTD_outBuffer ob{dst, cap, 0};
+    decode_frame(dctx.get(), in, ob, frame, [](ZSTD_outBuffer&) {});
+    if (scatter.identity()) {
+      scatter.placed(ob.pos);
+    } else {
+      scatter.put(dst, ob.pos);
+    }
+  }
+}
+
+}  // namespace
+
+void decode_array(const Source& src, std::uint64_t offset, std::uint64_t stored_length, const Shape& shape,
+                  const Encoding& e, std::uint8_t* out) {
+  const std::uint64_t expected = shape.bytes();
+  StoredBytes in(src, offset, stored_length);
+  Scatter scatter(shape, e, out);
+  if (e.codec == kCodecZstd) {
+    decode_zstd(in, scatter, out, expected);
+  } else {
+    while (in.left() > 0) {
+      const std::size_t n = in.fill(kChunk);
+      scatter.put(in.data(), n);
+      in.consume(n);
+    }
+  }
+  if (scatter.written() != expected) {
+    bad("data decodes to " + std::to_string(scatter.written()) + " bytes, " + std::to_string(expected) + " declared");
+  }
+}
+
+}  // namespace sogmm::format::detail

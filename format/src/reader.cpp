@@ -1,0 +1,142 @@
+// The reading procedure of spec/format.md section 9 on a file in memory or on
+// disk: from_bytes, load, read_info, read_info_file. Memory: the metadata
+// block, the decoded metadata, the float32 model and one array's staging at
+// most (spec/format.md section 8); the file itself is never held whole.
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "checks.hpp"
+#include "container.hpp"
+#include "crc32c.hpp"
+#include "decode.hpp"
+#include "schema.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/format.hpp"
+#include "source.hpp"
+
+namespace sogmm::format {
+namespace detail {
+namespace {
+
+constexpr bool kBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+const char* const kNames[3] = {"weights", "means", "covariances"};
+
+// Steps 1-16: the header and the trailer first, then the metadata block, read
+// only once its length is known to fit the file.
+ParsedMetadata read_metadata(const Source& src, const ReadOptions& options) {
+  const std::uint64_t size = src.size();
+  std::uint8_t prefix[kHeaderSize] = {};
+  const std::size_t prefix_size = size < kHeaderSize ? static_cast<std::size_t>(size) : kHeaderSize;
+  src.read(0, prefix, prefix_size);
+  std::uint8_t trailer[kTrailerSize] = {};
+  if (size >= kTrailerSize) src.read(size - kTrailerSize, trailer, kTrailerSize);
+  const Header h = check_header(prefix, prefix_size, size, trailer);
+  // 8-byte aligned, so that every FlatBuffers scalar read is aligned.
+  std::vector<std::uint64_t> block(static_cast<std::size_t>(pad8(h.metadata_length) / 8));
+  auto* bytes = reinterpret_cast<std::uint8_t*>(block.data());
+  src.read(kHeaderSize, bytes, h.metadata_length);
+  if (options.verify_checksums) check_metadata_crc(bytes, h);
+  return parse_metadata(bytes, h, options);
+}
+
+// Steps 17-18 for one array: its values as float32 at `out` (rows x cols, in
+// canonical order). F32 arrays are decoded in place; F64 ones through their
+// canonical bytes, then rounded to nearest float32 (IEEE 754: overflow gives
+// an infinity, which step 19 rejects).
+void read_array(const Source& src, const ArrayRecord& r, std::uint64_t rows, std::uint64_t cols, bool verify,
+                const char* name, float* out) {
+  const bool f64 = r.dtype == kDTypeF64;
+  const Shape shape{rows, cols, f64 ? 8u : 4u};
+  const Encoding encoding{r.order, r.filter, r.codec};
+  std::vector<std::uint8_t> staging(f64 ? static_cast<std::size_t>(shape.bytes()) : 0);
+  std::uint8_t* canonical = f64 ? staging.data() : reinterpret_cast<std::uint8_t*>(out);
+  decode_array(src, r.offset, r.stored_length, shape, encoding, canonical);
+  if (verify && crc32c(canonical, static_cast<std::size_t>(shape.bytes())) != r.crc32c) {
+    fail(ErrorCode::Format, "checksum_mismatch", std::string(name) + ": CRC-32C of the decoded bytes does not match");
+  }
+  const std::uint64_t n = rows * cols;
+  if (f64) {
+    static_assert(std::numeric_limits<float>::is_iec559, "IEEE 754 rounding from binary64 to binary32");
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const std::uint64_t bits = load_le<std::uint64_t>(canonical + 8 * i);
+      double d;
+      std::memcpy(&d, &bits, 8);
+      out[i] = static_cast<float>(d);
+    }
+  } else if constexpr (kBigEndian) {
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const std::uint32_t bits = load_le<std::uint32_t>(canonical + 4 * i);
+      std::memcpy(out + i, &bits, 4);
+    }
+  }
+}
+
+// UPPER_PACKED -> full: 10 values per component at the start of `cov` become
+// 16. Backwards, so that no component overwrites one not yet expanded
+// (component k's 16 values start at 16 k >= the end of every packed j < k).
+void expand_upper_in_place(float* cov, std::uint64_t m) {
+  constexpr int kUpper[10][2] = {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1}, {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}};
+  for (std::uint64_t k = m; k-- > 0;) {
+    float packed[10];
+    std::memcpy(packed, cov + 10 * k, sizeof packed);
+    float* full = cov + 16 * k;
+    for (int t = 0; t < 10; ++t) {
+      full[kUpper[t][0] * 4 + kUpper[t][1]] = full[kUpper[t][1] * 4 + kUpper[t][0]] = packed[t];
+    }
+  }
+}
+
+// The whole procedure. *info (if not null) gets the file information, with
+// its `metadata` left default: the returned model holds the metadata.
+Model read_model(const Source& src, const ReadOptions& options, FileInfo* info) {
+  ParsedMetadata meta = read_metadata(src, options);
+  const std::uint64_t m = meta.info.n_components;  // its arrays fit the cap (step 15)
+  Model model = std::move(meta.info.metadata);
+  Gmm& g = model.gmm;
+  g.resize(static_cast<std::size_t>(m));
+  float* const dest[3] = {g.weights.data(), g.means.data(), g.covariances.data()};
+  for (int i = 0; i < 3; ++i) {
+    read_array(src, meta.arrays[i], m, columns(i, meta.packed), options.verify_checksums, kNames[i], dest[i]);
+  }
+  if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
+  check_values(g);  // 19
+  if (info != nullptr) {
+    *info = std::move(meta.info);
+    info->metadata = Model{};
+  }
+  return model;
+}
+
+const std::uint8_t* bytes_of(const void* data, std::size_t size, const char* who) {
+  if (data == nullptr && size != 0) throw Error(ErrorCode::InvalidArgument, std::string(who) + ": null data");
+  return static_cast<const std::uint8_t*>(data);
+}
+
+}  // namespace
+}  // namespace detail
+
+Model from_bytes(const void* data, std::size_t size, const ReadOptions& options) {
+  const detail::MemorySource src(detail::bytes_of(data, size, "from_bytes"), size);
+  return detail::read_model(src, options, nullptr);
+}
+
+FileInfo read_info(const void* data, std::size_t size, const ReadOptions& options) {
+  const detail::MemorySource src(detail::bytes_of(data, size, "read_info"), size);
+  return detail::read_metadata(src, options).info;
+}
+
+Model load(const std::string& path, const ReadOptions& options) { return load(path, options, nullptr); }
+
+Model load(const std::string& path, const ReadOptions& options, FileInfo* info) {
+  const detail::FileSource src(path);
+  return detail::read_model(src, options, info);
+}
+
+FileInfo read_info_file(const std::string& path, const ReadOptions& options) {
+  const detail::FileSource src(path);
+  return detail::read_metadata(src, options).info;
+}
+
+}  // namespace sogmm::format
