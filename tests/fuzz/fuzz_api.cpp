@@ -33,6 +33,7 @@ namespace {
 constexpr int kSlots = 4;
 constexpr std::size_t kMaxPoints = 192;
 constexpr int kMaxSteps = 48;
+constexpr std::size_t kMaxMergedComponents = 4096;
 
 struct State {
   std::array<sogmm_model*, kSlots> models{};
@@ -375,6 +376,13 @@ void step_inference(State& st, sogmm_fuzz::Reader& in) {
 
 void step_merge(State& st, sogmm_fuzz::Reader& in) {
   const int a = in.take<std::uint8_t>() % kSlots, b = in.take<std::uint8_t>() % kSlots;
+  // Merging a model with itself doubles it: a program of merges alone would
+  // reach millions of components, legitimately (maps grow), but slowly. Keep
+  // each input cheap.
+  std::size_t ma = 0, mb = 0;
+  if (st.models[a] && st.models[b] && sogmm_model_n_components(st.models[a], &ma) == SOGMM_OK &&
+      sogmm_model_n_components(st.models[b], &mb) == SOGMM_OK && ma + mb > kMaxMergedComponents)
+    return;
   sogmm_model* out = reinterpret_cast<sogmm_model*>(1);
   const sogmm_status s = sogmm_model_merge(&out, st.models[a], st.models[b]);
   check_created(s, out);
