@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_model_check.hpp"
 #include "fuzz_util.hpp"
 #include "sogmm/sogmm.h"
 
@@ -56,25 +57,7 @@ void check_status(sogmm_status s) {
   if (s != SOGMM_OK) FUZZ_CHECK(sogmm_last_error()[0] != '\0');
 }
 
-void check_model(const sogmm_model* model) {
-  std::size_t m = 0;
-  FUZZ_CHECK(sogmm_model_n_components(model, &m) == SOGMM_OK);
-  FUZZ_CHECK(m >= 1);
-  std::vector<float> w(m), mu(4 * m), cov(16 * m);
-  FUZZ_CHECK(sogmm_model_get_weights_f32(model, w.data(), w.size()) == SOGMM_OK);
-  FUZZ_CHECK(sogmm_model_get_means_f32(model, mu.data(), mu.size()) == SOGMM_OK);
-  FUZZ_CHECK(sogmm_model_get_covariances_f32(model, cov.data(), cov.size()) == SOGMM_OK);
-  double sum = 0;
-  for (float v : w) {
-    FUZZ_CHECK(std::isfinite(v) && v >= 0);
-    sum += v;
-  }
-  FUZZ_CHECK(std::fabs(sum - 1.0) <= 1e-4);
-  for (float v : mu) FUZZ_CHECK(std::isfinite(v));
-  for (float v : cov) FUZZ_CHECK(std::isfinite(v));
-  for (std::size_t k = 0; k < m; ++k)
-    for (int i = 0; i < 4; ++i) FUZZ_CHECK(cov[16 * k + 5 * i] > 0);  // diagonal of an SPD matrix
-}
+using sogmm_fuzz::check_model;
 
 // A handle-creating call: on error *out is NULL; on success the model is valid.
 void check_created(sogmm_status s, sogmm_model* out) {
