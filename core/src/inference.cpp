@@ -14,7 +14,6 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
-#include "sogmm/checked.hpp"
 #include "sogmm/model.hpp"
 
 namespace sogmm {
@@ -259,15 +258,18 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
     for (int i = 0; i < 16; ++i) out.covariances[16 * k + i] = static_cast<float>(c(i / 4, i % 4));
     // A finite pose can still move a mean out of float32 range (a translation
     // of 1e39): an error here rather than a model that no later call accepts.
+    // (Messages are built only on failure: a map has tens of thousands of components.)
     for (int i = 0; i < 4; ++i) {
-      require(std::isfinite(out.means[4 * k + i]), ErrorCode::InvalidArgument,
-              "pose moves the mean of component " + std::to_string(k) + " to coordinate " + std::to_string(i) +
-                  " = " + checked::exact(mu[i]) + ", beyond the float32 range");
+      if (!std::isfinite(out.means[4 * k + i]))
+        throw Error(ErrorCode::InvalidArgument, "pose moves the mean of component " + std::to_string(k) +
+                                                    " to coordinate " + std::to_string(i) + " = " +
+                                                    checked::exact(mu[i]) + ", beyond the float32 range");
     }
     for (int i = 0; i < 16; ++i) {
-      require(std::isfinite(out.covariances[16 * k + i]), ErrorCode::InvalidArgument,
-              "pose makes the covariance of component " + std::to_string(k) + " non-finite in float32 (entry " +
-                  std::to_string(i) + " = " + checked::exact(c(i / 4, i % 4)) + ")");
+      if (!std::isfinite(out.covariances[16 * k + i]))
+        throw Error(ErrorCode::InvalidArgument, "pose makes the covariance of component " + std::to_string(k) +
+                                                    " non-finite in float32 (entry " + std::to_string(i) + " = " +
+                                                    checked::exact(c(i / 4, i % 4)) + ")");
     }
   }
   return out;

@@ -41,6 +41,12 @@ inline int team_size(int requested) {
 /// exception is rethrown on the calling thread once the team has finished.
 template <class Body>
 void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& body) {
+  // One thread: a plain loop (same order as a one-thread team), without the
+  // cost of opening a parallel region, e.g. once per k-means++ step.
+  if (threads <= 1) {
+    for (std::size_t i = 0; i < n; ++i) body(i, 0);
+    return;
+  }
   std::atomic<bool> failed{false};
   std::exception_ptr first_error;
   std::mutex error_mutex;

@@ -126,10 +126,15 @@ MetadataBounds check_metadata_limits(const Model& model) {
              std::to_string(tables) + " tables, more than the " + std::to_string(kMaxMetadataTables) +
              " a reader verifies");
   }
+  // Refused when the block could reach the limit (its upper bound), not only
+  // when it must (its lower bound): FlatBuffers itself cannot build a buffer
+  // of 2^31 bytes (an assertion in debug builds), and building first would
+  // allocate ~2 GiB before the exact size is known. This refuses at most a
+  // few KiB of metadata below the limit that would have fitted.
   const MetadataBounds bounds = metadata_bounds(model);
-  if (bounds.lower >= kMetadataLengthLimit) {
+  if (bounds.upper >= kMetadataLengthLimit) {
     fail(ErrorCode::Limit, "limit",
-         "the metadata (producer strings and key/value pairs) needs at least " + std::to_string(bounds.lower) +
+         "the metadata (producer strings and key/value pairs) may need up to " + std::to_string(bounds.upper) +
              " bytes; a metadata block must be smaller than 2^31 - 1 bytes");
   }
   return bounds;

@@ -84,10 +84,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double u = std::isfinite(bw_raw) ? std::fabs(std::fmod(bw_raw, 1.0)) : 0.5;
     bw = 1e-3 * std::pow(1e4, u);  // [1e-3, 10)
   }
-  // The setter's rule (spec/api.md): finite, > 0, and bw^2 and 1 / (2 bw^2)
-  // finite and nonzero, so the mode counter never sees an infinite kernel.
+  // The setter's rule (spec/api.md): bw, bw^2, (3 bw)^2 and 1 / (2 bw^2)
+  // finite and non-zero, so the mode counter never sees an infinite kernel.
   auto finite_nonzero = [](double v) { return std::isfinite(v) && v != 0.0; };
-  // The documented rule: bw, bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and non-zero.
   const bool bw_valid = std::isfinite(bw) && bw > 0 && finite_nonzero(bw * bw) && std::isfinite(9.0 * bw * bw) &&
                         finite_nonzero(1.0 / (2.0 * bw * bw));
   FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, bw) == (bw_valid ? SOGMM_OK : SOGMM_E_INVALID_ARG));

@@ -244,11 +244,10 @@ TEST_F(OutOfMemory, SaveAndLoadReportNomemForEveryFailedAllocation) {
   });
 }
 
-// Disabled until format/src/atomic_file.cpp (the format layer's, not the
-// core's) stops losing its temporary file when an allocation fails: it creates
-// the file with mkstemp and only then copies the name into the std::string of
-// its cleanup guard, so a std::bad_alloc there leaves "model.sogmm.tmp-XXXXXX"
-// and its descriptor behind (found by this sweep at the 44th allocation).
+// A failed save leaves no temporary file: atomic_file.cpp once created it with
+// mkstemp before copying the name into its cleanup guard, so a std::bad_alloc
+// there left "model.sogmm.tmp-XXXXXX" and its descriptor behind (found by this
+// sweep at the 44th allocation).
 TEST_F(OutOfMemory, FailedSaveLeavesNoTemporaryFile) {
   const std::string path = dir_ + "/model.sogmm";
   ASSERT_EQ(sogmm_model_save(model_, path.c_str(), nullptr), SOGMM_OK) << sogmm_last_error();

@@ -147,7 +147,8 @@ typedef int32_t sogmm_key;
                                     * default 1e-6: added to covariance diagonals */
 #define SOGMM_OPT_MAX_ITER 104     /* i64, [1, 2^31-1]; default 100: EM iterations at most */
 #define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
-#define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores */
+#define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores; a request is capped at
+                                    * 4 x the cores (libgomp aborts when it cannot start a thread) */
 #define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default FLAT_BINNED */
 #define SOGMM_OPT_TRUNCATION_NATS 108 /* f64, >= 0, finite; default 0 = exact E-step. > 0: truncated E-step
                                        * that skips components provably more than this many nats below
