@@ -1,0 +1,162 @@
+//! Raw declarations of libsogmm's C API, written by hand from
+//! `capi/include/sogmm/sogmm.h` (no bindgen: the header is small and plain C99,
+//! and a hand-written file keeps the toolchain light). The documentation of
+//! every item is in the header and in spec/api.md; the safe API is the `sogmm`
+//! crate.
+//!
+//! `tests/header_drift.rs` parses sogmm.h and fails when a prototype or a
+//! constant here differs from it (name, argument count, argument or return
+//! types, value). Keep declarations one per line in the header's order.
+#![no_std]
+#![allow(non_camel_case_types)]
+
+pub use core::ffi::{c_char, c_void};
+
+/// Opaque handle: a fitted 4-D GMM plus metadata.
+#[repr(C)]
+pub struct sogmm_model {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+/// Opaque handle: enum-keyed parameters for fit, save, load, sample.
+#[repr(C)]
+pub struct sogmm_options {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+/// Opaque handle: bytes produced by the library.
+#[repr(C)]
+pub struct sogmm_buffer {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+
+pub type sogmm_status = i32;
+pub type sogmm_key = i32;
+
+// ---- versions -------------------------------------------------------------
+pub const SOGMM_VERSION_MAJOR: u32 = 0;
+pub const SOGMM_VERSION_MINOR: u32 = 1;
+pub const SOGMM_VERSION_PATCH: u32 = 0;
+pub const SOGMM_VERSION_STRING: &str = "0.1.0";
+pub const SOGMM_ABI_VERSION: u32 = 1;
+
+// ---- status codes ---------------------------------------------------------
+pub const SOGMM_OK: sogmm_status = 0;
+pub const SOGMM_E_NULL_ARG: sogmm_status = -1;
+pub const SOGMM_E_INVALID_ARG: sogmm_status = -2;
+pub const SOGMM_E_INVALID_DATA: sogmm_status = -3;
+pub const SOGMM_E_NUMERIC: sogmm_status = -4;
+pub const SOGMM_E_IO: sogmm_status = -5;
+pub const SOGMM_E_FORMAT: sogmm_status = -6;
+pub const SOGMM_E_LIMIT: sogmm_status = -7;
+pub const SOGMM_E_NOMEM: sogmm_status = -8;
+pub const SOGMM_E_BUFFER_TOO_SMALL: sogmm_status = -9;
+pub const SOGMM_E_NOT_FOUND: sogmm_status = -10;
+pub const SOGMM_E_INTERNAL: sogmm_status = -11;
+
+// ---- option keys ----------------------------------------------------------
+pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;
+pub const SOGMM_OPT_N_COMPONENTS: sogmm_key = 101;
+pub const SOGMM_OPT_TOL: sogmm_key = 102;
+pub const SOGMM_OPT_REG_COVAR: sogmm_key = 103;
+pub const SOGMM_OPT_MAX_ITER: sogmm_key = 104;
+pub const SOGMM_OPT_SEED: sogmm_key = 105;
+pub const SOGMM_OPT_THREADS: sogmm_key = 106;
+pub const SOGMM_OPT_MODE_COUNTER: sogmm_key = 107;
+pub const SOGMM_OPT_TRUNCATION_NATS: sogmm_key = 108;
+pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
+pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
+pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
+pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;
+pub const SOGMM_OPT_DEPTH_MIN: sogmm_key = 201;
+pub const SOGMM_OPT_DEPTH_MAX: sogmm_key = 202;
+pub const SOGMM_OPT_DECIMATION: sogmm_key = 203;
+pub const SOGMM_OPT_ZSTD_LEVEL: sogmm_key = 300;
+pub const SOGMM_OPT_FLOAT64: sogmm_key = 301;
+pub const SOGMM_OPT_COMPRESS: sogmm_key = 302;
+pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
+pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
+pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
+
+// ---- color formats --------------------------------------------------------
+pub const SOGMM_COLOR_GRAY8: i32 = 1;
+pub const SOGMM_COLOR_RGB8: i32 = 2;
+pub const SOGMM_COLOR_GRAY_F32: i32 = 3;
+
+// ---- information keys -----------------------------------------------------
+pub const SOGMM_INFO_SUPPORT_SIZE: sogmm_key = 10001;
+pub const SOGMM_INFO_CREATED_UNIX_MS: sogmm_key = 10002;
+pub const SOGMM_INFO_FIT_ITERATIONS: sogmm_key = 10100;
+pub const SOGMM_INFO_FIT_CONVERGED: sogmm_key = 10101;
+pub const SOGMM_INFO_FIT_LOG_LIKELIHOOD: sogmm_key = 10102;
+pub const SOGMM_INFO_FIT_BANDWIDTH: sogmm_key = 10103;
+pub const SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED: sogmm_key = 10104;
+pub const SOGMM_INFO_FIT_TOL: sogmm_key = 10105;
+pub const SOGMM_INFO_FIT_REG_COVAR: sogmm_key = 10106;
+pub const SOGMM_INFO_FIT_MAX_ITER: sogmm_key = 10107;
+pub const SOGMM_INFO_FIT_SEED: sogmm_key = 10108;
+pub const SOGMM_INFO_FIT_N_POINTS: sogmm_key = 10150;
+pub const SOGMM_INFO_FIT_SECONDS_MODE_COUNT: sogmm_key = 10151;
+pub const SOGMM_INFO_FIT_SECONDS_SEEDING: sogmm_key = 10152;
+pub const SOGMM_INFO_FIT_SECONDS_EM: sogmm_key = 10153;
+pub const SOGMM_INFO_FIT_SECONDS_TOTAL: sogmm_key = 10154;
+pub const SOGMM_INFO_FIT_N_INIT: sogmm_key = 10155;
+pub const SOGMM_INFO_FIT_RUN: sogmm_key = 10156;
+pub const SOGMM_INFO_CAMERA_WIDTH: sogmm_key = 10200;
+pub const SOGMM_INFO_CAMERA_HEIGHT: sogmm_key = 10201;
+pub const SOGMM_INFO_CAMERA_FX: sogmm_key = 10202;
+pub const SOGMM_INFO_CAMERA_FY: sogmm_key = 10203;
+pub const SOGMM_INFO_CAMERA_CX: sogmm_key = 10204;
+pub const SOGMM_INFO_CAMERA_CY: sogmm_key = 10205;
+pub const SOGMM_INFO_CAMERA_DECIMATION: sogmm_key = 10206;
+pub const SOGMM_INFO_CAMERA_DEPTH_SCALE: sogmm_key = 10207;
+pub const SOGMM_INFO_CAMERA_DEPTH_MIN: sogmm_key = 10208;
+pub const SOGMM_INFO_CAMERA_DEPTH_MAX: sogmm_key = 10209;
+
+extern "C" {
+    pub fn sogmm_version_number() -> u32;
+    pub fn sogmm_version_string() -> *const c_char;
+    pub fn sogmm_abi_version() -> u32;
+    pub fn sogmm_status_string(status: sogmm_status) -> *const c_char;
+    pub fn sogmm_last_error() -> *const c_char;
+    pub fn sogmm_options_create(out: *mut *mut sogmm_options) -> sogmm_status;
+    pub fn sogmm_options_clone(out: *mut *mut sogmm_options, src: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_options_free(options: *mut sogmm_options);
+    pub fn sogmm_options_set_f64(options: *mut sogmm_options, key: sogmm_key, value: f64) -> sogmm_status;
+    pub fn sogmm_options_set_i64(options: *mut sogmm_options, key: sogmm_key, value: i64) -> sogmm_status;
+    pub fn sogmm_options_get_f64(options: *const sogmm_options, key: sogmm_key, out: *mut f64) -> sogmm_status;
+    pub fn sogmm_options_get_i64(options: *const sogmm_options, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_fit_points_f32(out: *mut *mut sogmm_model, points: *const f32, n: usize, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_fit_points_fixed_k_f32(out: *mut *mut sogmm_model, points: *const f32, n: usize, k: usize, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_fit_rgbd(out: *mut *mut sogmm_model, depth: *const u16, color: *const u8, color_format: i32, width: u32, height: u32, fx: f64, fy: f64, cx: f64, cy: f64, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_rgbd_to_points_f32(out: *mut f32, capacity: usize, n_points: *mut usize, depth: *const u16, color: *const u8, color_format: i32, width: u32, height: u32, fx: f64, fy: f64, cx: f64, cy: f64, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_model_from_arrays_f32(out: *mut *mut sogmm_model, m: usize, weights: *const f32, means: *const f32, covariances: *const f32, support_size: u64) -> sogmm_status;
+    pub fn sogmm_model_clone(out: *mut *mut sogmm_model, model: *const sogmm_model) -> sogmm_status;
+    pub fn sogmm_model_free(model: *mut sogmm_model);
+    pub fn sogmm_model_n_components(model: *const sogmm_model, out: *mut usize) -> sogmm_status;
+    pub fn sogmm_model_get_weights_f32(model: *const sogmm_model, out: *mut f32, capacity: usize) -> sogmm_status;
+    pub fn sogmm_model_get_means_f32(model: *const sogmm_model, out: *mut f32, capacity: usize) -> sogmm_status;
+    pub fn sogmm_model_get_covariances_f32(model: *const sogmm_model, out: *mut f32, capacity: usize) -> sogmm_status;
+    pub fn sogmm_model_get_info_f64(model: *const sogmm_model, key: sogmm_key, out: *mut f64) -> sogmm_status;
+    pub fn sogmm_model_get_info_i64(model: *const sogmm_model, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_model_get_pose(model: *const sogmm_model, pose_out: *mut f64) -> sogmm_status;
+    pub fn sogmm_model_set_pose(model: *mut sogmm_model, pose: *const f64) -> sogmm_status;
+    pub fn sogmm_model_clear_pose(model: *mut sogmm_model) -> sogmm_status;
+    pub fn sogmm_model_get_value(model: *const sogmm_model, key: *const c_char, value_out: *mut *const c_char) -> sogmm_status;
+    pub fn sogmm_model_set_value(model: *mut sogmm_model, key: *const c_char, value: *const c_char) -> sogmm_status;
+    pub fn sogmm_model_value_count(model: *const sogmm_model, out: *mut usize) -> sogmm_status;
+    pub fn sogmm_model_value_at(model: *const sogmm_model, index: usize, key_out: *mut *const c_char, value_out: *mut *const c_char) -> sogmm_status;
+    pub fn sogmm_model_sample_f32(model: *const sogmm_model, n: usize, seed: u64, dims: i32, options: *const sogmm_options, out: *mut f32) -> sogmm_status;
+    pub fn sogmm_model_regress_gray_f32(model: *const sogmm_model, xyz: *const f32, n: usize, mean_out: *mut f32, variance_out: *mut f32) -> sogmm_status;
+    pub fn sogmm_model_score_samples_f32(model: *const sogmm_model, points: *const f32, n: usize, dims: i32, out: *mut f64) -> sogmm_status;
+    pub fn sogmm_model_merge(out: *mut *mut sogmm_model, a: *const sogmm_model, b: *const sogmm_model) -> sogmm_status;
+    pub fn sogmm_model_transform(out: *mut *mut sogmm_model, model: *const sogmm_model, pose: *const f64) -> sogmm_status;
+    pub fn sogmm_model_save(model: *const sogmm_model, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_model_load(out: *mut *mut sogmm_model, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_model_save_to_memory(out: *mut *mut sogmm_buffer, model: *const sogmm_model, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_model_load_from_memory(out: *mut *mut sogmm_model, data: *const c_void, size: usize, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_buffer_data(buffer: *const sogmm_buffer) -> *const u8;
+    pub fn sogmm_buffer_size(buffer: *const sogmm_buffer) -> usize;
+    pub fn sogmm_buffer_free(buffer: *mut sogmm_buffer);
+}

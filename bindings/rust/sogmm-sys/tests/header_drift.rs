@@ -1,0 +1,241 @@
+//! Fails when src/lib.rs drifts from capi/include/sogmm/sogmm.h: every
+//! `SOGMM_API` prototype of the header must appear in the extern block with
+//! the same name, argument count, argument types and return type (C types
+//! translated by the fixed table in `rust_type`), every numeric or string
+//! `#define SOGMM_*` constant must appear with the same value, and the crate
+//! must declare nothing the header lacks. Both files are parsed as text, so
+//! the test needs no C compiler and no bindgen.
+use std::collections::BTreeMap;
+
+const HEADER: &str = include_str!("../../../../capi/include/sogmm/sogmm.h");
+const LIB_RS: &str = include_str!("../src/lib.rs");
+
+/// name -> (argument types, return type); `None` return = void.
+type Protos = BTreeMap<String, (Vec<String>, Option<String>)>;
+
+fn strip_c_comments(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(i) = rest.find("/*") {
+        out.push_str(&rest[..i]);
+        rest = match rest[i..].find("*/") {
+            Some(j) => &rest[i + j + 2..],
+            None => "",
+        };
+    }
+    out.push_str(rest);
+    out.lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n")
+}
+
+/// A C type (without the parameter name) as the Rust type the crate must use.
+fn rust_type(c: &str) -> String {
+    let spaced = c.replace('*', " * ");
+    let toks: Vec<&str> = spaced.split_whitespace().collect();
+    let mut base_const = false;
+    let mut i = 0;
+    if toks.get(0) == Some(&"const") {
+        base_const = true;
+        i = 1;
+    }
+    let base = match toks[i] {
+        "void" => "c_void",
+        "char" => "c_char",
+        "float" => "f32",
+        "double" => "f64",
+        "int32_t" => "i32",
+        "uint32_t" => "u32",
+        "int64_t" => "i64",
+        "uint64_t" => "u64",
+        "uint16_t" => "u16",
+        "uint8_t" => "u8",
+        "size_t" => "usize",
+        other => other, // sogmm_* typedefs keep their names
+    };
+    let mut ty = base.to_string();
+    let mut pointee_const = base_const;
+    let mut j = i + 1;
+    while j < toks.len() {
+        match toks[j] {
+            "*" => {
+                ty = format!("*{} {}", if pointee_const { "const" } else { "mut" }, ty);
+                pointee_const = false;
+            }
+            "const" => pointee_const = true, // `T* const`: the next level's pointee
+            t => panic!("unexpected token {t:?} in C type {c:?}"),
+        }
+        j += 1;
+    }
+    ty
+}
+
+/// Splits "const float* points" into the type and the name.
+fn split_param(p: &str) -> String {
+    let p = p.trim();
+    let cut = p.rfind(|c: char| !(c.is_alphanumeric() || c == '_')).expect("parameter without a type");
+    p[..=cut].trim().to_string()
+}
+
+/// The header without comments and preprocessor lines (with their `\`
+/// continuations): only C declarations remain.
+fn c_declarations(header: &str) -> String {
+    let mut out = String::new();
+    let mut continued = false;
+    for line in strip_c_comments(header).lines() {
+        let directive = continued || line.trim_start().starts_with('#');
+        continued = directive && line.trim_end().ends_with('\\');
+        if !directive {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+fn header_protos(header: &str) -> Protos {
+    let text = c_declarations(header);
+    let mut protos = Protos::new();
+    for stmt in text.split(';') {
+        let Some(at) = stmt.find("SOGMM_API ") else { continue };
+        let decl = stmt[at + "SOGMM_API ".len()..].split_whitespace().collect::<Vec<_>>().join(" ");
+        let open = decl.find('(').unwrap_or_else(|| panic!("no '(' in {decl:?}"));
+        let close = decl.rfind(')').unwrap();
+        let head = decl[..open].trim();
+        let name_at = head.rfind(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap();
+        let name = head[name_at + 1..].to_string();
+        let ret = head[..=name_at].trim();
+        let ret = if ret == "void" { None } else { Some(rust_type(ret)) };
+        let args_text = decl[open + 1..close].trim();
+        let args = if args_text == "void" || args_text.is_empty() {
+            Vec::new()
+        } else {
+            args_text.split(',').map(|a| rust_type(&split_param(a))).collect()
+        };
+        assert!(protos.insert(name.clone(), (args, ret)).is_none(), "{name} declared twice");
+    }
+    protos
+}
+
+fn rust_protos(lib: &str) -> Protos {
+    let block = lib.split("extern \"C\" {").nth(1).expect("no extern block");
+    let block = &block[..block.find("\n}").expect("unclosed extern block")];
+    let mut protos = Protos::new();
+    for stmt in block.split(';') {
+        let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
+        let Some(rest) = decl.strip_prefix("pub fn ") else { continue };
+        let open = rest.find('(').unwrap();
+        let close = rest.rfind(')').unwrap();
+        let name = rest[..open].to_string();
+        let args = rest[open + 1..close]
+            .split(',')
+            .filter(|a| !a.trim().is_empty())
+            .map(|a| a.split_once(':').expect("argument without a type").1.trim().to_string())
+            .collect();
+        let ret = rest[close + 1..].trim().strip_prefix("->").map(|r| r.trim().to_string());
+        assert!(protos.insert(name.clone(), (args, ret)).is_none(), "{name} declared twice");
+    }
+    protos
+}
+
+/// `#define SOGMM_X <integer | (-integer) | "string">` of the header.
+fn header_consts(header: &str) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    for line in strip_c_comments(header).lines() {
+        let mut it = line.split_whitespace();
+        if it.next() != Some("#define") {
+            continue;
+        }
+        let (Some(name), Some(value), None) = (it.next(), it.next(), it.next()) else { continue };
+        let value = value.trim_start_matches('(').trim_end_matches(')');
+        let numeric = value.trim_start_matches('-').chars().all(|c| c.is_ascii_digit()) && !value.is_empty();
+        if name.starts_with("SOGMM_") && (numeric || value.starts_with('"')) {
+            out.insert(name.to_string(), value.to_string());
+        }
+    }
+    out
+}
+
+fn rust_consts(lib: &str) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    for line in lib.lines() {
+        let Some(rest) = line.trim().strip_prefix("pub const ") else { continue };
+        let (name, rest) = rest.split_once(':').unwrap();
+        let value = rest.split_once('=').unwrap().1.trim().trim_end_matches(';').trim();
+        out.insert(name.trim().to_string(), value.to_string());
+    }
+    out
+}
+
+/// Every difference between the header and the crate, one line each.
+fn drift(header: &str, lib: &str) -> Vec<String> {
+    let mut problems = Vec::new();
+    let (h, r) = (header_protos(header), rust_protos(lib));
+    for (name, c) in &h {
+        match r.get(name) {
+            None => problems.push(format!("{name}: in sogmm.h, missing in sogmm-sys")),
+            Some(rs) if rs.0.len() != c.0.len() => problems.push(format!(
+                "{name}: {} arguments in sogmm.h, {} in sogmm-sys",
+                c.0.len(),
+                rs.0.len()
+            )),
+            Some(rs) if rs != c => problems.push(format!("{name}: sogmm.h says {c:?}, sogmm-sys says {rs:?}")),
+            Some(_) => {}
+        }
+    }
+    for name in r.keys().filter(|n| !h.contains_key(*n)) {
+        problems.push(format!("{name}: in sogmm-sys, not in sogmm.h"));
+    }
+    let (hc, rc) = (header_consts(header), rust_consts(lib));
+    for (name, v) in &hc {
+        match rc.get(name) {
+            None => problems.push(format!("{name}: #define in sogmm.h, missing in sogmm-sys")),
+            Some(rv) if rv != v => problems.push(format!("{name}: {v} in sogmm.h, {rv} in sogmm-sys")),
+            Some(_) => {}
+        }
+    }
+    for name in rc.keys().filter(|n| !hc.contains_key(*n)) {
+        problems.push(format!("{name}: const in sogmm-sys, not in sogmm.h"));
+    }
+    problems
+}
+
+#[test]
+fn sys_crate_matches_header() {
+    let problems = drift(HEADER, LIB_RS);
+    assert!(problems.is_empty(), "sogmm-sys drifted from sogmm.h:\n{}", problems.join("\n"));
+    // The parse found the whole API, not an empty subset that trivially agrees.
+    assert!(header_protos(HEADER).len() >= 44, "only {} prototypes parsed", header_protos(HEADER).len());
+    assert!(header_consts(HEADER).len() >= 70, "only {} constants parsed", header_consts(HEADER).len());
+}
+
+/// The checker itself catches each kind of drift (a header edited as a future
+/// change would edit it).
+#[test]
+fn drift_is_detected() {
+    let cases = [
+        ("size_t k, const sogmm_options* options", "uint32_t k, const sogmm_options* options", "sogmm_fit_points_fixed_k_f32"),
+        ("uint64_t seed,\n", "uint64_t seed, int extra,\n", "arguments"),
+        ("const sogmm_model* model, double* pose_out", "sogmm_model* model, double* pose_out", "sogmm_model_get_pose"),
+        ("SOGMM_API uint32_t sogmm_abi_version", "SOGMM_API int32_t sogmm_abi_version", "sogmm_abi_version"),
+        ("#define SOGMM_E_INTERNAL (-11)", "#define SOGMM_E_INTERNAL (-11)\n#define SOGMM_E_CANCELLED (-12)", "SOGMM_E_CANCELLED"),
+        ("#define SOGMM_OPT_N_INIT 109", "#define SOGMM_OPT_N_INIT 110", "SOGMM_OPT_N_INIT"),
+        ("SOGMM_API void sogmm_buffer_free(sogmm_buffer* buffer);", "", "sogmm_buffer_free"),
+        ("SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);",
+         "SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);\nSOGMM_API void sogmm_new(void);", "sogmm_new"),
+    ];
+    for (from, to, expect) in cases {
+        assert!(HEADER.contains(from), "test case out of date: {from:?}");
+        let problems = drift(&HEADER.replacen(from, to, 1), LIB_RS);
+        assert!(
+            problems.iter().any(|p| p.contains(expect)),
+            "edit {from:?} -> {to:?} not reported (got {problems:?})"
+        );
+    }
+}
+
+#[test]
+fn c_types_translate() {
+    assert_eq!(rust_type("const char**"), "*mut *const c_char");
+    assert_eq!(rust_type("sogmm_model**"), "*mut *mut sogmm_model");
+    assert_eq!(rust_type("const void*"), "*const c_void");
+    assert_eq!(rust_type("size_t"), "usize");
+}

@@ -1,0 +1,385 @@
+//! `Model`: an owned sogmm_model handle and every operation on it.
+use std::ffi::{CStr, CString};
+use std::path::Path;
+use std::ptr::{self, NonNull};
+
+use sogmm_sys as sys;
+
+use crate::error::{check, Error, Result, Status};
+use crate::options::{opt_ptr, Options};
+
+/// A fitted 4-D GMM (x, y, z, gray) with its metadata. Arrays come out as
+/// row-major `Vec`s: weights (M), means (M x 4), covariances (M x 4 x 4).
+pub struct Model {
+    ptr: NonNull<sys::sogmm_model>,
+}
+
+// SAFETY: spec/api.md 1.1 and 6: functions taking a const model (queries,
+// inference, merge, transform, clone, save) may run concurrently on one
+// handle and are the `&self` methods; set_pose, clear_pose, set_value and
+// free need exclusive use, which `&mut self` and `Drop` give. The library
+// has no global mutable state, so moving a handle between threads is fine.
+unsafe impl Send for Model {}
+unsafe impl Sync for Model {}
+
+/// The color image of an RGB-D frame, registered to the depth image.
+#[derive(Clone, Copy, Debug)]
+pub enum Color<'a> {
+    /// width * height bytes, gray 0..255.
+    Gray8(&'a [u8]),
+    /// width * height * 3 bytes, interleaved R, G, B.
+    Rgb8(&'a [u8]),
+    /// width * height floats, gray used as given (meant to be in [0, 1]).
+    GrayF32(&'a [f32]),
+}
+
+/// One RGB-D frame: raw depth (SOGMM_OPT_DEPTH_SCALE units per metre, 0 = no
+/// reading), color, size and the full-size pinhole intrinsics.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame<'a> {
+    pub depth: &'a [u16],
+    pub color: Color<'a>,
+    pub width: u32,
+    pub height: u32,
+    pub fx: f64,
+    pub fy: f64,
+    pub cx: f64,
+    pub cy: f64,
+}
+
+fn invalid(msg: String) -> Error {
+    Error::new(Status::InvalidArg, msg)
+}
+
+/// Number of `cols`-wide rows in `data`, refusing a ragged slice.
+fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
+    if data.len() % cols != 0 {
+        return Err(invalid(format!("{what} has {} floats, not a multiple of {cols}", data.len())));
+    }
+    Ok(data.len() / cols)
+}
+
+fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
+    n.checked_mul(per).ok_or_else(|| Error::new(Status::Limit, format!("{what}: {n} x {per} overflows usize")))
+}
+
+fn c_string(s: &str, what: &str) -> Result<CString> {
+    CString::new(s).map_err(|_| invalid(format!("{what} contains a NUL byte")))
+}
+
+fn c_path(p: &Path) -> Result<CString> {
+    use std::os::unix::ffi::OsStrExt;
+    CString::new(p.as_os_str().as_bytes()).map_err(|_| invalid(format!("path {p:?} contains a NUL byte")))
+}
+
+/// Copies a library-owned string (valid until the model is next mutated,
+/// which `&self` rules out meanwhile).
+fn owned(p: *const sys::c_char) -> String {
+    // SAFETY: the library returned a valid NUL-terminated string.
+    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+}
+
+impl Model {
+    /// Runs a C constructor taking an out-pointer first.
+    fn make(f: impl FnOnce(*mut *mut sys::sogmm_model) -> i32) -> Result<Model> {
+        crate::ensure_abi()?;
+        let mut out = ptr::null_mut();
+        check(f(&mut out))?;
+        Ok(Model { ptr: NonNull::new(out).expect("libsogmm returned OK and a NULL model") })
+    }
+
+    fn raw(&self) -> *const sys::sogmm_model {
+        self.ptr.as_ptr()
+    }
+
+    /// Fits a model to n points: `points` holds n rows (x, y, z, gray).
+    /// Uses the fit keys of `options` (None = defaults).
+    pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
+        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, opt_ptr(options)) })
+    }
+
+    /// Fits exactly `k` components (1 <= k <= n).
+    pub fn fit_fixed_k(points: &[f32], k: usize, options: Option<&Options>) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        // SAFETY: as fit.
+        Model::make(|out| unsafe { sys::sogmm_fit_points_fixed_k_f32(out, points.as_ptr(), n, k, opt_ptr(options)) })
+    }
+
+    /// Fits one RGB-D frame; decimation and depth range come from `options`.
+    /// The slice lengths are checked against width and height here, since C
+    /// cannot see them.
+    pub fn fit_rgbd(frame: &Frame<'_>, options: Option<&Options>) -> Result<Model> {
+        let pixels = len_of(frame.width as usize, frame.height as usize, "image size")?;
+        if frame.depth.len() != pixels {
+            return Err(invalid(format!("depth has {} values, width * height = {pixels}", frame.depth.len())));
+        }
+        let (color, format, got, want): (*const u8, i32, usize, usize) = match frame.color {
+            Color::Gray8(c) => (c.as_ptr(), sys::SOGMM_COLOR_GRAY8, c.len(), pixels),
+            Color::Rgb8(c) => (c.as_ptr(), sys::SOGMM_COLOR_RGB8, c.len(), len_of(pixels, 3, "RGB size")?),
+            Color::GrayF32(c) => (c.as_ptr().cast(), sys::SOGMM_COLOR_GRAY_F32, c.len(), pixels),
+        };
+        if got != want {
+            return Err(invalid(format!("color has {got} values, the frame needs {want}")));
+        }
+        // SAFETY: depth and color hold the sizes C reads for width x height.
+        Model::make(|out| unsafe {
+            sys::sogmm_fit_rgbd(
+                out,
+                frame.depth.as_ptr(),
+                color,
+                format,
+                frame.width,
+                frame.height,
+                frame.fx,
+                frame.fy,
+                frame.cx,
+                frame.cy,
+                opt_ptr(options),
+            )
+        })
+    }
+
+    /// Builds a model from M weights, M x 4 means and M x 4 x 4 covariances
+    /// (copied). `support_size` = points it stands for (0 = unknown).
+    pub fn from_arrays(weights: &[f32], means: &[f32], covariances: &[f32], support_size: u64) -> Result<Model> {
+        let m = weights.len();
+        if means.len() != len_of(m, 4, "means")? || covariances.len() != len_of(m, 16, "covariances")? {
+            return Err(invalid(format!(
+                "{m} weights need {} means and {} covariance floats, got {} and {}",
+                m.saturating_mul(4),
+                m.saturating_mul(16),
+                means.len(),
+                covariances.len()
+            )));
+        }
+        // SAFETY: lengths checked above.
+        Model::make(|out| unsafe {
+            sys::sogmm_model_from_arrays_f32(out, m, weights.as_ptr(), means.as_ptr(), covariances.as_ptr(), support_size)
+        })
+    }
+
+    /// Reads a .sogmm file (read keys of `options` apply).
+    pub fn load(path: impl AsRef<Path>, options: Option<&Options>) -> Result<Model> {
+        let p = c_path(path.as_ref())?;
+        // SAFETY: NUL-terminated path.
+        Model::make(|out| unsafe { sys::sogmm_model_load(out, p.as_ptr(), opt_ptr(options)) })
+    }
+
+    /// Reads a model from the bytes of a .sogmm file.
+    pub fn from_bytes(data: &[u8], options: Option<&Options>) -> Result<Model> {
+        // SAFETY: `data` holds data.len() bytes.
+        Model::make(|out| unsafe {
+            sys::sogmm_model_load_from_memory(out, data.as_ptr().cast(), data.len(), opt_ptr(options))
+        })
+    }
+
+    /// Deep copy including metadata; fails only when memory runs out.
+    pub fn try_clone(&self) -> Result<Model> {
+        // SAFETY: valid handle.
+        Model::make(|out| unsafe { sys::sogmm_model_clone(out, self.raw()) })
+    }
+
+    /// Number of components M (>= 1).
+    pub fn n_components(&self) -> usize {
+        let mut m = 0;
+        // SAFETY: valid handle; cannot fail for one.
+        check(unsafe { sys::sogmm_model_n_components(self.raw(), &mut m) }).expect("n_components of a valid model");
+        m
+    }
+
+    fn array(
+        &self,
+        per: usize,
+        get: unsafe extern "C" fn(*const sys::sogmm_model, *mut f32, usize) -> i32,
+    ) -> Result<Vec<f32>> {
+        let mut v = vec![0.0f32; len_of(self.n_components(), per, "array")?];
+        // SAFETY: `v` has room for v.len() floats, the capacity passed.
+        check(unsafe { get(self.raw(), v.as_mut_ptr(), v.len()) })?;
+        Ok(v)
+    }
+
+    /// The M weights.
+    pub fn weights(&self) -> Result<Vec<f32>> {
+        self.array(1, sys::sogmm_model_get_weights_f32)
+    }
+
+    /// The M x 4 means, row-major.
+    pub fn means(&self) -> Result<Vec<f32>> {
+        self.array(4, sys::sogmm_model_get_means_f32)
+    }
+
+    /// The M x 4 x 4 covariances, row-major.
+    pub fn covariances(&self) -> Result<Vec<f32>> {
+        self.array(16, sys::sogmm_model_get_covariances_f32)
+    }
+
+    /// An f64 SOGMM_INFO_* value; `None` when the model does not have it.
+    pub fn info_f64(&self, key: i32) -> Result<Option<f64>> {
+        let mut v = 0.0;
+        // SAFETY: valid handle and out-pointer.
+        not_found_is_none(check(unsafe { sys::sogmm_model_get_info_f64(self.raw(), key, &mut v) }), v)
+    }
+
+    /// An i64 SOGMM_INFO_* value; `None` when the model does not have it.
+    pub fn info_i64(&self, key: i32) -> Result<Option<i64>> {
+        let mut v = 0;
+        // SAFETY: valid handle and out-pointer.
+        not_found_is_none(check(unsafe { sys::sogmm_model_get_info_i64(self.raw(), key, &mut v) }), v)
+    }
+
+    /// The 4 x 4 row-major pose of the model's frame, if set.
+    pub fn pose(&self) -> Result<Option<[f64; 16]>> {
+        let mut p = [0.0; 16];
+        // SAFETY: room for 16 doubles.
+        not_found_is_none(check(unsafe { sys::sogmm_model_get_pose(self.raw(), p.as_mut_ptr()) }), p)
+    }
+
+    /// Sets the pose (must be a finite rigid transform).
+    pub fn set_pose(&mut self, pose: &[f64; 16]) -> Result<()> {
+        // SAFETY: exclusive through &mut self; 16 doubles.
+        check(unsafe { sys::sogmm_model_set_pose(self.ptr.as_ptr(), pose.as_ptr()) })
+    }
+
+    pub fn clear_pose(&mut self) -> Result<()> {
+        // SAFETY: exclusive through &mut self.
+        check(unsafe { sys::sogmm_model_clear_pose(self.ptr.as_ptr()) })
+    }
+
+    /// The value of a metadata key (its first pair), if present.
+    pub fn value(&self, key: &str) -> Result<Option<String>> {
+        let k = c_string(key, "key")?;
+        let mut v = ptr::null();
+        // SAFETY: NUL-terminated key; `v` is copied before any mutation.
+        let r = check(unsafe { sys::sogmm_model_get_value(self.raw(), k.as_ptr(), &mut v) });
+        Ok(not_found_is_none(r, ())?.map(|()| owned(v)))
+    }
+
+    /// Adds a key/value pair or replaces the value of the first pair with that key.
+    pub fn set_value(&mut self, key: &str, value: &str) -> Result<()> {
+        let (k, v) = (c_string(key, "key")?, c_string(value, "value")?);
+        // SAFETY: exclusive through &mut self; NUL-terminated strings.
+        check(unsafe { sys::sogmm_model_set_value(self.ptr.as_ptr(), k.as_ptr(), v.as_ptr()) })
+    }
+
+    /// Every metadata pair, in order.
+    pub fn values(&self) -> Result<Vec<(String, String)>> {
+        let mut n = 0;
+        // SAFETY: valid handle and out-pointer.
+        check(unsafe { sys::sogmm_model_value_count(self.raw(), &mut n) })?;
+        (0..n)
+            .map(|i| {
+                let (mut k, mut v) = (ptr::null(), ptr::null());
+                // SAFETY: i < count; pointers copied at once.
+                check(unsafe { sys::sogmm_model_value_at(self.raw(), i, &mut k, &mut v) })?;
+                Ok((owned(k), owned(v)))
+            })
+            .collect()
+    }
+
+    /// Draws n points as n rows of `dims` floats (4: x, y, z, gray; 3: x, y,
+    /// z), grouped by component, with the default truncation. Same seed, same
+    /// samples.
+    pub fn sample(&self, n: usize, seed: u64, dims: i32) -> Result<Vec<f32>> {
+        self.sample_with(n, seed, dims, None)
+    }
+
+    /// As `sample`, with SOGMM_OPT_SAMPLE_TRUNCATION from `options`.
+    pub fn sample_with(&self, n: usize, seed: u64, dims: i32, options: Option<&Options>) -> Result<Vec<f32>> {
+        if dims != 3 && dims != 4 {
+            return Err(invalid(format!("dims must be 3 or 4, got {dims}")));
+        }
+        let mut out = vec![0.0f32; len_of(n, dims as usize, "samples")?];
+        // SAFETY: `out` holds n * dims floats.
+        check(unsafe { sys::sogmm_model_sample_f32(self.raw(), n, seed, dims, opt_ptr(options), out.as_mut_ptr()) })?;
+        Ok(out)
+    }
+
+    /// Expected gray and its conditional variance at n points (`xyz`: n rows of 3).
+    pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
+        let n = rows(xyz, 3, "xyz")?;
+        let (mut mean, mut var) = (vec![0.0f32; n], vec![0.0f32; n]);
+        // SAFETY: n rows in, n floats of room in each output.
+        check(unsafe {
+            sys::sogmm_model_regress_gray_f32(self.raw(), xyz.as_ptr(), n, mean.as_mut_ptr(), var.as_mut_ptr())
+        })?;
+        Ok((mean, var))
+    }
+
+    /// Log-density of rows of `dims` floats (4: joint; 3: marginal over gray).
+    pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
+        if dims != 3 && dims != 4 {
+            return Err(invalid(format!("dims must be 3 or 4, got {dims}")));
+        }
+        let n = rows(points, dims as usize, "points")?;
+        let mut out = vec![0.0f64; n];
+        // SAFETY: n rows in, n doubles of room out.
+        check(unsafe { sys::sogmm_model_score_samples_f32(self.raw(), points.as_ptr(), n, dims, out.as_mut_ptr()) })?;
+        Ok(out)
+    }
+
+    /// A new model with the components of both, weighted by support size.
+    pub fn merge(&self, other: &Model) -> Result<Model> {
+        // SAFETY: both handles valid; const use only.
+        Model::make(|out| unsafe { sys::sogmm_model_merge(out, self.raw(), other.raw()) })
+    }
+
+    /// A new model moved by a rigid 4 x 4 row-major transform.
+    pub fn transform(&self, pose: &[f64; 16]) -> Result<Model> {
+        // SAFETY: 16 doubles.
+        Model::make(|out| unsafe { sys::sogmm_model_transform(out, self.raw(), pose.as_ptr()) })
+    }
+
+    /// Writes a .sogmm file atomically (write keys of `options` apply).
+    pub fn save(&self, path: impl AsRef<Path>, options: Option<&Options>) -> Result<()> {
+        let p = c_path(path.as_ref())?;
+        // SAFETY: NUL-terminated path; const use of the model.
+        check(unsafe { sys::sogmm_model_save(self.raw(), p.as_ptr(), opt_ptr(options)) })
+    }
+
+    /// The bytes of a .sogmm file.
+    pub fn to_bytes(&self, options: Option<&Options>) -> Result<Vec<u8>> {
+        let mut buf = ptr::null_mut();
+        // SAFETY: valid out-pointer.
+        check(unsafe { sys::sogmm_model_save_to_memory(&mut buf, self.raw(), opt_ptr(options)) })?;
+        // SAFETY: the buffer owns size bytes at data until freed just below.
+        let bytes = unsafe {
+            let (data, size) = (sys::sogmm_buffer_data(buf), sys::sogmm_buffer_size(buf));
+            let v = std::slice::from_raw_parts(data, size).to_vec();
+            sys::sogmm_buffer_free(buf);
+            v
+        };
+        Ok(bytes)
+    }
+}
+
+/// `Ok(Some(value))` on success, `Ok(None)` for SOGMM_E_NOT_FOUND.
+fn not_found_is_none<T>(r: Result<()>, value: T) -> Result<Option<T>> {
+    match r {
+        Ok(()) => Ok(Some(value)),
+        Err(e) if e.status() == Status::NotFound => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
+impl Clone for Model {
+    /// Panics only when memory runs out, as `Vec::clone` would; use
+    /// `try_clone` to handle that.
+    fn clone(&self) -> Model {
+        self.try_clone().unwrap_or_else(|e| panic!("cloning a sogmm model failed: {e}"))
+    }
+}
+
+impl Drop for Model {
+    fn drop(&mut self) {
+        // SAFETY: we own the handle; nothing else uses it once dropped.
+        unsafe { sys::sogmm_model_free(self.ptr.as_ptr()) }
+    }
+}
+
+impl std::fmt::Debug for Model {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Model").field("n_components", &self.n_components()).finish_non_exhaustive()
+    }
+}

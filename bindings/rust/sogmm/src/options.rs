@@ -1,0 +1,203 @@
+//! `Options` (an owned sogmm_options handle) and its builder.
+use std::ptr::{self, NonNull};
+
+use sogmm_sys as sys;
+
+use crate::error::{check, Result};
+
+/// Enum-keyed parameters for fit, save, load and sample (sogmm_options).
+/// Ranges are checked by the library: the setter (or `OptionsBuilder::build`)
+/// fails with `Status::InvalidArg` and a message naming the key.
+pub struct Options {
+    ptr: NonNull<sys::sogmm_options>,
+}
+
+// SAFETY: spec/api.md 1.1: distinct handles never interfere; functions taking
+// a const handle (the getters, and every call reading options) may run
+// concurrently, and those are exactly the `&self` methods; setters and free
+// need exclusive use, which `&mut self` and `Drop` guarantee.
+unsafe impl Send for Options {}
+unsafe impl Sync for Options {}
+
+/// Mean-shift variant of the mode count (SOGMM_OPT_MODE_COUNTER).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeCounter {
+    /// The authors' flat mean shift with bin seeding (default).
+    FlatBinned,
+    /// The paper's Gaussian blurring mean shift.
+    GaussianBlurring,
+}
+
+impl Options {
+    /// Every default.
+    pub fn new() -> Result<Options> {
+        crate::ensure_abi()?;
+        let mut out = ptr::null_mut();
+        // SAFETY: `out` is a valid out-pointer.
+        check(unsafe { sys::sogmm_options_create(&mut out) })?;
+        Ok(Options { ptr: NonNull::new(out).expect("sogmm_options_create returned OK and NULL") })
+    }
+
+    /// A builder collecting keys; `build` applies them in order.
+    pub fn builder() -> OptionsBuilder {
+        OptionsBuilder::default()
+    }
+
+    pub fn set_f64(&mut self, key: i32, value: f64) -> Result<()> {
+        // SAFETY: valid handle, exclusive through &mut self.
+        check(unsafe { sys::sogmm_options_set_f64(self.ptr.as_ptr(), key, value) })
+    }
+
+    pub fn set_i64(&mut self, key: i32, value: i64) -> Result<()> {
+        // SAFETY: as set_f64.
+        check(unsafe { sys::sogmm_options_set_i64(self.ptr.as_ptr(), key, value) })
+    }
+
+    pub fn get_f64(&self, key: i32) -> Result<f64> {
+        let mut v = 0.0;
+        // SAFETY: valid handle; `v` is a valid out-pointer.
+        check(unsafe { sys::sogmm_options_get_f64(self.ptr.as_ptr(), key, &mut v) })?;
+        Ok(v)
+    }
+
+    pub fn get_i64(&self, key: i32) -> Result<i64> {
+        let mut v = 0;
+        // SAFETY: as get_f64.
+        check(unsafe { sys::sogmm_options_get_i64(self.ptr.as_ptr(), key, &mut v) })?;
+        Ok(v)
+    }
+
+    /// Deep copy (sogmm_options_clone); fails only when memory runs out.
+    pub fn try_clone(&self) -> Result<Options> {
+        let mut out = ptr::null_mut();
+        // SAFETY: valid handle and out-pointer.
+        check(unsafe { sys::sogmm_options_clone(&mut out, self.ptr.as_ptr()) })?;
+        Ok(Options { ptr: NonNull::new(out).expect("sogmm_options_clone returned OK and NULL") })
+    }
+
+    pub(crate) fn as_ptr(&self) -> *const sys::sogmm_options {
+        self.ptr.as_ptr()
+    }
+}
+
+/// The C pointer of optional options: NULL means "all defaults".
+pub(crate) fn opt_ptr(o: Option<&Options>) -> *const sys::sogmm_options {
+    o.map_or(ptr::null(), Options::as_ptr)
+}
+
+impl Clone for Options {
+    /// Panics only when memory runs out, as `Vec::clone` would; use
+    /// `try_clone` to handle that.
+    fn clone(&self) -> Options {
+        self.try_clone().unwrap_or_else(|e| panic!("cloning sogmm options failed: {e}"))
+    }
+}
+
+impl Drop for Options {
+    fn drop(&mut self) {
+        // SAFETY: we own the handle; nothing else uses it once dropped.
+        unsafe { sys::sogmm_options_free(self.ptr.as_ptr()) }
+    }
+}
+
+impl std::fmt::Debug for Options {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Options").finish_non_exhaustive()
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Value {
+    F64(f64),
+    I64(i64),
+}
+
+/// Collects option values; `build()` creates the handle and sets them in
+/// order, returning the library's error for the first value it refuses.
+/// Validation stays in the C library, the one place that knows the ranges.
+#[derive(Clone, Debug, Default)]
+#[must_use]
+pub struct OptionsBuilder {
+    values: Vec<(i32, Value)>,
+}
+
+macro_rules! setters {
+    ($($(#[$doc:meta])* $name:ident($t:ty) => $key:ident as $kind:ident $conv:expr;)*) => {
+        $($(#[$doc])* pub fn $name(self, v: $t) -> Self {
+            #[allow(clippy::redundant_closure_call)]
+            let value = ($conv)(v);
+            self.$kind(sys::$key, value)
+        })*
+    };
+}
+
+impl OptionsBuilder {
+    /// Any f64 key, e.g. an experimental one.
+    pub fn f64(mut self, key: i32, v: f64) -> Self {
+        self.values.push((key, Value::F64(v)));
+        self
+    }
+
+    /// Any i64 key.
+    pub fn i64(mut self, key: i32, v: i64) -> Self {
+        self.values.push((key, Value::I64(v)));
+        self
+    }
+
+    setters! {
+        /// Mean-shift bandwidth (default 0.02).
+        bandwidth(f64) => SOGMM_OPT_BANDWIDTH as f64 |v| v;
+        /// Fixed K; 0 = self-organizing (default).
+        n_components(i64) => SOGMM_OPT_N_COMPONENTS as i64 |v| v;
+        /// EM stop tolerance (default 1e-3).
+        tol(f64) => SOGMM_OPT_TOL as f64 |v| v;
+        /// Added to covariance diagonals (default 1e-6).
+        reg_covar(f64) => SOGMM_OPT_REG_COVAR as f64 |v| v;
+        /// EM iterations at most (default 100).
+        max_iter(i64) => SOGMM_OPT_MAX_ITER as i64 |v| v;
+        /// k-means++ seed (default 0); the u64's bits, as the header says.
+        seed(u64) => SOGMM_OPT_SEED as i64 |v: u64| v as i64;
+        /// OpenMP threads of a fit; 0 = all cores (default).
+        threads(i64) => SOGMM_OPT_THREADS as i64 |v| v;
+        /// Mode-count variant.
+        mode_counter(ModeCounter) => SOGMM_OPT_MODE_COUNTER as i64 |m| match m {
+            ModeCounter::FlatBinned => sys::SOGMM_MODE_COUNTER_FLAT_BINNED,
+            ModeCounter::GaussianBlurring => sys::SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING,
+        };
+        /// Truncated E-step margin in nats; 0 = exact (default).
+        truncation_nats(f64) => SOGMM_OPT_TRUNCATION_NATS as f64 |v| v;
+        /// Runs of k-means++ + EM (default 1).
+        n_init(i64) => SOGMM_OPT_N_INIT as i64 |v| v;
+        /// Raw depth units per metre (default 1000).
+        depth_scale(f64) => SOGMM_OPT_DEPTH_SCALE as f64 |v| v;
+        /// Nearest valid depth in metres, exclusive (default 0.1).
+        depth_min(f64) => SOGMM_OPT_DEPTH_MIN as f64 |v| v;
+        /// Farthest valid depth in metres, inclusive (default 3.0).
+        depth_max(f64) => SOGMM_OPT_DEPTH_MAX as f64 |v| v;
+        /// Integer image decimation (default 1).
+        decimation(i64) => SOGMM_OPT_DECIMATION as i64 |v| v;
+        /// zstd level of saved arrays (default 19).
+        zstd_level(i64) => SOGMM_OPT_ZSTD_LEVEL as i64 |v| v;
+        /// Store arrays as float64 (default false).
+        float64(bool) => SOGMM_OPT_FLOAT64 as i64 |b| i64::from(b);
+        /// Compress arrays (default true).
+        compress(bool) => SOGMM_OPT_COMPRESS as i64 |b| i64::from(b);
+        /// Cap on decoded bytes when loading; 0 = the format's default.
+        max_decoded_bytes(i64) => SOGMM_OPT_MAX_DECODED_BYTES as i64 |v| v;
+        /// Verify checksums when loading (default true).
+        verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 |b| i64::from(b);
+        /// Sampling truncation in standard deviations (default 2.5; may be inf).
+        sample_truncation(f64) => SOGMM_OPT_SAMPLE_TRUNCATION as f64 |v| v;
+    }
+
+    pub fn build(&self) -> Result<Options> {
+        let mut o = Options::new()?;
+        for &(key, v) in &self.values {
+            match v {
+                Value::F64(x) => o.set_f64(key, x)?,
+                Value::I64(x) => o.set_i64(key, x)?,
+            }
+        }
+        Ok(o)
+    }
+}

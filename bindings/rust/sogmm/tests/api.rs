@@ -1,0 +1,196 @@
+//! Tests of the safe API against hand-computed values and invariants.
+use sogmm::{Color, Frame, Model, Options, Status};
+
+/// One 4-D Gaussian: mean (0, 0, 0, 0.5); covariance diag(1, 1, 1, 0.5) with
+/// cov(x, gray) = 0.2.
+fn one_gaussian() -> Model {
+    let mut cov = [0.0f32; 16];
+    for i in 0..3 {
+        cov[i * 5] = 1.0;
+    }
+    cov[15] = 0.5;
+    cov[3] = 0.2; // (x, gray)
+    cov[12] = 0.2; // (gray, x)
+    Model::from_arrays(&[1.0], &[0.0, 0.0, 0.0, 0.5], &cov, 10).unwrap()
+}
+
+/// Deterministic points: two blobs (around x = -1 and x = +1, gray 0.2 and
+/// 0.8) from a fixed linear congruential generator.
+fn two_blobs(n: usize) -> Vec<f32> {
+    let mut s: u64 = 12345;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 40) as f32 / (1u64 << 24) as f32) - 0.5 // [-0.5, 0.5)
+    };
+    let mut pts = Vec::with_capacity(n * 4);
+    for i in 0..n {
+        let (cx, g) = if i % 2 == 0 { (-1.0, 0.2) } else { (1.0, 0.8) };
+        pts.extend_from_slice(&[cx + 0.1 * next(), 0.1 * next(), 2.0 + 0.1 * next(), g + 0.01 * next()]);
+    }
+    pts
+}
+
+#[test]
+fn arrays_round_trip_bitwise() {
+    let m = one_gaussian();
+    assert_eq!(m.n_components(), 1);
+    assert_eq!(m.weights().unwrap(), vec![1.0]);
+    assert_eq!(m.means().unwrap(), vec![0.0, 0.0, 0.0, 0.5]);
+    assert_eq!(m.covariances().unwrap()[3], 0.2);
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_SUPPORT_SIZE).unwrap(), Some(10));
+    // A model built from arrays has no fit report: None, not an error.
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap(), None);
+}
+
+#[test]
+fn regression_matches_closed_form() {
+    // Gaussian conditioning: mean = 0.5 + 0.2 * x, variance = 0.5 - 0.2^2.
+    let (mean, var) = one_gaussian().regress_gray(&[1.0, 0.0, 0.0, -2.0, 5.0, 1.0]).unwrap();
+    assert!((mean[0] - 0.7).abs() < 1e-6 && (mean[1] - 0.1).abs() < 1e-6, "{mean:?}");
+    assert!(var.iter().all(|v| (v - 0.46).abs() < 1e-6), "{var:?}");
+}
+
+#[test]
+fn score_matches_closed_form() {
+    // log N(mu; mu, S) = -0.5 (4 ln 2 pi + ln det S), det S = 0.5 - 0.04.
+    let got = one_gaussian().score_samples(&[0.0, 0.0, 0.0, 0.5], 4).unwrap();
+    let want = -0.5 * (4.0 * (2.0 * std::f64::consts::PI).ln() + 0.46f64.ln());
+    assert!((got[0] - want).abs() < 1e-5, "{got:?} vs {want}");
+    // Marginal over gray: a 3-D standard normal at its mean.
+    let got3 = one_gaussian().score_samples(&[0.0, 0.0, 0.0], 3).unwrap();
+    assert!((got3[0] + 1.5 * (2.0 * std::f64::consts::PI).ln()).abs() < 1e-5);
+}
+
+#[test]
+fn fixed_k_fit_finds_both_blobs() {
+    let opts = Options::builder().seed(7).threads(1).build().unwrap();
+    let m = Model::fit_fixed_k(&two_blobs(400), 2, Some(&opts)).unwrap();
+    let mut xs: Vec<(f32, f32)> = m.means().unwrap().chunks(4).map(|r| (r[0], r[3])).collect();
+    xs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!((xs[0].0 + 1.0).abs() < 0.05 && (xs[0].1 - 0.2).abs() < 0.01, "{xs:?}");
+    assert!((xs[1].0 - 1.0).abs() < 0.05 && (xs[1].1 - 0.8).abs() < 0.01, "{xs:?}");
+    let w = m.weights().unwrap();
+    assert!((w[0] - 0.5).abs() < 1e-3 && (w[1] - 0.5).abs() < 1e-3, "{w:?}");
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_FIT_N_POINTS).unwrap(), Some(400));
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_FIT_SEED).unwrap(), Some(7));
+}
+
+#[test]
+fn self_organizing_fit_and_seeds() {
+    let opts = Options::builder().bandwidth(0.5).seed(3).threads(1).build().unwrap();
+    let a = Model::fit(&two_blobs(200), Some(&opts)).unwrap();
+    let b = Model::fit(&two_blobs(200), Some(&opts)).unwrap();
+    assert_eq!(a.means().unwrap(), b.means().unwrap(), "same seed, same fit");
+    assert_eq!(a.sample(100, 9, 4).unwrap(), b.sample(100, 9, 4).unwrap());
+    assert_ne!(a.sample(100, 9, 4).unwrap(), a.sample(100, 10, 4).unwrap());
+    assert_eq!(a.sample(50, 1, 3).unwrap().len(), 150);
+}
+
+#[test]
+fn errors_carry_status_and_message() {
+    let e = Model::fit(&[f32::NAN, 0.0, 0.0, 0.0], None).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidData);
+    assert_eq!(e.code(), -3);
+    assert!(!e.message().is_empty());
+    assert!(e.to_string().starts_with("invalid"), "{e}");
+
+    let e = Options::builder().bandwidth(-1.0).build().unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+    assert!(e.message().to_lowercase().contains("bandwidth"), "{}", e.message());
+
+    let e = Model::fit(&[0.0; 5], None).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg); // ragged rows, refused before C
+
+    let e = Model::from_bytes(b"not a model", None).unwrap_err();
+    assert_eq!(e.status(), Status::Format);
+
+    let e = Model::load("/nonexistent/dir/x.sogmm", None).unwrap_err();
+    assert_eq!(e.status(), Status::Io);
+
+    let e = one_gaussian().sample(1, 0, 5).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+}
+
+#[test]
+fn options_get_set_clone() {
+    let mut o = Options::builder().seed(u64::MAX).zstd_level(3).build().unwrap();
+    assert_eq!(o.get_i64(sogmm::sys::SOGMM_OPT_SEED).unwrap(), -1); // the u64's bits
+    let c = o.clone();
+    o.set_i64(sogmm::sys::SOGMM_OPT_ZSTD_LEVEL, 5).unwrap();
+    assert_eq!(c.get_i64(sogmm::sys::SOGMM_OPT_ZSTD_LEVEL).unwrap(), 3, "clone is deep");
+    assert_eq!(o.get_f64(sogmm::sys::SOGMM_OPT_BANDWIDTH).unwrap(), 0.02, "default");
+    assert_eq!(o.get_f64(sogmm::sys::SOGMM_OPT_SEED).unwrap_err().status(), Status::InvalidArg);
+}
+
+#[test]
+fn bytes_and_files_round_trip() {
+    let mut m = one_gaussian();
+    m.set_value("origin", "rust test").unwrap();
+    let pose = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 2.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 0.0, 1.0];
+    m.set_pose(&pose).unwrap();
+    let opts = Options::builder().zstd_level(1).build().unwrap();
+    let back = Model::from_bytes(&m.to_bytes(Some(&opts)).unwrap(), None).unwrap();
+    assert_eq!(back.covariances().unwrap(), m.covariances().unwrap());
+    assert_eq!(back.value("origin").unwrap().as_deref(), Some("rust test"));
+    assert_eq!(back.value("absent").unwrap(), None);
+    assert_eq!(back.pose().unwrap(), Some(pose));
+
+    let path = std::env::temp_dir().join(format!("sogmm-rust-{}.sogmm", std::process::id()));
+    m.save(&path, None).unwrap();
+    let loaded = Model::load(&path, None).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(loaded.values().unwrap(), vec![("origin".to_string(), "rust test".to_string())]);
+}
+
+#[test]
+fn clone_is_deep_and_merge_transform_work() {
+    let a = one_gaussian();
+    let mut b = a.clone();
+    b.set_value("k", "v").unwrap();
+    assert_eq!(a.value("k").unwrap(), None);
+    let ab = a.merge(&b).unwrap();
+    assert_eq!(ab.n_components(), 2);
+    assert_eq!(ab.weights().unwrap(), vec![0.5, 0.5]);
+    let moved = a.transform(&[1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]).unwrap();
+    assert_eq!(moved.means().unwrap(), vec![1.0, 0.0, 0.0, 0.5]);
+}
+
+#[test]
+fn rgbd_fit_checks_slice_lengths() {
+    let (w, h) = (32u32, 24u32);
+    let depth: Vec<u16> = (0..w * h).map(|i| 1000 + (i % w) as u16 * 10).collect();
+    let gray: Vec<u8> = (0..w * h).map(|i| if i % w < w / 2 { 40 } else { 200 }).collect();
+    let frame = Frame { depth: &depth, color: Color::Gray8(&gray), width: w, height: h, fx: 30.0, fy: 30.0, cx: 15.5, cy: 11.5 };
+    let opts = Options::builder().bandwidth(0.1).threads(1).build().unwrap();
+    let m = Model::fit_rgbd(&frame, Some(&opts)).unwrap();
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_CAMERA_WIDTH).unwrap(), Some(32));
+    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_SUPPORT_SIZE).unwrap(), Some((w * h) as i64));
+    let short = Frame { depth: &depth[1..], ..frame };
+    assert_eq!(Model::fit_rgbd(&short, None).unwrap_err().status(), Status::InvalidArg);
+    let rgb_too_short = Frame { color: Color::Rgb8(&gray), ..frame };
+    assert_eq!(Model::fit_rgbd(&rgb_too_short, None).unwrap_err().status(), Status::InvalidArg);
+}
+
+#[test]
+fn shared_model_across_threads_matches_serial() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Model>();
+    assert_send_sync::<Options>();
+    let m = one_gaussian();
+    let serial: Vec<Vec<f32>> = (0..4).map(|s| m.sample(500, s, 4).unwrap()).collect();
+    let parallel: Vec<Vec<f32>> = std::thread::scope(|sc| {
+        let hs: Vec<_> = (0..4).map(|s| { let m = &m; sc.spawn(move || m.sample(500, s, 4).unwrap()) }).collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(serial, parallel);
+    // The error message is per thread: a failure elsewhere does not leak here.
+    std::thread::scope(|sc| {
+        sc.spawn(|| assert!(Model::fit(&[f32::NAN; 4], None).is_err()));
+    });
+    assert!(m.sample(1, 0, 4).is_ok());
+}
+
+#[test]
+fn version_is_the_header_version() {
+    assert_eq!(sogmm::version(), sogmm::sys::SOGMM_VERSION_STRING);
+}
