@@ -1,0 +1,31 @@
+// Package sogmm is the Go API of libsogmm: fit, store, load, sample and
+// regress Self-Organizing Gaussian Mixture Models (4-D: x, y, z, gray) of
+// RGB-D frames, over the library's C API.
+//
+// Linking: cgo links libsogmm dynamically (-lsogmm). Point the linker at the
+// library with CGO_LDFLAGS, e.g.
+//
+//	CGO_LDFLAGS="-L$BUILD/capi -Wl,-rpath,$BUILD/capi" go test ./...
+//
+// which is what the ctest entries go_vet and go_test_race do. The header
+// comes from this repository (capi/include), and the first handle created
+// checks that the loaded library has the ABI version the header declares.
+//
+// Handles (*Model, *Options) own C memory: call Close when done. A finalizer
+// frees a handle that was dropped without Close, as a safety net only (the
+// Go GC does not see C memory, so it may run late). Close must not run
+// concurrently with other calls on the same handle; all other methods of a
+// Model may run concurrently (they only read it), except SetPose, ClearPose
+// and SetValue, which need exclusive use, as in the C API's thread rules.
+package sogmm
+
+/*
+#cgo CFLAGS: -I${SRCDIR}/../../capi/include
+#cgo LDFLAGS: -lsogmm
+#include <stdlib.h>
+#include "sogmm/sogmm.h"
+#if SOGMM_ABI_VERSION != 1
+#error "these bindings are written for SOGMM_ABI_VERSION 1"
+#endif
+*/
+import "C"

@@ -1,0 +1,207 @@
+package sogmm
+
+// #include "sogmm/sogmm.h"
+import "C"
+
+import "runtime"
+
+// Key names an option (SOGMM_OPT_*) or a model information value (SOGMM_INFO_*).
+type Key int32
+
+// Option keys (types and ranges: sogmm.h and spec/api.md).
+const (
+	OptBandwidth        Key = C.SOGMM_OPT_BANDWIDTH
+	OptNComponents      Key = C.SOGMM_OPT_N_COMPONENTS
+	OptTol              Key = C.SOGMM_OPT_TOL
+	OptRegCovar         Key = C.SOGMM_OPT_REG_COVAR
+	OptMaxIter          Key = C.SOGMM_OPT_MAX_ITER
+	OptSeed             Key = C.SOGMM_OPT_SEED
+	OptThreads          Key = C.SOGMM_OPT_THREADS
+	OptModeCounter      Key = C.SOGMM_OPT_MODE_COUNTER
+	OptTruncationNats   Key = C.SOGMM_OPT_TRUNCATION_NATS
+	OptNInit            Key = C.SOGMM_OPT_N_INIT
+	OptDepthScale       Key = C.SOGMM_OPT_DEPTH_SCALE
+	OptDepthMin         Key = C.SOGMM_OPT_DEPTH_MIN
+	OptDepthMax         Key = C.SOGMM_OPT_DEPTH_MAX
+	OptDecimation       Key = C.SOGMM_OPT_DECIMATION
+	OptZstdLevel        Key = C.SOGMM_OPT_ZSTD_LEVEL
+	OptFloat64          Key = C.SOGMM_OPT_FLOAT64
+	OptCompress         Key = C.SOGMM_OPT_COMPRESS
+	OptMaxDecodedBytes  Key = C.SOGMM_OPT_MAX_DECODED_BYTES
+	OptVerifyChecksums  Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
+	OptSampleTruncation Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
+)
+
+// Options is an owned sogmm_options handle: parameters for fit, save, load
+// and sample. A nil *Options passed to any function means "all defaults".
+type Options struct {
+	ptr *C.sogmm_options
+}
+
+// Option sets one value; the library checks its range (ErrInvalidArg with a
+// message naming the key).
+type Option func(*Options) error
+
+// NewOptions creates a handle with every default, then applies opts in order.
+func NewOptions(opts ...Option) (*Options, error) {
+	if err := abiOnce(); err != nil {
+		return nil, err
+	}
+	o := &Options{}
+	if err := call(func() C.sogmm_status { return C.sogmm_options_create(&o.ptr) }); err != nil {
+		return nil, err
+	}
+	runtime.SetFinalizer(o, (*Options).Close)
+	if err := o.Set(opts...); err != nil {
+		o.Close()
+		return nil, err
+	}
+	return o, nil
+}
+
+// Set applies opts in order and stops at the first refused value.
+func (o *Options) Set(opts ...Option) error {
+	for _, set := range opts {
+		if err := set(o); err != nil {
+			return err
+		}
+	}
+	return nil
+}
+
+// Close frees the handle. It is idempotent; it must not race with other calls.
+func (o *Options) Close() {
+	if o == nil || o.ptr == nil {
+		return
+	}
+	runtime.SetFinalizer(o, nil)
+	C.sogmm_options_free(o.ptr)
+	o.ptr = nil
+}
+
+func (o *Options) raw() (*C.sogmm_options, error) {
+	if o == nil {
+		return nil, nil // NULL = defaults
+	}
+	if o.ptr == nil {
+		return nil, ErrClosed
+	}
+	return o.ptr, nil
+}
+
+// SetF64 sets an f64 key.
+func (o *Options) SetF64(key Key, v float64) error {
+	if o == nil || o.ptr == nil {
+		return ErrClosed
+	}
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return C.sogmm_options_set_f64(o.ptr, C.sogmm_key(key), C.double(v)) })
+}
+
+// SetI64 sets an i64 key.
+func (o *Options) SetI64(key Key, v int64) error {
+	if o == nil || o.ptr == nil {
+		return ErrClosed
+	}
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return C.sogmm_options_set_i64(o.ptr, C.sogmm_key(key), C.int64_t(v)) })
+}
+
+// GetF64 reads an f64 key.
+func (o *Options) GetF64(key Key) (float64, error) {
+	if o == nil || o.ptr == nil {
+		return 0, ErrClosed
+	}
+	defer runtime.KeepAlive(o)
+	var v C.double
+	err := call(func() C.sogmm_status { return C.sogmm_options_get_f64(o.ptr, C.sogmm_key(key), &v) })
+	return float64(v), err
+}
+
+// GetI64 reads an i64 key.
+func (o *Options) GetI64(key Key) (int64, error) {
+	if o == nil || o.ptr == nil {
+		return 0, ErrClosed
+	}
+	defer runtime.KeepAlive(o)
+	var v C.int64_t
+	err := call(func() C.sogmm_status { return C.sogmm_options_get_i64(o.ptr, C.sogmm_key(key), &v) })
+	return int64(v), err
+}
+
+// Clone is a deep copy.
+func (o *Options) Clone() (*Options, error) {
+	if o == nil || o.ptr == nil {
+		return nil, ErrClosed
+	}
+	defer runtime.KeepAlive(o)
+	c := &Options{}
+	if err := call(func() C.sogmm_status { return C.sogmm_options_clone(&c.ptr, o.ptr) }); err != nil {
+		return nil, err
+	}
+	runtime.SetFinalizer(c, (*Options).Close)
+	return c, nil
+}
+
+// F64 sets any f64 key (e.g. an experimental one).
+func F64(key Key, v float64) Option { return func(o *Options) error { return o.SetF64(key, v) } }
+
+// I64 sets any i64 key.
+func I64(key Key, v int64) Option { return func(o *Options) error { return o.SetI64(key, v) } }
+
+func boolI64(b bool) int64 {
+	if b {
+		return 1
+	}
+	return 0
+}
+
+// Bandwidth of the mean shift (default 0.02).
+func Bandwidth(v float64) Option { return F64(OptBandwidth, v) }
+
+// NComponents: fixed K; 0 = self-organizing (default).
+func NComponents(k int64) Option { return I64(OptNComponents, k) }
+
+// Tol is the EM stop tolerance (default 1e-3).
+func Tol(v float64) Option { return F64(OptTol, v) }
+
+// RegCovar is added to covariance diagonals (default 1e-6).
+func RegCovar(v float64) Option { return F64(OptRegCovar, v) }
+
+// MaxIter bounds EM iterations (default 100).
+func MaxIter(n int64) Option { return I64(OptMaxIter, n) }
+
+// Seed of k-means++ (default 0); stored as the uint64's bits.
+func Seed(s uint64) Option { return I64(OptSeed, int64(s)) }
+
+// Threads of a fit; 0 = all cores (default).
+func Threads(n int64) Option { return I64(OptThreads, n) }
+
+// NInit runs of k-means++ + EM (default 1).
+func NInit(n int64) Option { return I64(OptNInit, n) }
+
+// Decimation of RGB-D frames (default 1).
+func Decimation(d int64) Option { return I64(OptDecimation, d) }
+
+// DepthScale is raw depth units per metre (default 1000).
+func DepthScale(v float64) Option { return F64(OptDepthScale, v) }
+
+// DepthRange sets the valid depth range in metres (min exclusive, max inclusive).
+func DepthRange(min, max float64) Option {
+	return func(o *Options) error { return o.Set(F64(OptDepthMin, min), F64(OptDepthMax, max)) }
+}
+
+// ZstdLevel of saved arrays (default 19).
+func ZstdLevel(l int64) Option { return I64(OptZstdLevel, l) }
+
+// StoreFloat64 stores arrays as float64 (default false).
+func StoreFloat64(b bool) Option { return I64(OptFloat64, boolI64(b)) }
+
+// Compress arrays when saving (default true).
+func Compress(b bool) Option { return I64(OptCompress, boolI64(b)) }
+
+// VerifyChecksums when loading (default true).
+func VerifyChecksums(b bool) Option { return I64(OptVerifyChecksums, boolI64(b)) }
+
+// SampleTruncation in standard deviations (default 2.5; may be +Inf).
+func SampleTruncation(v float64) Option { return F64(OptSampleTruncation, v) }
