@@ -1,0 +1,39 @@
+//! The Rust participant of the cross-language matrix test (protocol:
+//! bindings/matrix/run_matrix.py).
+//!   matrix write <points.f32> <out.sogmm>
+//!   matrix read <in.sogmm> <query.f32> <out.bin>
+use std::io::Write;
+
+use sogmm::{Model, Options};
+
+fn floats(path: &str) -> Vec<f32> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+    bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    match args.iter().map(String::as_str).collect::<Vec<_>>()[1..] {
+        ["write", points, out] => {
+            let opts = Options::builder().bandwidth(0.05).seed(16).threads(1).build()?;
+            Model::fit(&floats(points), Some(&opts))?.save(out, None)?;
+        }
+        ["read", model, query, out] => {
+            let q = floats(query);
+            let m = Model::load(model, None)?;
+            let (mean, var) = m.regress_gray(&q)?;
+            let mut f = std::io::BufWriter::new(std::fs::File::create(out)?);
+            for a in [m.weights()?, m.means()?, m.covariances()?, m.sample(256, 2024, 4)?, mean, var] {
+                for x in a {
+                    f.write_all(&x.to_le_bytes())?;
+                }
+            }
+            for x in m.score_samples(&q, 3)? {
+                f.write_all(&x.to_le_bytes())?;
+            }
+            f.flush()?;
+        }
+        _ => return Err("usage: matrix write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin>".into()),
+    }
+    Ok(())
+}
