@@ -40,6 +40,15 @@ PYTHON=${PYTHON:-python3}
 "$PYTHON" -m pip install -q --disable-pip-version-check \
   -r tools/requirements-dev.txt 2>&1 | grep -v -i 'root user' || true
 
+# Rust and Go bindings (ctest rust_*, go_*, matrix_*): they use the machine's
+# cargo (Rust >= 1.70) and go (>= 1.21) when present and skip with a message
+# otherwise. Neither fetches anything: the crates and the Go module have no
+# dependencies (Cargo.lock lists only the two crates; there is no go.sum).
+for tool in cargo go; do
+  PATH="$PATH:$HOME/.cargo/bin:/usr/local/go/bin" command -v "$tool" >/dev/null ||
+    echo "setup: $tool not found: the ctest $tool-based binding tests will be skipped" >&2
+done
+
 if [ "${1:-}" = "--no-build" ]; then exit 0; fi
 BUILD_DIR=${SOGMM_BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release \
