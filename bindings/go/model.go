@@ -6,6 +6,7 @@ import "C"
 
 import (
 	"fmt"
+	"math"
 	"runtime"
 	"unsafe"
 )
@@ -392,6 +393,9 @@ func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, err
 	}
 	if n < 0 {
 		return nil, invalidArg("n must be >= 0, got %d", n)
+	}
+	if n > math.MaxInt/dims {
+		return nil, &Error{Status: ErrLimit, Message: fmt.Sprintf("%d samples of %d floats overflow int", n, dims)}
 	}
 	p, err := m.raw()
 	if err != nil {

@@ -153,6 +153,9 @@ func TestErrorsWorkWithErrorsIs(t *testing.T) {
 	if _, err = m.Sample(1, 0, 5, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("dims 5: %v", err)
 	}
+	if _, err = m.Sample(math.MaxInt/2, 0, 4, nil); !errors.Is(err, ErrLimit) {
+		t.Fatalf("huge n: %v", err)
+	}
 }
 
 func TestBytesFilesMetadata(t *testing.T) {

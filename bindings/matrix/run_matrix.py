@@ -75,7 +75,7 @@ def participants(args, env: dict, workdir: Path) -> tuple[dict[str, list[str]], 
     cargo = find_tool("cargo", args.cargo)
     if cargo:
         manifest = ROOT / "bindings" / "rust" / "Cargo.toml"
-        run([cargo, "build", "--quiet", "--example", "matrix", "--manifest-path", str(manifest)], env)
+        run([cargo, "build", "--quiet", "--locked", "--example", "matrix", "--manifest-path", str(manifest)], env)
         target = Path(env.get("CARGO_TARGET_DIR", ROOT / "bindings" / "rust" / "target"))
         found["Rust"] = [str(target / "debug" / "examples" / "matrix")]
     else:

@@ -109,6 +109,8 @@ fn errors_carry_status_and_message() {
 
     let e = one_gaussian().sample(1, 0, 5).unwrap_err();
     assert_eq!(e.status(), Status::InvalidArg);
+    let e = one_gaussian().sample(usize::MAX / 2, 0, 4).unwrap_err();
+    assert_eq!(e.status(), Status::Limit); // n * dims overflows: refused before allocating
 }
 
 #[test]
