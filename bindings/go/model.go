@@ -135,12 +135,12 @@ type Frame struct {
 	Fx, Fy, Cx, Cy float64
 }
 
-// FitRGBD fits one frame; decimation and depth range come from o. Slice
-// lengths are checked here, since C cannot see them.
-func FitRGBD(f Frame, o *Options) (*Model, error) {
+// colorArgs checks every slice length against Width and Height (C cannot
+// see them) and returns the color pointer and its SOGMM_COLOR_* format.
+func (f *Frame) colorArgs() (unsafe.Pointer, C.int32_t, error) {
 	pixels := int(f.Width) * int(f.Height)
 	if len(f.Depth) != pixels {
-		return nil, invalidArg("depth has %d values, width * height = %d", len(f.Depth), pixels)
+		return nil, 0, invalidArg("depth has %d values, width * height = %d", len(f.Depth), pixels)
 	}
 	var color unsafe.Pointer
 	var format C.int32_t
@@ -153,10 +153,19 @@ func FitRGBD(f Frame, o *Options) (*Model, error) {
 	case f.GrayF32 != nil && f.Gray8 == nil && f.RGB8 == nil:
 		color, format, given = unsafe.Pointer(unsafe.SliceData(f.GrayF32)), C.SOGMM_COLOR_GRAY_F32, len(f.GrayF32)
 	default:
-		return nil, invalidArg("a frame needs exactly one of Gray8, RGB8, GrayF32")
+		return nil, 0, invalidArg("a frame needs exactly one of Gray8, RGB8, GrayF32")
 	}
 	if given != want {
-		return nil, invalidArg("color has %d values, the frame needs %d", given, want)
+		return nil, 0, invalidArg("color has %d values, the frame needs %d", given, want)
+	}
+	return color, format, nil
+}
+
+// FitRGBD fits one frame; decimation and depth range come from o.
+func FitRGBD(f Frame, o *Options) (*Model, error) {
+	color, format, err := f.colorArgs()
+	if err != nil {
+		return nil, err
 	}
 	op, err := optionsPtr(o)
 	if err != nil {
@@ -168,6 +177,37 @@ func FitRGBD(f Frame, o *Options) (*Model, error) {
 			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx),
 			C.double(f.Cy), op)
 	})
+}
+
+// Points returns the points FitRGBD would fit, without fitting: N rows (x, y,
+// z, gray) in the camera frame (decimation and depth range from o). A frame
+// without a valid pixel gives an empty slice.
+func (f Frame) Points(o *Options) ([]float32, error) {
+	color, format, err := f.colorArgs()
+	if err != nil {
+		return nil, err
+	}
+	op, err := optionsPtr(o)
+	if err != nil {
+		return nil, err
+	}
+	defer runtime.KeepAlive(o)
+	var n C.size_t
+	fill := func(out []float32) error {
+		return call(func() C.sogmm_status {
+			return C.sogmm_rgbd_to_points_f32(floats(out), C.size_t(len(out)), &n,
+				(*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format, C.uint32_t(f.Width),
+				C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy), op)
+		})
+	}
+	if err := fill(nil); err != nil { // capacity 0: only counts
+		return nil, err
+	}
+	out := make([]float32, 4*int(n))
+	if err := fill(out); err != nil {
+		return nil, err
+	}
+	return out, nil
 }
 
 // FromArrays builds a model from M weights, M x 4 means and M x 4 x 4

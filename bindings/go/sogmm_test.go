@@ -355,3 +355,26 @@ func TestOptionsCloneAndGet(t *testing.T) {
 		t.Fatal("no version")
 	}
 }
+
+func TestFramePointsByHand(t *testing.T) {
+	// 2 x 2 frame, fx = fy = 2, cx = cy = 0.5: x = (u - 0.5) z / 2, y = (v - 0.5) z / 2.
+	f := Frame{Depth: []uint16{1000, 2000, 0, 1000}, Gray8: []uint8{0, 255, 7, 51}, Width: 2, Height: 2,
+		Fx: 2, Fy: 2, Cx: 0.5, Cy: 0.5}
+	got, err := f.Points(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	want := []float32{-0.25, -0.25, 1, 0, 0.5, -0.5, 2, 1, 0.25, 0.25, 1, 0.2}
+	if len(got) != len(want) {
+		t.Fatalf("got %v", got)
+	}
+	for i := range want {
+		if math.Abs(float64(got[i]-want[i])) > 1e-6 {
+			t.Fatalf("got %v want %v", got, want)
+		}
+	}
+	f.Depth = []uint16{0, 0, 0, 0}
+	if none, err := f.Points(nil); err != nil || len(none) != 0 {
+		t.Fatalf("no valid pixel: %v %v", none, err)
+	}
+}

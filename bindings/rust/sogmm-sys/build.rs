@@ -20,7 +20,10 @@ use std::process::Command;
 fn main() {
     println!("cargo:rerun-if-env-changed=SOGMM_LIB_DIR");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG_PATH");
-    let dir = env::var("SOGMM_LIB_DIR").ok().filter(|d| !d.is_empty()).or_else(pkg_config_dir);
+    let dir = env::var("SOGMM_LIB_DIR")
+        .ok()
+        .filter(|d| !d.is_empty())
+        .or_else(pkg_config_dir);
     if let Some(dir) = &dir {
         println!("cargo:rustc-link-search=native={dir}");
         println!("cargo:lib_dir={dir}");
@@ -32,7 +35,10 @@ fn main() {
 
 /// The first -L folder pkg-config reports for sogmm, if any.
 fn pkg_config_dir() -> Option<String> {
-    let out = Command::new("pkg-config").args(["--libs-only-L", "sogmm"]).output().ok()?;
+    let out = Command::new("pkg-config")
+        .args(["--libs-only-L", "sogmm"])
+        .output()
+        .ok()?;
     if !out.status.success() {
         return None;
     }

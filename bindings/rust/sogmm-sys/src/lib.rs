@@ -6,7 +6,7 @@
 //!
 //! `tests/header_drift.rs` parses sogmm.h and fails when a prototype or a
 //! constant here differs from it (name, argument count, argument or return
-//! types, value). Keep declarations one per line in the header's order.
+//! types, value). Keep the declarations in the header's order.
 #![no_std]
 #![allow(non_camel_case_types)]
 
@@ -127,11 +127,55 @@ extern "C" {
     pub fn sogmm_options_set_i64(options: *mut sogmm_options, key: sogmm_key, value: i64) -> sogmm_status;
     pub fn sogmm_options_get_f64(options: *const sogmm_options, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_options_get_i64(options: *const sogmm_options, key: sogmm_key, out: *mut i64) -> sogmm_status;
-    pub fn sogmm_fit_points_f32(out: *mut *mut sogmm_model, points: *const f32, n: usize, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_fit_points_fixed_k_f32(out: *mut *mut sogmm_model, points: *const f32, n: usize, k: usize, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_fit_rgbd(out: *mut *mut sogmm_model, depth: *const u16, color: *const u8, color_format: i32, width: u32, height: u32, fx: f64, fy: f64, cx: f64, cy: f64, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_rgbd_to_points_f32(out: *mut f32, capacity: usize, n_points: *mut usize, depth: *const u16, color: *const u8, color_format: i32, width: u32, height: u32, fx: f64, fy: f64, cx: f64, cy: f64, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_model_from_arrays_f32(out: *mut *mut sogmm_model, m: usize, weights: *const f32, means: *const f32, covariances: *const f32, support_size: u64) -> sogmm_status;
+    pub fn sogmm_fit_points_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_fit_points_fixed_k_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        k: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_fit_rgbd(
+        out: *mut *mut sogmm_model,
+        depth: *const u16,
+        color: *const u8,
+        color_format: i32,
+        width: u32,
+        height: u32,
+        fx: f64,
+        fy: f64,
+        cx: f64,
+        cy: f64,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_rgbd_to_points_f32(
+        out: *mut f32,
+        capacity: usize,
+        n_points: *mut usize,
+        depth: *const u16,
+        color: *const u8,
+        color_format: i32,
+        width: u32,
+        height: u32,
+        fx: f64,
+        fy: f64,
+        cx: f64,
+        cy: f64,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_model_from_arrays_f32(
+        out: *mut *mut sogmm_model,
+        m: usize,
+        weights: *const f32,
+        means: *const f32,
+        covariances: *const f32,
+        support_size: u64,
+    ) -> sogmm_status;
     pub fn sogmm_model_clone(out: *mut *mut sogmm_model, model: *const sogmm_model) -> sogmm_status;
     pub fn sogmm_model_free(model: *mut sogmm_model);
     pub fn sogmm_model_n_components(model: *const sogmm_model, out: *mut usize) -> sogmm_status;
@@ -143,19 +187,68 @@ extern "C" {
     pub fn sogmm_model_get_pose(model: *const sogmm_model, pose_out: *mut f64) -> sogmm_status;
     pub fn sogmm_model_set_pose(model: *mut sogmm_model, pose: *const f64) -> sogmm_status;
     pub fn sogmm_model_clear_pose(model: *mut sogmm_model) -> sogmm_status;
-    pub fn sogmm_model_get_value(model: *const sogmm_model, key: *const c_char, value_out: *mut *const c_char) -> sogmm_status;
+    pub fn sogmm_model_get_value(
+        model: *const sogmm_model,
+        key: *const c_char,
+        value_out: *mut *const c_char,
+    ) -> sogmm_status;
     pub fn sogmm_model_set_value(model: *mut sogmm_model, key: *const c_char, value: *const c_char) -> sogmm_status;
     pub fn sogmm_model_value_count(model: *const sogmm_model, out: *mut usize) -> sogmm_status;
-    pub fn sogmm_model_value_at(model: *const sogmm_model, index: usize, key_out: *mut *const c_char, value_out: *mut *const c_char) -> sogmm_status;
-    pub fn sogmm_model_sample_f32(model: *const sogmm_model, n: usize, seed: u64, dims: i32, options: *const sogmm_options, out: *mut f32) -> sogmm_status;
-    pub fn sogmm_model_regress_gray_f32(model: *const sogmm_model, xyz: *const f32, n: usize, mean_out: *mut f32, variance_out: *mut f32) -> sogmm_status;
-    pub fn sogmm_model_score_samples_f32(model: *const sogmm_model, points: *const f32, n: usize, dims: i32, out: *mut f64) -> sogmm_status;
+    pub fn sogmm_model_value_at(
+        model: *const sogmm_model,
+        index: usize,
+        key_out: *mut *const c_char,
+        value_out: *mut *const c_char,
+    ) -> sogmm_status;
+    pub fn sogmm_model_sample_f32(
+        model: *const sogmm_model,
+        n: usize,
+        seed: u64,
+        dims: i32,
+        options: *const sogmm_options,
+        out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_model_regress_gray_f32(
+        model: *const sogmm_model,
+        xyz: *const f32,
+        n: usize,
+        mean_out: *mut f32,
+        variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_model_score_samples_f32(
+        model: *const sogmm_model,
+        points: *const f32,
+        n: usize,
+        dims: i32,
+        out: *mut f64,
+    ) -> sogmm_status;
     pub fn sogmm_model_merge(out: *mut *mut sogmm_model, a: *const sogmm_model, b: *const sogmm_model) -> sogmm_status;
-    pub fn sogmm_model_transform(out: *mut *mut sogmm_model, model: *const sogmm_model, pose: *const f64) -> sogmm_status;
-    pub fn sogmm_model_save(model: *const sogmm_model, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_model_load(out: *mut *mut sogmm_model, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_model_save_to_memory(out: *mut *mut sogmm_buffer, model: *const sogmm_model, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_model_load_from_memory(out: *mut *mut sogmm_model, data: *const c_void, size: usize, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_model_transform(
+        out: *mut *mut sogmm_model,
+        model: *const sogmm_model,
+        pose: *const f64,
+    ) -> sogmm_status;
+    pub fn sogmm_model_save(
+        model: *const sogmm_model,
+        path: *const c_char,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_model_load(
+        out: *mut *mut sogmm_model,
+        path: *const c_char,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_model_save_to_memory(
+        out: *mut *mut sogmm_buffer,
+        model: *const sogmm_model,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_model_load_from_memory(
+        out: *mut *mut sogmm_model,
+        data: *const c_void,
+        size: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_buffer_data(buffer: *const sogmm_buffer) -> *const u8;
     pub fn sogmm_buffer_size(buffer: *const sogmm_buffer) -> usize;
     pub fn sogmm_buffer_free(buffer: *mut sogmm_buffer);

@@ -24,7 +24,10 @@ fn strip_c_comments(s: &str) -> String {
         };
     }
     out.push_str(rest);
-    out.lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n")
+    out.lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// A C type (without the parameter name) as the Rust type the crate must use.
@@ -33,7 +36,7 @@ fn rust_type(c: &str) -> String {
     let toks: Vec<&str> = spaced.split_whitespace().collect();
     let mut base_const = false;
     let mut i = 0;
-    if toks.get(0) == Some(&"const") {
+    if toks.first() == Some(&"const") {
         base_const = true;
         i = 1;
     }
@@ -71,7 +74,9 @@ fn rust_type(c: &str) -> String {
 /// Splits "const float* points" into the type and the name.
 fn split_param(p: &str) -> String {
     let p = p.trim();
-    let cut = p.rfind(|c: char| !(c.is_alphanumeric() || c == '_')).expect("parameter without a type");
+    let cut = p
+        .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .expect("parameter without a type");
     p[..=cut].trim().to_string()
 }
 
@@ -96,7 +101,10 @@ fn header_protos(header: &str) -> Protos {
     let mut protos = Protos::new();
     for stmt in text.split(';') {
         let Some(at) = stmt.find("SOGMM_API ") else { continue };
-        let decl = stmt[at + "SOGMM_API ".len()..].split_whitespace().collect::<Vec<_>>().join(" ");
+        let decl = stmt[at + "SOGMM_API ".len()..]
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         let open = decl.find('(').unwrap_or_else(|| panic!("no '(' in {decl:?}"));
         let close = decl.rfind(')').unwrap();
         let head = decl[..open].trim();
@@ -110,7 +118,10 @@ fn header_protos(header: &str) -> Protos {
         } else {
             args_text.split(',').map(|a| rust_type(&split_param(a))).collect()
         };
-        assert!(protos.insert(name.clone(), (args, ret)).is_none(), "{name} declared twice");
+        assert!(
+            protos.insert(name.clone(), (args, ret)).is_none(),
+            "{name} declared twice"
+        );
     }
     protos
 }
@@ -121,7 +132,9 @@ fn rust_protos(lib: &str) -> Protos {
     let mut protos = Protos::new();
     for stmt in block.split(';') {
         let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
-        let Some(rest) = decl.strip_prefix("pub fn ") else { continue };
+        let Some(rest) = decl.strip_prefix("pub fn ") else {
+            continue;
+        };
         let open = rest.find('(').unwrap();
         let close = rest.rfind(')').unwrap();
         let name = rest[..open].to_string();
@@ -130,8 +143,14 @@ fn rust_protos(lib: &str) -> Protos {
             .filter(|a| !a.trim().is_empty())
             .map(|a| a.split_once(':').expect("argument without a type").1.trim().to_string())
             .collect();
-        let ret = rest[close + 1..].trim().strip_prefix("->").map(|r| r.trim().to_string());
-        assert!(protos.insert(name.clone(), (args, ret)).is_none(), "{name} declared twice");
+        let ret = rest[close + 1..]
+            .trim()
+            .strip_prefix("->")
+            .map(|r| r.trim().to_string());
+        assert!(
+            protos.insert(name.clone(), (args, ret)).is_none(),
+            "{name} declared twice"
+        );
     }
     protos
 }
@@ -144,7 +163,9 @@ fn header_consts(header: &str) -> BTreeMap<String, String> {
         if it.next() != Some("#define") {
             continue;
         }
-        let (Some(name), Some(value), None) = (it.next(), it.next(), it.next()) else { continue };
+        let (Some(name), Some(value), None) = (it.next(), it.next(), it.next()) else {
+            continue;
+        };
         let value = value.trim_start_matches('(').trim_end_matches(')');
         let numeric = value.trim_start_matches('-').chars().all(|c| c.is_ascii_digit()) && !value.is_empty();
         if name.starts_with("SOGMM_") && (numeric || value.starts_with('"')) {
@@ -157,7 +178,9 @@ fn header_consts(header: &str) -> BTreeMap<String, String> {
 fn rust_consts(lib: &str) -> BTreeMap<String, String> {
     let mut out = BTreeMap::new();
     for line in lib.lines() {
-        let Some(rest) = line.trim().strip_prefix("pub const ") else { continue };
+        let Some(rest) = line.trim().strip_prefix("pub const ") else {
+            continue;
+        };
         let (name, rest) = rest.split_once(':').unwrap();
         let value = rest.split_once('=').unwrap().1.trim().trim_end_matches(';').trim();
         out.insert(name.trim().to_string(), value.to_string());
@@ -201,10 +224,22 @@ fn drift(header: &str, lib: &str) -> Vec<String> {
 #[test]
 fn sys_crate_matches_header() {
     let problems = drift(HEADER, LIB_RS);
-    assert!(problems.is_empty(), "sogmm-sys drifted from sogmm.h:\n{}", problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "sogmm-sys drifted from sogmm.h:\n{}",
+        problems.join("\n")
+    );
     // The parse found the whole API, not an empty subset that trivially agrees.
-    assert!(header_protos(HEADER).len() >= 44, "only {} prototypes parsed", header_protos(HEADER).len());
-    assert!(header_consts(HEADER).len() >= 70, "only {} constants parsed", header_consts(HEADER).len());
+    assert!(
+        header_protos(HEADER).len() >= 44,
+        "only {} prototypes parsed",
+        header_protos(HEADER).len()
+    );
+    assert!(
+        header_consts(HEADER).len() >= 70,
+        "only {} constants parsed",
+        header_consts(HEADER).len()
+    );
 }
 
 /// The checker itself catches each kind of drift (a header edited as a future
@@ -212,15 +247,42 @@ fn sys_crate_matches_header() {
 #[test]
 fn drift_is_detected() {
     let cases = [
-        ("size_t k, const sogmm_options* options", "uint32_t k, const sogmm_options* options", "sogmm_fit_points_fixed_k_f32"),
+        (
+            "size_t k, const sogmm_options* options",
+            "uint32_t k, const sogmm_options* options",
+            "sogmm_fit_points_fixed_k_f32",
+        ),
         ("uint64_t seed,\n", "uint64_t seed, int extra,\n", "arguments"),
-        ("const sogmm_model* model, double* pose_out", "sogmm_model* model, double* pose_out", "sogmm_model_get_pose"),
-        ("SOGMM_API uint32_t sogmm_abi_version", "SOGMM_API int32_t sogmm_abi_version", "sogmm_abi_version"),
-        ("#define SOGMM_E_INTERNAL (-11)", "#define SOGMM_E_INTERNAL (-11)\n#define SOGMM_E_CANCELLED (-12)", "SOGMM_E_CANCELLED"),
-        ("#define SOGMM_OPT_N_INIT 109", "#define SOGMM_OPT_N_INIT 110", "SOGMM_OPT_N_INIT"),
-        ("SOGMM_API void sogmm_buffer_free(sogmm_buffer* buffer);", "", "sogmm_buffer_free"),
-        ("SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);",
-         "SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);\nSOGMM_API void sogmm_new(void);", "sogmm_new"),
+        (
+            "const sogmm_model* model, double* pose_out",
+            "sogmm_model* model, double* pose_out",
+            "sogmm_model_get_pose",
+        ),
+        (
+            "SOGMM_API uint32_t sogmm_abi_version",
+            "SOGMM_API int32_t sogmm_abi_version",
+            "sogmm_abi_version",
+        ),
+        (
+            "#define SOGMM_E_INTERNAL (-11)",
+            "#define SOGMM_E_INTERNAL (-11)\n#define SOGMM_E_CANCELLED (-12)",
+            "SOGMM_E_CANCELLED",
+        ),
+        (
+            "#define SOGMM_OPT_N_INIT 109",
+            "#define SOGMM_OPT_N_INIT 110",
+            "SOGMM_OPT_N_INIT",
+        ),
+        (
+            "SOGMM_API void sogmm_buffer_free(sogmm_buffer* buffer);",
+            "",
+            "sogmm_buffer_free",
+        ),
+        (
+            "SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);",
+            "SOGMM_API sogmm_status sogmm_model_clear_pose(sogmm_model* model);\nSOGMM_API void sogmm_new(void);",
+            "sogmm_new",
+        ),
     ];
     for (from, to, expect) in cases {
         assert!(HEADER.contains(from), "test case out of date: {from:?}");

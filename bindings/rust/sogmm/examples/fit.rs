@@ -13,7 +13,16 @@ fn main() -> Result<(), sogmm::Error> {
             _ => 230,
         })
         .collect();
-    let frame = Frame { depth: &depth, color: Color::Gray8(&gray), width: w, height: h, fx: 140.0, fy: 140.0, cx: 79.5, cy: 59.5 };
+    let frame = Frame {
+        depth: &depth,
+        color: Color::Gray8(&gray),
+        width: w,
+        height: h,
+        fx: 140.0,
+        fy: 140.0,
+        cx: 79.5,
+        cy: 59.5,
+    };
     let opts = Options::builder().bandwidth(0.05).decimation(4).seed(1).build()?;
     let mut model = Model::fit_rgbd(&frame, Some(&opts))?;
     println!("libsogmm {}: {} components", sogmm::version(), model.n_components());
@@ -29,6 +38,10 @@ fn main() -> Result<(), sogmm::Error> {
     model.save(&path, None)?;
     let loaded = Model::load(&path, None)?;
     std::fs::remove_file(&path).ok();
-    println!("saved and reloaded {}: {} components", path.display(), loaded.n_components());
+    println!(
+        "saved and reloaded {}: {} components",
+        path.display(),
+        loaded.n_components()
+    );
     Ok(())
 }

@@ -8,7 +8,10 @@ use sogmm::{Model, Options};
 
 fn floats(path: &str) -> Vec<f32> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
-    bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -23,7 +26,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let m = Model::load(model, None)?;
             let (mean, var) = m.regress_gray(&q)?;
             let mut f = std::io::BufWriter::new(std::fs::File::create(out)?);
-            for a in [m.weights()?, m.means()?, m.covariances()?, m.sample(256, 2024, 4)?, mean, var] {
+            for a in [
+                m.weights()?,
+                m.means()?,
+                m.covariances()?,
+                m.sample(256, 2024, 4)?,
+                mean,
+                var,
+            ] {
                 for x in a {
                     f.write_all(&x.to_le_bytes())?;
                 }

@@ -72,15 +72,23 @@ pub struct Error {
 
 impl Error {
     pub fn new(status: Status, message: impl Into<String>) -> Error {
-        Error { status, message: message.into() }
+        Error {
+            status,
+            message: message.into(),
+        }
     }
 
     /// The error of the call that just returned `code` on this thread.
     pub(crate) fn last(code: i32) -> Error {
         // SAFETY: sogmm_last_error never returns NULL; the text is valid until
         // the next sogmm_* call on this thread, and is copied here at once.
-        let msg = unsafe { CStr::from_ptr(sys::sogmm_last_error()) }.to_string_lossy().into_owned();
-        Error { status: Status::from_code(code), message: msg }
+        let msg = unsafe { CStr::from_ptr(sys::sogmm_last_error()) }
+            .to_string_lossy()
+            .into_owned();
+        Error {
+            status: Status::from_code(code),
+            message: msg,
+        }
     }
 
     pub fn status(&self) -> Status {

@@ -36,7 +36,9 @@ pub use sogmm_sys as sys;
 /// "MAJOR.MINOR.PATCH" of the loaded library.
 pub fn version() -> &'static str {
     // SAFETY: static, never-NULL, ASCII.
-    unsafe { CStr::from_ptr(sys::sogmm_version_string()) }.to_str().unwrap_or("?")
+    unsafe { CStr::from_ptr(sys::sogmm_version_string()) }
+        .to_str()
+        .unwrap_or("?")
 }
 
 /// Checks once per process that the loaded libsogmm has the ABI version of
@@ -50,7 +52,10 @@ pub(crate) fn ensure_abi() -> Result<()> {
     } else {
         Err(Error::new(
             Status::Internal,
-            format!("libsogmm has ABI version {loaded}, these bindings need {}", sys::SOGMM_ABI_VERSION),
+            format!(
+                "libsogmm has ABI version {loaded}, these bindings need {}",
+                sys::SOGMM_ABI_VERSION
+            ),
         ))
     }
 }

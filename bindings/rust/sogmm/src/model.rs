@@ -47,6 +47,66 @@ pub struct Frame<'a> {
     pub cy: f64,
 }
 
+impl Frame<'_> {
+    /// The color pointer and SOGMM_COLOR_* format, after checking every slice
+    /// length against width and height (C cannot see them).
+    fn color_args(&self) -> Result<(*const u8, i32)> {
+        let pixels = len_of(self.width as usize, self.height as usize, "image size")?;
+        if self.depth.len() != pixels {
+            return Err(invalid(format!(
+                "depth has {} values, width * height = {pixels}",
+                self.depth.len()
+            )));
+        }
+        let (color, format, got, want): (*const u8, i32, usize, usize) = match self.color {
+            Color::Gray8(c) => (c.as_ptr(), sys::SOGMM_COLOR_GRAY8, c.len(), pixels),
+            Color::Rgb8(c) => (
+                c.as_ptr(),
+                sys::SOGMM_COLOR_RGB8,
+                c.len(),
+                len_of(pixels, 3, "RGB size")?,
+            ),
+            Color::GrayF32(c) => (c.as_ptr().cast(), sys::SOGMM_COLOR_GRAY_F32, c.len(), pixels),
+        };
+        if got != want {
+            return Err(invalid(format!("color has {got} values, the frame needs {want}")));
+        }
+        Ok((color, format))
+    }
+
+    /// The points `Model::fit_rgbd` would fit, without fitting: N rows (x, y,
+    /// z, gray) in the camera frame (decimation and depth range from
+    /// `options`). A frame without a valid pixel gives an empty Vec.
+    pub fn to_points(&self, options: Option<&Options>) -> Result<Vec<f32>> {
+        let (color, format) = self.color_args()?;
+        let call = |out: *mut f32, capacity: usize, n: &mut usize| {
+            // SAFETY: slices checked by color_args; `out` has `capacity` floats.
+            check(unsafe {
+                sys::sogmm_rgbd_to_points_f32(
+                    out,
+                    capacity,
+                    n,
+                    self.depth.as_ptr(),
+                    color,
+                    format,
+                    self.width,
+                    self.height,
+                    self.fx,
+                    self.fy,
+                    self.cx,
+                    self.cy,
+                    opt_ptr(options),
+                )
+            })
+        };
+        let mut n = 0;
+        call(ptr::null_mut(), 0, &mut n)?; // capacity 0: only counts
+        let mut points = vec![0.0f32; len_of(n, 4, "points")?];
+        call(points.as_mut_ptr(), points.len(), &mut n)?;
+        Ok(points)
+    }
+}
+
 fn invalid(msg: String) -> Error {
     Error::new(Status::InvalidArg, msg)
 }
@@ -54,13 +114,17 @@ fn invalid(msg: String) -> Error {
 /// Number of `cols`-wide rows in `data`, refusing a ragged slice.
 fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     if data.len() % cols != 0 {
-        return Err(invalid(format!("{what} has {} floats, not a multiple of {cols}", data.len())));
+        return Err(invalid(format!(
+            "{what} has {} floats, not a multiple of {cols}",
+            data.len()
+        )));
     }
     Ok(data.len() / cols)
 }
 
 fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
-    n.checked_mul(per).ok_or_else(|| Error::new(Status::Limit, format!("{what}: {n} x {per} overflows usize")))
+    n.checked_mul(per)
+        .ok_or_else(|| Error::new(Status::Limit, format!("{what}: {n} x {per} overflows usize")))
 }
 
 fn c_string(s: &str, what: &str) -> Result<CString> {
@@ -85,7 +149,9 @@ impl Model {
         crate::ensure_abi()?;
         let mut out = ptr::null_mut();
         check(f(&mut out))?;
-        Ok(Model { ptr: NonNull::new(out).expect("libsogmm returned OK and a NULL model") })
+        Ok(Model {
+            ptr: NonNull::new(out).expect("libsogmm returned OK and a NULL model"),
+        })
     }
 
     fn raw(&self) -> *const sys::sogmm_model {
@@ -108,22 +174,9 @@ impl Model {
     }
 
     /// Fits one RGB-D frame; decimation and depth range come from `options`.
-    /// The slice lengths are checked against width and height here, since C
-    /// cannot see them.
     pub fn fit_rgbd(frame: &Frame<'_>, options: Option<&Options>) -> Result<Model> {
-        let pixels = len_of(frame.width as usize, frame.height as usize, "image size")?;
-        if frame.depth.len() != pixels {
-            return Err(invalid(format!("depth has {} values, width * height = {pixels}", frame.depth.len())));
-        }
-        let (color, format, got, want): (*const u8, i32, usize, usize) = match frame.color {
-            Color::Gray8(c) => (c.as_ptr(), sys::SOGMM_COLOR_GRAY8, c.len(), pixels),
-            Color::Rgb8(c) => (c.as_ptr(), sys::SOGMM_COLOR_RGB8, c.len(), len_of(pixels, 3, "RGB size")?),
-            Color::GrayF32(c) => (c.as_ptr().cast(), sys::SOGMM_COLOR_GRAY_F32, c.len(), pixels),
-        };
-        if got != want {
-            return Err(invalid(format!("color has {got} values, the frame needs {want}")));
-        }
-        // SAFETY: depth and color hold the sizes C reads for width x height.
+        let (color, format) = frame.color_args()?;
+        // SAFETY: color_args checked the slices against width x height.
         Model::make(|out| unsafe {
             sys::sogmm_fit_rgbd(
                 out,
@@ -156,7 +209,14 @@ impl Model {
         }
         // SAFETY: lengths checked above.
         Model::make(|out| unsafe {
-            sys::sogmm_model_from_arrays_f32(out, m, weights.as_ptr(), means.as_ptr(), covariances.as_ptr(), support_size)
+            sys::sogmm_model_from_arrays_f32(
+                out,
+                m,
+                weights.as_ptr(),
+                means.as_ptr(),
+                covariances.as_ptr(),
+                support_size,
+            )
         })
     }
 
@@ -219,21 +279,30 @@ impl Model {
     pub fn info_f64(&self, key: i32) -> Result<Option<f64>> {
         let mut v = 0.0;
         // SAFETY: valid handle and out-pointer.
-        not_found_is_none(check(unsafe { sys::sogmm_model_get_info_f64(self.raw(), key, &mut v) }), v)
+        not_found_is_none(
+            check(unsafe { sys::sogmm_model_get_info_f64(self.raw(), key, &mut v) }),
+            v,
+        )
     }
 
     /// An i64 SOGMM_INFO_* value; `None` when the model does not have it.
     pub fn info_i64(&self, key: i32) -> Result<Option<i64>> {
         let mut v = 0;
         // SAFETY: valid handle and out-pointer.
-        not_found_is_none(check(unsafe { sys::sogmm_model_get_info_i64(self.raw(), key, &mut v) }), v)
+        not_found_is_none(
+            check(unsafe { sys::sogmm_model_get_info_i64(self.raw(), key, &mut v) }),
+            v,
+        )
     }
 
     /// The 4 x 4 row-major pose of the model's frame, if set.
     pub fn pose(&self) -> Result<Option<[f64; 16]>> {
         let mut p = [0.0; 16];
         // SAFETY: room for 16 doubles.
-        not_found_is_none(check(unsafe { sys::sogmm_model_get_pose(self.raw(), p.as_mut_ptr()) }), p)
+        not_found_is_none(
+            check(unsafe { sys::sogmm_model_get_pose(self.raw(), p.as_mut_ptr()) }),
+            p,
+        )
     }
 
     /// Sets the pose (must be a finite rigid transform).
@@ -367,7 +436,8 @@ impl Clone for Model {
     /// Panics only when memory runs out, as `Vec::clone` would; use
     /// `try_clone` to handle that.
     fn clone(&self) -> Model {
-        self.try_clone().unwrap_or_else(|e| panic!("cloning a sogmm model failed: {e}"))
+        self.try_clone()
+            .unwrap_or_else(|e| panic!("cloning a sogmm model failed: {e}"))
     }
 }
 
@@ -380,6 +450,8 @@ impl Drop for Model {
 
 impl std::fmt::Debug for Model {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Model").field("n_components", &self.n_components()).finish_non_exhaustive()
+        f.debug_struct("Model")
+            .field("n_components", &self.n_components())
+            .finish_non_exhaustive()
     }
 }

@@ -35,7 +35,9 @@ impl Options {
         let mut out = ptr::null_mut();
         // SAFETY: `out` is a valid out-pointer.
         check(unsafe { sys::sogmm_options_create(&mut out) })?;
-        Ok(Options { ptr: NonNull::new(out).expect("sogmm_options_create returned OK and NULL") })
+        Ok(Options {
+            ptr: NonNull::new(out).expect("sogmm_options_create returned OK and NULL"),
+        })
     }
 
     /// A builder collecting keys; `build` applies them in order.
@@ -72,7 +74,9 @@ impl Options {
         let mut out = ptr::null_mut();
         // SAFETY: valid handle and out-pointer.
         check(unsafe { sys::sogmm_options_clone(&mut out, self.ptr.as_ptr()) })?;
-        Ok(Options { ptr: NonNull::new(out).expect("sogmm_options_clone returned OK and NULL") })
+        Ok(Options {
+            ptr: NonNull::new(out).expect("sogmm_options_clone returned OK and NULL"),
+        })
     }
 
     pub(crate) fn as_ptr(&self) -> *const sys::sogmm_options {
@@ -89,7 +93,8 @@ impl Clone for Options {
     /// Panics only when memory runs out, as `Vec::clone` would; use
     /// `try_clone` to handle that.
     fn clone(&self) -> Options {
-        self.try_clone().unwrap_or_else(|e| panic!("cloning sogmm options failed: {e}"))
+        self.try_clone()
+            .unwrap_or_else(|e| panic!("cloning sogmm options failed: {e}"))
     }
 }
 
@@ -179,13 +184,13 @@ impl OptionsBuilder {
         /// zstd level of saved arrays (default 19).
         zstd_level(i64) => SOGMM_OPT_ZSTD_LEVEL as i64 |v| v;
         /// Store arrays as float64 (default false).
-        float64(bool) => SOGMM_OPT_FLOAT64 as i64 |b| i64::from(b);
+        float64(bool) => SOGMM_OPT_FLOAT64 as i64 i64::from;
         /// Compress arrays (default true).
-        compress(bool) => SOGMM_OPT_COMPRESS as i64 |b| i64::from(b);
+        compress(bool) => SOGMM_OPT_COMPRESS as i64 i64::from;
         /// Cap on decoded bytes when loading; 0 = the format's default.
         max_decoded_bytes(i64) => SOGMM_OPT_MAX_DECODED_BYTES as i64 |v| v;
         /// Verify checksums when loading (default true).
-        verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 |b| i64::from(b);
+        verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 i64::from;
         /// Sampling truncation in standard deviations (default 2.5; may be inf).
         sample_truncation(f64) => SOGMM_OPT_SAMPLE_TRUNCATION as f64 |v| v;
     }

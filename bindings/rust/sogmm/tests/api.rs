@@ -121,14 +121,19 @@ fn options_get_set_clone() {
     o.set_i64(sogmm::sys::SOGMM_OPT_ZSTD_LEVEL, 5).unwrap();
     assert_eq!(c.get_i64(sogmm::sys::SOGMM_OPT_ZSTD_LEVEL).unwrap(), 3, "clone is deep");
     assert_eq!(o.get_f64(sogmm::sys::SOGMM_OPT_BANDWIDTH).unwrap(), 0.02, "default");
-    assert_eq!(o.get_f64(sogmm::sys::SOGMM_OPT_SEED).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        o.get_f64(sogmm::sys::SOGMM_OPT_SEED).unwrap_err().status(),
+        Status::InvalidArg
+    );
 }
 
 #[test]
 fn bytes_and_files_round_trip() {
     let mut m = one_gaussian();
     m.set_value("origin", "rust test").unwrap();
-    let pose = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 2.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 0.0, 1.0];
+    let pose = [
+        1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 2.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 0.0, 1.0,
+    ];
     m.set_pose(&pose).unwrap();
     let opts = Options::builder().zstd_level(1).build().unwrap();
     let back = Model::from_bytes(&m.to_bytes(Some(&opts)).unwrap(), None).unwrap();
@@ -141,7 +146,10 @@ fn bytes_and_files_round_trip() {
     m.save(&path, None).unwrap();
     let loaded = Model::load(&path, None).unwrap();
     std::fs::remove_file(&path).unwrap();
-    assert_eq!(loaded.values().unwrap(), vec![("origin".to_string(), "rust test".to_string())]);
+    assert_eq!(
+        loaded.values().unwrap(),
+        vec![("origin".to_string(), "rust test".to_string())]
+    );
 }
 
 #[test]
@@ -153,7 +161,11 @@ fn clone_is_deep_and_merge_transform_work() {
     let ab = a.merge(&b).unwrap();
     assert_eq!(ab.n_components(), 2);
     assert_eq!(ab.weights().unwrap(), vec![0.5, 0.5]);
-    let moved = a.transform(&[1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]).unwrap();
+    let moved = a
+        .transform(&[
+            1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ])
+        .unwrap();
     assert_eq!(moved.means().unwrap(), vec![1.0, 0.0, 0.0, 0.5]);
 }
 
@@ -162,15 +174,36 @@ fn rgbd_fit_checks_slice_lengths() {
     let (w, h) = (32u32, 24u32);
     let depth: Vec<u16> = (0..w * h).map(|i| 1000 + (i % w) as u16 * 10).collect();
     let gray: Vec<u8> = (0..w * h).map(|i| if i % w < w / 2 { 40 } else { 200 }).collect();
-    let frame = Frame { depth: &depth, color: Color::Gray8(&gray), width: w, height: h, fx: 30.0, fy: 30.0, cx: 15.5, cy: 11.5 };
+    let frame = Frame {
+        depth: &depth,
+        color: Color::Gray8(&gray),
+        width: w,
+        height: h,
+        fx: 30.0,
+        fy: 30.0,
+        cx: 15.5,
+        cy: 11.5,
+    };
     let opts = Options::builder().bandwidth(0.1).threads(1).build().unwrap();
     let m = Model::fit_rgbd(&frame, Some(&opts)).unwrap();
     assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_CAMERA_WIDTH).unwrap(), Some(32));
-    assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_SUPPORT_SIZE).unwrap(), Some((w * h) as i64));
-    let short = Frame { depth: &depth[1..], ..frame };
+    assert_eq!(
+        m.info_i64(sogmm::sys::SOGMM_INFO_SUPPORT_SIZE).unwrap(),
+        Some((w * h) as i64)
+    );
+    let short = Frame {
+        depth: &depth[1..],
+        ..frame
+    };
     assert_eq!(Model::fit_rgbd(&short, None).unwrap_err().status(), Status::InvalidArg);
-    let rgb_too_short = Frame { color: Color::Rgb8(&gray), ..frame };
-    assert_eq!(Model::fit_rgbd(&rgb_too_short, None).unwrap_err().status(), Status::InvalidArg);
+    let rgb_too_short = Frame {
+        color: Color::Rgb8(&gray),
+        ..frame
+    };
+    assert_eq!(
+        Model::fit_rgbd(&rgb_too_short, None).unwrap_err().status(),
+        Status::InvalidArg
+    );
 }
 
 #[test]
@@ -181,7 +214,12 @@ fn shared_model_across_threads_matches_serial() {
     let m = one_gaussian();
     let serial: Vec<Vec<f32>> = (0..4).map(|s| m.sample(500, s, 4).unwrap()).collect();
     let parallel: Vec<Vec<f32>> = std::thread::scope(|sc| {
-        let hs: Vec<_> = (0..4).map(|s| { let m = &m; sc.spawn(move || m.sample(500, s, 4).unwrap()) }).collect();
+        let hs: Vec<_> = (0..4)
+            .map(|s| {
+                let m = &m;
+                sc.spawn(move || m.sample(500, s, 4).unwrap())
+            })
+            .collect();
         hs.into_iter().map(|h| h.join().unwrap()).collect()
     });
     assert_eq!(serial, parallel);
@@ -195,4 +233,32 @@ fn shared_model_across_threads_matches_serial() {
 #[test]
 fn version_is_the_header_version() {
     assert_eq!(sogmm::version(), sogmm::sys::SOGMM_VERSION_STRING);
+}
+
+#[test]
+fn frame_to_points_by_hand() {
+    // 2 x 2 frame, fx = fy = 2, cx = cy = 0.5: x = (u - 0.5) z / 2, y = (v - 0.5) z / 2.
+    let depth = [1000u16, 2000, 0, 1000]; // 1 m, 2 m, no reading, 1 m
+    let gray = [0u8, 255, 7, 51];
+    let frame = Frame {
+        depth: &depth,
+        color: Color::Gray8(&gray),
+        width: 2,
+        height: 2,
+        fx: 2.0,
+        fy: 2.0,
+        cx: 0.5,
+        cy: 0.5,
+    };
+    let pts = frame.to_points(None).unwrap();
+    let want = [-0.25, -0.25, 1.0, 0.0, 0.5, -0.5, 2.0, 1.0, 0.25, 0.25, 1.0, 0.2];
+    assert_eq!(pts.len(), want.len(), "{pts:?}");
+    for (g, w) in pts.iter().zip(want) {
+        assert!((g - w).abs() < 1e-6, "{pts:?}");
+    }
+    let none = Frame {
+        depth: &[0, 0, 0, 0],
+        ..frame
+    };
+    assert!(none.to_points(None).unwrap().is_empty());
 }
