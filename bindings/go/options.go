@@ -89,54 +89,47 @@ func (o *Options) raw() (*C.sogmm_options, error) {
 	return o.ptr, nil
 }
 
-// SetF64 sets an f64 key.
-func (o *Options) SetF64(key Key, v float64) error {
+// do runs one C call on o's handle, keeping o alive until it returns.
+func (o *Options) do(f func(p *C.sogmm_options) C.sogmm_status) error {
 	if o == nil || o.ptr == nil {
 		return ErrClosed
 	}
 	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return C.sogmm_options_set_f64(o.ptr, C.sogmm_key(key), C.double(v)) })
+	return call(func() C.sogmm_status { return f(o.ptr) })
+}
+
+// SetF64 sets an f64 key.
+func (o *Options) SetF64(key Key, v float64) error {
+	return o.do(func(p *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_options_set_f64(p, C.sogmm_key(key), C.double(v))
+	})
 }
 
 // SetI64 sets an i64 key.
 func (o *Options) SetI64(key Key, v int64) error {
-	if o == nil || o.ptr == nil {
-		return ErrClosed
-	}
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return C.sogmm_options_set_i64(o.ptr, C.sogmm_key(key), C.int64_t(v)) })
+	return o.do(func(p *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_options_set_i64(p, C.sogmm_key(key), C.int64_t(v))
+	})
 }
 
 // GetF64 reads an f64 key.
 func (o *Options) GetF64(key Key) (float64, error) {
-	if o == nil || o.ptr == nil {
-		return 0, ErrClosed
-	}
-	defer runtime.KeepAlive(o)
 	var v C.double
-	err := call(func() C.sogmm_status { return C.sogmm_options_get_f64(o.ptr, C.sogmm_key(key), &v) })
+	err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_get_f64(p, C.sogmm_key(key), &v) })
 	return float64(v), err
 }
 
 // GetI64 reads an i64 key.
 func (o *Options) GetI64(key Key) (int64, error) {
-	if o == nil || o.ptr == nil {
-		return 0, ErrClosed
-	}
-	defer runtime.KeepAlive(o)
 	var v C.int64_t
-	err := call(func() C.sogmm_status { return C.sogmm_options_get_i64(o.ptr, C.sogmm_key(key), &v) })
+	err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_get_i64(p, C.sogmm_key(key), &v) })
 	return int64(v), err
 }
 
 // Clone is a deep copy.
 func (o *Options) Clone() (*Options, error) {
-	if o == nil || o.ptr == nil {
-		return nil, ErrClosed
-	}
-	defer runtime.KeepAlive(o)
 	c := &Options{}
-	if err := call(func() C.sogmm_status { return C.sogmm_options_clone(&c.ptr, o.ptr) }); err != nil {
+	if err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_clone(&c.ptr, p) }); err != nil {
 		return nil, err
 	}
 	runtime.SetFinalizer(c, (*Options).Close)
