@@ -110,9 +110,11 @@ run_one() {
       $(budget_flags "$t") -timeout=25 -rss_limit_mb=2048 -max_len="$(max_len_for "$t")" \
       -artifact_prefix="$artifacts/" -print_final_stats=1 >"$log" 2>&1; } 2>"$log.cpu" || status=$?
   local execs findings
-  execs=$(grep -ao 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+  # '|| true': under pipefail a grep that finds nothing would end this
+  # function before it reports (fork mode never prints the final stats).
+  execs=$(grep -ao 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || true)
   # Fork mode prints running totals as '#N: cov: ...' instead.
-  [ -n "$execs" ] || execs=$(grep -aoE '^#[0-9]+:' "$log" | tr -d '#:' | tail -1)
+  [ -n "$execs" ] || execs=$(grep -aoE '^#[0-9]+:' "$log" | tr -d '#:' | tail -1 || true)
   findings=$(find "$artifacts" -type f | wc -l)
   cpu=$(awk '{printf "%.0f", $1 + $2}' "$log.cpu" 2>/dev/null || echo "?")
   if [ "$KEEP_GOING" = 1 ] && [ "$findings" -gt 0 ]; then status=1; fi
