@@ -1,6 +1,7 @@
 // Issue 14 (exact at every scale), geometry items: the mode count's cost with
 // a far outlier (item 3), gray regression off the surface (item 4) and
-// back-projection for a decimation that does not divide the image (item 7).
+// back-projection for a decimation that does not divide the image (item 7),
+// PSNR's data range (item 9; the renderer: tests/tools/test_render.cpp).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -12,6 +13,7 @@
 #include "sogmm/camera.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/mean_shift.hpp"
+#include "sogmm/metrics.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -279,4 +281,33 @@ TEST(ScaleGeometry, DecimationConventionIsDocumentedExample) {
   EXPECT_FLOAT_EQ(pc.xyzg[4], 0.0f);
   EXPECT_FLOAT_EQ(pc.xyzg[6], 2.0f);
   EXPECT_FLOAT_EQ(pc.xyzg[7], 0.75f);
+}
+
+// ---------------------------------------------------------------------------
+// Item 9: PSNR's data range is a parameter of the honest figure; the
+// paper-compatible one keeps the authors' fixed range 2.
+TEST(ScaleGeometry, PsnrDataRangeIsAParameter) {
+  const float truth[4] = {0.5f, 0.2f, -1.0f, 0.8f};
+  const float est[4] = {0.6f, 0.2f, -1.0f, 0.8f};
+  const double d = static_cast<double>(0.6f) - static_cast<double>(0.5f);
+  const double mse = d * d / 3.0;
+  const double paper = 10.0 * std::log10(4.0 / (d * d / 4.0));
+  const sogmm::PsnrResult one = sogmm::psnr_images(truth, est, 4);  // default: gray in [0, 1]
+  EXPECT_EQ(one.data_range, 1.0);
+  EXPECT_NEAR(one.psnr, 10.0 * std::log10(1.0 / mse), 1e-9);
+  const sogmm::PsnrResult two = sogmm::psnr_images(truth, est, 4, 2.0);
+  EXPECT_NEAR(two.psnr, 10.0 * std::log10(4.0 / mse), 1e-9);  // +6.02 dB
+  const double actual = static_cast<double>(0.8f) - static_cast<double>(0.2f);  // 0 = measured: max - min of valid truth
+  const sogmm::PsnrResult measured = sogmm::psnr_images(truth, est, 4, 0.0);
+  EXPECT_NEAR(measured.data_range, actual, 1e-12);
+  EXPECT_NEAR(measured.psnr, 10.0 * std::log10(actual * actual / mse), 1e-9);
+  for (const sogmm::PsnrResult& r : {one, two, measured}) EXPECT_NEAR(r.psnr_paper, paper, 1e-9);
+  sogmm_test::expect_error([&] { sogmm::psnr_images(truth, est, 4, -1.0); }, sogmm::ErrorCode::InvalidArgument,
+                           {"data range"}, "negative data range");
+  sogmm_test::expect_error([&] { sogmm::psnr_images(truth, est, 4, NAN); }, sogmm::ErrorCode::InvalidArgument,
+                           {"data range"}, "NaN data range");
+  const float flat[2] = {0.5f, 0.5f}, off[2] = {0.5f, 0.4f};
+  sogmm_test::expect_error([&] { sogmm::psnr_images(flat, off, 2, 0.0); }, sogmm::ErrorCode::InvalidData,
+                           {"constant"}, "measured range of a constant image");
+  EXPECT_TRUE(std::isinf(sogmm::psnr_images(flat, flat, 2, 0.0).psnr));
 }
