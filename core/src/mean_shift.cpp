@@ -37,8 +37,9 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
     require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
   // Grid and bin indices are (coordinate - origin) / bandwidth and
   // coordinate / bandwidth converted to 64-bit integers: bound both so that the
-  // conversions are exact and defined (a larger ratio could never be gridded
-  // anyway: the grid's own cell limit is 1e8).
+  // conversions are exact and defined (and the sparse grid's cell keys, at
+  // most (1e8 / 0.5 + 1)^2 for the duplicate suppression's half-bandwidth
+  // cells, stay far inside int64).
   constexpr double kMaxCellsPerAxis = 1.0e8;
   constexpr double kMaxBinIndex = 1.0e15;
   for (int axis = 0; axis < 2; ++axis) {
