@@ -90,13 +90,6 @@ Camera decimated(const Camera& camera, int d) {
   return out;
 }
 
-int nearest_source_index(int i, int src, int dst) {
-  // OpenCV INTER_NEAREST: floor(i * src / dst), clamped to the image. Integer
-  // arithmetic avoids the rounding that would shift pixels for odd sizes.
-  const long long s = static_cast<long long>(i) * src / dst;
-  return static_cast<int>(s < src ? s : src - 1);
-}
-
 float gray_from_rgb(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
   return (0.299f * r + 0.587f * g + 0.114f * b) / 255.0f;
 }
@@ -125,11 +118,12 @@ void for_each_valid_pixel(const RgbdView& frame, const DepthOptions& options, Vi
   require(frame.gray != nullptr, ErrorCode::InvalidData, "gray image is empty");
   const Camera cam = decimated(frame.camera, options.decimate);
   const double inv_scale = 1.0 / options.depth_scale;
+  const std::size_t d = static_cast<std::size_t>(options.decimate);
   for (int v = 0; v < cam.height; ++v) {
-    const int sv = nearest_source_index(v, frame.camera.height, cam.height);
     for (int u = 0; u < cam.width; ++u) {
-      const int su = nearest_source_index(u, frame.camera.width, cam.width);
-      const std::size_t src = static_cast<std::size_t>(sv) * frame.camera.width + su;
+      // Source pixel (d u, d v): the one the intrinsics divided by d describe
+      // (see decimated()); (H/d - 1) d < H, so it is always inside the image.
+      const std::size_t src = d * static_cast<std::size_t>(v) * frame.camera.width + d * static_cast<std::size_t>(u);
       const double z = frame.depth[src] * inv_scale;
       if (!(z > options.depth_min && z <= options.depth_max)) continue;
       visit(cam, u, v, z, frame.gray[src]);

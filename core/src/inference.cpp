@@ -170,15 +170,70 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
   }
 }
 
+namespace {
+
+// The prior of the gray regression (issue 14 item 4): one broad Gaussian
+// component in xyz that carries the mixture's prior gray (mean sum pi_m mu_g
+// and total variance sum pi_m (Sigma_gg + (mu_g - mean)^2)) and no spatial
+// gain. Its covariance is kBackgroundScale^2 times the mixture's total
+// spatial covariance and its weight kBackgroundWeight times the mixture's, so
+// on the surface its share is negligible (~1e-9 of a component at 1 sigma),
+// while a point beyond about 6.5 standard deviations of every component is
+// explained by it: the answer falls back smoothly to the prior instead of
+// following the nearest component's regression line without bound. Both
+// constants are dimensionless, so translating or scaling the model moves the
+// background with it.
+constexpr double kBackgroundWeight = 1e-6;
+constexpr double kBackgroundScale = 10.0;
+
+struct GrayBackground {
+  Eigen::Vector3d mean;
+  Mat3 inv_l;
+  double log_const = 0.0;
+  double gray = 0.0;
+  double variance = 0.0;
+
+  explicit GrayBackground(const Gmm& gmm) {
+    // Weighted moments in double, centred (two passes), so that a model far
+    // from the origin or with large gray means loses nothing to cancellation.
+    const std::size_t m = gmm.size();
+    double w = 0.0;
+    Eigen::Vector4d mu = Eigen::Vector4d::Zero();
+    for (std::size_t k = 0; k < m; ++k) {
+      w += gmm.weights[k];
+      mu += gmm.weights[k] * mean_of(gmm, k);
+    }
+    mu /= w;
+    Mat4 c = Mat4::Zero();
+    for (std::size_t k = 0; k < m; ++k) {
+      const Eigen::Vector4d d = mean_of(gmm, k) - mu;
+      c += gmm.weights[k] * (covariance_of(gmm, k) + d * d.transpose());
+    }
+    c /= w;
+    mean = mu.head<3>();
+    gray = mu[3];
+    variance = c(3, 3);
+    const Mat3 cov = kBackgroundScale * kBackgroundScale * c.topLeftCorner<3, 3>();
+    const Mat3 l = Eigen::LLT<Mat3>(cov).matrixL();
+    inv_l = l.triangularView<Eigen::Lower>().solve(Mat3::Identity());
+    log_const = std::log(kBackgroundWeight * w) - l.diagonal().array().log().sum() - 1.5 * kLog2Pi;
+  }
+  double log_density(const Eigen::Vector3d& x) const { return log_const - 0.5 * (inv_l * (x - mean)).squaredNorm(); }
+};
+
+}  // namespace
+
 void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_out, float* variance_out) {
   if (n == 0) return;
   require(xyz != nullptr && mean_out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
   require_finite(xyz, n, 3, "points to regress");
   const DensityCache<3> cache(gmm);
+  const GrayBackground background(gmm);
   const std::size_t m = gmm.size();
-  // Per component: gain A = Sigma_gx Sigma_xx^-1 and conditional variance.
-  std::vector<Eigen::RowVector3d> gain(m);
-  std::vector<double> cond_var(m), mean_g(m);
+  // Per component: gain A = Sigma_gx Sigma_xx^-1 and conditional variance;
+  // entry m is the background (no gain, the prior's gray and variance).
+  std::vector<Eigen::RowVector3d> gain(m + 1, Eigen::RowVector3d::Zero());
+  std::vector<double> cond_var(m + 1), mean_g(m + 1);
   for (std::size_t k = 0; k < m; ++k) {
     const Mat4 c = covariance_of(gmm, k);
     const Mat3 sxx = c.topLeftCorner<3, 3>();
@@ -187,28 +242,38 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
     cond_var[k] = std::max(0.0, c(3, 3) - gain[k].dot(sxg));
     mean_g[k] = gmm.mean(k)[3];
   }
-  PerThreadScratch scratch(m);
+  cond_var[m] = background.variance;
+  mean_g[m] = background.gray;
+  // Two rows per thread: log-weights, then the per-component conditional means.
+  const std::size_t row = checked::add<std::size_t>(m, 1, "components");
+  PerThreadScratch scratch(checked::mul<std::size_t>(row, 2, "scratch row"));
   detail::parallel_for(n, scratch.threads, kPointsPerChunk, [&](std::size_t i, int thread) {
     double* lw = scratch.of(thread);
+    double* lambda = lw + row;
     const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3f>(xyz + 3 * i).cast<double>();
-    double mx = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < m; ++k) mx = std::max(mx, lw[k] = cache.log_component(k, x));
-    // One exp per component that does not underflow: unnormalised weights
-    // e_k = exp(lw_k - max), normalised by their sum at the end.
-    double sum = 0.0, mu = 0.0, second = 0.0;
-    for (std::size_t k = 0; k < m; ++k) {
+    for (std::size_t k = 0; k < m; ++k) lw[k] = cache.log_component(k, x);
+    lw[m] = background.log_density(x);
+    const double mx = *std::max_element(lw, lw + row);
+    // One exp per entry that does not underflow: unnormalised weights
+    // e_k = exp(lw_k - max), normalised by their sum.
+    double sum = 0.0, mu = 0.0;
+    for (std::size_t k = 0; k < row; ++k) {
       const double d = lw[k] - mx;
-      if (!(d >= kExpUnderflow)) continue;
-      const double e = std::exp(d);
-      const double lambda = mean_g[k] + gain[k].dot(x - cache.mean[k]);
-      sum += e;
-      mu += e * lambda;
-      second += e * (cond_var[k] + lambda * lambda);
+      lw[k] = d >= kExpUnderflow ? std::exp(d) : 0.0;
+      if (lw[k] == 0.0) continue;
+      lambda[k] = k < m ? mean_g[k] + gain[k].dot(x - cache.mean[k]) : mean_g[k];
+      sum += lw[k];
+      mu += lw[k] * lambda[k];
     }
     mu /= sum;
-    second /= sum;
     mean_out[i] = static_cast<float>(mu);
-    if (variance_out) variance_out[i] = static_cast<float>(std::max(0.0, second - mu * mu));
+    if (!variance_out) return;
+    // Law of total variance about the mean just found (a sum of non-negative
+    // terms, not a difference of second moments, which cancels far out).
+    double var = 0.0;
+    for (std::size_t k = 0; k < row; ++k)
+      if (lw[k] != 0.0) var += lw[k] * (cond_var[k] + (lambda[k] - mu) * (lambda[k] - mu));
+    variance_out[i] = static_cast<float>(var / sum);
   });
 }
 

@@ -37,8 +37,9 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
     require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
   // Grid and bin indices are (coordinate - origin) / bandwidth and
   // coordinate / bandwidth converted to 64-bit integers: bound both so that the
-  // conversions are exact and defined (a larger ratio could never be gridded
-  // anyway: the grid's own cell limit is 1e8).
+  // conversions are exact and defined (and the sparse grid's cell keys, at
+  // most (1e8 / 0.5 + 1)^2 for the duplicate suppression's half-bandwidth
+  // cells, stay far inside int64).
   constexpr double kMaxCellsPerAxis = 1.0e8;
   constexpr double kMaxBinIndex = 1.0e15;
   for (int axis = 0; axis < 2; ++axis) {
@@ -54,25 +55,6 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
                 (axis == 0 ? "range" : "gray") + " values of the data (from " + checked::exact(lo) + " to " +
                 checked::exact(hi) + "): use a larger bandwidth");
   }
-}
-
-// Side of the cells of a neighbour grid for queries of radius `radius`: the
-// radius itself, or more when the points span more than max(1024, 2 sqrt(n) + 1)
-// radii on an axis, so that the dense grid has at most about max(2^20, 4 n)
-// cells however far apart the points are: a handful of scattered points
-// cannot make the grid allocate gigabytes. Queries stay exact (a cell is never
-// smaller than the radius), and real clouds (metres of range and gray in
-// [0, 1] against a centimetre bandwidth) keep cells equal to the radius.
-double grid_cell(const std::vector<double>& xy, double radius) {
-  const std::size_t n = xy.size() / 2;
-  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-  for (std::size_t i = 0; i < xy.size(); ++i) {
-    lo[i % 2] = std::min(lo[i % 2], xy[i]);
-    hi[i % 2] = std::max(hi[i % 2], xy[i]);
-  }
-  const double extent = n == 0 ? 0.0 : std::max(hi[0] - lo[0], hi[1] - lo[1]);
-  const double per_axis = std::max(1024.0, 2.0 * std::sqrt(static_cast<double>(n)) + 1.0);
-  return std::max(radius, extent / per_axis);
 }
 
 // Centres of the occupied cells of the bin-seeding grid.
@@ -110,7 +92,8 @@ struct Mode {
 // Orders modes strongest first (ties: larger centre first, as scikit-learn's
 // sort of (intensity, centre) tuples in reverse), drops exact duplicates and
 // every mode within `radius` of a stronger kept one.
-MeanShiftResult suppress_near_duplicates(std::vector<Mode> modes, double radius) {
+// `checks` is the neighbour_checks count of the work before.
+MeanShiftResult suppress_near_duplicates(std::vector<Mode> modes, double radius, std::uint64_t checks) {
   std::sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) {
     if (a.strength != b.strength) return a.strength > b.strength;
     if (a.x != b.x) return a.x > b.x;
@@ -125,12 +108,14 @@ MeanShiftResult suppress_near_duplicates(std::vector<Mode> modes, double radius)
     xy[2 * i + 1] = modes[i].y;
   }
   MeanShiftResult result;
+  result.neighbour_checks = checks;
   if (modes.empty()) return result;
-  detail::Grid2d grid(xy.data(), modes.size(), grid_cell(xy, radius));
+  detail::Grid2d grid(xy.data(), modes.size(), radius);
   std::vector<char> unique(modes.size(), 1);
   for (std::size_t i = 0; i < modes.size(); ++i) {
     if (!unique[i]) continue;
-    grid.for_each_within(modes[i].x, modes[i].y, radius, [&](std::uint32_t j) { unique[j] = 0; });
+    result.neighbour_checks +=
+        grid.for_each_within(modes[i].x, modes[i].y, radius, [&](std::uint32_t j) { unique[j] = 0; });
     unique[i] = 1;
   }
   for (std::size_t i = 0; i < modes.size(); ++i) {
@@ -149,11 +134,12 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   require(options.max_iter >= 0 && options.stop_fraction >= 0, ErrorCode::InvalidArgument,
           "mean shift max_iter and stop_fraction must be >= 0");
   const std::size_t n = xy.size() / 2;
-  const detail::Grid2d grid(xy.data(), n, grid_cell(xy, bandwidth));
+  const detail::Grid2d grid(xy.data(), n, bandwidth);
   const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
   const double stop = options.stop_fraction * bandwidth;
   std::vector<Mode> modes(n_seeds);
+  std::vector<std::uint64_t> checks(n_seeds, 0);  // per seed, summed in seed order after the loop
 
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::size_t s = 0; s < n_seeds; ++s) {
@@ -162,7 +148,7 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
     for (int it = 0;; ++it) {
       double sx = 0.0, sy = 0.0;
       std::size_t count = 0;
-      grid.for_each_within(mx, my, bandwidth, [&](std::uint32_t i) {
+      checks[s] += grid.for_each_within(mx, my, bandwidth, [&](std::uint32_t i) {
         sx += xy[2 * i];
         sy += xy[2 * i + 1];
         ++count;
@@ -179,7 +165,9 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   }
   // Seeds that saw no point are not modes.
   modes.erase(std::remove_if(modes.begin(), modes.end(), [](const Mode& m) { return m.strength == 0; }), modes.end());
-  return suppress_near_duplicates(std::move(modes), bandwidth);
+  std::uint64_t total = 0;
+  for (std::uint64_t c : checks) total += c;
+  return suppress_near_duplicates(std::move(modes), bandwidth, total);
 }
 
 MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, double bandwidth, int max_iter) {
@@ -190,14 +178,15 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
   const double radius = 3.0 * bandwidth;
   const double inv2s2 = 1.0 / (2.0 * bandwidth * bandwidth);
   const double stop2 = (1e-3 * bandwidth) * (1e-3 * bandwidth);
+  std::vector<std::uint64_t> checks(n, 0);  // per point, summed over iterations
   for (int it = 0; it < max_iter; ++it) {
-    const detail::Grid2d grid(xy.data(), n, grid_cell(xy, radius));
+    const detail::Grid2d grid(xy.data(), n, radius);
     double moved2 = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : moved2)
     for (std::size_t i = 0; i < n; ++i) {
       double sw = 0.0, sx = 0.0, sy = 0.0;
       const double x = xy[2 * i], y = xy[2 * i + 1];
-      grid.for_each_within(x, y, radius, [&](std::uint32_t j) {
+      checks[i] += grid.for_each_within(x, y, radius, [&](std::uint32_t j) {
         const double dx = xy[2 * j] - x, dy = xy[2 * j + 1] - y;
         const double w = std::exp(-(dx * dx + dy * dy) * inv2s2);
         sw += w;
@@ -224,7 +213,9 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
     }
     if (!assigned) modes.push_back({xy[2 * i], xy[2 * i + 1], 1});
   }
-  return suppress_near_duplicates(std::move(modes), 0.5 * bandwidth);
+  std::uint64_t total = 0;
+  for (std::uint64_t c : checks) total += c;
+  return suppress_near_duplicates(std::move(modes), 0.5 * bandwidth, total);
 }
 
 std::vector<double> range_gray_features(const PointsView& points) {

@@ -1,12 +1,14 @@
 // PSNR of regressed gray, and reconstruction error of sampled geometry.
 #include "sogmm/metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include <nanoflann.hpp>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 
@@ -44,8 +46,12 @@ std::vector<double> nearest_distances(const CloudAdaptor& index_cloud, const Clo
 
 }  // namespace
 
-PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels) {
+PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels, double data_range) {
+  require(std::isfinite(data_range) && data_range >= 0, ErrorCode::InvalidArgument,
+          "PSNR: data range must be finite and >= 0 (0 = the ground truth's actual range), got " +
+              checked::exact(data_range));
   double se_valid = 0.0, se_all = 0.0;
+  double lo = INFINITY, hi = -INFINITY;
   std::size_t valid = 0;
   for (std::size_t i = 0; i < pixels; ++i) {
     const double d = static_cast<double>(truth[i]) - estimate[i];
@@ -53,19 +59,24 @@ PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pi
     if (truth[i] >= 0.0f) {
       se_valid += d * d;
       ++valid;
+      lo = std::min<double>(lo, truth[i]);
+      hi = std::max<double>(hi, truth[i]);
     }
   }
   require(valid > 0, ErrorCode::InvalidData, "PSNR: the ground-truth image has no valid pixel");
   PsnrResult r;
+  r.data_range = data_range > 0 ? data_range : hi - lo;
   r.mse = se_valid / static_cast<double>(valid);
+  require(r.data_range > 0 || r.mse == 0, ErrorCode::InvalidData,
+          "PSNR: the ground truth is constant, so its actual data range is 0: give the data range");
   const double mse_all = se_all / static_cast<double>(pixels);
   // Identical images: report infinity, as PSNR is unbounded.
-  r.psnr = r.mse > 0 ? 10.0 * std::log10(1.0 / r.mse) : INFINITY;
+  r.psnr = r.mse > 0 ? 10.0 * std::log10(r.data_range * r.data_range / r.mse) : INFINITY;
   r.psnr_paper = mse_all > 0 ? 10.0 * std::log10(4.0 / mse_all) : INFINITY;
   return r;
 }
 
-PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera) {
+PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera, double data_range) {
   require_finite_points(truth, "ground-truth cloud");
   std::vector<float> xyz(3 * truth.size), gray(truth.size), regressed(truth.size);
   for (std::size_t i = 0; i < truth.size; ++i) {
@@ -75,7 +86,7 @@ PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera) {
   regress_gray(gmm, xyz.data(), truth.size, regressed.data(), nullptr);
   const std::vector<float> truth_image = project_to_image(truth, gray.data(), camera, -1.0f);
   const std::vector<float> estimate_image = project_to_image(truth, regressed.data(), camera, -1.0f);
-  return psnr_images(truth_image.data(), estimate_image.data(), truth_image.size());
+  return psnr_images(truth_image.data(), estimate_image.data(), truth_image.size(), data_range);
 }
 
 ReconstructionResult compare_clouds(const float* reconstructed, std::size_t n, int stride, const PointsView& truth,

@@ -1,4 +1,5 @@
-// Camera: decimation vs OpenCV INTER_NEAREST, intrinsics, back-projection,
+// Camera: decimation (equal to OpenCV INTER_NEAREST when d divides the size;
+// any d: tests/core/test_scale_geometry.cpp), intrinsics, back-projection,
 // depth range edges, gray, z-buffer projection, Open3D intrinsics JSON.
 #include <gtest/gtest.h>
 
@@ -10,23 +11,6 @@
 
 #include "sogmm/camera.hpp"
 #include "test_util.hpp"
-
-TEST(Camera, NearestSourceIndexMatchesOpenCv) {
-  // cv::resize INTER_NEAREST of an index ramp reveals which source pixel each
-  // destination pixel takes.
-  const std::pair<int, int> sizes[] = {{640, 128}, {480, 96}, {643, 128}, {481, 96},
-                                       {100, 33}, {1280, 256}, {7, 3}, {640, 213}};
-  for (auto [src, dst] : sizes) {
-    cv::Mat ramp(1, src, CV_32F);
-    for (int i = 0; i < src; ++i) ramp.at<float>(0, i) = static_cast<float>(i);
-    cv::Mat out;
-    cv::resize(ramp, out, cv::Size(dst, 1), 0, 0, cv::INTER_NEAREST);
-    for (int i = 0; i < dst; ++i)
-      EXPECT_EQ(sogmm::nearest_source_index(i, src, dst), static_cast<int>(out.at<float>(0, i)))
-          << src << " -> " << dst << " at " << i;
-  }
-  EXPECT_EQ(sogmm::nearest_source_index(7, 640, 128), 35);
-}
 
 TEST(Camera, DecimatedIntrinsics) {
   const sogmm::Camera c{640, 480, 525.0, 520.0, 319.5, 239.5};

@@ -194,15 +194,18 @@ TEST(RegressGray, MixingWeightsEnter) {
   EXPECT_NEAR(var, 0.3 * (0.04 + 0.0625) + 0.7 * (0.05 + 0.81) - m * m, 1e-6);
 }
 
-TEST(RegressGray, FarPointTakesNearestComponentNotZero) {
-  // 100 m along x: log-weights -5000 vs -4900.5, so w2 = 1 to double precision;
-  // lambda2 = 0.8 + 0.2 * y = 0.8, nu2^2 = 0.05 (the authors' code returns 0 here).
+TEST(RegressGray, FarPointTakesThePriorNotZero) {
+  // 100 m along x: log-weights -5000 and -4900.5 for the components, about -50
+  // for the background (issue 14 item 4), so the answer is the prior: gray
+  // 0.5 (0.2 + 0.8) / 1 = 0.5, variance 0.5 (0.05 + 0.09) + 0.5 (0.09 + 0.09)
+  // = 0.16 (the nearest component's line would give 0.8 + 0.2 y; the
+  // authors' code returns 0 here).
   const sogmm::Gmm g = regression_model(0.5, 0.5);
   const float xyz[3] = {100.0f, 0.0f, 0.0f};
   float mean, var;
   sogmm::regress_gray(g, xyz, 1, &mean, &var);
-  EXPECT_NEAR(mean, 0.8, 1e-6);
-  EXPECT_NEAR(var, 0.05, 1e-6);
+  EXPECT_NEAR(mean, 0.5, 1e-6);
+  EXPECT_NEAR(var, 0.16, 1e-6);
 }
 
 TEST(RegressGray, SingleComponentIsLinearRegression) {

@@ -114,7 +114,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     where = "at the depth of " + s.depth;
   } else {
     view = render_expected_surface(gmm, dc, d.depth_min, d.depth_max, s.max_mahalanobis);
-    where = "at the model's expected surface (depth of maximum density along each ray)";
+    where = "at the model's expected surface (first surface along each ray)";
   }
   std::size_t shown = 0;
   for (float g : view.gray) shown += g >= 0 ? 1 : 0;
@@ -146,9 +146,9 @@ Command add_render_command(CLI::App& root) {
   app->footer(
       "The image has the model's camera decimated by its decimation (or the flags'). Gray is regressed\n"
       "(E[gray | xyz], the paper's conditional) at the 3-D point of each pixel: the ground-truth point with\n"
-      "--depth, else the model's expected surface: the depth of maximum marginal density of the mixture\n"
-      "along the pixel's ray (1-D mean shift from every component peak on the ray; pixels whose ray passes\n"
-      "outside every component's 3-sigma ellipsoid stay empty/black).\n"
+      "--depth, else the model's expected surface: the nearest mode of the mixture's marginal density along\n"
+      "the pixel's ray, the first surface a camera sees (1-D mean shift from every component peak on the\n"
+      "ray; pixels whose ray passes outside every component's 3-sigma ellipsoid stay empty/black).\n"
       "--compare writes original gray | regressed gray | |error| heat map with colour bar and the PSNR.\n"
       "--uncertainty writes the conditional standard deviation of gray as a heat map with colour bar.\n\n"
       "Examples:\n"

@@ -110,15 +110,14 @@ RenderedView render_expected_surface(const Gmm& gmm, const Camera& camera, doubl
         if (r <= r_show && t > depth_min && t <= depth_max) starts.push_back(t);
       }
       if (starts.empty()) continue;
-      double best_t = -1, best_logp = -std::numeric_limits<double>::infinity();
+      // The first surface a camera would see: the nearest mode of the ray's
+      // 1-D mixture that a component peak on the ray climbs to (a denser
+      // surface behind it is occluded, however dense).
+      double best_t = -1;
       double max_log_c = -std::numeric_limits<double>::infinity();
       for (const Term& q : terms) max_log_c = std::max(max_log_c, q.log_c);
-      auto density = [&](double t) {  // relative to exp(max_log_c)
-        double s = 0;
-        for (const Term& q : terms) s += std::exp(q.log_c - max_log_c - 0.5 * q.a * (t - q.t) * (t - q.t));
-        return s;
-      };
       for (double t : starts) {
+        bool supported = true;
         for (int it = 0; it < 50; ++it) {  // 1-D mean shift towards a mode of the ray mixture
           double num = 0, den = 0;
           for (const Term& q : terms) {
@@ -126,19 +125,17 @@ RenderedView render_expected_surface(const Gmm& gmm, const Camera& camera, doubl
             num += w * q.t;
             den += w;
           }
-          if (!(den > 0)) break;
+          // No density here relative to the ray's strongest term (e.g. the peak
+          // of a weight-0 component): not a surface.
+          supported = den > 0;
+          if (!supported) break;
           const double next = num / den;
           const bool done = std::abs(next - t) < 1e-6;
           t = next;
           if (done) break;
         }
-        if (!(t > depth_min && t <= depth_max)) continue;
-        const double p = density(t);
-        const double logp = p > 0 ? std::log(p) : -std::numeric_limits<double>::infinity();
-        if (logp > best_logp) {
-          best_logp = logp;
-          best_t = t;
-        }
+        if (!supported || !(t > depth_min && t <= depth_max)) continue;
+        if (best_t < 0 || t < best_t) best_t = t;
       }
       if (best_t > 0) depth[static_cast<std::size_t>(v) * camera.width + u] = static_cast<float>(best_t);
     }

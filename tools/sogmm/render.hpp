@@ -26,12 +26,13 @@ RenderedView render_at_points(const Gmm& gmm, const std::vector<float>& xyzg, co
 /// The model's own expected surface, without a depth image. For each pixel
 /// ray x(t) = t d (d = ((u - cx)/fx, (v - cy)/fy, 1), t = depth), each
 /// component's 3-D marginal restricted to the ray is a scaled 1-D Gaussian in
-/// t; the pixel's depth is the mode of that 1-D mixture with the largest
-/// density (the depth of maximum marginal density along the ray), found by
-/// 1-D mean-shift started from every component peak in (depth_min,
-/// depth_max]. A pixel whose ray stays outside the `max_mahalanobis`-sigma
-/// ellipsoid of every component shows nothing. Gray and its standard
-/// deviation are then regressed at the 3-D point of that depth.
+/// t. 1-D mean shift from every component peak on the ray in (depth_min,
+/// depth_max] climbs to a mode of that 1-D mixture; the pixel's depth is the
+/// nearest such mode: the first surface a camera would see, not the densest
+/// one (a dense wall behind a sparse object in front is occluded). A pixel
+/// whose ray stays outside the `max_mahalanobis`-sigma ellipsoid of every
+/// component shows nothing. Gray and its standard deviation are then
+/// regressed at the 3-D point of that depth.
 RenderedView render_expected_surface(const Gmm& gmm, const Camera& camera, double depth_min, double depth_max,
                                      double max_mahalanobis = 3.0);
 

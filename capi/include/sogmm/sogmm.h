@@ -351,7 +351,9 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
 
 /* Expected gray at n 3-D points (`xyz`: n * 3 floats) into `mean_out` (n
  * floats) and, if `variance_out` is not NULL, the conditional variance (n
- * floats). n == 0 writes nothing (pointers may then be NULL). NaN/Inf input
+ * floats). Far from every component (beyond about 6.5 standard deviations)
+ * both fall back smoothly to the mixture's prior gray and total gray
+ * variance (sogmm::regress_gray, core/include/sogmm/inference.hpp). n == 0 writes nothing (pointers may then be NULL). NaN/Inf input
  * -> SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
                                                     float* mean_out, float* variance_out);

@@ -47,14 +47,15 @@ void validate(const DepthOptions& options);
 /// naming the values: e.g. fx = 1e-300 would give x = -inf).
 void check_backprojection(const Camera& camera, const DepthOptions& options);
 
-/// The camera of the image decimated by d: size (W/d, H/d) (integer division,
-/// as nearest-neighbour resizing to that size) and intrinsics divided by d.
+/// The camera of the image decimated by d: size (W/d, H/d) (integer division)
+/// and intrinsics divided by d. The one decimation convention of SOGMM:
+/// decimated pixel (u, v) is source pixel (d u, d v), so that pixel's ray is
+/// exactly the ray of the divided intrinsics, whether or not d divides the
+/// image size. (This equals OpenCV's INTER_NEAREST resize to (W/d, H/d) when d
+/// divides W and H; for other d, INTER_NEAREST picks floor(u W / (W/d)), whose
+/// ray the divided intrinsics do not describe: up to 12 mm off at d = 7 on
+/// 640x480, issue 14 item 7.)
 Camera decimated(const Camera& camera, int d);
-
-/// Source pixel index that nearest-neighbour resizing from `src` to `dst`
-/// pixels picks for destination index i: floor(i * src / dst), as OpenCV's
-/// INTER_NEAREST (for 640 -> 128, pixel 5 i).
-int nearest_source_index(int i, int src, int dst);
 
 /// Gray in [0, 1] from 8-bit RGB: (0.299 R + 0.587 G + 0.114 B) / 255.
 float gray_from_rgb(std::uint8_t r, std::uint8_t g, std::uint8_t b);
@@ -81,8 +82,10 @@ struct RgbdView {
 };
 
 /// Back-projects the valid pixels of a frame, after decimation, into (x, y, z,
-/// gray) points in the camera frame (x right, y down, z forward; metres). A
-/// pixel is valid when depth_min < depth / depth_scale <= depth_max. Points are
+/// gray) points in the camera frame (x right, y down, z forward; metres).
+/// Decimated pixel (u, v) reads depth and gray at source pixel (d u, d v) and
+/// back-projects with decimated(camera, d), so every point lies on the ray of
+/// the source pixel its depth was read from (see decimated()). A pixel is valid when depth_min < depth / depth_scale <= depth_max. Points are
 /// ordered row by row. Throws as check_backprojection() for a bad camera,
 /// options or image size.
 PointCloud backproject(const RgbdView& frame, const DepthOptions& options);

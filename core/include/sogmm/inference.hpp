@@ -34,13 +34,20 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
             double truncation = 2.5);
 
 /// Expected gray at 3-D points, the mixture of the per-component conditionals
-/// g | xyz (the paper's regression): weights w_m(x) ~ pi_m N(x | mu_xyz,
-/// Sigma_xx) normalised in the log domain (so a point far from every
-/// component takes the gray of the nearest ones, never 0 by underflow), means
-/// lambda_m(x) = mu_g + Sigma_gx Sigma_xx^-1 (x - mu_xyz). `variance`, if not
-/// null, receives the variance of the mixture conditional:
-/// sum_m w_m (nu_m^2 + lambda_m^2) - mean^2, nu_m^2 = Sigma_gg - Sigma_gx
-/// Sigma_xx^-1 Sigma_xg. `xyz` holds n rows of 3 floats.
+/// g | xyz (the paper's regression) plus one background term for points off
+/// the surface: weights w_m(x) ~ pi_m N(x | mu_xyz, Sigma_xx) normalised in
+/// the log domain, means lambda_m(x) = mu_g + Sigma_gx Sigma_xx^-1 (x - mu_xyz),
+/// variances nu_m^2 = Sigma_gg - Sigma_gx Sigma_xx^-1 Sigma_xg. The background
+/// has weight 1e-6 sum pi_m and density N(x | mu_tot, 100 Sigma_tot) (the
+/// mixture's total spatial mean and covariance, widened 10x) and answers the
+/// prior: gray sum pi_m mu_g / sum pi_m with the mixture's total gray variance
+/// and no spatial gain. On the surface its share is ~1e-9 (the answer is the
+/// paper's); beyond about 6.5 standard deviations of every component it takes
+/// over, so far from the model mean and variance tend smoothly to the prior's
+/// instead of extrapolating a regression line (issue 14 item 4).
+/// `variance`, if not null, receives the variance of this mixture
+/// conditional, sum_m w_m (nu_m^2 + (lambda_m - mean)^2) (computed about the
+/// mean, so it does not cancel far out). `xyz` holds n rows of 3 floats.
 void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance);
 
 /// Merges two models into one: components are concatenated and weights

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "sogmm/point_cloud.hpp"
@@ -25,6 +26,10 @@ struct MeanShiftOptions {
 struct MeanShiftResult {
   std::vector<double> centers;        ///< K x 2 row-major
   std::vector<std::size_t> strengths; ///< points within bandwidth of each centre
+  /// Cost of the run: points whose distance to a query was evaluated (all
+  /// neighbour queries, including duplicate suppression). Deterministic and
+  /// independent of the thread count, so tests can bound cost without a clock.
+  std::uint64_t neighbour_checks = 0;
   std::size_t size() const { return strengths.size(); }
 };
 
@@ -44,9 +49,11 @@ void require_usable_bandwidth(double bandwidth);
 /// to the mean of the points within distance `bandwidth` until it moves
 /// <= 1e-3 bandwidth or after 300 steps; converged seeds are ordered by the
 /// number of points within bandwidth (most first) and a seed within bandwidth
-/// of an already kept one is dropped. Radius queries use a uniform grid of cell
-/// size `bandwidth`. Runs in parallel over seeds; the result does not depend
-/// on the thread count. Throws Error(InvalidArgument) for a bandwidth that is
+/// of an already kept one is dropped. Radius queries use a sparse grid of cell
+/// size `bandwidth` (only occupied cells are stored), so the cost does not
+/// depend on the bounding box: a far outlier adds one cell and one mode.
+/// Runs in parallel over seeds; the result does not depend on the thread
+/// count. Throws Error(InvalidArgument) for a bandwidth that is
 /// not bandwidth_is_usable, Error(InvalidData) for empty or non-finite data.
 MeanShiftResult mean_shift_flat(const std::vector<double>& points2d, double bandwidth,
                                 const MeanShiftOptions& options = {});

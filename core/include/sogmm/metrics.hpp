@@ -12,25 +12,33 @@ namespace sogmm {
 
 /// Peak signal-to-noise ratios of regressed gray against the frame's gray.
 struct PsnrResult {
-  /// Honest: data range 1, only pixels valid in the ground truth, over the
-  /// decimated canvas. The headline figure.
+  /// Honest: 10 log10(data_range^2 / mse), only pixels valid in the ground
+  /// truth, over the decimated canvas. The headline figure.
   double psnr = 0.0;
-  /// As the authors' evaluation computes it: data range 2 (inferred from the
-  /// -1 empty pixels) and every pixel of the decimated canvas counted, the
-  /// empty ones as perfect. Add 13.98 dB to compare with the paper's printed
-  /// values (their benchmark also keeps the 640x480 canvas).
+  /// As the authors' evaluation computes it: data range 2 always (scikit-
+  /// image infers it from the -1 empty pixels, whatever the gray's actual
+  /// range) and every pixel of the decimated canvas counted, the empty ones as
+  /// perfect. Add 13.98 dB to compare with the paper's printed values (their
+  /// benchmark also keeps the 640x480 canvas).
   double psnr_paper = 0.0;
-  double mse = 0.0;  ///< mean squared gray error over valid pixels
+  double mse = 0.0;         ///< mean squared gray error over valid pixels
+  double data_range = 1.0;  ///< the data range `psnr` used (see psnr_images)
 };
 
 /// Regresses gray at every ground-truth point, projects regressed and true gray
-/// into two images of `camera` (z-buffer, empty = -1) and compares them.
+/// into two images of `camera` (z-buffer, empty = -1) and compares them with
+/// psnr_images(..., data_range).
 /// `truth` holds the ground-truth points (x, y, z, gray) in the camera frame.
-PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera);
+PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera, double data_range = 1.0);
 
-/// PSNR from two images with -1 for empty pixels. Honest: data range 1, pixels
-/// where `truth` >= 0. Paper: data range 2, all pixels.
-PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels);
+/// PSNR from two images with -1 for empty pixels. Honest: pixels where
+/// `truth` >= 0, with `data_range` as the peak: 1 (default) for gray in
+/// [0, 1]; 0 = the actual range of the valid truth pixels (max - min, e.g. for
+/// normalised thermal data; a constant image then has range 0 and PSNR
+/// +infinity only if it is matched exactly, else Error(InvalidData)). Paper:
+/// data range 2, all pixels. Throws Error(InvalidArgument) for a negative or
+/// non-finite data_range, Error(InvalidData) without a valid pixel.
+PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels, double data_range = 1.0);
 
 /// Geometric reconstruction quality from samples.
 struct ReconstructionResult {

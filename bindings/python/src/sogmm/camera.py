@@ -1,8 +1,8 @@
 """Pinhole camera intrinsics and RGB-D back-projection.
 
 :func:`rgbd_to_points` returns the points the C library fits for a frame
-(``sogmm_rgbd_to_points_f32``: nearest-neighbour decimation, intrinsics
-divided by the factor, valid depth in (depth_min, depth_trunc], gray from
+(``sogmm_rgbd_to_points_f32``: decimated pixel (u, v) is source pixel
+(d u, d v), intrinsics divided by the factor, valid depth in (depth_min, depth_trunc], gray from
 uint8 gray, uint8 RGB or float gray).
 """
 
@@ -182,8 +182,8 @@ def rgbd_to_points(
             (H, W, 3) RGB uint8.
         camera: intrinsics of the full-size images.
         depth_min, depth_trunc: a pixel is valid when depth_min < z <= depth_trunc (metres).
-        decimate: integer factor; nearest-neighbour resizing to (W // d, H // d)
-            and intrinsics divided by d, as the C library does.
+        decimate: integer factor; (W // d, H // d) pixels, pixel (u, v) read from
+            source pixel (d u, d v), intrinsics divided by d, as the C library does.
 
     Points are in the camera frame (x right, y down, z forward), ordered row
     by row, identical to what ``SOGMM.fit_rgbd`` fits.
