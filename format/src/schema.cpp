@@ -8,6 +8,7 @@
 
 #include "checks.hpp"
 #include "codec.hpp"
+#include "wire.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/metadata_string.hpp"
 #include "sogmm_generated.h"
@@ -188,10 +189,9 @@ void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3]
 }
 
 ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const ReadOptions& options) {
-  // 9. FlatBuffers verification (identifier, offsets, sizes, required fields).
-  if (!flatbuffers::BufferHasIdentifier(buf, fb::SogmmFileIdentifier())) {
-    fail(F, "bad_metadata", "metadata file identifier is not \"SGMM\"");
-  }
+  // 9. The wire rules of section 4.3 decide. FlatBuffers' own verifier, whose
+  // rules are weaker, then only guards the generated accessors used below.
+  verify_wire(buf, h.metadata_length);
   flatbuffers::Verifier verifier(buf, h.metadata_length, /*max_depth=*/64, kMaxMetadataTables);
   if (!fb::VerifySogmmFileBuffer(verifier)) fail(F, "bad_metadata", "metadata fails FlatBuffers verification");
   const fb::SogmmFile* root = fb::GetSogmmFile(buf);

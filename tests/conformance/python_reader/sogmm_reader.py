@@ -93,32 +93,52 @@ class _Verifier:
         self.check(pos, 4, 4)
         return struct.unpack_from("<I", self.buf, pos)[0]
 
+    def follow(self, at):
+        """The target of the offset at `at`: non-zero and inside the block."""
+        o = self.u32(at)
+        if o == 0 or at + o >= self.n:
+            raise _Bad(f"offset at {at} is 0 or points outside the block")
+        return at + o
+
     def i32(self, pos):
         self.check(pos, 4, 4)
         return struct.unpack_from("<i", self.buf, pos)[0]
 
 
 class _Table:
+    """A table checked by the wire rules of spec section 4.3: soffset aligned
+    to 4, vtable (size even, >= 4) and inline bytes (size >= 4) inside the
+    block; each known field inside the inline bytes, after the soffset, and
+    aligned to its size; every offset non-zero and pointing into the block.
+    Each visit of a table counts towards the limit of 100 000."""
+
     def __init__(self, v, pos, depth):
         if depth > MAX_DEPTH:
             raise _Bad("nesting too deep")
         v.tables += 1
         if v.tables > MAX_TABLES:
-            raise _Bad("too many tables")
+            raise _Bad("too many table visits")
         self.v = v
         self.depth = depth
         self.pos = pos
         vt = pos - v.i32(pos)
+        v.check(vt, 4, 2)
+        self.vt = vt
         self.vt_size = v.u16(vt)
-        v.check(vt, self.vt_size, 2)
         if self.vt_size < 4 or self.vt_size % 2:
             raise _Bad("bad vtable size")
-        v.check(pos, v.u16(vt + 2))
-        self.t = flatbuffers.table.Table(v.buf, pos)
+        v.check(vt, self.vt_size, 2)
+        self.inline_size = v.u16(vt + 2)
+        if self.inline_size < 4:
+            raise _Bad("bad table inline size")
+        v.check(pos, self.inline_size, 4)
 
     def _field(self, fid, size):
-        o = self.t.Offset(4 + 2 * fid) if 4 + 2 * fid < self.vt_size else 0
+        slot = 4 + 2 * fid
+        o = self.v.u16(self.vt + slot) if slot + 2 <= self.vt_size else 0
         if o:
+            if o < 4 or o + size > self.inline_size:
+                raise _Bad(f"field {fid} outside the table's inline bytes")
             self.v.check(self.pos + o, size, size)
         return o
 
@@ -129,10 +149,7 @@ class _Table:
 
     def _target(self, fid):
         o = self._field(fid, 4)
-        if not o:
-            return None
-        at = self.pos + o
-        return at + self.v.u32(at)
+        return None if not o else self.v.follow(self.pos + o)
 
     def table(self, fid):
         t = self._target(fid)
@@ -143,7 +160,7 @@ class _Table:
         if t is None:
             return None
         n = self.v.u32(t)
-        self.v.check(t + 4, n * elem, min(elem, 8))
+        self.v.check(t + 4, n * elem, elem)
         return t + 4, n
 
     def string_at(self, t):
@@ -163,14 +180,14 @@ class _Table:
         if vec is None:
             return None
         start, n = vec
-        return [self.string_at(start + 4 * i + self.v.u32(start + 4 * i)) for i in range(n)]
+        return [self.string_at(self.v.follow(start + 4 * i)) for i in range(n)]
 
     def tables_(self, fid):
         vec = self._vector(fid, 4)
         if vec is None:
             return None
         start, n = vec
-        return [_Table(self.v, start + 4 * i + self.v.u32(start + 4 * i), self.depth + 1) for i in range(n)]
+        return [_Table(self.v, self.v.follow(start + 4 * i), self.depth + 1) for i in range(n)]
 
     def doubles(self, fid):
         vec = self._vector(fid, 8)
@@ -382,7 +399,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         _format("bad_metadata", "file identifier")
     try:
         v = _Verifier(meta)
-        root = _Table(v, v.u32(0), 1)
+        root = _Table(v, v.follow(0), 1)
         md = _read_all_metadata(root)
     except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
