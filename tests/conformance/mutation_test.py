@@ -166,6 +166,7 @@ def main():
     ap.add_argument("--count", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--show", type=int, default=20, help="disagreements to print")
+    ap.add_argument("--keep", help="write the mutants to this folder (default: a temporary one)")
     a = ap.parse_args()
     vectors = pathlib.Path(a.vectors)
     manifest = json.loads((vectors / "manifest.json").read_text())
@@ -175,7 +176,9 @@ def main():
     originals = {f: (vectors / f).read_bytes() for f in valid}
     arrays = {f: raw_arrays(data) for f, data in originals.items()}
     rng = random.Random(a.seed)
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as scratch:
+        tmp = a.keep or scratch
+        pathlib.Path(tmp).mkdir(parents=True, exist_ok=True)
         mutants = []
         for i in range(a.count):
             base = rng.choice(pool)

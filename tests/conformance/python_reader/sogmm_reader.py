@@ -204,6 +204,8 @@ FILTERS = {0: "none", 1: "byte_stream_split"}
 CODECS = {0: "none", 1: "zstd"}
 LAYOUTS = {0: "upper_packed", 1: "full"}
 ARRAY_NAMES = ("weights", "means", "covariances")
+FIT_DOUBLES = ("bandwidth", "tol", "reg_covar", "log_likelihood")
+CAMERA_DOUBLES = ("fx", "fy", "cx", "cy", "depth_scale", "depth_min", "depth_max")
 UPPER = [(0, 0), (0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3)]
 
 
@@ -239,7 +241,7 @@ def _read_all_metadata(root):
     m["fit"] = None if f is None else {
         "bandwidth": f.scalar(0, "d", 0.0), "n_components_requested": f.scalar(1, "Q", 0),
         "tol": f.scalar(2, "d", 0.0), "reg_covar": f.scalar(3, "d", 0.0), "max_iter": f.scalar(4, "i", 0),
-        "n_iter": f.scalar(5, "i", 0), "converged": bool(f.scalar(6, "B", 0)),
+        "n_iter": f.scalar(5, "i", 0), "converged": f.scalar(6, "B", 0),
         "log_likelihood": f.scalar(7, "d", 0.0), "seed": f.scalar(8, "Q", 0)}
     c = root.table(14)
     m["camera"] = None if c is None else {
@@ -300,21 +302,103 @@ def _check_pose(p):
         _fail("invalid_data", "bad_pose", "rotation is a reflection")
 
 
+def _zstd_structure(st):
+    """The frame structure section 5.4 has a reader check itself (RFC 8878
+    field names): header descriptor reserved bit clear, content size present,
+    no reserved block type, blocks of at most 128 KiB, and in compressed
+    blocks the literals inside the block and the reserved bits of
+    Symbol_Compression_Modes clear."""
+    def need(pos, n):
+        if pos + n > len(st):
+            _format("decompression_failed", "zstd frame truncated")
+
+    def le(pos, n):
+        need(pos, n)
+        return int.from_bytes(st[pos:pos + n], "little")
+
+    pos = 0
+    while pos < len(st):
+        if le(pos, 4) != 0xFD2FB528:
+            _format("decompression_failed", "not a zstd frame")
+        fhd = le(pos + 4, 1)
+        if fhd & 0x08:
+            _format("decompression_failed", "reserved bit of the frame header descriptor")
+        single = fhd >> 5 & 1
+        if fhd >> 6 == 0 and not single:
+            _format("decompression_failed", "frame without content size")
+        pos += 5 + (0 if single else 1) + (0, 1, 2, 4)[fhd & 3] + (1, 2, 4, 8)[fhd >> 6]
+        last = False
+        while not last:
+            h = le(pos, 3)
+            pos += 3
+            last, kind, size = h & 1, h >> 1 & 3, h >> 3
+            if kind == 3:
+                _format("decompression_failed", "reserved block type")
+            if size > 128 << 10:
+                _format("decompression_failed", "block larger than 128 KiB")
+            if kind == 2:
+                _compressed_block(st, pos, size, le)
+            pos += 1 if kind == 1 else size
+            need(pos, 0)
+        pos += 4 if fhd >> 2 & 1 else 0
+        need(pos, 0)
+
+
+def _compressed_block(st, pos, size, le):
+    b0 = le(pos, 1)
+    kind, fmt = b0 & 3, b0 >> 2 & 3
+    if kind < 2:
+        header = 2 if fmt == 1 else 3 if fmt == 3 else 1
+        regenerated = b0 >> 3 if header == 1 else (b0 >> 4) + (le(pos + 1, header - 1) << 4)
+        content = regenerated if kind == 0 else 1
+    else:
+        header = 3 if fmt < 2 else 4 if fmt == 2 else 5
+        content = le(pos, header) >> 4 >> (10 if header == 3 else 14 if header == 4 else 18)
+    if header + content >= size:
+        _format("decompression_failed", "literals leave no room for the sequences section")
+    q = pos + header + content
+    left = size - header - content - 1
+    n0 = le(q, 1)
+    if n0 == 0:
+        if left:
+            _format("decompression_failed", "bytes after an empty sequences section")
+        return
+    count_bytes = 0 if n0 < 128 else 1 if n0 < 255 else 2
+    if left < count_bytes + 1:
+        _format("decompression_failed", "sequences section header beyond the block")
+    if le(q + 1 + count_bytes, 1) & 3:
+        _format("decompression_failed", "reserved bits of Symbol_Compression_Modes")
+
+
 def _zstd_frames(stored, expected):
+    """Section 5.4: frames back to back, each declaring its content size and
+    no dictionary; its content checksum, if present, is verified (by zstd)."""
     out = bytearray()
     pos = 0
     while pos < len(stored):
         if stored[pos:pos + 4] != b"\x28\xb5\x2f\xfd":
             _format("decompression_failed", "not a zstd frame")
-        d = zstandard.ZstdDecompressor().decompressobj()
+        try:
+            params = zstandard.get_frame_parameters(stored[pos:pos + 18])
+        except zstandard.ZstdError as e:
+            _format("decompression_failed", f"frame header: {e}")
+        if params.content_size == zstandard.CONTENTSIZE_UNKNOWN:
+            _format("decompression_failed", "frame without content size")
+        if params.dict_id:
+            _format("decompression_failed", "frame needs a dictionary")
+        if params.content_size > expected - len(out):
+            _format("decompression_failed", "frame declares more than is left")
+        start = len(out)
+        # Any window size: the content size bounds the output.
+        d = zstandard.ZstdDecompressor(max_window_size=1 << 31).decompressobj()
         consumed = None
         try:
             # Small input chunks keep every output burst bounded (bomb-safe).
             for i in range(pos, len(stored), 256):
                 chunk = stored[i:i + 256]
                 out += d.decompress(chunk)
-                if len(out) > expected:
-                    _format("decompression_failed", "decodes to more than declared")
+                if len(out) - start > params.content_size:
+                    _format("decompression_failed", "frame decodes to more than its content size")
                 if d.eof:
                     consumed = i + len(chunk) - len(d.unused_data)
                     break
@@ -322,6 +406,8 @@ def _zstd_frames(stored, expected):
             _format("decompression_failed", str(e))
         if consumed is None:
             _format("decompression_failed", "incomplete zstd frame")
+        if len(out) - start != params.content_size:
+            _format("decompression_failed", "frame decodes to less than its content size")
         pos = consumed
     if len(out) != expected:
         _format("decompression_failed", f"decodes to {len(out)} bytes, {expected} declared")
@@ -331,6 +417,8 @@ def _zstd_frames(stored, expected):
 def _decode(stored, rec, rows, cols):
     _, w, _ = DTYPES[rec["dtype"]]
     n = rows * cols
+    if rec["codec"] == 1:
+        _zstd_structure(stored)
     data = _zstd_frames(stored, n * w) if rec["codec"] == 1 else bytes(stored)
     if rec["filter"] == 1:  # byte k of element i is at k * n + i
         joined = bytearray(n * w)
@@ -415,6 +503,13 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         _format("bad_metadata", "axis units")
     if md["gray_min"] != 0.0 or md["gray_max"] != 1.0:
         _format("bad_metadata", "gray range")
+    if md["fit"] is not None:
+        if md["fit"]["converged"] > 1:
+            _format("bad_metadata", "a bool that is neither 0 nor 1")
+        md["fit"]["converged"] = md["fit"]["converged"] == 1
+    for table, names in (("fit", FIT_DOUBLES), ("camera", CAMERA_DOUBLES)):
+        if md[table] is not None and not all(math.isfinite(md[table][k]) for k in names):
+            _format("bad_metadata", f"a {table} double is not finite")
     _decode_strings(md, meta_len)
     if md["pose"] is not None:
         if len(md["pose"]) != 16:
@@ -451,7 +546,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         if rec["codec"] == 0 and n != rec["decoded_length"]:
             _format("bad_layout", "raw array length")
         for other in md["arrays"][:i]:
-            if off < other["offset"] + other["stored_length"] and other["offset"] < off + n:
+            if n and other["stored_length"] and off < other["offset"] + other["stored_length"] \
+                    and other["offset"] < off + n:
                 _format("bad_layout", "arrays overlap")
     out = {
         "file": {
@@ -506,6 +602,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
             asym = max(abs(a[i][j] - a[j][i]) for i in range(4) for j in range(4))
             if asym > 1e-5 * scale:
                 _fail("numeric", "not_symmetric", f"component {k}")
+            # Section 5.1: a reader returns (and tests) the symmetric part.
+            a = [[_round_f32((a[i][j] + a[j][i]) / 2) for j in range(4)] for i in range(4)]
         if not _cholesky_ok(a):
             _fail("numeric", "not_spd", f"component {k}")
         mats.append(a)
