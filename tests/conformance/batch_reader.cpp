@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     try {
       const sogmm::Model model = sogmm::format::from_bytes(bytes.data(), bytes.size());
       const sogmm::format::FileInfo info = sogmm::format::read_info(bytes.data(), bytes.size());
-      std::cout << "accept " << nlohmann::json::parse(sogmm::format::to_canonical_json(model, &info)).dump() << "\n";
+      std::cout << "accept " << nlohmann::ordered_json::parse(sogmm::format::to_canonical_json(model, &info)).dump() << "\n";
     } catch (const sogmm::format::FormatError& e) {
       std::cout << "reject " << sogmm_conformance::category_of(e.code()) << " " << e.reason() << "\n";
     } catch (const std::exception& e) {
