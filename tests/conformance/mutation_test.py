@@ -111,7 +111,10 @@ def edit_raw_value(rng, b, arrays):
         value = rng.choice(FLOATS)
     else:
         value = struct.unpack_from(code, b, at)[0] * rng.choice([-1.0, 0.0, 1.0001, 1e-8, 1e8])
-    struct.pack_into(code, b, at, value)
+    try:
+        struct.pack_into(code, b, at, value)
+    except OverflowError:  # beyond float32: the infinity it rounds to
+        struct.pack_into(code, b, at, math.copysign(math.inf, value))
     lo, hi = metadata_range(b)
     old = struct.pack("<I", crc)
     meta = bytes(b[lo:hi])
