@@ -93,7 +93,7 @@ SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a
     require_nonnull(a, "a");
     require_nonnull(b, "b");
     auto handle = std::make_unique<sogmm_model>();
-    handle->model.gmm = sogmm::merge(a->model.gmm, b->model.gmm);
+    handle->model = sogmm::merge(a->model, b->model);  // metadata: spec/format.md section 2.2
     handle->model.created_unix_ms = sogmm_capi::creation_time_now();
     *out = handle.release();
   }

@@ -42,7 +42,29 @@ bool cholesky_ok(const double* a) {
   return true;
 }
 
+// (A + A^T) / 2 of a float32 matrix, each entry rounded to float32 (section
+// 5.1): exact on a symmetric matrix; the same rounding in every reader.
+void symmetric_part(const float* c, double* s) {
+  for (int r = 0; r < 4; ++r) {
+    for (int q = 0; q < 4; ++q) {
+      s[r * 4 + q] = static_cast<float>((static_cast<double>(c[r * 4 + q]) + c[q * 4 + r]) / 2.0);
+    }
+  }
+}
+
 }  // namespace
+
+void symmetrize(Gmm& g) {
+  double s[16];
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    float* c = g.covariances.data() + 16 * k;
+    symmetric_part(c, s);
+    std::copy(s, s + 16, c);
+  }
+  // The returned model keeps the library's invariant (see check_values).
+  const std::string residual = validation_error(g, kWeightSumTolerance);
+  if (!residual.empty()) numeric("not_spd", residual);
+}
 
 void check_values(const Gmm& g) {
   const std::size_t m = g.size();
@@ -83,6 +105,7 @@ void check_values(const Gmm& g) {
     if (asym > kSymmetryTolerance * scale) {
       numeric("not_symmetric", "covariance of component " + std::to_string(k) + " is not symmetric");
     }
+    symmetric_part(g.covariance(k), a);  // what a reader returns, so what it tests
     if (!cholesky_ok(a)) {
       numeric("not_spd", "covariance of component " + std::to_string(k) + " is not positive definite");
     }
@@ -91,6 +114,29 @@ void check_values(const Gmm& g) {
   // Cholesky sums of a nearly singular matrix; what remains is such a matrix.
   const std::string residual = validation_error(g, kWeightSumTolerance);
   if (!residual.empty()) numeric("not_spd", residual);
+}
+
+void check_metadata_numbers(const Model& model, ErrorCode code) {
+  auto finite = [&](double v, const char* what) {
+    if (!std::isfinite(v)) fail(code, "bad_metadata", std::string(what) + " is " + checked::exact(v) + ", not finite");
+  };
+  if (model.fit.known) {
+    const FitInfo& f = model.fit;
+    finite(f.bandwidth, "fit.bandwidth");
+    finite(f.tol, "fit.tol");
+    finite(f.reg_covar, "fit.reg_covar");
+    finite(f.log_likelihood, "fit.log_likelihood");
+  }
+  if (model.camera.known) {
+    const CameraInfo& c = model.camera;
+    finite(c.camera.fx, "camera.fx");
+    finite(c.camera.fy, "camera.fy");
+    finite(c.camera.cx, "camera.cx");
+    finite(c.camera.cy, "camera.cy");
+    finite(c.depth_scale, "camera.depth_scale");
+    finite(c.depth_min, "camera.depth_min");
+    finite(c.depth_max, "camera.depth_max");
+  }
 }
 
 void check_pose(const std::array<double, 16>& p) {

@@ -148,6 +148,15 @@ std::string zstd_error(int frame, std::size_t code) {
          (ZSTD_getErrorCode(code) == ZSTD_error_dstSize_tooSmall ? " (decodes to more than declared)" : "");
 }
 
+// A frame's output against its declared content size (zstd checks this
+// itself; the format does not rely on that).
+void check_content_size(int frame, std::uint64_t got, std::uint64_t declared) {
+  if (got != declared) {
+    bad("frame " + std::to_string(frame) + " decodes to " + std::to_string(got) + " bytes, its header declares " +
+        std::to_string(declared));
+  }
+}
+
 // Feeds one frame's input to zstd until the frame ends; `flush` sees the
 // output after every step (a streamed frame empties it there).
 template <typename Flush>
@@ -165,6 +174,99 @@ void decode_frame(ZSTD_DCtx* dctx, StoredBytes& in, ZSTD_outBuffer& ob, int fram
     if (hint != 0 && !progress) bad("frame " + std::to_string(frame) + " decodes to more than declared");
   }
 }
+
+// The structure of the zstd frames that section 5.4 has every reader check
+// itself, before decoding: zstd versions differ on some of it (1.5.7
+// rejects set reserved bits of Symbol_Compression_Modes that 1.5.4 ignores),
+// and a file must have one verdict. RFC 8878 names the fields.
+class FrameWalker {
+ public:
+  explicit FrameWalker(StoredBytes& in) : in_(in) {}
+
+  void walk() {
+    for (frame_ = 0; in_.left() > 0; ++frame_) {
+      if (le(4) != ZSTD_MAGICNUMBER) bad(where() + "does not start with the zstd magic number");
+      const std::uint8_t fhd = byte();
+      if (fhd & 0x08) bad(where() + "reserved bit of the frame header descriptor is set");
+      const bool single = (fhd >> 5) & 1;
+      const int fcs_flag = fhd >> 6;
+      if (fcs_flag == 0 && !single) bad(where() + "does not declare its content size");
+      static constexpr int kDictionaryIdBytes[4] = {0, 1, 2, 4}, kContentSizeBytes[4] = {1, 2, 4, 8};
+      skip((single ? 0 : 1) + kDictionaryIdBytes[fhd & 3] + kContentSizeBytes[fcs_flag]);
+      for (bool last = false; !last;) {
+        const std::uint32_t h = static_cast<std::uint32_t>(le(3));
+        last = h & 1;
+        const std::uint32_t type = (h >> 1) & 3, size = h >> 3;
+        if (type == 3) bad(where() + "block of the reserved type 3");
+        if (size > (128u << 10)) bad(where() + "block larger than 128 KiB");
+        if (type == 2) {
+          compressed_block(size);
+        } else {
+          skip(type == 1 ? 1 : size);
+        }
+      }
+      if ((fhd >> 2) & 1) skip(4);  // content checksum, verified when decoding
+    }
+  }
+
+ private:
+  void compressed_block(std::uint32_t size) {
+    const std::uint8_t b0 = byte();
+    const int type = b0 & 3, format = (b0 >> 2) & 3;
+    std::uint64_t header = 0, content = 0;
+    if (type < 2) {  // raw or RLE literals: Regenerated_Size only
+      header = format == 1 ? 2 : format == 3 ? 3 : 1;
+      const std::uint64_t rest = le(static_cast<int>(header) - 1);
+      const std::uint64_t regenerated = header == 1 ? b0 >> 3 : (b0 >> 4) + (rest << 4);
+      content = type == 0 ? regenerated : 1;
+    } else {  // compressed or treeless: Regenerated_Size and Compressed_Size
+      header = format < 2 ? 3 : format == 2 ? 4 : 5;
+      const std::uint64_t v = (b0 + (le(static_cast<int>(header) - 1) << 8)) >> 4;
+      const int bits = header == 3 ? 10 : header == 4 ? 14 : 18;
+      content = v >> bits;
+    }
+    if (header + content >= size) bad(where() + "literals leave no room for the sequences section");
+    skip(content);
+    std::uint64_t left = size - header - content;
+    const std::uint8_t n0 = byte();
+    --left;
+    if (n0 == 0) {
+      if (left != 0) bad(where() + "bytes after an empty sequences section");
+      return;
+    }
+    const std::uint64_t count_bytes = n0 < 128 ? 0 : n0 < 255 ? 1 : 2;
+    if (left < count_bytes + 1) bad(where() + "sequences section header beyond the block");
+    skip(count_bytes);
+    if (byte() & 3) bad(where() + "reserved bits of Symbol_Compression_Modes are set");
+    skip(left - count_bytes - 1);
+  }
+
+  std::string where() const { return "frame " + std::to_string(frame_) + ": "; }
+
+  std::uint8_t byte() {
+    if (in_.available() == 0 && in_.fill(1) == 0) bad(where() + "truncated");
+    const std::uint8_t v = in_.data()[0];
+    in_.consume(1);
+    return v;
+  }
+  std::uint64_t le(int n) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(byte()) << (8 * i);
+    return v;
+  }
+  void skip(std::uint64_t n) {
+    while (n > 0) {
+      std::size_t a = in_.available();
+      if (a == 0 && (a = in_.fill(kChunk)) == 0) bad(where() + "truncated");
+      const std::size_t t = static_cast<std::size_t>(std::min<std::uint64_t>(a, n));
+      in_.consume(t);
+      n -= t;
+    }
+  }
+
+  StoredBytes& in_;
+  int frame_ = 0;
+};
 
 void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint64_t expected) {
   std::unique_ptr<ZSTD_DCtx, DCtxDeleter> dctx(ZSTD_createDCtx());
@@ -190,14 +292,21 @@ void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint
     const std::size_t need = ZSTD_getFrameHeader(&fh, in.data(), in.available());
     if (ZSTD_isError(need)) bad(zstd_error(frame, need));
     if (need > 0) bad("frame " + std::to_string(frame) + ": truncated frame header");
-    // Checked before anything is allocated: a frame may not promise more than is left.
+    // Section 5.4: every frame declares its content size and uses no
+    // dictionary, so its output is known before it is decoded, whatever the
+    // zstd version. Checked before anything is allocated: a frame may not
+    // promise more than is left.
+    if (fh.frameContentSize == ZSTD_CONTENTSIZE_UNKNOWN) {
+      bad("frame " + std::to_string(frame) + " does not declare its content size");
+    }
+    if (fh.dictID != 0) bad("frame " + std::to_string(frame) + " needs a dictionary");
     const std::uint64_t left = expected - scatter.written();
-    const bool known = fh.frameContentSize != ZSTD_CONTENTSIZE_UNKNOWN;
-    if (known && fh.frameContentSize > left) {
+    if (fh.frameContentSize > left) {
       bad("frame " + std::to_string(frame) + " declares " + std::to_string(fh.frameContentSize) +
           " bytes, more than the " + std::to_string(left) + " left of the declared length");
     }
-    const std::size_t cap = static_cast<std::size_t>(known ? fh.frameContentSize : left);
+    const std::size_t cap = static_cast<std::size_t>(fh.frameContentSize);
+    const std::uint64_t before = scatter.written();
     const bool streamed = !scatter.identity() && fh.windowSize < cap;
     ZSTD_DCtx_reset(dctx.get(), ZSTD_reset_session_only);  // a new output buffer per frame
     ZSTD_DCtx_setParameter(dctx.get(), ZSTD_d_stableOutBuffer, streamed ? 0 : 1);
@@ -208,6 +317,7 @@ void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint
         scatter.put(chunk.data(), o.pos);
         o.pos = 0;
       });
+      check_content_size(frame, scatter.written() - before, cap);
       continue;
     }
     std::uint8_t* dst = out + scatter.written();
@@ -221,6 +331,7 @@ void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint
     }
     ZSTD_outBuffer ob{dst, cap, 0};
     decode_frame(dctx.get(), in, ob, frame, [](ZSTD_outBuffer&) {});
+    check_content_size(frame, ob.pos, cap);
     if (scatter.identity()) {
       scatter.placed(ob.pos);
     } else {
@@ -237,6 +348,8 @@ void decode_array(const Source& src, std::uint64_t offset, std::uint64_t stored_
   StoredBytes in(src, offset, stored_length);
   Scatter scatter(shape, e, out);
   if (e.codec == kCodecZstd) {
+    StoredBytes structure(src, offset, stored_length);
+    FrameWalker(structure).walk();
     decode_zstd(in, scatter, out, expected);
   } else {
     while (in.left() > 0) {

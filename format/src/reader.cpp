@@ -102,6 +102,7 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info) 
   }
   if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
   check_values(g);  // 19
+  if (!meta.packed) symmetrize(g);
   if (info != nullptr) {
     *info = std::move(meta.info);
     info->metadata = Model{};

@@ -8,6 +8,7 @@
 
 #include "checks.hpp"
 #include "codec.hpp"
+#include "wire.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/metadata_string.hpp"
 #include "sogmm_generated.h"
@@ -188,10 +189,9 @@ void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3]
 }
 
 ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const ReadOptions& options) {
-  // 9. FlatBuffers verification (identifier, offsets, sizes, required fields).
-  if (!flatbuffers::BufferHasIdentifier(buf, fb::SogmmFileIdentifier())) {
-    fail(F, "bad_metadata", "metadata file identifier is not \"SGMM\"");
-  }
+  // 9. The wire rules of section 4.3 decide. FlatBuffers' own verifier, whose
+  // rules are weaker, then only guards the generated accessors used below.
+  verify_wire(buf, h.metadata_length);
   flatbuffers::Verifier verifier(buf, h.metadata_length, /*max_depth=*/64, kMaxMetadataTables);
   if (!fb::VerifySogmmFileBuffer(verifier)) fail(F, "bad_metadata", "metadata fails FlatBuffers verification");
   const fb::SogmmFile* root = fb::GetSogmmFile(buf);
@@ -218,6 +218,36 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
   check_metadata_strings(root, h.metadata_length);
   ParsedMetadata out;
   Model& model = out.info.metadata;
+  if (const fb::FitInfo* f = root->fit()) {
+    model.fit.known = true;
+    model.fit.bandwidth = f->bandwidth();
+    model.fit.n_components_requested = f->n_components_requested();
+    model.fit.tol = f->tol();
+    model.fit.reg_covar = f->reg_covar();
+    model.fit.max_iter = f->max_iter();
+    model.fit.n_iter = f->n_iter();
+    // A bool is the byte 0 or 1 (section 4.3); FlatBuffers would read any other byte as true.
+    const auto converged = reinterpret_cast<const flatbuffers::Table*>(f)->GetField<std::uint8_t>(
+        fb::FitInfo::VT_CONVERGED, 0);
+    if (converged > 1) fail(F, "bad_metadata", "fit.converged is " + std::to_string(converged) + ", not 0 or 1");
+    model.fit.converged = converged == 1;
+    model.fit.log_likelihood = f->log_likelihood();
+    model.fit.seed = f->seed();
+  }
+  if (const fb::Camera* c = root->camera()) {
+    model.camera.known = true;
+    model.camera.camera.width = c->width();
+    model.camera.camera.height = c->height();
+    model.camera.camera.fx = c->fx();
+    model.camera.camera.fy = c->fy();
+    model.camera.camera.cx = c->cx();
+    model.camera.camera.cy = c->cy();
+    model.camera.decimation = c->decimation();
+    model.camera.depth_scale = c->depth_scale();
+    model.camera.depth_min = c->depth_min();
+    model.camera.depth_max = c->depth_max();
+  }
+  check_metadata_numbers(model, F);
   if (root->pose()) {
     if (root->pose()->size() != 16) {
       fail(F, "bad_metadata", "pose has " + std::to_string(root->pose()->size()) + " values, not 16");
@@ -285,7 +315,9 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
     }
     for (int j = 0; j < i; ++j) {
       const ArrayRecord& o = out.arrays[j];
-      if (r.offset < o.offset + o.stored_length && o.offset < r.offset + r.stored_length) {
+      // Half-open byte ranges: an empty array overlaps nothing.
+      if (r.stored_length > 0 && o.stored_length > 0 && r.offset < o.offset + o.stored_length &&
+          o.offset < r.offset + r.stored_length) {
         fail(F, "bad_layout", name + " overlap " + kArrayNames[j]);
       }
     }
@@ -305,31 +337,6 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
   info.means = to_info(out.arrays[kMeans]);
   info.covariances = to_info(out.arrays[kCovariances]);
   model.gmm.support_size = root->support_size();
-  if (const fb::FitInfo* f = root->fit()) {
-    model.fit.known = true;
-    model.fit.bandwidth = f->bandwidth();
-    model.fit.n_components_requested = f->n_components_requested();
-    model.fit.tol = f->tol();
-    model.fit.reg_covar = f->reg_covar();
-    model.fit.max_iter = f->max_iter();
-    model.fit.n_iter = f->n_iter();
-    model.fit.converged = f->converged();
-    model.fit.log_likelihood = f->log_likelihood();
-    model.fit.seed = f->seed();
-  }
-  if (const fb::Camera* c = root->camera()) {
-    model.camera.known = true;
-    model.camera.camera.width = c->width();
-    model.camera.camera.height = c->height();
-    model.camera.camera.fx = c->fx();
-    model.camera.camera.fy = c->fy();
-    model.camera.camera.cx = c->cx();
-    model.camera.camera.cy = c->cy();
-    model.camera.decimation = c->decimation();
-    model.camera.depth_scale = c->depth_scale();
-    model.camera.depth_min = c->depth_min();
-    model.camera.depth_max = c->depth_max();
-  }
   model.producer_name = str(root->producer_name());
   model.producer_version = str(root->producer_version());
   model.created_unix_ms = root->created_unix_ms();

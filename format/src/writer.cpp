@@ -77,6 +77,7 @@ void validate_for_write(const Model& model) {
              " mean values, " + std::to_string(g.covariances.size()) + " covariance values");
   }
   check_strings(model, ErrorCode::InvalidData);
+  check_metadata_numbers(model, ErrorCode::InvalidData);
   if (model.pose) check_pose(*model.pose);
   check_values(g);
 }

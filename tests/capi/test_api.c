@@ -514,10 +514,20 @@ static void test_inference(void) {
     EXPECT_NEAR(w[2], 0.25 * 0.75, 1e-6);
     EXPECT_OK(sogmm_model_get_info_i64(mg, SOGMM_INFO_SUPPORT_SIZE, &s));
     EXPECT_TRUE(s == 400);
+    {
+      /* spec/format.md 2.2: the merged model counts its fits */
+      const char* v = NULL;
+      EXPECT_OK(sogmm_model_get_value(mg, "merged_fits", &v));
+      EXPECT_TRUE(v != NULL && strcmp(v, "2") == 0);
+    }
     sogmm_model_free(mg);
     REQUIRE_OK(sogmm_model_merge(&mg, m, m)); /* a == b allowed */
     EXPECT_TRUE(check_model(mg) == 4);
     sogmm_model_free(mg);
+    /* models in different frames are not merged */
+    REQUIRE_OK(sogmm_model_set_value(m, "coordinate_frame", "world"));
+    EXPECT_TRUE(sogmm_model_merge(&mg, m, b) == SOGMM_E_INVALID_ARG && mg == NULL);
+    REQUIRE_OK(sogmm_model_set_value(m, "coordinate_frame", "camera"));
   }
   /* transform: rotation about z by 90 degrees plus a translation */
   {

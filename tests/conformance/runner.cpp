@@ -10,27 +10,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common.hpp"
 #include "sogmm/format.hpp"
 
 namespace {
 
-const char* category_of(sogmm::ErrorCode c) {
-  switch (c) {
-    case sogmm::ErrorCode::Format: return "format";
-    case sogmm::ErrorCode::Limit: return "limit";
-    case sogmm::ErrorCode::InvalidData: return "invalid_data";
-    case sogmm::ErrorCode::Numeric: return "numeric";
-    case sogmm::ErrorCode::Io: return "io";
-    case sogmm::ErrorCode::InvalidArgument: return "invalid_argument";
-  }
-  return "?";
-}
-
-std::vector<std::uint8_t> slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open " + path);
-  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using sogmm_conformance::category_of;
+using sogmm_conformance::slurp;
 
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <cstring>
+
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -74,6 +76,12 @@ bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 }  // namespace
+
+float symmetric_tie(float a, float b) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &a, 4);
+  return bits % 2 == 0 ? a : b;
+}
 
 bool bit_equal(const Model& a, const Model& b) {
   const FitInfo &fa = a.fit, &fb = b.fit;

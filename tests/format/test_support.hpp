@@ -30,6 +30,12 @@ T le(const std::vector<std::uint8_t>& b, std::size_t off) {
 /// True when both models hold bit-identical arrays and equal metadata.
 bool bit_equal(const Model& a, const Model& b);
 
+/// What a reader returns for a FULL covariance whose entries (i, j) and
+/// (j, i) are the neighbouring floats a and b (spec/format.md 5.1): their
+/// mean is a tie, rounded to the one with an even significand. From the bits,
+/// not from the reader's arithmetic.
+float symmetric_tie(float a, float b);
+
 /// A fresh empty directory /tmp/PREFIX-XXXXXX for files a test writes.
 /// Throws std::runtime_error when it cannot be made.
 std::string make_scratch_dir(const std::string& prefix);

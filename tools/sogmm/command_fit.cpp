@@ -140,10 +140,9 @@ int run_sequence(const FitState& s) {
     camera_flags.intrinsics = guess;
   }
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
-  Gmm merged;
+  Model merged;  // spec/format.md section 2.2: merge() keeps the fit record's defined meaning
   Totals t;
   Camera camera;
-  EmReport last_em;
   nlohmann::json frames_json = nlohmann::json::array();
   std::string frame_list;
   for (std::size_t k = 0; k < selected.size(); ++k) {
@@ -156,13 +155,13 @@ int run_sequence(const FitState& s) {
     FitResult r = fit(cloud.view(), s.fit, progress.fit_callback(label));
     progress.em_done(label, r);
     t.add(r);
-    last_em = r.em;
     const std::size_t m = r.gmm.size();
-    const Gmm world = transform(r.gmm, poses[f.index]);
-    merged = k == 0 ? world : merge(merged, world);
+    Model world = make_model(transform(r.gmm, poses[f.index]), s.fit, r.em, camera, s.depth_options,
+                             {{kCoordinateFrameKey, "world"}});
+    merged = k == 0 ? std::move(world) : merge(merged, world);
     char buf[256];
     std::snprintf(buf, sizeof buf, "%s: %zu points, %zu components, %d EM iterations, %.2f s; map %zu components",
-                  label.c_str(), r.n_points, m, r.em.iterations, r.seconds_total, merged.size());
+                  label.c_str(), r.n_points, m, r.em.iterations, r.seconds_total, merged.gmm.size());
     progress.line(buf);
     frames_json.push_back({{"frame", f.index},
                            {"depth", f.depth},
@@ -173,16 +172,11 @@ int run_sequence(const FitState& s) {
     frame_list += (frame_list.empty() ? "" : ",") + std::to_string(f.index);
   }
   progress.finish();
-  FitOptions options = s.fit;
-  EmReport em = last_em;
-  em.iterations = t.iterations;  // total over frames
-  Model model = make_model(std::move(merged), options, em, camera, s.depth_options,
-                           {{"coordinate_frame", "world"},
-                            {"sequence", s.src.sequence},
-                            {"trajectory", s.src.trajectory},
-                            {"frames", frame_list}});
-  model.fit.converged = false;
-  model.fit.log_likelihood = 0.0;  // per-frame values; the merged model has no single one
+  Model model = std::move(merged);
+  model.producer_version = version_string();
+  model.created_unix_ms = unix_ms_now();
+  model.key_values.insert(model.key_values.end(),
+                          {{"sequence", s.src.sequence}, {"trajectory", s.src.trajectory}, {"frames", frame_list}});
   const std::uint64_t bytes = save_model(s.output, model);
   char what[512];
   std::snprintf(what, sizeof what,

@@ -163,7 +163,8 @@ def test_merge(points):
     np.testing.assert_allclose(c.weights_[: a.n_components_], a.weights_ * 0.8, rtol=1e-5)
     np.testing.assert_allclose(c.weights_[a.n_components_:], b.weights_ * 0.2, rtol=1e-5)
     np.testing.assert_array_equal(c.means_, np.concatenate([a.means_, b.means_]))
-    assert c.n_iter_ is None  # merged models have no fit report
+    # spec/format.md 2.2: the same fit settings, so a fit record with the total iterations
+    assert c.n_iter_ == a.n_iter_ + b.n_iter_
     with pytest.raises(sogmm.InvalidArgumentError):
         a.merge("not a model")
 

@@ -366,8 +366,14 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
                                                      size_t n, int32_t dims, double* out);
 
 /* New model with the components of a and b, weights re-weighted by support
- * size; support size a + b. Both must be in the same frame. The result has
- * no fit report, camera, pose or key/values. a may equal b. Support size 0
+ * size; support size a + b. Both must be in the same frame (key
+ * "coordinate_frame": absent or "camera", or "world"), else
+ * SOGMM_E_INVALID_ARG. Metadata as spec/format.md section 2.2: key/values
+ * "coordinate_frame" (when "world") and "merged_fits" (fits of a + fits of
+ * b; a model without it counts 1); the fit report when both have one with
+ * the same settings (n_iter summed, converged if both, log-likelihood
+ * weighted by support size), else none; the camera when both are equal; no
+ * pose; other key/values are not kept. a may equal b. Support size 0
  * means unknown: if both are 0 the models count equally; if only one is 0 ->
  * SOGMM_E_INVALID_ARG (weighing a known count against an unknown one would be
  * a guess; rebuild that model with its support size). a + b overflowing

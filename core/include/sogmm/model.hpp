@@ -66,6 +66,25 @@ inline constexpr double kPoseTolerance = 1e-3;
 /// offending value at round-trip precision.
 std::string rigid_pose_error(const std::array<double, 16>& pose);
 
+/// Key of Model::key_values naming the frame of the means: absent or
+/// "camera" (the camera frame), "world" (spec/format.md section 2.1).
+inline constexpr const char* kCoordinateFrameKey = "coordinate_frame";
+/// Key of Model::key_values counting the fits a merged model holds (decimal,
+/// >= 2; spec/format.md section 2.2).
+inline constexpr const char* kMergedFitsKey = "merged_fits";
+
+/// The frame of a model: the value of its first coordinate_frame key, or "camera".
+std::string coordinate_frame(const Model& model);
+
+/// The merge of spec/format.md section 2.2: merge(a.gmm, b.gmm) (see
+/// sogmm/inference.hpp) with its metadata. The fit record is kept when both
+/// fits used the same settings, with n_iter summed (saturating), converged
+/// only if both did and log_likelihood weighted by support size; the camera
+/// when both are equal; no pose; key_values are coordinate_frame (unless
+/// "camera") and merged_fits (the fits of a plus those of b). Models in
+/// different frames -> Error(InvalidArgument); the Gmm rules as merge().
+Model merge(const Model& a, const Model& b);
+
 /// Library version, "MAJOR.MINOR.PATCH".
 const char* version_string();
 

@@ -93,32 +93,52 @@ class _Verifier:
         self.check(pos, 4, 4)
         return struct.unpack_from("<I", self.buf, pos)[0]
 
+    def follow(self, at):
+        """The target of the offset at `at`: non-zero and inside the block."""
+        o = self.u32(at)
+        if o == 0 or at + o >= self.n:
+            raise _Bad(f"offset at {at} is 0 or points outside the block")
+        return at + o
+
     def i32(self, pos):
         self.check(pos, 4, 4)
         return struct.unpack_from("<i", self.buf, pos)[0]
 
 
 class _Table:
+    """A table checked by the wire rules of spec section 4.3: soffset aligned
+    to 4, vtable (size even, >= 4) and inline bytes (size >= 4) inside the
+    block; each known field inside the inline bytes, after the soffset, and
+    aligned to its size; every offset non-zero and pointing into the block.
+    Each visit of a table counts towards the limit of 100 000."""
+
     def __init__(self, v, pos, depth):
         if depth > MAX_DEPTH:
             raise _Bad("nesting too deep")
         v.tables += 1
         if v.tables > MAX_TABLES:
-            raise _Bad("too many tables")
+            raise _Bad("too many table visits")
         self.v = v
         self.depth = depth
         self.pos = pos
         vt = pos - v.i32(pos)
+        v.check(vt, 4, 2)
+        self.vt = vt
         self.vt_size = v.u16(vt)
-        v.check(vt, self.vt_size, 2)
         if self.vt_size < 4 or self.vt_size % 2:
             raise _Bad("bad vtable size")
-        v.check(pos, v.u16(vt + 2))
-        self.t = flatbuffers.table.Table(v.buf, pos)
+        v.check(vt, self.vt_size, 2)
+        self.inline_size = v.u16(vt + 2)
+        if self.inline_size < 4:
+            raise _Bad("bad table inline size")
+        v.check(pos, self.inline_size, 4)
 
     def _field(self, fid, size):
-        o = self.t.Offset(4 + 2 * fid) if 4 + 2 * fid < self.vt_size else 0
+        slot = 4 + 2 * fid
+        o = self.v.u16(self.vt + slot) if slot + 2 <= self.vt_size else 0
         if o:
+            if o < 4 or o + size > self.inline_size:
+                raise _Bad(f"field {fid} outside the table's inline bytes")
             self.v.check(self.pos + o, size, size)
         return o
 
@@ -129,10 +149,7 @@ class _Table:
 
     def _target(self, fid):
         o = self._field(fid, 4)
-        if not o:
-            return None
-        at = self.pos + o
-        return at + self.v.u32(at)
+        return None if not o else self.v.follow(self.pos + o)
 
     def table(self, fid):
         t = self._target(fid)
@@ -143,7 +160,7 @@ class _Table:
         if t is None:
             return None
         n = self.v.u32(t)
-        self.v.check(t + 4, n * elem, min(elem, 8))
+        self.v.check(t + 4, n * elem, elem)
         return t + 4, n
 
     def string_at(self, t):
@@ -163,14 +180,14 @@ class _Table:
         if vec is None:
             return None
         start, n = vec
-        return [self.string_at(start + 4 * i + self.v.u32(start + 4 * i)) for i in range(n)]
+        return [self.string_at(self.v.follow(start + 4 * i)) for i in range(n)]
 
     def tables_(self, fid):
         vec = self._vector(fid, 4)
         if vec is None:
             return None
         start, n = vec
-        return [_Table(self.v, start + 4 * i + self.v.u32(start + 4 * i), self.depth + 1) for i in range(n)]
+        return [_Table(self.v, self.v.follow(start + 4 * i), self.depth + 1) for i in range(n)]
 
     def doubles(self, fid):
         vec = self._vector(fid, 8)
@@ -187,6 +204,8 @@ FILTERS = {0: "none", 1: "byte_stream_split"}
 CODECS = {0: "none", 1: "zstd"}
 LAYOUTS = {0: "upper_packed", 1: "full"}
 ARRAY_NAMES = ("weights", "means", "covariances")
+FIT_DOUBLES = ("bandwidth", "tol", "reg_covar", "log_likelihood")
+CAMERA_DOUBLES = ("fx", "fy", "cx", "cy", "depth_scale", "depth_min", "depth_max")
 UPPER = [(0, 0), (0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3)]
 
 
@@ -222,7 +241,7 @@ def _read_all_metadata(root):
     m["fit"] = None if f is None else {
         "bandwidth": f.scalar(0, "d", 0.0), "n_components_requested": f.scalar(1, "Q", 0),
         "tol": f.scalar(2, "d", 0.0), "reg_covar": f.scalar(3, "d", 0.0), "max_iter": f.scalar(4, "i", 0),
-        "n_iter": f.scalar(5, "i", 0), "converged": bool(f.scalar(6, "B", 0)),
+        "n_iter": f.scalar(5, "i", 0), "converged": f.scalar(6, "B", 0),
         "log_likelihood": f.scalar(7, "d", 0.0), "seed": f.scalar(8, "Q", 0)}
     c = root.table(14)
     m["camera"] = None if c is None else {
@@ -283,21 +302,103 @@ def _check_pose(p):
         _fail("invalid_data", "bad_pose", "rotation is a reflection")
 
 
+def _zstd_structure(st):
+    """The frame structure section 5.4 has a reader check itself (RFC 8878
+    field names): header descriptor reserved bit clear, content size present,
+    no reserved block type, blocks of at most 128 KiB, and in compressed
+    blocks the literals inside the block and the reserved bits of
+    Symbol_Compression_Modes clear."""
+    def need(pos, n):
+        if pos + n > len(st):
+            _format("decompression_failed", "zstd frame truncated")
+
+    def le(pos, n):
+        need(pos, n)
+        return int.from_bytes(st[pos:pos + n], "little")
+
+    pos = 0
+    while pos < len(st):
+        if le(pos, 4) != 0xFD2FB528:
+            _format("decompression_failed", "not a zstd frame")
+        fhd = le(pos + 4, 1)
+        if fhd & 0x08:
+            _format("decompression_failed", "reserved bit of the frame header descriptor")
+        single = fhd >> 5 & 1
+        if fhd >> 6 == 0 and not single:
+            _format("decompression_failed", "frame without content size")
+        pos += 5 + (0 if single else 1) + (0, 1, 2, 4)[fhd & 3] + (1, 2, 4, 8)[fhd >> 6]
+        last = False
+        while not last:
+            h = le(pos, 3)
+            pos += 3
+            last, kind, size = h & 1, h >> 1 & 3, h >> 3
+            if kind == 3:
+                _format("decompression_failed", "reserved block type")
+            if size > 128 << 10:
+                _format("decompression_failed", "block larger than 128 KiB")
+            if kind == 2:
+                _compressed_block(st, pos, size, le)
+            pos += 1 if kind == 1 else size
+            need(pos, 0)
+        pos += 4 if fhd >> 2 & 1 else 0
+        need(pos, 0)
+
+
+def _compressed_block(st, pos, size, le):
+    b0 = le(pos, 1)
+    kind, fmt = b0 & 3, b0 >> 2 & 3
+    if kind < 2:
+        header = 2 if fmt == 1 else 3 if fmt == 3 else 1
+        regenerated = b0 >> 3 if header == 1 else (b0 >> 4) + (le(pos + 1, header - 1) << 4)
+        content = regenerated if kind == 0 else 1
+    else:
+        header = 3 if fmt < 2 else 4 if fmt == 2 else 5
+        content = le(pos, header) >> 4 >> (10 if header == 3 else 14 if header == 4 else 18)
+    if header + content >= size:
+        _format("decompression_failed", "literals leave no room for the sequences section")
+    q = pos + header + content
+    left = size - header - content - 1
+    n0 = le(q, 1)
+    if n0 == 0:
+        if left:
+            _format("decompression_failed", "bytes after an empty sequences section")
+        return
+    count_bytes = 0 if n0 < 128 else 1 if n0 < 255 else 2
+    if left < count_bytes + 1:
+        _format("decompression_failed", "sequences section header beyond the block")
+    if le(q + 1 + count_bytes, 1) & 3:
+        _format("decompression_failed", "reserved bits of Symbol_Compression_Modes")
+
+
 def _zstd_frames(stored, expected):
+    """Section 5.4: frames back to back, each declaring its content size and
+    no dictionary; its content checksum, if present, is verified (by zstd)."""
     out = bytearray()
     pos = 0
     while pos < len(stored):
         if stored[pos:pos + 4] != b"\x28\xb5\x2f\xfd":
             _format("decompression_failed", "not a zstd frame")
-        d = zstandard.ZstdDecompressor().decompressobj()
+        try:
+            params = zstandard.get_frame_parameters(stored[pos:pos + 18])
+        except zstandard.ZstdError as e:
+            _format("decompression_failed", f"frame header: {e}")
+        if params.content_size == zstandard.CONTENTSIZE_UNKNOWN:
+            _format("decompression_failed", "frame without content size")
+        if params.dict_id:
+            _format("decompression_failed", "frame needs a dictionary")
+        if params.content_size > expected - len(out):
+            _format("decompression_failed", "frame declares more than is left")
+        start = len(out)
+        # Any window size: the content size bounds the output.
+        d = zstandard.ZstdDecompressor(max_window_size=1 << 31).decompressobj()
         consumed = None
         try:
             # Small input chunks keep every output burst bounded (bomb-safe).
             for i in range(pos, len(stored), 256):
                 chunk = stored[i:i + 256]
                 out += d.decompress(chunk)
-                if len(out) > expected:
-                    _format("decompression_failed", "decodes to more than declared")
+                if len(out) - start > params.content_size:
+                    _format("decompression_failed", "frame decodes to more than its content size")
                 if d.eof:
                     consumed = i + len(chunk) - len(d.unused_data)
                     break
@@ -305,6 +406,8 @@ def _zstd_frames(stored, expected):
             _format("decompression_failed", str(e))
         if consumed is None:
             _format("decompression_failed", "incomplete zstd frame")
+        if len(out) - start != params.content_size:
+            _format("decompression_failed", "frame decodes to less than its content size")
         pos = consumed
     if len(out) != expected:
         _format("decompression_failed", f"decodes to {len(out)} bytes, {expected} declared")
@@ -314,6 +417,8 @@ def _zstd_frames(stored, expected):
 def _decode(stored, rec, rows, cols):
     _, w, _ = DTYPES[rec["dtype"]]
     n = rows * cols
+    if rec["codec"] == 1:
+        _zstd_structure(stored)
     data = _zstd_frames(stored, n * w) if rec["codec"] == 1 else bytes(stored)
     if rec["filter"] == 1:  # byte k of element i is at k * n + i
         joined = bytearray(n * w)
@@ -382,7 +487,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         _format("bad_metadata", "file identifier")
     try:
         v = _Verifier(meta)
-        root = _Table(v, v.u32(0), 1)
+        root = _Table(v, v.follow(0), 1)
         md = _read_all_metadata(root)
     except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
@@ -398,6 +503,13 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         _format("bad_metadata", "axis units")
     if md["gray_min"] != 0.0 or md["gray_max"] != 1.0:
         _format("bad_metadata", "gray range")
+    if md["fit"] is not None:
+        if md["fit"]["converged"] > 1:
+            _format("bad_metadata", "a bool that is neither 0 nor 1")
+        md["fit"]["converged"] = md["fit"]["converged"] == 1
+    for table, names in (("fit", FIT_DOUBLES), ("camera", CAMERA_DOUBLES)):
+        if md[table] is not None and not all(math.isfinite(md[table][k]) for k in names):
+            _format("bad_metadata", f"a {table} double is not finite")
     _decode_strings(md, meta_len)
     if md["pose"] is not None:
         if len(md["pose"]) != 16:
@@ -434,7 +546,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         if rec["codec"] == 0 and n != rec["decoded_length"]:
             _format("bad_layout", "raw array length")
         for other in md["arrays"][:i]:
-            if off < other["offset"] + other["stored_length"] and other["offset"] < off + n:
+            if n and other["stored_length"] and off < other["offset"] + other["stored_length"] \
+                    and other["offset"] < off + n:
                 _format("bad_layout", "arrays overlap")
     out = {
         "file": {
@@ -489,6 +602,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
             asym = max(abs(a[i][j] - a[j][i]) for i in range(4) for j in range(4))
             if asym > 1e-5 * scale:
                 _fail("numeric", "not_symmetric", f"component {k}")
+            # Section 5.1: a reader returns (and tests) the symmetric part.
+            a = [[_round_f32((a[i][j] + a[j][i]) / 2) for j in range(4)] for i in range(4)]
         if not _cholesky_ok(a):
             _fail("numeric", "not_spd", f"component {k}")
         mats.append(a)
