@@ -18,7 +18,7 @@ PYTHON=${PYTHON:-python3}
 # numpy: the version pinned for the project's tooling.
 numpy_pin=$(grep -E '^numpy==' "$root/tools/requirements-dev.txt")
 index=${PIP_INDEX_URL:-https://pypi.org/simple}
-if ! "$PYTHON" - "$index/numpy/" <<'PY'
+if ! "$PYTHON" - "$index/numpy/" 2>/dev/null <<'PY'
 import sys, urllib.request
 urllib.request.urlopen(sys.argv[1], timeout=20).read(1)
 PY
