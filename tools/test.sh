@@ -2,8 +2,8 @@
 # Runs every test of the project: installs dependencies and builds (via
 # tools/setup.sh), runs the whole ctest suite (C++ core, format and
 # conformance, C API, Python, Rust and Go bindings, the cross-language
-# matrix, tools), then rebuilds the C API and core tests with
-# AddressSanitizer + UndefinedBehaviorSanitizer and runs them, runs
+# matrix, the manylinux wheel in a fresh venv, tools), then rebuilds the C API
+# and core tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, runs
 # the hardening tests and fuzz replays there, the concurrency tests under
 # ThreadSanitizer, and a seeded, bounded libFuzzer search per target.
 #

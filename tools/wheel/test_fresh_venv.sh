@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# ctest wheel_fresh_venv: the repaired wheel installs and works on a clean
+# machine. Builds the manylinux wheel around the Release build's libsogmm
+# (build_wheel.sh --lib: no second compile), installs it with the pinned numpy
+# from PyPI into a fresh venv outside the checkout, then runs smoke_test.py in
+# an emptied environment (no build folder on PATH, LD_LIBRARY_PATH or
+# PYTHONPATH, no SOGMM_LIBRARY_PATH, cwd outside the checkout) and checks with
+# ldd that libgomp resolves to the copy inside the wheel (sogmm.libs/).
+# Exits 77 (skipped) only when PyPI cannot be reached.
+#
+# Usage: bash tools/wheel/test_fresh_venv.sh LIBSOGMM OUT_DIR
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+lib=$1 out=$2
+PYTHON=${PYTHON:-python3}
+
+# numpy: the version pinned for the project's tooling.
+numpy_pin=$(grep -E '^numpy==' "$root/tools/requirements-dev.txt")
+index=${PIP_INDEX_URL:-https://pypi.org/simple}
+if ! "$PYTHON" - "$index/numpy/" 2>/dev/null <<'PY'
+import sys, urllib.request
+urllib.request.urlopen(sys.argv[1], timeout=20).read(1)
+PY
+then
+  echo "SKIP: $index is unreachable (the test installs $numpy_pin from it)"
+  exit 77
+fi
+
+SECONDS=0
+bash "$here/build_wheel.sh" --lib "$lib" --out "$out"
+echo "time: wheel build + repair ${SECONDS}s"
+wheel=$(ls "$out"/sogmm-*-manylinux_*.whl)
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+# The venv's own pip (ensurepip), no system site-packages.
+"$PYTHON" -m venv "$tmp/venv"
+vpy="$tmp/venv/bin/python"
+"$vpy" -m pip install -q --disable-pip-version-check --only-binary=:all: "$numpy_pin" "$wheel"
+echo "time: + venv and install ${SECONDS}s"
+
+mkdir "$tmp/run"
+cp "$here/smoke_test.py" "$tmp/run/"
+cd "$tmp/run"
+env -i PATH=/usr/bin:/bin HOME="$tmp" LANG=C.UTF-8 OMP_NUM_THREADS=2 \
+  "$vpy" -I smoke_test.py "$tmp/venv" "$root"
+echo "time: + smoke test ${SECONDS}s"
