@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "covariance_storage.hpp"
 #include "em_kernel.hpp"
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
@@ -41,34 +42,59 @@ void check_options(const EmOptions& o) {
           "EM truncation_nats must be finite and >= 0 (0 = exact), got " + checked::exact(o.truncation_nats));
 }
 
-// Points as four coordinate arrays (structure of arrays), padded to whole
-// blocks. Points are sorted along a Z-order curve of 5 cm voxels so that each
-// block is spatially compact: whole rows of negligible components can then be
-// skipped exactly, and the truncated E-step's bounds are tight. Sums run in
-// that (deterministic) order.
+// The frame the fit works in: the midpoint of the data's bounding box per
+// coordinate, so that every coordinate the float32 kernels see is at most half
+// the data's extent whatever its offset (a cloud 10 km from the origin is
+// fitted exactly as the same cloud at the origin), and the data's scale, from
+// which every floor that the user does not set is derived.
+struct Frame {
+  double origin[4];
+  double extent;  // largest side of the 4-D bounding box (> 0)
+
+  explicit Frame(const PointsView& pts) {
+    float lo[4], hi[4];
+    for (int j = 0; j < 4; ++j) lo[j] = hi[j] = pts[0][j];
+    for (std::size_t i = 1; i < pts.size; ++i)
+      for (int j = 0; j < 4; ++j) {
+        lo[j] = std::min(lo[j], pts[i][j]);
+        hi[j] = std::max(hi[j], pts[i][j]);
+      }
+    extent = 0.0;
+    for (int j = 0; j < 4; ++j) {
+      // Exact in double: float sums and halves need no rounding.
+      origin[j] = 0.5 * (static_cast<double>(lo[j]) + static_cast<double>(hi[j]));
+      extent = std::max(extent, static_cast<double>(hi[j]) - static_cast<double>(lo[j]));
+    }
+    if (!(extent > 0.0)) extent = 1.0;  // all points equal: any unit will do
+  }
+};
+
+// Points relative to the frame's origin as four coordinate arrays (structure
+// of arrays), padded to whole blocks. Points are sorted along a Z-order curve
+// of cells 2^-20 of the extent so that each block is spatially compact: whole
+// rows of negligible components can then be skipped exactly, and the truncated
+// E-step's bounds are tight. Sums run in that (deterministic) order, which a
+// translation or a scaling of the data does not change.
 struct SoaPoints {
   std::vector<float> x, y, z, g;
   std::size_t n = 0;
   std::size_t n_blocks = 0;
   std::vector<float> box;  // per block: min[4], max[4]
 
-  explicit SoaPoints(const PointsView& pts) : n(pts.size) {
+  SoaPoints(const PointsView& pts, const Frame& frame) : n(pts.size) {
     std::vector<std::uint32_t> order(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-    sort_by_z_order(pts, order);
+    sort_by_z_order(pts, frame, order);
     n_blocks = (n + kBlock - 1) / kBlock;
     const std::size_t padded = n_blocks * kBlock;
     x.assign(padded, 0.f);
     y.assign(padded, 0.f);
     z.assign(padded, 0.f);
     g.assign(padded, 0.f);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float* p = pts[order[i]];
-      x[i] = p[0];
-      y[i] = p[1];
-      z[i] = p[2];
-      g[i] = p[3];
-    }
+    float* out[4] = {x.data(), y.data(), z.data(), g.data()};
+    for (std::size_t i = 0; i < n; ++i)
+      for (int j = 0; j < 4; ++j)
+        out[j][i] = static_cast<float>(static_cast<double>(pts[order[i]][j]) - frame.origin[j]);
     box.resize(8 * n_blocks);
     for (std::size_t b = 0; b < n_blocks; ++b) {
       float* bb = &box[8 * b];
@@ -96,15 +122,15 @@ struct SoaPoints {
     v = (v | v << 2) & 0x1249249249249249ull;
     return v;
   }
-  static void sort_by_z_order(const PointsView& pts, std::vector<std::uint32_t>& order) {
-    float lo[3] = {INFINITY, INFINITY, INFINITY};
-    for (std::size_t i = 0; i < pts.size; ++i)
-      for (int j = 0; j < 3; ++j) lo[j] = std::min(lo[j], pts[i][j]);
+  static void sort_by_z_order(const PointsView& pts, const Frame& frame, std::vector<std::uint32_t>& order) {
+    const double cell = std::ldexp(frame.extent, -20);
     std::vector<std::uint64_t> key(pts.size);
     for (std::size_t i = 0; i < pts.size; ++i) {
       std::uint64_t c[3];
-      for (int j = 0; j < 3; ++j)
-        c[j] = checked::to_int<std::uint64_t>(std::min(2097151.0, std::floor((pts[i][j] - lo[j]) / 0.05)), "EM block cell");
+      for (int j = 0; j < 3; ++j) {
+        const double from_low = static_cast<double>(pts[i][j]) - frame.origin[j] + 0.5 * frame.extent;
+        c[j] = checked::to_int<std::uint64_t>(std::clamp(std::floor(from_low / cell), 0.0, 2097151.0), "EM block cell");
+      }
       key[i] = spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2;
     }
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
@@ -179,74 +205,113 @@ void truncated_log_density(const detail::EmKernels& kernels, const detail::Block
                       row_lp_max + first, max_lp);
 }
 
-// Writes component k's packed kernel parameters from its float covariance.
-// The precision Cholesky factor U = L^-T (covariance = L L^T) is computed in
-// double by a triangular solve. Returns false when the covariance is not
-// positive definite.
-bool pack_component(const Gmm& gmm, std::size_t k, double log_weight, float* out) {
-  Eigen::Matrix4d cov = Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
+// The fit's working model, in double and relative to the frame's origin:
+// float32 means would round every update to the float grid at the data's
+// offset (1 mm at 10 km), and float32 covariances cannot hold a thin
+// component of a large scene. float32 is only the kernels' and the storage's
+// type.
+struct Working {
+  std::vector<double> mean;        // M x 4, relative to Frame::origin
+  std::vector<double> covariance;  // M x 16, row-major
+  std::vector<double> log_weight;  // M
+  std::size_t size() const { return log_weight.size(); }
+};
+
+// Writes component k's packed kernel parameters. The precision Cholesky
+// factor U = L^-T (covariance = L L^T) is computed in double by a triangular
+// solve. Returns false when the covariance is not positive definite.
+bool pack_component(const Working& w, std::size_t k, float* out) {
+  const Eigen::Matrix4d cov = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&w.covariance[16 * k]);
   Eigen::LLT<Eigen::Matrix4d> llt(cov);
   if (llt.info() != Eigen::Success) return false;
   const Eigen::Matrix4d l = llt.matrixL();
   if (!(l.diagonal().minCoeff() > 0.0)) return false;
   const Eigen::Matrix4d u = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d::Identity()).transpose();
-  for (int i = 0; i < 4; ++i) out[i] = gmm.mean(k)[i];
+  for (int i = 0; i < 4; ++i) out[i] = static_cast<float>(w.mean[4 * k + i]);
   int t = 4;
   for (int i = 0; i < 4; ++i)
     for (int j = i; j < 4; ++j) out[t++] = static_cast<float>(u(i, j));
-  out[14] = static_cast<float>(log_weight + u.diagonal().array().log().sum() - 2.0 * kLog2Pi);
+  out[14] = static_cast<float>(w.log_weight[k] + u.diagonal().array().log().sum() - 2.0 * kLog2Pi);
   out[15] = 0.f;
   return std::isfinite(out[14]);
 }
 
-// Packs every component. A covariance that is numerically not positive
-// definite even after regularisation gets escalating extra diagonal loading
-// rather than producing NaN; if even that fails the fit stops with an error.
-void pack_all(Gmm& gmm, const std::vector<double>& log_weights, double reg_covar, std::vector<float>& params) {
-  const std::size_t m = gmm.size();
-  params.assign(m * kParamStride, 0.f);
-  for (std::size_t k = 0; k < m; ++k) {
-    double extra = std::max(reg_covar, 1e-12);
-    int attempts = 0;
-    while (!pack_component(gmm, k, log_weights[k], &params[k * kParamStride])) {
-      require(++attempts <= 12, ErrorCode::Numeric,
-              "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
-      float* c = gmm.covariances.data() + 16 * k;
-      for (int i = 0; i < 4; ++i) c[5 * i] += static_cast<float>(extra);
-      extra *= 10.0;
-    }
+// Makes component k's covariance numerically positive definite in double,
+// with escalating diagonal loading when it is not (reg_covar = 0 on a
+// degenerate component): first reg_covar or 1e-12 of the component's largest
+// variance (of the data's extent squared when it has none), then x10 up to
+// 12 times, so the loading follows the component's own scale.
+void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed) {
+  double* c = &w.covariance[16 * k];
+  double own = 0.0;
+  for (int i = 0; i < 4; ++i) own = std::max(own, c[5 * i]);
+  double extra = std::max(reg_covar, 1e-12 * (own > 0.0 ? own : data_scale2));
+  int attempts = 0;
+  while (!pack_component(w, k, packed)) {
+    require(++attempts <= 12, ErrorCode::Numeric,
+            "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
+    for (int i = 0; i < 4; ++i) c[5 * i] += extra;
+    extra *= 10.0;
   }
 }
 
-// M-step for one component from its centred statistics; returns sum r + guard.
-double m_step_component(const double* st, double reg_covar, float* mean, float* cov) {
+void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params) {
+  params.assign(w.size() * kParamStride, 0.f);
+  for (std::size_t k = 0; k < w.size(); ++k) make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride]);
+}
+
+// M-step for one component from its statistics, which are centred at the
+// packed (float32) mean `centre`; returns sum r + guard.
+double m_step_component(const double* st, double reg_covar, const float* centre, double* mean, double* cov) {
   const double nk = st[0] + kEmptyGuard;
   if (st[0] <= 0.0) {
     // No point is responsible: keep the mean, reset the shape to the regulariser.
-    for (int i = 0; i < 16; ++i) cov[i] = (i % 5 == 0) ? static_cast<float>(reg_covar) : 0.f;
+    for (int i = 0; i < 16; ++i) cov[i] = (i % 5 == 0) ? reg_covar : 0.0;
     return nk;
   }
   double delta[4];
   for (int i = 0; i < 4; ++i) delta[i] = st[1 + i] / nk;
-  // sum r (d - delta)(d - delta)^T / nk with d centred at the old mean.
+  // sum r (d - delta)(d - delta)^T / nk with d centred at the packed mean.
   const double shrink = st[0] / nk;
   int t = 5;
   for (int i = 0; i < 4; ++i) {
     for (int j = i; j < 4; ++j) {
       double c = st[t++] / nk - 2.0 * delta[i] * delta[j] + shrink * delta[i] * delta[j];
       if (i == j) c += reg_covar;
-      cov[4 * i + j] = cov[4 * j + i] = static_cast<float>(c);
+      cov[4 * i + j] = cov[4 * j + i] = c;
     }
   }
-  for (int i = 0; i < 4; ++i) mean[i] = static_cast<float>(mean[i] + delta[i]);
+  for (int i = 0; i < 4; ++i) mean[i] = static_cast<double>(centre[i]) + delta[i];
   return nk;
 }
 
-Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, const EmOptions& options,
-           EmReport* report, const EmIterationCallback& on_iteration) {
-  const std::size_t n = points.size, m = gmm.size();
+// The model handed out: means moved back from the frame, covariances checked
+// in double and rounded to float32 so that they stay positive definite.
+Gmm to_model(Working& w, const Frame& frame, double reg_covar, std::size_t n) {
+  const std::size_t m = w.size();
+  Gmm gmm;
+  gmm.resize(m);
+  std::vector<float> packed(kParamStride);
+  double max_lw = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < m; ++k) max_lw = std::max(max_lw, w.log_weight[k]);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < m; ++k) sum += std::exp(w.log_weight[k] - max_lw);
+  for (std::size_t k = 0; k < m; ++k) {
+    make_positive_definite(w, k, reg_covar, frame.extent * frame.extent, packed.data());
+    detail::store_covariance(&w.covariance[16 * k], &gmm.covariances[16 * k]);
+    for (int i = 0; i < 4; ++i) gmm.means[4 * k + i] = static_cast<float>(frame.origin[i] + w.mean[4 * k + i]);
+    gmm.weights[k] = static_cast<float>(std::exp(w.log_weight[k] - max_lw) / sum);
+  }
+  gmm.support_size = n;
+  return gmm;
+}
+
+Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOptions& options, EmReport* report,
+           const EmIterationCallback& on_iteration) {
+  const std::size_t n = points.size, m = w.size();
   const bool truncated = options.truncation_nats > 0;
-  const SoaPoints soa(points);
+  const double data_scale2 = frame.extent * frame.extent;
+  const SoaPoints soa(points, frame);
   const std::size_t n_blocks = soa.n_blocks;
   // Chunks as equal as possible and a whole number of full waves, so no wave
   // ends with a lone chunk that leaves threads idle.
@@ -259,27 +324,33 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
   std::vector<float> params;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
+  // Per chunk of a wave: its partial sums, reduced in chunk order afterwards
+  // (so the result does not depend on which thread ran which chunk).
   std::vector<double> slot_stats(kWave * m * kStatStride);
   std::vector<double> slot_ll(kWave);
   std::vector<double> slot_pairs(kWave);
-  std::vector<float> slot_scratch(kWave * (kBlock + 1) * m);
+  // Per thread: one block's log-density rows and row maxima, (kBlock + 1) x M
+  // floats, so the scratch is threads x block, not waves x block.
+  const std::size_t scratch_floats = checked::mul<std::size_t>(kBlock + 1, m, "EM scratch");
+  std::vector<float> thread_scratch(checked::mul<std::size_t>(static_cast<std::size_t>(threads), scratch_floats, "EM scratch"));
   // Truncated E-step: per block, the components that mattered last iteration.
   std::vector<std::vector<std::uint32_t>> warm(truncated ? n_blocks : 0);
   std::vector<double> stats(m * kStatStride);
+  std::vector<double> nk(m);
 
   EmReport rep;
   double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
   for (int iter = 1; iter <= options.max_iter; ++iter) {
-    pack_all(gmm, log_weights, options.reg_covar, params);
+    pack_all(w, options.reg_covar, data_scale2, params);
     std::fill(stats.begin(), stats.end(), 0.0);
     double total_ll = 0.0;
     for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
       const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
-      detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int) {
+      detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
         double* st = &slot_stats[s * m * kStatStride];
         std::fill(st, st + m * kStatStride, 0.0);
-        float* scratch = &slot_scratch[s * (kBlock + 1) * m];  // m rows, then m row maxima
+        float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
         float* row_max = scratch + m * kBlock;
         std::vector<std::uint32_t> list;
         std::vector<double> upper;
@@ -331,17 +402,12 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
 
     // M-step.
     double weight_sum = 0.0;
-    std::vector<double> nk(m);
     for (std::size_t k = 0; k < m; ++k) {
-      nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, gmm.means.data() + 4 * k,
-                               gmm.covariances.data() + 16 * k);
+      nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, &params[k * kParamStride], &w.mean[4 * k],
+                               &w.covariance[16 * k]);
       weight_sum += nk[k];
     }
-    for (std::size_t k = 0; k < m; ++k) {
-      const double w = nk[k] / weight_sum;
-      gmm.weights[k] = static_cast<float>(w);
-      log_weights[k] = std::log(w);
-    }
+    for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
 
     rep.iterations = iter;
     rep.log_likelihood = mean_ll;
@@ -353,9 +419,8 @@ Gmm run_em(const PointsView& points, Gmm gmm, std::vector<double> log_weights, c
     previous = mean_ll;
   }
   rep.pair_fraction = pairs_evaluated / (static_cast<double>(n) * m * rep.iterations);
-  gmm.support_size = n;
   if (report) *report = rep;
-  return gmm;
+  return to_model(w, frame, options.reg_covar, n);
 }
 
 }  // namespace
@@ -367,20 +432,21 @@ Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indice
   const std::size_t m = seed_indices.size();
   require(m >= 1 && m <= points.size, ErrorCode::InvalidArgument,
           "number of components must be in [1, N = " + std::to_string(points.size) + "], got " + std::to_string(m));
-  Gmm init;
-  init.resize(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    require(seed_indices[k] < points.size, ErrorCode::InvalidArgument,
-            "seed index " + std::to_string(seed_indices[k]) + " is out of range");
-    for (int i = 0; i < 4; ++i) init.means[4 * k + i] = points[seed_indices[k]][i];
-    for (int i = 0; i < 16; ++i) init.covariances[16 * k + i] = (i % 5 == 0) ? static_cast<float>(options.reg_covar) : 0.f;
-    init.weights[k] = 1.0f / static_cast<float>(m);
-  }
+  const Frame frame(points);
+  Working w;
+  w.mean.resize(4 * m);
+  w.covariance.assign(16 * m, 0.0);
   // One-hot responsibilities on the seeds give each component weight 1 / N
   // before normalisation (scikit-learn's _initialize); only the first
   // iteration's log-likelihood sees the difference.
-  std::vector<double> log_weights(m, -std::log(static_cast<double>(points.size)));
-  return run_em(points, std::move(init), std::move(log_weights), options, report, on_iteration);
+  w.log_weight.assign(m, -std::log(static_cast<double>(points.size)));
+  for (std::size_t k = 0; k < m; ++k) {
+    require(seed_indices[k] < points.size, ErrorCode::InvalidArgument,
+            "seed index " + std::to_string(seed_indices[k]) + " is out of range");
+    for (int i = 0; i < 4; ++i) w.mean[4 * k + i] = static_cast<double>(points[seed_indices[k]][i]) - frame.origin[i];
+    for (int i = 0; i < 4; ++i) w.covariance[16 * k + 5 * i] = options.reg_covar;
+  }
+  return run_em(points, std::move(w), frame, options, report, on_iteration);
 }
 
 Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options, EmReport* report,
@@ -388,10 +454,17 @@ Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& o
   check_options(options);
   require_finite_points(points, "EM input");
   validate(initial);
-  std::vector<double> log_weights(initial.size());
-  for (std::size_t k = 0; k < initial.size(); ++k)
-    log_weights[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
-  return run_em(points, initial, std::move(log_weights), options, report, on_iteration);
+  const Frame frame(points);
+  const std::size_t m = initial.size();
+  Working w;
+  w.mean.resize(4 * m);
+  w.covariance.assign(initial.covariances.begin(), initial.covariances.end());
+  w.log_weight.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    for (int i = 0; i < 4; ++i) w.mean[4 * k + i] = static_cast<double>(initial.mean(k)[i]) - frame.origin[i];
+    w.log_weight[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
+  }
+  return run_em(points, std::move(w), frame, options, report, on_iteration);
 }
 
 }  // namespace sogmm

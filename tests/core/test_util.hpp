@@ -125,6 +125,33 @@ inline void set_component(sogmm::Gmm& g, std::size_t k, double w, const Eigen::V
     for (int j = 0; j < 4; ++j) g.covariances[16 * k + 4 * i + j] = static_cast<float>(cov(i, j));
 }
 
+/// Mean log-likelihood per point of a (float32) model on points, in double
+/// (an independent check of the EM's own figure).
+inline double score(const sogmm::Gmm& g, const std::vector<float>& pts) {
+  const std::size_t n = pts.size() / 4, m = g.size();
+  std::vector<Eigen::Matrix4d> l(m);
+  std::vector<double> c(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    l[k] = Eigen::LLT<Eigen::Matrix4d>(cov_of(g, k)).matrixL();
+    c[k] = std::log(static_cast<double>(g.weights[k])) - l[k].diagonal().array().log().sum() - 2.0 * 1.8378770664093454836 /* log 2 pi */;
+  }
+  double total = 0.0;
+  std::vector<double> lp(m);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector4d x(pts[4 * i], pts[4 * i + 1], pts[4 * i + 2], pts[4 * i + 3]);
+    double best = -INFINITY;
+    for (std::size_t k = 0; k < m; ++k) {
+      const Eigen::Vector4d y = l[k].triangularView<Eigen::Lower>().solve(x - mean_of(g, k));
+      lp[k] = c[k] - 0.5 * y.squaredNorm();
+      best = std::max(best, lp[k]);
+    }
+    double s = 0.0;
+    for (std::size_t k = 0; k < m; ++k) s += std::exp(lp[k] - best);
+    total += best + std::log(s);
+  }
+  return total / static_cast<double>(n);
+}
+
 /// Small deterministic normal generator independent of sogmm::Rng (splitmix64
 /// + Box-Muller), for building synthetic data the core did not produce.
 class TestRng {

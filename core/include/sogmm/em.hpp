@@ -14,7 +14,14 @@ namespace sogmm {
 /// Parameters of the EM. Defaults are the paper's.
 struct EmOptions {
   double tol = 1e-3;        ///< stop when |change of mean log-likelihood| < tol
-  double reg_covar = 1e-6;  ///< added to every covariance diagonal in every M-step
+  /// Added to every covariance diagonal in every M-step, in the data's units
+  /// squared (the paper's 1e-6 m^2); the user's value is used as given. The
+  /// floors the fit adds on its own are relative: the loading that rescues a
+  /// covariance that is not positive definite starts at 1e-12 of the
+  /// component's largest variance (of the data's extent squared when it has
+  /// none), and the float32 storage of a covariance keeps it positive definite
+  /// with the least change (see fit_em).
+  double reg_covar = 1e-6;
   int max_iter = 100;       ///< at most this many E+M iterations
   int threads = 0;          ///< worker threads; 0 = all available cores; at most 4 x omp_get_num_procs()
   /// 0 (default): exact E-step, every point against every component.
@@ -48,10 +55,18 @@ using EmIterationCallback = std::function<void(int iteration, double log_likelih
 /// Fits a GMM by EM starting from one-hot responsibilities on the seed points
 /// (the paper's and scikit-learn's k-means++ initialisation): the first model
 /// has means = seed points, covariances = reg_covar I and equal weights.
-/// Memory is O(N + K): points are processed in fixed-size blocks through a
-/// fused E+M pass, and partial sums are reduced in a fixed order, so the
-/// result is bit-identical for any thread count. Parameters are float32; all
-/// sums are accumulated in double across blocks.
+/// Memory is O(N + threads x 257 x K + 16 x 15 x K): points are processed in
+/// fixed-size blocks through a fused E+M pass (scratch per thread), and
+/// partial sums of up to 16 chunks are reduced in a fixed order, so the
+/// result is bit-identical for any thread count.
+/// Precision: the fit works relative to the midpoint of the data's bounding
+/// box, so a cloud far from the origin is fitted as well as the same cloud at
+/// the origin; means and covariances are held in double between iterations
+/// (the block kernels run in float32, sums accumulate in double). Every
+/// covariance that leaves the fit is checked in double and rounded to float32
+/// so that it stays positive definite (an eigenvalue floor relative to the
+/// component's own largest eigenvalue only if no rounding is), so the model
+/// returned always passes validate().
 /// Throws Error(InvalidArgument) for bad options or seed indices, and
 /// Error(InvalidData) for empty or non-finite points.
 Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indices,

@@ -1,0 +1,132 @@
+// Rounding a fitted covariance to float32 storage (see covariance_storage.hpp).
+#include "covariance_storage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "sogmm/error.hpp"
+
+namespace sogmm::detail {
+namespace {
+
+using Mat4 = Eigen::Matrix4d;
+constexpr double kPlainRoundingNats = 1e-9;
+
+// Cholesky factor of `c` as validate() accepts it, or false.
+bool factor(const Mat4& c, Mat4& l) {
+  const Eigen::LLT<Mat4> llt(c);
+  if (llt.info() != Eigen::Success) return false;
+  l = llt.matrixL();
+  return l.diagonal().minCoeff() > 0.0;
+}
+
+// KL(N(0, S) || N(0, C)) from the Cholesky factors of S and C.
+double divergence(const Mat4& ls, const Mat4& lc) {
+  const Mat4 w = lc.triangularView<Eigen::Lower>().solve(ls);
+  const double log_det_ratio = 2.0 * (lc.diagonal().array().log().sum() - ls.diagonal().array().log().sum());
+  return 0.5 * (w.squaredNorm() - 4.0 + log_det_ratio);
+}
+
+// Steps 1-2 of store_covariance for one target; returns the divergence of the
+// best positive definite candidate written to `out`, or infinity.
+double best_rounding(const Mat4& s, const Mat4& ls, float* out) {
+  static constexpr int kRow[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 3};
+  static constexpr int kCol[10] = {0, 1, 2, 3, 1, 2, 3, 2, 3, 3};
+  float nearest[10], down[10], up[10];
+  for (int e = 0; e < 10; ++e) {
+    const double v = s(kRow[e], kCol[e]);
+    nearest[e] = static_cast<float>(v);
+    const double r = nearest[e];
+    down[e] = r <= v ? nearest[e] : std::nextafter(nearest[e], -std::numeric_limits<float>::infinity());
+    up[e] = r >= v ? nearest[e] : std::nextafter(nearest[e], std::numeric_limits<float>::infinity());
+  }
+  auto to_matrix = [](const float* entries) {
+    Mat4 c;
+    for (int e = 0; e < 10; ++e) c(kRow[e], kCol[e]) = c(kCol[e], kRow[e]) = entries[e];
+    return c;
+  };
+  auto write = [&](const float* entries) {
+    for (int e = 0; e < 10; ++e) out[4 * kRow[e] + kCol[e]] = out[4 * kCol[e] + kRow[e]] = entries[e];
+  };
+  Mat4 lc;
+  if (factor(to_matrix(nearest), lc)) {
+    const double d = divergence(ls, lc);
+    if (d <= kPlainRoundingNats) {
+      write(nearest);
+      return d;
+    }
+  }
+  double best = std::numeric_limits<double>::infinity();
+  float candidate[10];
+  for (int mask = 0; mask < 1024; ++mask) {
+    for (int e = 0; e < 10; ++e) candidate[e] = (mask >> e & 1) ? up[e] : down[e];
+    if (!factor(to_matrix(candidate), lc)) continue;
+    const double d = divergence(ls, lc);
+    if (d < best) {  // strict: the first of equals (lowest mask) wins, deterministically
+      best = d;
+      write(candidate);
+    }
+  }
+  if (!(best < std::numeric_limits<double>::infinity())) return best;
+  // Then move single entries by up to 8 float steps while that lowers the
+  // divergence: the corners only reach one step from each entry.
+  float current[10];
+  for (int e = 0; e < 10; ++e) current[e] = out[4 * kRow[e] + kCol[e]];
+  for (int pass = 0; pass < 16; ++pass) {
+    bool improved = false;
+    for (int e = 0; e < 10; ++e)
+      for (int step = -8; step <= 8; ++step) {
+        if (step == 0) continue;
+        std::copy(current, current + 10, candidate);
+        for (int i = 0; i < std::abs(step); ++i)
+          candidate[e] = std::nextafter(candidate[e], step > 0 ? std::numeric_limits<float>::infinity()
+                                                               : -std::numeric_limits<float>::infinity());
+        if (!factor(to_matrix(candidate), lc)) continue;
+        const double d = divergence(ls, lc);
+        if (d < best) {
+          best = d;
+          std::copy(candidate, candidate + 10, current);
+          improved = true;
+        }
+      }
+    if (!improved) break;
+  }
+  write(current);
+  return best;
+}
+
+}  // namespace
+
+double store_covariance(const double* cov, float* out) {
+  Mat4 s = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(cov);
+  s = 0.5 * (s + s.transpose());
+  Mat4 ls;
+  require(s.allFinite() && factor(s, ls), ErrorCode::Numeric,
+          "EM: a covariance to store is not positive definite");
+  const double d = best_rounding(s, ls, out);
+  if (d < std::numeric_limits<double>::infinity()) return d;
+  // Step 3: an eigenvalue floor relative to the component's largest one.
+  const Eigen::SelfAdjointEigenSolver<Mat4> eig(s);
+  const Eigen::Vector4d lambda = eig.eigenvalues();
+  for (double eps = std::ldexp(1.0, -23); eps <= 1.0; eps *= 4.0) {
+    const Eigen::Vector4d floored = lambda.cwiseMax(eps * lambda.maxCoeff());
+    const Mat4 f = eig.eigenvectors() * floored.asDiagonal() * eig.eigenvectors().transpose();
+    Mat4 lf;
+    if (!factor(f, lf)) continue;
+    if (best_rounding(f, lf, out) < std::numeric_limits<double>::infinity()) {
+      Mat4 lc;
+      Mat4 c = Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(out).cast<double>();
+      factor(c, lc);
+      return divergence(ls, lc);
+    }
+  }
+  throw Error(ErrorCode::Numeric, "EM: no positive definite float32 covariance near a fitted one");
+}
+
+}  // namespace sogmm::detail
