@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm::detail {
@@ -109,6 +110,11 @@ double store_covariance(const double* cov, float* out) {
   Mat4 ls;
   require(s.allFinite() && factor(s, ls), ErrorCode::Numeric,
           "EM: a covariance to store is not positive definite");
+  // float32 storage: an entry beyond its range has no float32 value (and the
+  // conversion would be undefined), so such a component cannot be stored.
+  require(s.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()), ErrorCode::Numeric,
+          "EM: a covariance entry is beyond the float32 range (" + checked::exact(s.cwiseAbs().maxCoeff()) +
+              "); scale the data down");
   const double d = best_rounding(s, ls, out);
   if (d < std::numeric_limits<double>::infinity()) return d;
   // Step 3: an eigenvalue floor relative to the component's largest one.

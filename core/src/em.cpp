@@ -61,7 +61,7 @@ struct Frame {
       }
     extent = 0.0;
     for (int j = 0; j < 4; ++j) {
-      // Exact in double: float sums and halves need no rounding.
+      // The origin need not be exact: it only has to be near the data's centre.
       origin[j] = 0.5 * (static_cast<double>(lo[j]) + static_cast<double>(hi[j]));
       extent = std::max(extent, static_cast<double>(hi[j]) - static_cast<double>(lo[j]));
     }

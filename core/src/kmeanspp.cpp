@@ -28,9 +28,9 @@ inline double dist2(const float* a, const float* b) {
 // A new seed q can only move a point p if |p - q|^2 < closest[p], so a node
 // whose box is at least `max_closest` (squared) away from q holds no point
 // that q gains or moves and is skipped whole. The test is exact: a box edge
-// is a point coordinate, and the difference of two floats is exact in double,
-// so the box distance as computed never exceeds a member's distance as
-// computed. The work per candidate is the points near it, not K clusters.
+// is a point coordinate, and rounding is monotone, so the box distance as
+// computed (each coordinate's gap to the box, no larger than to any member)
+// never exceeds a member's distance as computed. The work per candidate is the points near it, not K clusters.
 class SeedTree {
  public:
   SeedTree(const PointsView& points, std::vector<double>& closest) : points_(points), closest_(closest) {

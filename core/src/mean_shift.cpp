@@ -179,10 +179,13 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
   const double inv2s2 = 1.0 / (2.0 * bandwidth * bandwidth);
   const double stop2 = (1e-3 * bandwidth) * (1e-3 * bandwidth);
   std::vector<std::uint64_t> checks(n, 0);  // per point, summed over iterations
+  // Per point, summed in point order after the loop: an OpenMP reduction
+  // would add in thread order, and the stop test (so the iteration count and
+  // the modes) would depend on the thread count.
+  std::vector<double> moved2_of(n);
   for (int it = 0; it < max_iter; ++it) {
     const detail::Grid2d grid(xy.data(), n, radius);
-    double moved2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : moved2)
+#pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       double sw = 0.0, sx = 0.0, sy = 0.0;
       const double x = xy[2 * i], y = xy[2 * i + 1];
@@ -195,9 +198,11 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
       });
       next[2 * i] = sx / sw;
       next[2 * i + 1] = sy / sw;
-      moved2 += (next[2 * i] - x) * (next[2 * i] - x) + (next[2 * i + 1] - y) * (next[2 * i + 1] - y);
+      moved2_of[i] = (next[2 * i] - x) * (next[2 * i] - x) + (next[2 * i + 1] - y) * (next[2 * i + 1] - y);
     }
     xy.swap(next);
+    double moved2 = 0.0;
+    for (double m : moved2_of) moved2 += m;
     if (moved2 / n < stop2) break;
   }
   // Collapse the blurred points into modes: greedy assignment to a mode within

@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/model.hpp"
@@ -54,7 +55,9 @@ Model merge(const Model& a, const Model& b) {
   out.gmm = merge(a.gmm, b.gmm);
   if (a.fit.known && b.fit.known && same_fit_settings(a.fit, b.fit)) {
     out.fit = a.fit;
-    const std::int64_t n_iter = std::int64_t{a.fit.n_iter} + b.fit.n_iter;
+    // A file may hold any int32 here; a count of iterations is never negative,
+    // so each side counts from 0 and the sum saturates (spec/format.md 2.2).
+    const std::int64_t n_iter = std::int64_t{std::max(a.fit.n_iter, 0)} + std::max(b.fit.n_iter, 0);
     out.fit.n_iter = static_cast<std::int32_t>(std::min<std::int64_t>(n_iter, std::numeric_limits<std::int32_t>::max()));
     out.fit.converged = a.fit.converged && b.fit.converged;
     // Weighted as merge() weighs the components (support 0 on both: equally).
@@ -64,7 +67,9 @@ Model merge(const Model& a, const Model& b) {
   }
   if (same_camera(a.camera, b.camera)) out.camera = a.camera;
   if (frame != "camera") out.key_values.emplace_back(kCoordinateFrameKey, frame);
-  out.key_values.emplace_back(kMergedFitsKey, std::to_string(fit_count(a) + fit_count(b)));
+  // Counts read from files may be as large as 19 digits: the sum is checked.
+  out.key_values.emplace_back(kMergedFitsKey,
+                              std::to_string(checked::add(fit_count(a), fit_count(b), "merge: merged_fits")));
   return out;
 }
 

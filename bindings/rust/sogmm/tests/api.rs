@@ -45,7 +45,7 @@ fn arrays_round_trip_bitwise() {
 #[test]
 fn regression_matches_closed_form() {
     // Gaussian conditioning: mean = 0.5 + 0.2 * x, variance = 0.5 - 0.2^2.
-    // Both points are within 2.3 sigma: far out (beyond ~5 sigma) the answer
+    // Both points are within 2.3 sigma: far out (beyond ~6.5 sigma) the answer
     // blends towards the prior on purpose (sogmm.h, sogmm_model_regress_gray).
     let (mean, var) = one_gaussian().regress_gray(&[1.0, 0.0, 0.0, -2.0, 0.5, 1.0]).unwrap();
     assert!((mean[0] - 0.7).abs() < 1e-6 && (mean[1] - 0.1).abs() < 1e-6, "{mean:?}");
