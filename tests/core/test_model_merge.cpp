@@ -92,4 +92,24 @@ TEST(ModelMerge, IterationTotalSaturates) {
   EXPECT_EQ(sogmm::merge(a, b).fit.n_iter, std::numeric_limits<std::int32_t>::max());
 }
 
+// A file may hold any int32 as n_iter: a negative one counts as 0, so the
+// total never falls (the sum of two INT32_MIN would wrap to 0 or worse).
+TEST(ModelMerge, NegativeIterationCountsAsZero) {
+  const Model a = fitted(0.f, 1, std::numeric_limits<std::int32_t>::min(), true, 0.0),
+              b = fitted(1.f, 1, 5, true, 0.0);
+  EXPECT_EQ(sogmm::merge(a, b).fit.n_iter, 5);
+  EXPECT_EQ(sogmm::merge(a, a).fit.n_iter, 0);
+}
+
+// merged_fits read from files may hold up to 19 digits; a sum beyond 2^64 - 1
+// is a Limit error, not a wrapped count.
+TEST(ModelMerge, FitCountOverflowIsALimitError) {
+  Model a = fitted(0.f, 1, 1, true, 0.0), b = fitted(1.f, 1, 1, true, 0.0);
+  a.key_values.emplace_back("merged_fits", "9999999999999999999");
+  b.key_values.emplace_back("merged_fits", "9999999999999999999");
+  expect_error([&] { sogmm::merge(a, b); }, sogmm::ErrorCode::Limit, {"merged_fits"}, "merged_fits overflow");
+  b.key_values.back().second = "2";
+  EXPECT_EQ(value(sogmm::merge(a, b), "merged_fits"), "10000000000000000001");
+}
+
 }  // namespace
