@@ -27,6 +27,7 @@ const (
 	ErrBufferTooSmall Status = C.SOGMM_E_BUFFER_TOO_SMALL
 	ErrNotFound       Status = C.SOGMM_E_NOT_FOUND
 	ErrInternal       Status = C.SOGMM_E_INTERNAL
+	ErrCancelled      Status = C.SOGMM_E_CANCELLED // a progress func or the context stopped the call
 )
 
 // ErrClosed is returned by methods of a handle after Close.
@@ -38,10 +39,14 @@ func (s Status) Error() string {
 }
 
 // Error is a failed call: its status and the message naming what was wrong.
-// errors.Is(err, sogmm.ErrInvalidArg) and the like hold through Unwrap.
+// errors.Is(err, sogmm.ErrInvalidArg) and the like hold through Unwrap. A
+// cancelled call (ErrCancelled) carries its Cause: the context's error or the
+// error the progress func returned, so errors.Is(err, context.Canceled) holds
+// too.
 type Error struct {
 	Status  Status
 	Message string
+	Cause   error
 }
 
 func (e *Error) Error() string {
@@ -49,8 +54,13 @@ func (e *Error) Error() string {
 		int32(e.Status), e.Message)
 }
 
-// Unwrap returns the Status, for errors.Is and errors.As.
-func (e *Error) Unwrap() error { return e.Status }
+// Unwrap returns the Status and the Cause (if any), for errors.Is and errors.As.
+func (e *Error) Unwrap() []error {
+	if e.Cause == nil {
+		return []error{e.Status}
+	}
+	return []error{e.Status, e.Cause}
+}
 
 // call runs one C call and, on failure, reads the thread-local message on the
 // same OS thread: the goroutine is locked to its thread for both (git2go's

@@ -32,6 +32,7 @@ sogmm_status map_code(sogmm::ErrorCode code) noexcept {
     case sogmm::ErrorCode::Io: return SOGMM_E_IO;
     case sogmm::ErrorCode::Format: return SOGMM_E_FORMAT;
     case sogmm::ErrorCode::Limit: return SOGMM_E_LIMIT;
+    case sogmm::ErrorCode::Cancelled: return SOGMM_E_CANCELLED;
   }
   return SOGMM_E_INTERNAL;
 }
@@ -94,6 +95,7 @@ SOGMM_API const char* sogmm_status_string(sogmm_status status) {
     case SOGMM_E_BUFFER_TOO_SMALL: return "output buffer too small";
     case SOGMM_E_NOT_FOUND: return "not found";
     case SOGMM_E_INTERNAL: return "internal error";
+    case SOGMM_E_CANCELLED: return "cancelled by the progress callback";
     default: return "unknown status";
   }
 }

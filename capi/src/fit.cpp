@@ -47,7 +47,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   sogmm::PointsView view;
   view.data = points;
   view.size = n;
-  sogmm::FitResult r = sogmm::fit(view, fo);
+  sogmm::FitResult r = sogmm::fit(view, fo, sogmm_capi::progress_sink(o));
 
   auto handle = std::make_unique<sogmm_model>();
   sogmm::Model& m = handle->model;

@@ -1,7 +1,9 @@
 // Inference on a model: sample, regress gray, score, merge, transform.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
@@ -52,8 +54,16 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
     if (n == 0) return SOGMM_OK;
     require_nonnull(out, "out");
     sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "samples");
-    const double truncation = sogmm_capi::opts_or_default(options).sample_truncation;
-    sogmm::sample(model->model.gmm, n, seed, dims, out, truncation);
+    const sogmm_options& o = sogmm_capi::opts_or_default(options);
+    if (!o.progress) {
+      sogmm::sample(model->model.gmm, n, seed, dims, out, o.sample_truncation);
+    } else {
+      // A cancel must leave `out` untouched: draw into a buffer, copy on success.
+      std::vector<float> drawn(n * static_cast<std::size_t>(dims));
+      const sogmm::ProgressScope scope(sogmm_capi::progress_sink(o));
+      sogmm::sample(model->model.gmm, n, seed, dims, drawn.data(), o.sample_truncation);
+      std::copy(drawn.begin(), drawn.end(), out);
+    }
   }
   SOGMM_CATCH
 }

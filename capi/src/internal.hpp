@@ -15,6 +15,7 @@
 #include "sogmm/camera.hpp"
 #include "sogmm/model.hpp"
 #include "sogmm/point_cloud.hpp"
+#include "sogmm/progress.hpp"
 #include "sogmm/sogmm.h"
 
 // ---- handles -----------------------------------------------------------
@@ -45,6 +46,9 @@ struct sogmm_options {
   std::int64_t verify_checksums = 1;
   // sample
   double sample_truncation = 2.5;
+  // progress (sogmm_options_set_progress): not a key, never stored in files
+  sogmm_progress_fn progress = nullptr;
+  void* progress_user_data = nullptr;
 };
 
 /// Timings of a fit run in this process (not part of the file format).
@@ -89,6 +93,9 @@ sogmm_status handle_current_exception() noexcept;
 
 /// Milliseconds since 1970 UTC, for Model::created_unix_ms.
 std::int64_t creation_time_now();
+
+/// The options' progress callback as a core sink (empty without one).
+sogmm::ProgressSink progress_sink(const sogmm_options& o);
 
 /// Shared defaults for "NULL options".
 const sogmm_options& default_options();

@@ -28,7 +28,21 @@ void check_f64(sogmm_key key, double v, bool ok, const char* range) {
 
 }  // namespace
 
+// The C stages are the core's numbers (documented as stable there).
+static_assert(static_cast<int>(sogmm::Stage::ModeCount) == SOGMM_STAGE_MODE_COUNT);
+static_assert(static_cast<int>(sogmm::Stage::Seeding) == SOGMM_STAGE_SEEDING);
+static_assert(static_cast<int>(sogmm::Stage::Em) == SOGMM_STAGE_EM);
+static_assert(static_cast<int>(sogmm::Stage::Run) == SOGMM_STAGE_RUN);
+static_assert(static_cast<int>(sogmm::Stage::Sampling) == SOGMM_STAGE_SAMPLING);
+
 namespace sogmm_capi {
+sogmm::ProgressSink progress_sink(const sogmm_options& o) {
+  if (!o.progress) return {};
+  return [fn = o.progress, user_data = o.progress_user_data](const sogmm::Progress& p) {
+    return fn(static_cast<std::int32_t>(p.stage), p.step, p.total, p.log_likelihood, user_data) != 0;
+  };
+}
+
 const sogmm_options& default_options() {
   static const sogmm_options defaults{};
   return defaults;
@@ -57,6 +71,15 @@ SOGMM_API sogmm_status sogmm_options_clone(sogmm_options** out, const sogmm_opti
 }
 
 SOGMM_API void sogmm_options_free(sogmm_options* options) { delete options; }
+
+SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_progress_fn fn, void* user_data) {
+  SOGMM_TRY {
+    sogmm_capi::require_nonnull(options, "options");
+    options->progress = fn;
+    options->progress_user_data = fn ? user_data : nullptr;
+  }
+  SOGMM_CATCH
+}
 
 SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key key, double v) {
   SOGMM_TRY {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "parallel.hpp"
+#include "progress.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
@@ -31,7 +32,7 @@ class ScopedOmpThreads {
 };
 }  // namespace
 
-FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress) {
+FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   // Limits first: nothing is read or allocated for an oversized request.
   require(points.size <= kMaxPoints, ErrorCode::Limit,
@@ -56,12 +57,13 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
   // Every parallel loop of the fit (mode count, seeding, EM) uses this many.
   const int threads = detail::team_size(options.em.threads);
   const ScopedOmpThreads scoped_threads(threads);
+  const ProgressScope progress_scope(progress);
 
   FitResult result;
   result.n_points = points.size;
   std::size_t k = options.n_components;
   if (!fixed_k) {
-    if (progress) progress(FitStage::ModeCount, 0, 0.0);
+    detail::progress_begin(Stage::ModeCount, 0);
     const auto t = std::chrono::steady_clock::now();
     const std::vector<double> features = range_gray_features(points);
     const MeanShiftResult modes = options.mode_counter == ModeCounter::FlatBinned
@@ -77,19 +79,22 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
 
   EmOptions em = options.em;
   em.threads = threads;
-  EmIterationCallback on_iteration;
-  if (progress) on_iteration = [&progress](int iteration, double ll) { progress(FitStage::Em, iteration, ll); };
+  const EmIterationCallback on_iteration = [](int iteration, double ll) {
+    detail::progress_event(static_cast<std::uint64_t>(iteration), ll);
+  };
   // Runs are sequential, each using every thread, so the kept model is the
   // same for any thread count.
   for (int run = 0; run < options.n_init; ++run) {
-    if (progress && options.n_init > 1)
-      progress(FitStage::Run, run + 1, run == 0 ? 0.0 : result.em.log_likelihood);
-    if (progress) progress(FitStage::Seeding, static_cast<int>(k), 0.0);
+    if (options.n_init > 1) {
+      detail::progress_begin(Stage::Run, static_cast<std::uint64_t>(options.n_init));
+      detail::progress_event(static_cast<std::uint64_t>(run) + 1, run == 0 ? 0.0 : result.em.log_likelihood);
+    }
+    detail::progress_begin(Stage::Seeding, k);
     auto t = std::chrono::steady_clock::now();
     const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed + static_cast<std::uint64_t>(run));
     result.seconds_seeding += seconds_since(t);
 
-    if (progress) progress(FitStage::Em, 0, 0.0);
+    detail::progress_begin(Stage::Em, static_cast<std::uint64_t>(em.max_iter));
     t = std::chrono::steady_clock::now();
     EmReport report;
     Gmm gmm = fit_em(points, seeds, em, &report, on_iteration);

@@ -156,12 +156,14 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
     ++counts[std::min(k, m - 1)];
   }
   const TruncatedNormal truncated(truncation);
+  detail::progress_begin(Stage::Sampling, n);
   std::size_t row = 0;
   for (std::size_t k = 0; k < m; ++k) {
     if (counts[k] == 0) continue;
     const Mat4 l = Eigen::LLT<Mat4>(covariance_of(gmm, k)).matrixL();
     const Eigen::Vector4d mu = mean_of(gmm, k);
     for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
+      if (row % kPointsPerChunk == 0) detail::progress_at(row);
       Eigen::Vector4d z;
       for (int i = 0; i < 4; ++i) z[i] = std::isinf(truncation) ? rng.normal() : truncated(rng);
       const Eigen::Vector4d x = mu + l * z;

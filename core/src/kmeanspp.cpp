@@ -225,6 +225,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
   std::vector<std::size_t> candidates(trials);
   std::vector<double> gain(trials);
   for (std::size_t c = 1; c < k; ++c) {
+    detail::progress_at(c);
     // Candidates drawn with probability proportional to the squared distance
     // to the nearest seed (as scikit-learn: uniform * potential, searched in
     // the running sum).

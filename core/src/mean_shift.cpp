@@ -8,6 +8,8 @@
 #include <utility>
 
 #include "grid2d.hpp"
+#include "parallel.hpp"
+#include "progress.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
@@ -140,9 +142,9 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   const double stop = options.stop_fraction * bandwidth;
   std::vector<Mode> modes(n_seeds);
   std::vector<std::uint64_t> checks(n_seeds, 0);  // per seed, summed in seed order after the loop
-
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::size_t s = 0; s < n_seeds; ++s) {
+  detail::progress_begin(Stage::ModeCount, n_seeds);
+  detail::parallel_for(n_seeds, detail::team_size(0), 16, [&](std::size_t s, int thread) {
+    if (thread == 0) detail::progress_at(s);
     double mx = seeds[2 * s], my = seeds[2 * s + 1];
     std::size_t within = 0;
     for (int it = 0;; ++it) {
@@ -162,7 +164,7 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
       if (moved <= stop || it == options.max_iter) break;
     }
     modes[s] = {mx, my, within};
-  }
+  });
   // Seeds that saw no point are not modes.
   modes.erase(std::remove_if(modes.begin(), modes.end(), [](const Mode& m) { return m.strength == 0; }), modes.end());
   std::uint64_t total = 0;
@@ -183,10 +185,11 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
   // would add in thread order, and the stop test (so the iteration count and
   // the modes) would depend on the thread count.
   std::vector<double> moved2_of(n);
+  detail::progress_begin(Stage::ModeCount, static_cast<std::uint64_t>(max_iter));
   for (int it = 0; it < max_iter; ++it) {
+    detail::progress_at(static_cast<std::uint64_t>(it));
     const detail::Grid2d grid(xy.data(), n, radius);
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
+    detail::parallel_for(n, detail::team_size(0), 256, [&](std::size_t i, int) {
       double sw = 0.0, sx = 0.0, sy = 0.0;
       const double x = xy[2 * i], y = xy[2 * i + 1];
       checks[i] += grid.for_each_within(x, y, radius, [&](std::uint32_t j) {
@@ -199,7 +202,7 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
       next[2 * i] = sx / sw;
       next[2 * i + 1] = sy / sw;
       moved2_of[i] = (next[2 * i] - x) * (next[2 * i] - x) + (next[2 * i + 1] - y) * (next[2 * i + 1] - y);
-    }
+    });
     xy.swap(next);
     double moved2 = 0.0;
     for (double m : moved2_of) moved2 += m;

@@ -16,6 +16,8 @@
 #include <exception>
 #include <mutex>
 
+#include "progress.hpp"
+
 namespace sogmm::detail {
 
 /// Threads per processor above which no team grows (see team_size).
@@ -39,12 +41,18 @@ inline int team_size(int requested) {
 /// below `threads`, for indexing per-thread scratch allocated beforehand. If
 /// a call throws, the calls not yet started are skipped and the first
 /// exception is rethrown on the calling thread once the team has finished.
+/// Thread 0 (the calling thread) polls the progress sink at the start of each
+/// chunk it takes, so a cancel (a throw there) stops every thread within one
+/// chunk.
 template <class Body>
 void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& body) {
   // One thread: a plain loop (same order as a one-thread team), without the
   // cost of opening a parallel region, e.g. once per k-means++ step.
   if (threads <= 1) {
-    for (std::size_t i = 0; i < n; ++i) body(i, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i % std::max<std::size_t>(chunk, 1) == 0) progress_poll();
+      body(i, 0);
+    }
     return;
   }
   std::atomic<bool> failed{false};
@@ -55,7 +63,9 @@ void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& bod
   for (std::size_t i = 0; i < n; ++i) {
     if (failed.load(std::memory_order_relaxed)) continue;
     try {
-      body(i, omp_get_thread_num());
+      const int thread = omp_get_thread_num();
+      if (thread == 0 && i % step == 0) progress_poll();
+      body(i, thread);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(error_mutex);
       if (!first_error) first_error = std::current_exception();

@@ -18,7 +18,7 @@ static void test_versions_and_errors(void) {
     sogmm_status codes[] = {SOGMM_OK, SOGMM_E_NULL_ARG, SOGMM_E_INVALID_ARG, SOGMM_E_INVALID_DATA,
                             SOGMM_E_NUMERIC, SOGMM_E_IO, SOGMM_E_FORMAT, SOGMM_E_LIMIT,
                             SOGMM_E_NOMEM, SOGMM_E_BUFFER_TOO_SMALL, SOGMM_E_NOT_FOUND,
-                            SOGMM_E_INTERNAL};
+                            SOGMM_E_INTERNAL, SOGMM_E_CANCELLED};
     size_t i, j;
     for (i = 0; i < sizeof codes / sizeof codes[0]; ++i) {
       EXPECT_TRUE(sogmm_status_string(codes[i]) != NULL);

@@ -237,16 +237,18 @@ TEST(Em, LogLikelihoodNonDecreasingAndStagesReported) {
   o.bandwidth = 0.05;
   o.seed = 3;
   std::vector<double> lls;
-  std::vector<sogmm::FitStage> stages;
-  const sogmm::FitResult r = sogmm::fit({m.points.data(), m.labels.size()}, o,
-                                        [&](sogmm::FitStage s, int, double ll) {
-                                          stages.push_back(s);
-                                          if (s == sogmm::FitStage::Em) lls.push_back(ll);
-                                        });
+  std::vector<sogmm::Stage> stages;
+  const sogmm::FitResult r = sogmm::fit({m.points.data(), m.labels.size()}, o, [&](const sogmm::Progress& p) {
+    stages.push_back(p.stage);
+    // One value per iteration: heartbeats repeat the last step.
+    if (p.stage == sogmm::Stage::Em && p.step == lls.size() + 1) lls.push_back(p.log_likelihood);
+    return false;
+  });
   EXPECT_TRUE(sogmm_test::model_is_valid(r.gmm));
   ASSERT_FALSE(stages.empty());
-  EXPECT_EQ(stages.front(), sogmm::FitStage::ModeCount);
-  EXPECT_EQ(stages.back(), sogmm::FitStage::Em);
+  EXPECT_EQ(stages.front(), sogmm::Stage::ModeCount);
+  EXPECT_EQ(stages.back(), sogmm::Stage::Em);
+  EXPECT_EQ(lls.size(), static_cast<std::size_t>(r.em.iterations)) << "one report per EM iteration";
   ASSERT_GE(lls.size(), 2u);
   for (std::size_t i = 2; i < lls.size(); ++i)  // EM never decreases the likelihood (up to reg_covar / float noise)
     EXPECT_GE(lls[i], lls[i - 1] - 1e-5) << "iteration " << i;
@@ -321,8 +323,9 @@ TEST(Runs, KeepTheBestOfSingleFitsWithConsecutiveSeeds) {
   o.n_init = 4;
   o.em.threads = 2;
   std::vector<int> runs_reported;
-  const sogmm::FitResult best = sogmm::fit(v, o, [&](sogmm::FitStage s, int i, double) {
-    if (s == sogmm::FitStage::Run) runs_reported.push_back(i);
+  const sogmm::FitResult best = sogmm::fit(v, o, [&](const sogmm::Progress& p) {
+    if (p.stage == sogmm::Stage::Run && p.step > 0) runs_reported.push_back(static_cast<int>(p.step));
+    return false;
   });
   EXPECT_EQ(runs_reported, std::vector<int>({1, 2, 3, 4}));
   ASSERT_EQ(best.run_log_likelihoods.size(), 4u);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <new>
 
+#include "sigint_cancel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
@@ -149,15 +150,30 @@ void ProgressPrinter::em_done(const std::string& label, const FitResult& r) {
   show(label + ": " + buf, true);
 }
 
-FitProgress ProgressPrinter::fit_callback(const std::string& label) {
-  if (mode_ == ProgressMode::Off) return {};
+ProgressSink ProgressPrinter::fit_callback(const std::string& label) {
   struct Clock {
     std::chrono::steady_clock::time_point start;
     std::string done;  // finished stages, "mode count 0.04 s, seeding 0.12 s"
     const char* current = nullptr;
+    Stage stage{};
+    std::uint64_t step = 0;
+    bool started = false;
   };
   auto c = std::make_shared<Clock>();
-  return [this, c, label](FitStage stage, int iteration, double ll) {
+  return [this, c, label](const Progress& p) {
+    if (SigintCancel::requested()) return true;
+    if (mode_ == ProgressMode::Off) return false;
+    // A stage starts when the stage changes or EM restarts at step 0 (a new
+    // run); other reports of the same stage are iterations or heartbeats.
+    const bool starts = !c->started || p.stage != c->stage || (p.step == 0 && c->step != 0);
+    const bool new_step = !starts && p.step != c->step;
+    c->started = true;
+    c->stage = p.stage;
+    c->step = p.step;
+    if (!starts && !(p.stage == Stage::Em && new_step) && p.stage != Stage::Run) return false;
+    const Stage stage = p.stage;
+    const int iteration = static_cast<int>(p.step);
+    const double ll = p.log_likelihood;
     const auto now = std::chrono::steady_clock::now();
     char buf[160];
     auto close_stage = [&]() {
@@ -171,7 +187,7 @@ FitProgress ProgressPrinter::fit_callback(const std::string& label) {
         show(label + ": " + buf, true);
       }
     };
-    if (stage == FitStage::Em && iteration > 0) {  // after an EM iteration
+    if (stage == Stage::Em && iteration > 0) {  // after an EM iteration
       const double s = std::chrono::duration<double>(now - c->start).count();
       std::snprintf(buf, sizeof buf, "EM iteration %d, mean log-likelihood %.4f (%.3f s)", iteration, ll, s);
       // Live: every iteration on one line; lines: every 10th, to keep logs short.
@@ -180,23 +196,25 @@ FitProgress ProgressPrinter::fit_callback(const std::string& label) {
       } else {
         show(label + ": " + c->done + (c->done.empty() ? "" : "; ") + buf, false);
       }
-      return;
+      return false;
     }
+    if (stage == Stage::Run && iteration == 0) return false;  // the Run stage's start; its event follows
     close_stage();
-    if (stage == FitStage::Run) {  // a new run of k-means++ + EM starts
+    if (stage == Stage::Run) {  // a new run of k-means++ + EM starts
       c->current = nullptr;
       if (iteration > 1) std::snprintf(buf, sizeof buf, "run %d (best mean log-likelihood so far %.4f)", iteration, ll);
       else std::snprintf(buf, sizeof buf, "run %d", iteration);
       show(label + ": " + buf, mode_ == ProgressMode::Lines);
-      return;
+      return false;
     }
-    c->current = stage == FitStage::ModeCount ? "mode count" : stage == FitStage::Seeding ? "seeding" : "EM";
+    c->current = stage == Stage::ModeCount ? "mode count" : stage == Stage::Seeding ? "seeding" : "EM";
     c->start = now;
-    const std::string what = stage == FitStage::ModeCount ? "mode count (mean shift)..."
-                             : stage == FitStage::Seeding ? "seeding (k-means++)..."
-                                                          : "EM...";
+    const std::string what = stage == Stage::ModeCount ? "mode count (mean shift)..."
+                             : stage == Stage::Seeding ? "seeding (k-means++)..."
+                                                       : "EM...";
     show(label + ": " + (mode_ == ProgressMode::Live && !c->done.empty() ? c->done + "; " : std::string()) + what,
          mode_ == ProgressMode::Lines);
+    return false;
   };
 }
 
@@ -220,6 +238,10 @@ int run_guarded(const std::function<int()>& body) {
   try {
     return body();
   } catch (const Error& e) {
+    if (e.code() == ErrorCode::Cancelled) {
+      std::fprintf(stderr, "sogmm: interrupted: %s; nothing written\n", e.what());
+      return kExitInterrupted;
+    }
     std::fprintf(stderr, "sogmm: error: %s\n", e.what());
     switch (e.code()) {
       case ErrorCode::InvalidArgument: return kExitUsage;

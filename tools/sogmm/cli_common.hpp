@@ -16,7 +16,8 @@
 namespace sogmm::tools {
 
 /// Exit codes of every sogmm tool.
-enum ExitCode { kExitOk = 0, kExitUsage = 2, kExitInvalidData = 3, kExitIo = 4 };
+/// kExitInterrupted: cancelled by SIGINT (128 + 2, the shell's convention).
+enum ExitCode { kExitOk = 0, kExitUsage = 2, kExitInvalidData = 3, kExitIo = 4, kExitInterrupted = 130 };
 
 /// Camera given on the command line: --intrinsics FILE, or all of
 /// --width --height --fx --fy --cx --cy.
@@ -101,8 +102,13 @@ ProgressMode progress_mode(bool quiet, bool lines);
 class ProgressPrinter {
  public:
   explicit ProgressPrinter(ProgressMode mode) : mode_(mode) {}
-  /// The callback for sogmm::fit(); stage times are measured between calls.
-  FitProgress fit_callback(const std::string& label);
+  ~ProgressPrinter() { finish(); }
+  ProgressPrinter(const ProgressPrinter&) = delete;
+  ProgressPrinter& operator=(const ProgressPrinter&) = delete;
+  /// The sink for sogmm::fit(): prints stages (times measured between
+  /// reports) and cancels once SIGINT arrived (see SigintCancel), in every
+  /// mode, Off included.
+  ProgressSink fit_callback(const std::string& label);
   /// A line that stays (e.g. "frame 2/3 done"): printed in Lines and Live modes.
   void line(const std::string& text);
   /// "EM done in T s: I iterations, mean log-likelihood L" after a fit (Lines mode).

@@ -10,6 +10,7 @@
 #include "file_util.hpp"
 #include "model_io.hpp"
 #include "sequence.hpp"
+#include "sigint_cancel.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/metadata_string.hpp"
@@ -216,6 +217,7 @@ Command add_fit_command(CLI::App& root) {
   CLI::App* a = app;
   return {app, [s, a]() {
             check_output_path(s->output);
+            const SigintCancel ctrl_c;  // Ctrl-C cancels the fits; the output is written only after them
             const bool single = !s->src.depth.empty() || !s->src.color.empty();
             require(single != !s->src.sequence.empty(), ErrorCode::InvalidArgument,
                     "fit: give --depth D --color C, or --sequence DIR --trajectory FILE");

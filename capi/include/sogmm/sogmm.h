@@ -110,6 +110,7 @@ typedef int32_t sogmm_status;
 #define SOGMM_E_BUFFER_TOO_SMALL (-9) /* a caller's output capacity is too small */
 #define SOGMM_E_NOT_FOUND (-10)       /* the requested value is not present (unknown metadata) */
 #define SOGMM_E_INTERNAL (-11)        /* unexpected internal error (a bug: please report) */
+#define SOGMM_E_CANCELLED (-12)       /* the progress callback returned non-zero (sogmm_progress_fn) */
 
 /* Static, never-NULL description of a status, e.g. "invalid argument".
  * Unknown codes give "unknown status". */
@@ -189,6 +190,44 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
 SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key key, int64_t value);
 SOGMM_API sogmm_status sogmm_options_get_f64(const sogmm_options* options, sogmm_key key, double* out);
 SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm_key key, int64_t* out);
+
+/* ---- progress and cancel ---------------------------------------------- */
+/* Stages reported to a progress callback. New stages are only appended:
+ * pass unknown numbers through. `step` counts work done in the stage,
+ * `total` is 0 when unknown. */
+#define SOGMM_STAGE_MODE_COUNT 1 /* mean shift; step/total: seeds (flat) or iterations (blurring) */
+#define SOGMM_STAGE_SEEDING 2    /* k-means++; step/total: components seeded / K */
+#define SOGMM_STAGE_EM 3         /* EM; step: iterations done (0 at the start), total: max_iter;
+                                  * log_likelihood: mean per point of the last iteration's E-step */
+#define SOGMM_STAGE_RUN 4        /* SOGMM_OPT_N_INIT > 1 only: run `step` (from 1) of `total` starts;
+                                  * log_likelihood: the best final value of the runs before (0 at first) */
+#define SOGMM_STAGE_SAMPLING 5   /* sogmm_model_sample_f32; step/total: points drawn / requested */
+
+/* Progress callback. Return 0 to continue; any non-zero value cancels: the
+ * call stops within one report interval, frees everything it allocated,
+ * writes no output (handle out-pointers get NULL, output arrays are left
+ * untouched) and returns SOGMM_E_CANCELLED, with a last-error message naming
+ * the stage. Thread: called only on the thread that called the sogmm_*
+ * function, inside that call, one call at a time (never on a worker thread,
+ * never after the call returned), so it may use thread-affine state (the
+ * Python GIL and signal handling, a thread-local error). Cadence: at the start
+ * of each stage, after each EM iteration, and during long loops at most about
+ * 20 ms apart (plus one work chunk, a few milliseconds), so that a cancel
+ * takes effect within about 50 ms. Within a stage, `step` never decreases.
+ * Rules: return quickly; do not call sogmm_* functions from the callback
+ * (they would overwrite the thread's last error); never throw, longjmp or
+ * unwind out of it. Results never depend on the callback (only whether the
+ * call finishes). */
+typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t total, double log_likelihood,
+                                     void* user_data);
+
+/* Sets the progress callback of `options` (fn = NULL removes it); user_data
+ * is passed through and not owned. sogmm_options_clone copies the pair.
+ * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
+ * sogmm_fit_rgbd (from the mode count on) and sogmm_model_sample_f32
+ * (which then draws into a temporary buffer: n * dims floats more memory);
+ * other functions ignore it. Bindings set it on a private clone for one call. */
+SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_progress_fn fn, void* user_data);
 
 /* ---- fitting ---------------------------------------------------------- */
 /* Fits a model to n points (x, y, z, gray): `points` holds n * 4 floats.

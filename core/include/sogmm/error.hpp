@@ -18,6 +18,7 @@ enum class ErrorCode {
   Io = 4,               ///< a file could not be read or written
   Format = 5,           ///< a file or buffer is not a valid .sogmm / JSON document
   Limit = 6,            ///< input exceeds a documented resource limit
+  Cancelled = 7,        ///< a progress sink asked to stop (sogmm/progress.hpp)
 };
 
 /// Exception carrying an ErrorCode and a human-readable, one-line message.

@@ -11,6 +11,7 @@
 #include "sogmm/gmm.hpp"
 #include "sogmm/mean_shift.hpp"
 #include "sogmm/point_cloud.hpp"
+#include "sogmm/progress.hpp"
 
 namespace sogmm {
 
@@ -52,17 +53,6 @@ struct FitOptions {
 /// Upper bound of FitOptions::n_init.
 inline constexpr int kMaxRuns = 1000;
 
-/// Which stage a fit is in, for progress reports.
-enum class FitStage { ModeCount, Seeding, Em, Run };
-
-/// Called at the start of each stage and after each EM iteration; may be
-/// empty. ModeCount: (0, 0). Run (only when n_init > 1): (r, best), before
-/// run r (from 1) starts, with the best final mean log-likelihood of the runs
-/// so far (0 before the first). Seeding: (K, 0), the number of components about
-/// to be seeded. Em: (0, 0) at the start, then (iteration, mean
-/// log-likelihood of that iteration's E-step) after each iteration.
-using FitProgress = std::function<void(FitStage stage, int iteration, double log_likelihood)>;
-
 /// A fitted model and how it was obtained.
 struct FitResult {
   Gmm gmm;
@@ -80,7 +70,11 @@ struct FitResult {
 /// Error(Limit) for N > kMaxPoints or K > kMaxComponents (checked before the
 /// points are read), Error(InvalidArgument) for bandwidth <= 0, K outside
 /// [1, N] or n_init outside [1, kMaxRuns], Error(InvalidData) for an empty or non-finite cloud, Error(Numeric)
-/// if the result fails validation.
-FitResult fit(const PointsView& points, const FitOptions& options, const FitProgress& progress = {});
+/// if the result fails validation, Error(Cancelled) when a progress sink
+/// cancels. `progress` (may be empty) is installed as a ProgressScope for the
+/// call: stages ModeCount (skipped for a fixed K), then per run Run (only when
+/// n_init > 1), Seeding and Em, whose log-likelihood after each iteration is
+/// that iteration's E-step mean. The result does not depend on the sink.
+FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress = {});
 
 }  // namespace sogmm

@@ -15,6 +15,7 @@ from . import _ffi
 from .camera import Camera, rgbd_to_points
 from .errors import (
     BufferTooSmallError,
+    CancelledError,
     FormatError,
     InternalError,
     InvalidArgumentError,
@@ -50,6 +51,7 @@ def library_path() -> str:
 __all__ = [
     "ABI_VERSION",
     "BufferTooSmallError",
+    "CancelledError",
     "Camera",
     "FormatError",
     "GMM",

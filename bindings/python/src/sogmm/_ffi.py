@@ -102,6 +102,9 @@ HANDLE_OUT = POINTER(c_void_p)  # sogmm_xxx**
 STATUS = c_int32
 KEY = c_int32
 
+# sogmm_progress_fn: (stage, step, total, log_likelihood, user_data) -> 0 / non-zero = cancel.
+PROGRESS_FN = ctypes.CFUNCTYPE(c_int32, c_int32, c_uint64, c_uint64, c_double, c_void_p)
+
 # name -> (restype, argtypes). Keep in the order of sogmm.h.
 _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_version_number": (c_uint32, []),
@@ -116,6 +119,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_options_set_i64": (STATUS, [HANDLE, KEY, c_int64]),
     "sogmm_options_get_f64": (STATUS, [HANDLE, KEY, POINTER(c_double)]),
     "sogmm_options_get_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
+    "sogmm_options_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
     "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
     "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
     "sogmm_fit_rgbd": (

@@ -100,6 +100,12 @@ class InternalError(SogmmError, RuntimeError):
     status = -11
 
 
+class CancelledError(SogmmError):
+    """The progress callback stopped the call (it returned a true value)."""
+
+    status = -12
+
+
 class NotFittedError(SogmmError, AttributeError):
     """A fitted attribute or method was used before ``fit``."""
 
@@ -118,6 +124,7 @@ _BY_STATUS = {
         BufferTooSmallError,
         NotFoundError,
         InternalError,
+        CancelledError,
     )
 }
 

@@ -19,6 +19,7 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, NotFittedError, NotFoundError
+from .progress import ProgressArg, call_with_progress
 
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
 
@@ -568,25 +569,33 @@ class SOGMM(GMM):
                 raise InvalidArgumentError(f"option {key} must be a number, got {v!r}")
         return _ffi.Options(f64=f64, i64=i64)
 
-    def fit(self, X, y=None) -> "SOGMM":
-        """Fits the model to (n, 4) points (x, y, z, gray). Returns self."""
+    def fit(self, X, y=None, progress: ProgressArg = None) -> "SOGMM":
+        """Fits the model to (n, 4) points (x, y, z, gray). Returns self.
+
+        progress: None, True (a tqdm bar per stage) or a callable(stage, step,
+        total, log_likelihood) called on this thread about every 20 ms (stages:
+        sogmm.progress.STAGE_*); a truthy return cancels the fit with
+        CancelledError, an exception it raises cancels and is re-raised. Ctrl-C
+        cancels the fit and raises KeyboardInterrupt. A cancelled fit leaves
+        the estimator as it was."""
         x = _rows(X, (4,), "X")
         out = c_void_p()
         with self._fit_options() as o:
-            check(lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
+            call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
         self._attach(out)
         return self
 
     def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = 1000.0, depth_min: float = 0.1,
-                 depth_trunc: float = 3.0, decimate: int = 1) -> "SOGMM":
+                 depth_trunc: float = 3.0, decimate: int = 1, progress: ProgressArg = None) -> "SOGMM":
         """Fits the model to one RGB-D frame (arguments as :func:`sogmm.rgbd_to_points`).
 
         The C library back-projects the frame (uint8 gray, uint8 RGB or float
-        gray) and records the camera in the model (``camera_``). Returns self."""
+        gray) and records the camera in the model (``camera_``). progress and
+        Ctrl-C as :meth:`fit`. Returns self."""
         f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
         out = c_void_p()
         with self._fit_options(f.f64, f.i64) as o:
-            check(lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr))
+            call_with_progress(o, progress, lambda: lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr))
         self._attach(out)
         return self
 

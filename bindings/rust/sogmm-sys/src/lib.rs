@@ -33,6 +33,10 @@ pub struct sogmm_buffer {
 
 pub type sogmm_status = i32;
 pub type sogmm_key = i32;
+/// Progress callback: (stage, step, total, log_likelihood, user_data) -> 0 to
+/// continue, non-zero to cancel. Called only on the calling thread.
+pub type sogmm_progress_fn =
+    Option<unsafe extern "C" fn(stage: i32, step: u64, total: u64, log_likelihood: f64, user_data: *mut c_void) -> i32>;
 
 // ---- versions -------------------------------------------------------------
 pub const SOGMM_VERSION_MAJOR: u32 = 0;
@@ -54,6 +58,7 @@ pub const SOGMM_E_NOMEM: sogmm_status = -8;
 pub const SOGMM_E_BUFFER_TOO_SMALL: sogmm_status = -9;
 pub const SOGMM_E_NOT_FOUND: sogmm_status = -10;
 pub const SOGMM_E_INTERNAL: sogmm_status = -11;
+pub const SOGMM_E_CANCELLED: sogmm_status = -12;
 
 // ---- option keys ----------------------------------------------------------
 pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;
@@ -78,6 +83,13 @@ pub const SOGMM_OPT_COMPRESS: sogmm_key = 302;
 pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
 pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
 pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
+
+// ---- progress stages --------------------------------------------------------
+pub const SOGMM_STAGE_MODE_COUNT: i32 = 1;
+pub const SOGMM_STAGE_SEEDING: i32 = 2;
+pub const SOGMM_STAGE_EM: i32 = 3;
+pub const SOGMM_STAGE_RUN: i32 = 4;
+pub const SOGMM_STAGE_SAMPLING: i32 = 5;
 
 // ---- color formats --------------------------------------------------------
 pub const SOGMM_COLOR_GRAY8: i32 = 1;
@@ -127,6 +139,11 @@ extern "C" {
     pub fn sogmm_options_set_i64(options: *mut sogmm_options, key: sogmm_key, value: i64) -> sogmm_status;
     pub fn sogmm_options_get_f64(options: *const sogmm_options, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_options_get_i64(options: *const sogmm_options, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_options_set_progress(
+        options: *mut sogmm_options,
+        fn_: sogmm_progress_fn,
+        user_data: *mut c_void,
+    ) -> sogmm_status;
     pub fn sogmm_fit_points_f32(
         out: *mut *mut sogmm_model,
         points: *const f32,

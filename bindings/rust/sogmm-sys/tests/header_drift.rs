@@ -188,9 +188,60 @@ fn rust_consts(lib: &str) -> BTreeMap<String, String> {
     out
 }
 
+/// `typedef R (*sogmm_x_fn)(args);` of the header: name -> (argument types,
+/// return type), as header_protos.
+fn header_callbacks(header: &str) -> Protos {
+    let mut out = Protos::new();
+    for stmt in c_declarations(header).split(';') {
+        let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
+        let Some(rest) = decl.strip_prefix("typedef ") else { continue };
+        let Some(star) = rest.find("(*") else { continue };
+        let ret = rest[..star].trim();
+        let name_end = rest[star..].find(')').unwrap() + star;
+        let name = rest[star + 2..name_end].trim().to_string();
+        let args_text = &rest[name_end + 1..];
+        let args_text = args_text.trim().trim_start_matches('(').trim_end_matches(')');
+        let args = args_text.split(',').map(|a| rust_type(&split_param(a))).collect();
+        let ret = if ret == "void" { None } else { Some(rust_type(ret)) };
+        out.insert(name, (args, ret));
+    }
+    out
+}
+
+/// `pub type sogmm_x_fn = Option<unsafe extern "C" fn(a: T, ...) -> R>;` of the crate.
+fn rust_callbacks(lib: &str) -> Protos {
+    let mut out = Protos::new();
+    for stmt in lib.split(';') {
+        let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
+        let Some(at) = decl.find("pub type ") else { continue };
+        let decl = &decl[at + "pub type ".len()..];
+        let Some((name, ty)) = decl.split_once(" = Option<unsafe extern \"C\" fn(") else { continue };
+        let close = ty.rfind(')').unwrap();
+        let args = ty[..close]
+            .split(',')
+            .filter(|a| !a.trim().is_empty())
+            .map(|a| a.split_once(':').expect("argument without a name").1.trim().to_string())
+            .collect();
+        let ret = ty[close + 1..].trim().trim_end_matches('>').trim().strip_prefix("->").map(|r| r.trim().to_string());
+        out.insert(name.trim().to_string(), (args, ret));
+    }
+    out
+}
+
 /// Every difference between the header and the crate, one line each.
 fn drift(header: &str, lib: &str) -> Vec<String> {
     let mut problems = Vec::new();
+    let (hcb, rcb) = (header_callbacks(header), rust_callbacks(lib));
+    for (name, c) in &hcb {
+        match rcb.get(name) {
+            None => problems.push(format!("{name}: callback type in sogmm.h, missing in sogmm-sys")),
+            Some(rs) if rs != c => problems.push(format!("{name}: sogmm.h says {c:?}, sogmm-sys says {rs:?}")),
+            Some(_) => {}
+        }
+    }
+    for name in rcb.keys().filter(|n| !hcb.contains_key(*n)) {
+        problems.push(format!("{name}: callback type in sogmm-sys, not in sogmm.h"));
+    }
     let (h, r) = (header_protos(header), rust_protos(lib));
     for (name, c) in &h {
         match r.get(name) {
@@ -264,9 +315,14 @@ fn drift_is_detected() {
             "sogmm_abi_version",
         ),
         (
-            "#define SOGMM_E_INTERNAL (-11)",
-            "#define SOGMM_E_INTERNAL (-11)\n#define SOGMM_E_CANCELLED (-12)",
-            "SOGMM_E_CANCELLED",
+            "#define SOGMM_E_CANCELLED (-12)",
+            "#define SOGMM_E_CANCELLED (-12)\n#define SOGMM_E_NEXT (-13)",
+            "SOGMM_E_NEXT",
+        ),
+        (
+            "double log_likelihood,\n                                     void* user_data);",
+            "float log_likelihood,\n                                     void* user_data);",
+            "sogmm_progress_fn",
         ),
         (
             "#define SOGMM_OPT_N_INIT 109",

@@ -21,6 +21,8 @@ pub enum Status {
     BufferTooSmall,
     NotFound,
     Internal,
+    /// A progress callback asked to stop (SOGMM_E_CANCELLED).
+    Cancelled,
     Unknown(i32),
 }
 
@@ -38,6 +40,7 @@ impl Status {
             sys::SOGMM_E_BUFFER_TOO_SMALL => Status::BufferTooSmall,
             sys::SOGMM_E_NOT_FOUND => Status::NotFound,
             sys::SOGMM_E_INTERNAL => Status::Internal,
+            sys::SOGMM_E_CANCELLED => Status::Cancelled,
             other => Status::Unknown(other),
         }
     }
@@ -56,6 +59,7 @@ impl Status {
             Status::BufferTooSmall => sys::SOGMM_E_BUFFER_TOO_SMALL,
             Status::NotFound => sys::SOGMM_E_NOT_FOUND,
             Status::Internal => sys::SOGMM_E_INTERNAL,
+            Status::Cancelled => sys::SOGMM_E_CANCELLED,
             Status::Unknown(c) => c,
         }
     }

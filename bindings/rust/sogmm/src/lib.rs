@@ -24,6 +24,7 @@
 pub mod error;
 pub mod model;
 pub mod options;
+pub mod progress;
 
 use std::ffi::CStr;
 use std::sync::OnceLock;
@@ -31,6 +32,7 @@ use std::sync::OnceLock;
 pub use error::{Error, Result, Status};
 pub use model::{Color, Frame, Model};
 pub use options::{ModeCounter, Options, OptionsBuilder};
+pub use progress::{Progress, Stage};
 pub use sogmm_sys as sys;
 
 /// "MAJOR.MINOR.PATCH" of the loaded library.

@@ -7,6 +7,8 @@ use sogmm_sys as sys;
 
 use crate::error::{check, Error, Result, Status};
 use crate::options::{opt_ptr, Options};
+use crate::progress::{with_progress, Progress};
+use std::ops::ControlFlow;
 
 /// A fitted 4-D GMM (x, y, z, gray) with its metadata. Arrays come out as
 /// row-major `Vec`s: weights (M), means (M x 4), covariances (M x 4 x 4).
@@ -166,6 +168,34 @@ impl Model {
         Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, opt_ptr(options)) })
     }
 
+    /// As `fit`, reporting progress to `on_progress` (called only on this
+    /// thread, during the call; see `Progress`). Returning
+    /// `ControlFlow::Break(())` cancels: the result is `Err` with
+    /// `Status::Cancelled` and no model. A panic in the closure cancels the
+    /// fit too and then resumes on this thread once the library returned.
+    pub fn fit_with_progress(
+        points: &[f32],
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        crate::ensure_abi()?;
+        with_progress(options, on_progress, |o| {
+            // SAFETY: as fit; `o` is a valid options handle for the call.
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, o) })
+        })
+    }
+
+    /// As `fit_rgbd`, with progress and cancel as `fit_with_progress`.
+    pub fn fit_rgbd_with_progress(
+        frame: &Frame<'_>,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Model> {
+        crate::ensure_abi()?;
+        with_progress(options, on_progress, |o| Model::fit_rgbd_raw(frame, o))
+    }
+
     /// Fits exactly `k` components (1 <= k <= n).
     pub fn fit_fixed_k(points: &[f32], k: usize, options: Option<&Options>) -> Result<Model> {
         let n = rows(points, 4, "points")?;
@@ -175,6 +205,11 @@ impl Model {
 
     /// Fits one RGB-D frame; decimation and depth range come from `options`.
     pub fn fit_rgbd(frame: &Frame<'_>, options: Option<&Options>) -> Result<Model> {
+        Model::fit_rgbd_raw(frame, opt_ptr(options))
+    }
+
+    /// fit_rgbd with a raw options pointer (NULL = defaults).
+    fn fit_rgbd_raw(frame: &Frame<'_>, options: *const sys::sogmm_options) -> Result<Model> {
         let (color, format) = frame.color_args()?;
         // SAFETY: color_args checked the slices against width x height.
         Model::make(|out| unsafe {
@@ -189,7 +224,7 @@ impl Model {
                 frame.fy,
                 frame.cx,
                 frame.cy,
-                opt_ptr(options),
+                options,
             )
         })
     }

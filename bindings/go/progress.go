@@ -1,0 +1,125 @@
+package sogmm
+
+/*
+#include <stdint.h>
+#include "sogmm/sogmm.h"
+sogmm_status sogmm_go_set_progress(sogmm_options* options, uintptr_t handle);
+*/
+import "C"
+
+import (
+	"context"
+	"runtime/cgo"
+)
+
+// Stage is what a long call is doing (SOGMM_STAGE_*). The library may add
+// stages; pass unknown values through.
+type Stage int32
+
+const (
+	StageModeCount Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
+	StageSeeding   Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
+	StageEM        Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
+	StageRun       Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
+	StageSampling  Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
+)
+
+// Progress is one report. Total is 0 when unknown; LogLikelihood is the mean
+// per point of the last EM iteration (StageEM) or of the best run so far
+// (StageRun), else 0. Reports come at each stage start, after each EM
+// iteration and about every 20 ms during long loops; Step never decreases
+// within a stage.
+type Progress struct {
+	Stage         Stage
+	Step, Total   uint64
+	LogLikelihood float64
+}
+
+// ProgressFunc receives reports on the goroutine that made the call, during
+// the call. A non-nil error cancels: the call returns an *Error with Status
+// ErrCancelled and that error as Cause, and no model.
+type ProgressFunc func(Progress) error
+
+// progressState lives for one call, behind a cgo.Handle. The library calls
+// back only on the calling thread (locked by call()), one report at a time,
+// so its fields need no lock.
+type progressState struct {
+	ctx      context.Context
+	fn       ProgressFunc
+	cause    error
+	panicked bool
+	panicVal any
+}
+
+//export sogmmGoProgress
+func sogmmGoProgress(stage C.int32_t, step, total C.uint64_t, ll C.double, handle C.uintptr_t) (stop C.int32_t) {
+	s := cgo.Handle(handle).Value().(*progressState)
+	if s.cause != nil || s.panicked {
+		return 1
+	}
+	// A panic must not unwind through the C++ frames: keep it and raise it
+	// again once the library has returned.
+	defer func() {
+		if r := recover(); r != nil {
+			s.panicked, s.panicVal = true, r
+			stop = 1
+		}
+	}()
+	if err := context.Cause(s.ctx); err != nil {
+		s.cause = err
+		return 1
+	}
+	if s.fn != nil {
+		if err := s.fn(Progress{Stage(stage), uint64(step), uint64(total), float64(ll)}); err != nil {
+			s.cause = err
+			return 1
+		}
+	}
+	return 0
+}
+
+// withProgress runs create with a private copy of o (nil = defaults) that
+// reports to fn and watches ctx; ctx's error or fn's becomes the Cause of
+// the ErrCancelled error, and a panic in fn is raised again here.
+func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
+	create func(private *Options) (*Model, error)) (*Model, error) {
+	var private *Options
+	var err error
+	if o == nil {
+		private, err = NewOptions()
+	} else {
+		private, err = o.Clone()
+	}
+	if err != nil {
+		return nil, err
+	}
+	defer private.Close()
+	state := &progressState{ctx: ctx, fn: fn}
+	h := cgo.NewHandle(state)
+	defer h.Delete()
+	if err := private.do(func(p *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_go_set_progress(p, C.uintptr_t(h))
+	}); err != nil {
+		return nil, err
+	}
+	m, err := create(private)
+	if state.panicked {
+		panic(state.panicVal)
+	}
+	if e, ok := err.(*Error); ok && e.Status == ErrCancelled {
+		e.Cause = state.cause
+	}
+	return m, err
+}
+
+// FitContext is Fit with cancellation: it stops within about 50 ms once ctx
+// is done (the error then satisfies errors.Is(err, ErrCancelled) and
+// errors.Is(err, ctx.Err())) and reports progress to fn (may be nil).
+func FitContext(ctx context.Context, points []float32, o *Options, fn ProgressFunc) (*Model, error) {
+	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return Fit(points, p) })
+}
+
+// FitRGBDContext is FitRGBD with cancellation and progress as FitContext.
+func FitRGBDContext(ctx context.Context, f Frame, o *Options, fn ProgressFunc) (*Model, error) {
+	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return FitRGBD(f, p) })
+}

@@ -1,0 +1,17 @@
+// C side of the progress callback: the trampoline the library calls, which
+// forwards to the exported Go function, and the setter that turns a
+// cgo.Handle (an integer) into the void* user_data in C, so that no Go code
+// converts an integer to a pointer.
+#include <stdint.h>
+
+#include "_cgo_export.h"
+#include "sogmm/sogmm.h"
+
+static int32_t sogmm_go_trampoline(int32_t stage, uint64_t step, uint64_t total, double log_likelihood,
+                                   void* user_data) {
+  return sogmmGoProgress(stage, step, total, log_likelihood, (uintptr_t)user_data);
+}
+
+sogmm_status sogmm_go_set_progress(sogmm_options* options, uintptr_t handle) {
+  return sogmm_options_set_progress(options, sogmm_go_trampoline, (void*)handle);
+}

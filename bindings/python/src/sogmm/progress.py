@@ -1,0 +1,122 @@
+"""Progress reports and cancellation of long C calls (sogmm_progress_fn).
+
+The library calls the progress callback only on the thread that made the
+call, during the call, about every 20 ms. That makes it the point where Python
+can act while C runs: a callable may cancel (truthy return), an exception in
+it cancels and is re-raised after the call, and Ctrl-C cancels the fit and
+raises KeyboardInterrupt.
+
+Ctrl-C: Python runs signal handlers only on the main thread, between bytecodes,
+so during a C call nothing happens until the callback runs Python code. On the
+main thread, while the default handler is active, the call installs a handler
+that only records SIGINT; the callback sees the record and cancels, and
+KeyboardInterrupt is raised once the library has returned (cleanly, with
+nothing allocated left behind). Elsewhere, an exception the current handler
+raises inside the callback is caught and re-raised the same way.
+"""
+from __future__ import annotations
+
+import signal
+import threading
+from typing import Callable, Optional, Union
+
+from . import _ffi
+from ._ffi import check, lib
+
+#: Stage numbers of sogmm.h (SOGMM_STAGE_*) and their names.
+STAGE_MODE_COUNT = 1
+STAGE_SEEDING = 2
+STAGE_EM = 3
+STAGE_RUN = 4
+STAGE_SAMPLING = 5
+STAGE_NAMES = {
+    STAGE_MODE_COUNT: "mode count",
+    STAGE_SEEDING: "seeding",
+    STAGE_EM: "EM",
+    STAGE_RUN: "run",
+    STAGE_SAMPLING: "sampling",
+}
+
+#: progress= accepts None, True (a tqdm bar) or callable(stage, step, total, log_likelihood) -> truthy cancels.
+ProgressArg = Union[None, bool, Callable[[int, int, int, float], object]]
+
+
+class _TqdmSink:
+    """One tqdm bar per stage: step of total, the EM log-likelihood as postfix."""
+
+    def __init__(self):
+        try:
+            from tqdm.auto import tqdm
+        except ImportError as e:  # pragma: no cover - tqdm is pinned for the tests
+            raise ImportError("progress=True needs tqdm (pip install tqdm)") from e
+        self._tqdm = tqdm
+        self._bar = None
+        self._stage = None
+
+    def __call__(self, stage: int, step: int, total: int, log_likelihood: float) -> bool:
+        if stage != self._stage or self._bar is None:
+            self.close()
+            self._stage = stage
+            self._bar = self._tqdm(total=total or None, desc=STAGE_NAMES.get(stage, f"stage {stage}"),
+                                   leave=False)
+        if step > self._bar.n:
+            self._bar.update(step - self._bar.n)
+        if stage == STAGE_EM and step > 0:
+            self._bar.set_postfix(loglik=f"{log_likelihood:.4f}", refresh=False)
+        return False
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+
+def _sink(progress: ProgressArg):
+    if progress is None or progress is False:
+        return None
+    if progress is True:
+        return _TqdmSink()
+    if callable(progress):
+        return progress
+    raise TypeError(f"progress must be None, True or a callable(stage, step, total, log_likelihood), got {progress!r}")
+
+
+def call_with_progress(options: _ffi.Options, progress: ProgressArg, c_call: Callable[[], int]) -> None:
+    """Runs ``c_call()`` (one C call using ``options``, returning its status)
+    with the progress callback set on ``options``; raises what the call or the
+    callback raised, KeyboardInterrupt on Ctrl-C, CancelledError when the
+    callable returned a truthy value."""
+    sink = _sink(progress)
+    state = {"error": None, "sigint": False}
+
+    def callback(stage, step, total, log_likelihood, _user_data):
+        try:
+            if state["error"] is None and not state["sigint"] and sink is not None:
+                if sink(int(stage), int(step), int(total), float(log_likelihood)):
+                    return 1
+        except BaseException as e:  # KeyboardInterrupt too: never let it unwind into C
+            state["error"] = e
+        # Checked last: a SIGINT handled while this function ran counts now.
+        return 1 if state["error"] is not None or state["sigint"] else 0
+
+    c_callback = _ffi.PROGRESS_FN(callback)  # kept alive by this frame during the call
+    check(lib.sogmm_options_set_progress(options.ptr, c_callback, None))
+    previous = None
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        def on_sigint(signum, frame):
+            state["sigint"] = True
+
+        previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        status = c_call()
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+        if isinstance(sink, _TqdmSink):
+            sink.close()
+    if state["error"] is not None:
+        raise state["error"]
+    if state["sigint"]:
+        raise KeyboardInterrupt
+    check(status)

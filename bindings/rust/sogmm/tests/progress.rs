@@ -1,0 +1,87 @@
+//! Progress reports and cancellation through the closure API.
+use std::ops::ControlFlow;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use sogmm::{Model, Options, Progress, Stage, Status};
+
+/// Deterministic cloud: n points uniform in a unit cube (fixed LCG), so EM
+/// with several components runs many iterations.
+fn cube(n: usize) -> Vec<f32> {
+    let mut s: u64 = 99;
+    (0..4 * n)
+        .map(|_| {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        })
+        .collect()
+}
+
+fn opts() -> Options {
+    Options::builder().n_components(8).tol(1e-12).max_iter(25).seed(5).threads(2).build().unwrap()
+}
+
+#[test]
+fn reports_em_iterations_in_order_and_change_nothing() {
+    let pts = cube(3000);
+    let mut seen: Vec<Progress> = Vec::new();
+    let m = Model::fit_with_progress(&pts, Some(&opts()), |p| {
+        seen.push(p);
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    let plain = Model::fit(&pts, Some(&opts())).unwrap();
+    assert_eq!(m.means().unwrap(), plain.means().unwrap(), "progress changed the model");
+    assert_eq!(m.covariances().unwrap(), plain.covariances().unwrap());
+    let iterations = m.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap().unwrap() as u64;
+    // Stages in order: seeding then EM (fixed K: no mode count).
+    assert_eq!(seen.first().unwrap().stage, Stage::Seeding);
+    assert_eq!(seen.last().unwrap().stage, Stage::Em);
+    let em: Vec<&Progress> = seen.iter().filter(|p| p.stage == Stage::Em).collect();
+    assert!(em.windows(2).all(|w| w[0].step <= w[1].step), "EM steps decrease: {em:?}");
+    assert!(em.iter().all(|p| p.total == 25));
+    let mut steps: Vec<u64> = em.iter().map(|p| p.step).collect();
+    steps.dedup();
+    assert_eq!(steps, (0..=iterations).collect::<Vec<_>>(), "every iteration reported once");
+    let last = em.last().unwrap().log_likelihood;
+    assert_eq!(last, m.info_f64(sogmm::sys::SOGMM_INFO_FIT_LOG_LIKELIHOOD).unwrap().unwrap());
+}
+
+#[test]
+fn break_cancels_with_no_model() {
+    let pts = cube(3000);
+    let mut calls = 0;
+    let r = Model::fit_with_progress(&pts, Some(&opts()), |p| {
+        calls += 1;
+        if p.stage == Stage::Em && p.step == 2 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    let e = r.unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+    assert_eq!(e.code(), sogmm::sys::SOGMM_E_CANCELLED);
+    assert!(e.message().contains("EM iteration 2"), "{}", e.message());
+    let after = calls;
+    assert!(after >= 3);
+    // The options passed in are untouched: a later fit has no callback.
+    assert!(Model::fit(&pts, Some(&opts())).is_ok());
+}
+
+#[test]
+fn a_panic_cancels_then_resumes_here() {
+    let pts = cube(3000);
+    let mut after_panic = 0;
+    let r = catch_unwind(AssertUnwindSafe(|| {
+        Model::fit_with_progress(&pts, Some(&opts()), |p| {
+            if p.stage == Stage::Em && p.step >= 1 {
+                after_panic += 1;
+                panic!("boom");
+            }
+            ControlFlow::Continue(())
+        })
+    }));
+    let payload = r.unwrap_err();
+    assert_eq!(payload.downcast_ref::<&str>(), Some(&"boom"));
+    assert_eq!(after_panic, 1, "the closure is not called again after a panic");
+}
