@@ -74,8 +74,13 @@ def test_constants_match_the_header():
                              ("E_FORMAT", sogmm.FormatError), ("E_LIMIT", sogmm.LimitError),
                              ("E_NOMEM", sogmm.SogmmMemoryError), ("E_BUFFER_TOO_SMALL", sogmm.BufferTooSmallError),
                              ("E_NOT_FOUND", sogmm.NotFoundError), ("E_INTERNAL", sogmm.InternalError),
-                             ("E_NULL_ARG", sogmm.NullArgumentError)]:
+                             ("E_NULL_ARG", sogmm.NullArgumentError), ("E_CANCELLED", sogmm.CancelledError)]:
         assert cls.status == defines[status_name], status_name
+    from sogmm import progress
+    stages = {name: value for name, value in defines.items() if name.startswith("STAGE_")}
+    assert len(stages) >= 5
+    for name, value in stages.items():
+        assert getattr(progress, name) == value, name
 
 
 def test_versions():

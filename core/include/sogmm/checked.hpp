@@ -48,8 +48,10 @@ bool try_to_int(double v, Int* out) {
 template <typename Int>
 Int to_int(double v, const char* what) {
   Int out{};
-  require(try_to_int(v, &out), ErrorCode::Limit,
-          std::string(what) + " (" + exact(v) + ") is not a finite value in the integer range");
+  // The message only on failure: this runs once per point in the mode count
+  // and the EM setup, where formatting V every time cost seconds per frame.
+  if (!try_to_int(v, &out))
+    throw Error(ErrorCode::Limit, std::string(what) + " (" + exact(v) + ") is not a finite value in the integer range");
   return out;
 }
 
