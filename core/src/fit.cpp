@@ -66,6 +66,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
     detail::progress_begin(Stage::ModeCount, 0);
     const auto t = std::chrono::steady_clock::now();
     const std::vector<double> features = range_gray_features(points);
+    detail::progress_poll();
     const MeanShiftResult modes = options.mode_counter == ModeCounter::FlatBinned
                                       ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
                                       : mean_shift_gaussian_blurring(features, options.bandwidth);

@@ -219,6 +219,7 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
   centers.push_back(static_cast<std::size_t>(rng.next() % n));
   std::vector<double> closest(n);
   for (std::size_t i = 0; i < n; ++i) closest[i] = dist2(points[i], points[centers[0]]);
+  detail::progress_poll();
   SeedTree tree(points, closest);
   PotentialSampler sampler(closest);
 

@@ -136,7 +136,9 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   require(options.max_iter >= 0 && options.stop_fraction >= 0, ErrorCode::InvalidArgument,
           "mean shift max_iter and stop_fraction must be >= 0");
   const std::size_t n = xy.size() / 2;
+  detail::progress_poll();  // serial set-up: a report (and a cancel) between its steps
   const detail::Grid2d grid(xy.data(), n, bandwidth);
+  detail::progress_poll();
   const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
   const double stop = options.stop_fraction * bandwidth;
