@@ -86,10 +86,9 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
   // Runs are sequential, each using every thread, so the kept model is the
   // same for any thread count.
   for (int run = 0; run < options.n_init; ++run) {
-    if (options.n_init > 1) {
-      detail::progress_begin(Stage::Run, static_cast<std::uint64_t>(options.n_init));
-      detail::progress_event(static_cast<std::uint64_t>(run) + 1, run == 0 ? 0.0 : result.em.log_likelihood);
-    }
+    if (options.n_init > 1)
+      detail::progress_begin(Stage::Run, static_cast<std::uint64_t>(options.n_init), static_cast<std::uint64_t>(run) + 1,
+                             run == 0 ? 0.0 : result.em.log_likelihood);
     detail::progress_begin(Stage::Seeding, k);
     auto t = std::chrono::steady_clock::now();
     const std::vector<std::size_t> seeds = kmeanspp_seeds(points, k, options.seed + static_cast<std::uint64_t>(run));

@@ -68,9 +68,9 @@ ProgressScope::~ProgressScope() {
 
 namespace detail {
 
-void progress_begin(Stage stage, std::uint64_t total) {
+void progress_begin(Stage stage, std::uint64_t total, std::uint64_t step, double log_likelihood) {
   if (!t_state) return;
-  t_state->current = Progress{stage, 0, total, 0.0};
+  t_state->current = Progress{stage, step, total, log_likelihood};
   report(*t_state);
 }
 

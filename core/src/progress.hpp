@@ -13,8 +13,9 @@
 
 namespace sogmm::detail {
 
-/// A stage starts (step 0 of `total`, 0 = unknown): always reported.
-void progress_begin(Stage stage, std::uint64_t total);
+/// A stage starts at `step` of `total` (0 = unknown), with a log-likelihood
+/// where it has one: always reported.
+void progress_begin(Stage stage, std::uint64_t total, std::uint64_t step = 0, double log_likelihood = 0.0);
 /// Step `step` of the current stage is done, with its log-likelihood: always
 /// reported (EM iterations, runs).
 void progress_event(std::uint64_t step, double log_likelihood);

@@ -198,7 +198,6 @@ ProgressSink ProgressPrinter::fit_callback(const std::string& label) {
       }
       return false;
     }
-    if (stage == Stage::Run && iteration == 0) return false;  // the Run stage's start; its event follows
     close_stage();
     if (stage == Stage::Run) {  // a new run of k-means++ + EM starts
       c->current = nullptr;
