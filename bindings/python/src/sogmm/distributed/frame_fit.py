@@ -49,23 +49,29 @@ def _read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     with Image.open(frame.depth) as im:
         depth = np.array(im)
     with Image.open(frame.color) as im:
-        color = np.array(im.convert("RGB") if im.mode not in ("L", "RGB") else im)
-    if depth.dtype != np.uint16:
-        depth = depth.astype(np.uint16) if depth.dtype.kind in "iu" and depth.min() >= 0 and depth.max() < 65536 else depth
+        color = np.array(im if im.mode in ("L", "RGB") else im.convert("RGB"))
+    # Pillow may open a 16-bit PNG as 32-bit mode "I"; values in range are uint16.
+    if depth.dtype.kind in "iu" and depth.dtype != np.uint16 and depth.size and 0 <= depth.min() <= depth.max() < 65536:
+        depth = depth.astype(np.uint16)
     return depth, color
 
 
 def _test_hold(frame: int) -> None:
-    """Test hook (tests/test_distributed.py kills a worker mid-task): with
-    SOGMM_DISTRIBUTED_PID_DIR set, a frame listed in SOGMM_DISTRIBUTED_HOLD_FRAMES
-    writes its worker's pid on its first attempt and waits up to 60 s to be killed."""
+    """Test hook (tests_ray kills a worker mid-task): with SOGMM_DISTRIBUTED_PID_DIR
+    set, a frame listed in the file PID_DIR/hold (comma-separated ids) writes its
+    worker's pid to PID_DIR/<frame>.pid on its first attempt and then waits up to
+    60 s to be killed; a retry finds the pid file and runs normally."""
     pid_dir = os.environ.get("SOGMM_DISTRIBUTED_PID_DIR")
-    held = os.environ.get("SOGMM_DISTRIBUTED_HOLD_FRAMES", "")
-    if not pid_dir or str(frame) not in held.split(","):
+    if not pid_dir:
+        return
+    try:
+        with open(os.path.join(pid_dir, "hold")) as f:
+            held = f.read().split(",")
+    except OSError:
         return
     marker = os.path.join(pid_dir, f"{frame}.pid")
-    if os.path.exists(marker):
-        return  # a retry: run normally
+    if str(frame) not in held or os.path.exists(marker):
+        return
     with open(marker + ".tmp", "w") as f:
         f.write(str(os.getpid()))
     os.replace(marker + ".tmp", marker)
