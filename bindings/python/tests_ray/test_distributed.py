@@ -129,10 +129,11 @@ def test_command_line_on_an_existing_cluster(local_ray, sequence, reference, tmp
     address = local_ray.get_runtime_context().gcs_address
     cmd = [sys.executable, "-m", "sogmm.distributed", "--address", address, "--sequence", str(sequence),
            "--trajectory", str(sequence / "trajectory.log"), "-o", str(out), "--bandwidth", "0.05", "--decimate", "2",
-           "--seed", "3", "--fan-in", "3", "-q"]
+           "--seed", "3", "--fan-in", "3"]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stderr
     assert f"skipped frame {BAD_FRAME}" in p.stderr
+    assert f"{N_FRAMES}/{N_FRAMES}" in p.stderr  # the progress bar counted every frame
     m = sogmm.load(out)
     for name in ("weights_", "means_", "covariances_"):
         assert getattr(m, name).tobytes() == getattr(reference, name).tobytes(), name
