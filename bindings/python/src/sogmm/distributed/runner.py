@@ -50,9 +50,9 @@ def merge_tree(items: list, fan_in: int, reduce) -> object:
     return items[0]
 
 
-def _merge_task(*parts):
+def _merge_task(reduce, *parts):
     start = time.perf_counter()
-    out = reduce_partials(list(parts))
+    out = reduce(list(parts))
     return {"seconds": time.perf_counter() - start, "bytes": size_bytes(out)}, out
 
 
@@ -73,7 +73,8 @@ def _progress(total: int, enabled: bool):
 
 def build_map(frames: list[Frame], settings: FitSettings, camera, *, workers: int | None = None,
               address: str | None = None, fan_in: int = 8, tile_size: float = 2.0, on_error: str = "skip",
-              max_retries: int = 3, progress: bool = True, metadata: dict | None = None) -> MapResult:
+              max_retries: int = 3, progress: bool = True, metadata: dict | None = None,
+              reduce=reduce_partials) -> MapResult:
     """Fits ``frames`` as Ray tasks and merges them into one canonical world-frame map.
 
     Uses the running Ray if ``ray.init`` was called, else connects to ``address``
@@ -83,7 +84,9 @@ def build_map(frames: list[Frame], settings: FitSettings, camera, *, workers: in
     ``on_error``: "skip" (a bad frame is left out and listed in ``skipped``) or
     "fail" (FrameError naming the frame). A worker that dies is retried by Ray
     up to ``max_retries`` times. The model does not depend on any of these
-    choices (see sogmm.distributed.partial)."""
+    choices (see sogmm.distributed.partial). ``reduce`` is the tree's one reduce
+    function (list of partial maps -> partial map; a module-level function, so
+    workers import it): the plain merge today, a map with fusion later."""
     import ray
 
     if on_error not in ("skip", "fail"):
@@ -102,13 +105,14 @@ def build_map(frames: list[Frame], settings: FitSettings, camera, *, workers: in
             ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
     try:
         return _run(ray, frames, settings, camera_dict(camera), fan_in, tile_size, on_error, max_retries, progress,
-                    metadata)
+                    metadata, reduce)
     finally:
         if started_here:
             ray.shutdown()
 
 
-def _run(ray, frames, settings, camera, fan_in, tile_size, on_error, max_retries, progress, metadata) -> MapResult:
+def _run(ray, frames, settings, camera, fan_in, tile_size, on_error, max_retries, progress, metadata,
+         reduce_fn) -> MapResult:
     start = time.perf_counter()
     fit = ray.remote(fit_frame).options(num_returns=2, num_cpus=1, max_retries=max_retries, retry_exceptions=False)
     merge = ray.remote(_merge_task).options(num_returns=2, num_cpus=1, max_retries=max_retries,
@@ -124,7 +128,7 @@ def _run(ray, frames, settings, camera, fan_in, tile_size, on_error, max_retries
     merge_infos = []
 
     def reduce(*parts):
-        info, out = merge.remote(*parts)
+        info, out = merge.remote(reduce_fn, *parts)
         merge_infos.append(info)
         return out
 
