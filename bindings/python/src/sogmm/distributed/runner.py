@@ -120,10 +120,10 @@ def _run(ray, frames, settings, camera, fan_in, tile_size, on_error, max_retries
     settings_ref = ray.put(settings)
     camera_ref = ray.put(camera)
     tiles = defaultdict(list)
-    info_refs = {}
+    pending = []  # the fit tasks' small info objects, watched for progress and failures
     for f in sorted(frames, key=lambda f: f.index):
         info, part = fit.remote(f, settings_ref, camera_ref)
-        info_refs[info] = f.index
+        pending.append(info)
         tiles[_tile(f, tile_size)].append(part)
     merge_infos = []
 
@@ -136,7 +136,6 @@ def _run(ray, frames, settings, camera, fan_in, tile_size, on_error, max_retries
 
     bar = _progress(len(frames), progress)
     skipped, seconds_fit, bytes_moved = [], 0.0, 0
-    pending = list(info_refs)
     try:
         while pending:
             done, pending = ray.wait(pending, num_returns=min(len(pending), 16), timeout=1.0)
