@@ -1,0 +1,95 @@
+"""python -m sogmm.distributed: `sogmm fit --sequence` on a Ray cluster.
+
+    python -m sogmm.distributed --sequence DIR --trajectory LOG --workers N -o map.sogmm [--decimate 5 ...]
+    python -m sogmm.distributed --address HEAD:6379 --sequence DIR --trajectory LOG -o map.sogmm
+
+Exit status 0 on success, 1 with one line on stderr on bad input or a failed job.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from ..camera import Camera
+from ..errors import SogmmError
+from .frame_fit import FitSettings
+from .runner import build_map
+from .sequence import load_frames
+
+
+def _parser() -> argparse.ArgumentParser:
+    d = FitSettings()
+    ap = argparse.ArgumentParser(prog="python -m sogmm.distributed", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sequence", required=True, help="DIR/depth/*.png + DIR/color/*.{jpg,png} (paired in name order)")
+    ap.add_argument("--trajectory", required=True, help="Redwood .log camera-to-world poses")
+    ap.add_argument("--frames", default=":", help="I, A:B (B excluded) or A:B:STEP; default all")
+    ap.add_argument("-o", "--output", required=True, help="output map (.sogmm, world frame)")
+    ap.add_argument("--intrinsics", help="Open3D PinholeCameraIntrinsic JSON (default DIR/intrinsics.json)")
+    ap.add_argument("--workers", type=int, default=None, help="CPUs of the local Ray (default all); ignored with --address")
+    ap.add_argument("--address", help="connect to an existing Ray cluster (HEAD:6379 or 'auto')")
+    ap.add_argument("--fan-in", type=int, default=8, help="models merged per merge task (default %(default)s)")
+    ap.add_argument("--tile-size", type=float, default=2.0,
+                    help="merge tiles by camera position, metres (0 = one tile; default %(default)s)")
+    ap.add_argument("--on-error", choices=("skip", "fail"), default="skip",
+                    help="a bad frame is skipped (and reported) or fails the job (default %(default)s)")
+    ap.add_argument("--max-retries", type=int, default=3, help="Ray retries of a task whose worker died")
+    g = ap.add_argument_group("fit and depth flags (as `sogmm fit`)")
+    g.add_argument("--bandwidth", type=float, default=d.bandwidth)
+    g.add_argument("--components", type=int, default=None, help="fixed number of components K")
+    g.add_argument("--seed", type=int, default=d.seed)
+    g.add_argument("--n-init", type=int, default=d.n_init)
+    g.add_argument("--threads", type=int, default=d.threads, help="threads per fit task (default %(default)s)")
+    g.add_argument("--tol", type=float, default=d.tol)
+    g.add_argument("--max-iter", type=int, default=d.max_iter)
+    g.add_argument("--reg-covar", type=float, default=d.reg_covar)
+    g.add_argument("--truncate", type=float, default=d.truncate)
+    g.add_argument("--decimate", type=int, default=d.decimate)
+    g.add_argument("--depth-scale", type=float, default=d.depth_scale)
+    g.add_argument("--depth-min", type=float, default=d.depth_min)
+    g.add_argument("--depth-max", type=float, default=d.depth_max)
+    ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    ap.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    return ap
+
+
+def main(argv=None) -> int:
+    a = _parser().parse_args(argv)
+    try:
+        settings = FitSettings(bandwidth=a.bandwidth, n_components=a.components, seed=a.seed, n_init=a.n_init,
+                               threads=a.threads, tol=a.tol, max_iter=a.max_iter, reg_covar=a.reg_covar,
+                               truncate=a.truncate, decimate=a.decimate, depth_scale=a.depth_scale,
+                               depth_min=a.depth_min, depth_max=a.depth_max)
+        intrinsics = a.intrinsics or str(Path(a.sequence) / "intrinsics.json")
+        if not os.path.isfile(intrinsics):
+            raise SogmmError(f"no camera: give --intrinsics FILE (or put intrinsics.json in {a.sequence})")
+        camera = Camera.from_json(intrinsics)
+        frames = load_frames(a.sequence, a.trajectory, a.frames)
+        meta = {"sequence": a.sequence, "trajectory": a.trajectory, **settings.metadata()}
+        r = build_map(frames, settings, camera, workers=a.workers, address=a.address, fan_in=a.fan_in,
+                      tile_size=a.tile_size, on_error=a.on_error, max_retries=a.max_retries, progress=not a.quiet,
+                      metadata=meta)
+        r.model.save(a.output)
+    except (SogmmError, OSError) as e:
+        print(f"sogmm.distributed: {e}", file=sys.stderr)
+        return 1
+    for frame, message in r.skipped:
+        print(f"sogmm.distributed: skipped frame {frame}: {message}", file=sys.stderr)
+    summary = {"output": a.output, "frames": r.n_frames, "skipped": [f for f, _ in r.skipped],
+               "n_components": r.model.n_components_, "seconds_wall": r.seconds_wall, "seconds_fit": r.seconds_fit,
+               "seconds_merge": r.seconds_merge, "bytes_moved_per_frame": r.bytes_moved / max(len(frames), 1)}
+    if a.json:
+        print(json.dumps(summary))
+    else:
+        print(f"Fitted {r.n_frames} frames of {a.sequence} ({len(r.skipped)} skipped) into {summary['n_components']} "
+              f"components in {r.seconds_wall:.2f} s (fit {r.seconds_fit:.2f} s, merge {r.seconds_merge:.2f} s of "
+              f"task time; {summary['bytes_moved_per_frame'] / 1024:.1f} KiB moved per frame). Wrote {a.output}.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,104 @@
+"""Fitting one posed frame into a leaf partial map: the work of one Ray task.
+
+Pure Python over the package's own library: a Ray worker imports sogmm (and so
+opens libsogmm) itself; only file names, numbers and bytes cross processes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+
+import numpy as np
+
+from ..camera import Camera
+from ..errors import SogmmError
+from ..model import SOGMM
+from .partial import leaf, size_bytes
+from .sequence import Frame
+
+
+@dataclasses.dataclass(frozen=True)
+class FitSettings:
+    """The fit and depth flags of `sogmm fit --sequence` (same names and defaults),
+    except ``threads``: 1, as each Ray task holds one CPU."""
+
+    bandwidth: float = 0.02
+    n_components: int | None = None
+    seed: int = 0
+    n_init: int = 1
+    threads: int = 1
+    tol: float = 1e-3
+    max_iter: int = 100
+    reg_covar: float = 1e-6
+    truncate: float = 0.0
+    decimate: int = 1
+    depth_scale: float = 1000.0
+    depth_min: float = 0.1
+    depth_max: float = 3.0
+
+    def metadata(self) -> dict[str, str]:
+        """The settings as model key/values (the fit record is not settable from Python)."""
+        return {f"fit_{k}": repr(v) for k, v in dataclasses.asdict(self).items() if k != "threads"}
+
+
+def _read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+    from PIL import Image  # the `ray` extra installs Pillow
+
+    with Image.open(frame.depth) as im:
+        depth = np.array(im)
+    with Image.open(frame.color) as im:
+        color = np.array(im if im.mode in ("L", "RGB") else im.convert("RGB"))
+    # Pillow may open a 16-bit PNG as 32-bit mode "I"; values in range are uint16.
+    if depth.dtype.kind in "iu" and depth.dtype != np.uint16 and depth.size and 0 <= depth.min() <= depth.max() < 65536:
+        depth = depth.astype(np.uint16)
+    return depth, color
+
+
+def _test_hold(frame: int) -> None:
+    """Test hook (tests_ray kills a worker mid-task): with SOGMM_DISTRIBUTED_PID_DIR
+    set, a frame listed in the file PID_DIR/hold (comma-separated ids) writes its
+    worker's pid to PID_DIR/<frame>.pid on its first attempt and then waits up to
+    60 s to be killed; a retry finds the pid file and runs normally."""
+    pid_dir = os.environ.get("SOGMM_DISTRIBUTED_PID_DIR")
+    if not pid_dir:
+        return
+    try:
+        with open(os.path.join(pid_dir, "hold")) as f:
+            held = f.read().split(",")
+    except OSError:
+        return
+    marker = os.path.join(pid_dir, f"{frame}.pid")
+    if str(frame) not in held or os.path.exists(marker):
+        return
+    with open(marker + ".tmp", "w") as f:
+        f.write(str(os.getpid()))
+    os.replace(marker + ".tmp", marker)
+    time.sleep(60)
+
+
+def fit_frame(frame: Frame, settings: FitSettings, camera: dict) -> tuple[dict, dict | None]:
+    """(info, leaf partial map) of one frame; a bad frame gives (info with
+    ``error``, None) instead of raising, so Ray retries only worker deaths."""
+    _test_hold(frame.index)
+    start = time.perf_counter()
+    info = {"frame": frame.index, "pid": os.getpid(), "error": None}
+    try:
+        depth, color = _read_images(frame)
+        model = SOGMM(bandwidth=settings.bandwidth, seed=settings.seed, tol=settings.tol, reg_covar=settings.reg_covar,
+                      max_iter=settings.max_iter, n_components=settings.n_components, n_threads=settings.threads,
+                      truncation_nats=settings.truncate, n_init=settings.n_init)
+        model.fit_rgbd(depth, color, Camera(**camera), depth_scale=settings.depth_scale, depth_min=settings.depth_min,
+                       depth_trunc=settings.depth_max, decimate=settings.decimate)
+        part = leaf(frame.index, model.transform(np.asarray(frame.pose).reshape(4, 4)))
+    except (SogmmError, OSError, ValueError) as e:  # PIL raises OSError / ValueError for bad images
+        info.update(error=f"{type(e).__name__}: {e}", seconds=time.perf_counter() - start, bytes=0)
+        return info, None
+    info.update(seconds=time.perf_counter() - start, bytes=size_bytes(part), n_components=model.n_components_)
+    return info, part
+
+
+def camera_dict(camera: Camera) -> dict:
+    """A camera as plain fields (what crosses to the workers)."""
+    return dataclasses.asdict(camera)

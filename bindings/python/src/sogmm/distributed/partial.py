@@ -1,0 +1,115 @@
+"""Partial maps: what the merge tree of :mod:`sogmm.distributed` passes around.
+
+A partial map is a dict of plain bytes and ints (Ray moves it without pickling
+any sogmm object):
+
+- ``model``: a world-frame ``.sogmm`` file (uncompressed: zstd level 19 costs
+  more than the bytes it saves between tasks) holding the components of its
+  frames, frame by frame in the order of ``table``;
+- ``table``: one :data:`TABLE` row per frame (id, support size, components,
+  the fit's mean log-likelihood, EM iterations, converged);
+- ``weights``: each frame's own fitted weights (float32), in model order.
+
+:func:`reduce_partials` is the one reduce function of the tree (today a plain
+world-frame merge, ``sogmm_model_merge``; a map with fusion plugs in here), and
+:func:`finalize` turns the root into the canonical model.
+
+Why a canonical model: ``sogmm_model_merge`` concatenates means and
+covariances bit for bit but rescales every weight, ``float(w * s_a / (s_a +
+s_b))``, rounding once per merge, so the weights of a chain of merges (the
+sequential ``sogmm fit --sequence``) and of a tree differ in the last bits,
+and so does the fit record's weighted mean log-likelihood. :func:`finalize`
+therefore orders components by (frame id, component index) and recomputes
+every weight from the frame's own weight with one rounding,
+``float32(w_fk * (s_f / S))`` with S the total support, and the mean
+log-likelihood as an exactly rounded sum (``math.fsum``). The result is a pure
+function of the set of fitted frames: independent of completion order,
+worker count, fan-in and tiling, and bitwise equal to
+:func:`sequential_partial` (the frames folded one by one) after the same step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InvalidDataError
+from ..model import GMM
+
+#: Per-frame provenance row of a partial map.
+TABLE = np.dtype([("frame", "<i8"), ("support", "<u8"), ("n", "<i8"), ("log_likelihood", "<f8"),
+                  ("n_iter", "<i8"), ("converged", "<i8")])
+
+
+def leaf(frame: int, world: GMM) -> dict:
+    """The partial map of one fitted frame already moved to the world frame."""
+    row = np.array([(frame, world.support_size_, world.n_components_, world.lower_bound_ or 0.0,
+                     world.n_iter_ or 0, int(bool(world.converged_)))], dtype=TABLE)
+    return {"model": world.to_bytes(compress=False), "table": row.tobytes(),
+            "weights": world.weights_.astype("<f4").tobytes()}
+
+
+def size_bytes(part: dict | None) -> int:
+    """Bytes a partial map occupies in the object store (its three buffers)."""
+    return 0 if part is None else len(part["model"]) + len(part["table"]) + len(part["weights"])
+
+
+def reduce_partials(parts: list) -> dict | None:
+    """One node of the merge tree: the union of the partial maps (None = no frame).
+
+    Inputs are merged in order of their first frame id, so the tree's interior
+    models are reproducible too (the canonical result does not need it)."""
+    parts = sorted((p for p in parts if p is not None), key=lambda p: int(np.frombuffer(p["table"], TABLE)["frame"][0]))
+    if not parts:
+        return None
+    if len(parts) == 1:
+        return parts[0]
+    model = GMM.from_bytes(parts[0]["model"])
+    for p in parts[1:]:
+        model = model.merge(GMM.from_bytes(p["model"]))
+    return {"model": model.to_bytes(compress=False), "table": b"".join(p["table"] for p in parts),
+            "weights": b"".join(p["weights"] for p in parts)}
+
+
+def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
+    """The canonical world-frame model of a root partial map (see the module doc).
+
+    The fit settings, camera and pose of the frames' records are not carried
+    (the Python binding cannot set them); ``metadata`` key/values are added, and
+    ``coordinate_frame`` = world, ``merged_fits``, ``frames`` and
+    ``log_likelihood`` (mean per point of all frames, as spec/format.md 2.2)."""
+    if part is None:
+        raise InvalidDataError("no frame was fitted: the map is empty")
+    table = np.frombuffer(part["table"], TABLE)
+    w0 = np.frombuffer(part["weights"], "<f4")
+    model = GMM.from_bytes(part["model"])
+    if len(np.unique(table["frame"])) != len(table):
+        raise InvalidDataError("a frame appears twice in the merge tree")
+    if int(table["n"].sum()) != model.n_components_ or w0.size != model.n_components_:
+        raise InvalidDataError("partial map: table and model disagree on the number of components")
+    start = np.concatenate([[0], np.cumsum(table["n"])[:-1]])
+    order = np.argsort(table["frame"], kind="stable")
+    index = np.concatenate([np.arange(start[i], start[i] + table["n"][i]) for i in order])
+    total = sum(int(s) for s in table["support"])  # exact integer sum
+    share = np.repeat(table["support"][order].astype(np.float64) / float(total), table["n"][order])
+    weights = (w0[index].astype(np.float64) * share).astype(np.float32)
+    out = GMM.from_arrays(weights, model.means_[index], model.covariances_[index], support_size=total)
+    t = table[order]
+    ll = math.fsum(float(s) * l for s, l in zip(t["support"], t["log_likelihood"])) / total
+    values = {"coordinate_frame": "world", "frames": ",".join(str(int(f)) for f in t["frame"]), "log_likelihood": repr(ll),
+              "n_iter": str(int(t["n_iter"].sum())), "converged": "true" if t["converged"].all() else "false"}
+    if len(t) >= 2:  # spec/format.md 2.2: written only for a merge (>= 2)
+        values["merged_fits"] = str(len(t))
+    values.update(metadata or {})
+    for k, v in values.items():
+        out.set_metadata(k, v)
+    return out
+
+
+def sequential_partial(leaves: list) -> dict | None:
+    """The frames folded one by one in the given order (the sequential build)."""
+    acc = None
+    for p in leaves:
+        acc = p if acc is None else reduce_partials([acc, p])
+    return acc
