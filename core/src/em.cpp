@@ -405,6 +405,11 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
     for (std::size_t k = 0; k < m; ++k) {
       nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, &params[k * kParamStride], &w.mean[4 * k],
                                &w.covariance[16 * k]);
+      if (!options.quantisation.empty()) {
+        double mean[4];
+        for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
+        options.quantisation.add_covariance_at(mean, &w.covariance[16 * k]);
+      }
       weight_sum += nk[k];
     }
     for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);

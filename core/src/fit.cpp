@@ -8,6 +8,7 @@
 #include <string>
 
 #include "parallel.hpp"
+#include "sogmm/depth_quantisation.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
@@ -77,6 +78,9 @@ FitResult fit(const PointsView& points, const FitOptions& options, const FitProg
 
   EmOptions em = options.em;
   em.threads = threads;
+  // Quantised depth would let components collapse onto single depth levels
+  // (see DepthQuantisation): fit the dequantised depths instead.
+  if (em.quantisation.empty()) em.quantisation = DepthQuantisation::detect(points);
   EmIterationCallback on_iteration;
   if (progress) on_iteration = [&progress](int iteration, double ll) { progress(FitStage::Em, iteration, ll); };
   // Runs are sequential, each using every thread, so the kept model is the

@@ -6,6 +6,7 @@
 #include <functional>
 #include <vector>
 
+#include "sogmm/depth_quantisation.hpp"
 #include "sogmm/gmm.hpp"
 #include "sogmm/point_cloud.hpp"
 
@@ -35,6 +36,11 @@ struct EmOptions {
   /// the components already evaluated, so it holds from the first iteration
   /// on (the tight k-means++ start included) without any fallback.
   double truncation_nats = 0.0;
+  /// Depth quantisation of the points (empty by default: none). When set, every
+  /// M-step adds the quantisation bin's variance along the component's viewing
+  /// ray (DepthQuantisation::add_covariance_at), so EM fits the dequantised
+  /// depths. fit() detects it for camera-frame clouds.
+  DepthQuantisation quantisation;
 };
 
 /// What the EM did.

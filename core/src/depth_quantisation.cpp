@@ -1,0 +1,35 @@
+// Depth quantisation of a camera-frame cloud (see depth_quantisation.hpp).
+#include "sogmm/depth_quantisation.hpp"
+
+#include <algorithm>
+
+namespace sogmm {
+
+DepthQuantisation DepthQuantisation::detect(const PointsView& points) {
+  DepthQuantisation q;
+  std::vector<double> z(points.size);
+  for (std::size_t i = 0; i < points.size; ++i) {
+    z[i] = points[i][2];
+    if (!(z[i] > 0.0)) return q;  // not a camera-frame cloud in front of the camera
+  }
+  std::sort(z.begin(), z.end());
+  z.erase(std::unique(z.begin(), z.end()), z.end());
+  if (z.size() < 2 || z.size() * kMinPointsPerLevel > points.size) return q;
+  q.levels_ = std::move(z);
+  return q;
+}
+
+void DepthQuantisation::add_covariance_at(const double mean[4], double covariance[16]) const {
+  if (empty() || !(mean[2] > 0.0)) return;
+  // The bin containing mean z: between levels j - 1 and j.
+  const std::size_t last = levels_.size() - 1;
+  const std::size_t j = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::upper_bound(levels_.begin(), levels_.end(), mean[2]) - levels_.begin()), 1, last);
+  const double w = levels_[j] - levels_[j - 1];
+  const double v[3] = {mean[0] / mean[2], mean[1] / mean[2], 1.0};
+  const double s = w * w / 12.0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) covariance[4 * a + b] += s * v[a] * v[b];
+}
+
+}  // namespace sogmm
