@@ -2,6 +2,7 @@
 #include "sogmm/depth_quantisation.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace sogmm {
 
@@ -19,7 +20,7 @@ DepthQuantisation DepthQuantisation::detect(const PointsView& points) {
   return q;
 }
 
-void DepthQuantisation::add_covariance_at(const double mean[4], double covariance[16]) const {
+void DepthQuantisation::floor_covariance_at(const double mean[4], double covariance[16]) const {
   if (empty() || !(mean[2] > 0.0)) return;
   // The bin containing mean z: between levels j - 1 and j.
   const std::size_t last = levels_.size() - 1;
@@ -27,9 +28,16 @@ void DepthQuantisation::add_covariance_at(const double mean[4], double covarianc
       static_cast<std::size_t>(std::upper_bound(levels_.begin(), levels_.end(), mean[2]) - levels_.begin()), 1, last);
   const double w = levels_[j] - levels_[j - 1];
   const double v[3] = {mean[0] / mean[2], mean[1] / mean[2], 1.0};
-  const double s = w * w / 12.0;
+  const double norm2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  const double u[3] = {v[0] / std::sqrt(norm2), v[1] / std::sqrt(norm2), v[2] / std::sqrt(norm2)};
+  // Variance of the bin along the unit ray u, and the component's own.
+  const double bin = w * w / 12.0 * norm2;
+  double own = 0.0;
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) covariance[4 * a + b] += s * v[a] * v[b];
+    for (int b = 0; b < 3; ++b) own += u[a] * covariance[4 * a + b] * u[b];
+  if (!(own < bin)) return;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) covariance[4 * a + b] += (bin - own) * u[a] * u[b];
 }
 
 }  // namespace sogmm

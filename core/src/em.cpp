@@ -408,7 +408,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
       if (!options.quantisation.empty()) {
         double mean[4];
         for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
-        options.quantisation.add_covariance_at(mean, &w.covariance[16 * k]);
+        options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
       }
       weight_sum += nk[k];
     }

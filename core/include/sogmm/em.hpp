@@ -37,9 +37,10 @@ struct EmOptions {
   /// on (the tight k-means++ start included) without any fallback.
   double truncation_nats = 0.0;
   /// Depth quantisation of the points (empty by default: none). When set, every
-  /// M-step adds the quantisation bin's variance along the component's viewing
-  /// ray (DepthQuantisation::add_covariance_at), so EM fits the dequantised
-  /// depths. fit() detects it for camera-frame clouds.
+  /// M-step floors each component's variance along its viewing ray at the
+  /// quantisation bin's (DepthQuantisation::floor_covariance_at), so no
+  /// component collapses onto one depth level. fit() detects it for
+  /// camera-frame clouds.
   DepthQuantisation quantisation;
 };
 
