@@ -423,6 +423,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
     }
     previous = mean_ll;
   }
+  rep.kernel = kernels.isa;
   rep.pair_fraction = pairs_evaluated / (static_cast<double>(n) * m * rep.iterations);
   if (report) *report = rep;
   return to_model(w, frame, options.reg_covar, n);

@@ -53,6 +53,9 @@ struct EmReport {
   /// Point-component pairs evaluated / (N * M * iterations): 1 for the exact
   /// E-step, less when truncation skipped pairs.
   double pair_fraction = 1.0;
+  /// The SIMD kernel that ran the E-step: "avx512", "avx2" or "sse2" (the
+  /// best the CPU supports, capped by the SOGMM_ISA environment variable).
+  const char* kernel = "";
 };
 
 /// Called after each EM iteration with the iteration number (from 1) and the
