@@ -2,7 +2,7 @@
 // 1. the mean log-likelihood of every EM iteration (tol 0) and, after given
 //    iteration counts, how many components have their smallest covariance
 //    eigenvalue at the reg_covar floor and along which axis it points;
-// 2. plain EM and EM on the dequantised depths (DepthQuantisation), each with
+// 2. plain EM and EM with the depth-bin floor (DepthQuantisation), each with
 //    the default tol and max_iter: iterations, converged, mean log-likelihood
 //    of the fitted points, and of a held-out copy of the frame whose points
 //    are moved along their rays uniformly within their depth bins (what the
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   app.add_option("--trace-iter", trace_iter, "iterations of the traced EM (0: no trace)");
   app.add_option("--reg-covar", em.reg_covar);
   app.add_option("--at", at, "iteration counts at which to count components at the floor");
-  app.add_flag("--dequantise", dequantise, "trace EM on the dequantised depths");
+  app.add_flag("--dequantise", dequantise, "trace EM with the depth-bin floor along the rays");
   app.add_flag("--dither", dither, "fit the dithered frame instead of the quantised one");
   app.add_option("--dump-points", dump, "write N, M (uint64), N x 4 float32 points, M seed indices (uint64)");
   CLI11_PARSE(app, argc, argv);
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
     EmReport rep;
     const Gmm g = fit_em(cloud.view(), seeds, t, &rep);
     std::printf("%s EM: %d iterations, converged %d, LL fitted points %.5f, LL held-out dithered frame %.5f\n",
-                dq ? "dequantised" : "plain", rep.iterations, rep.converged ? 1 : 0, rep.log_likelihood,
+                dq ? "floored" : "plain", rep.iterations, rep.converged ? 1 : 0, rep.log_likelihood,
                 mean_log_likelihood(g, held_out.xyzg.data(), held_out.size(), 4));
   }
   return 0;
