@@ -20,6 +20,7 @@ const (
 	OptModeCounter      Key = C.SOGMM_OPT_MODE_COUNTER
 	OptTruncationNats   Key = C.SOGMM_OPT_TRUNCATION_NATS
 	OptNInit            Key = C.SOGMM_OPT_N_INIT
+	OptDequantiseDepth  Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
 	OptDepthScale       Key = C.SOGMM_OPT_DEPTH_SCALE
 	OptDepthMin         Key = C.SOGMM_OPT_DEPTH_MIN
 	OptDepthMax         Key = C.SOGMM_OPT_DEPTH_MAX

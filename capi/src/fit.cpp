@@ -21,6 +21,7 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
                        : sogmm::ModeCounter::FlatBinned;
   f.seed = static_cast<std::uint64_t>(o.seed);
   f.n_init = static_cast<int>(o.n_init);
+  f.dequantise_depth = o.dequantise_depth != 0;
   f.em.tol = o.tol;
   f.em.reg_covar = o.reg_covar;
   f.em.max_iter = static_cast<int>(o.max_iter);

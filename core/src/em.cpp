@@ -405,6 +405,11 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
     for (std::size_t k = 0; k < m; ++k) {
       nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, &params[k * kParamStride], &w.mean[4 * k],
                                &w.covariance[16 * k]);
+      if (!options.quantisation.empty()) {
+        double mean[4];
+        for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
+        options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+      }
       weight_sum += nk[k];
     }
     for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
@@ -418,6 +423,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
     }
     previous = mean_ll;
   }
+  rep.kernel = kernels.isa;
   rep.pair_fraction = pairs_evaluated / (static_cast<double>(n) * m * rep.iterations);
   if (report) *report = rep;
   return to_model(w, frame, options.reg_covar, n);

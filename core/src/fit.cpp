@@ -9,6 +9,7 @@
 
 #include "parallel.hpp"
 #include "progress.hpp"
+#include "sogmm/depth_quantisation.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
@@ -80,6 +81,9 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
 
   EmOptions em = options.em;
   em.threads = threads;
+  // Quantised depth lets components collapse onto single depth levels (see
+  // DepthQuantisation); on request, fit the dequantised depths instead.
+  if (options.dequantise_depth && em.quantisation.empty()) em.quantisation = DepthQuantisation::detect(points);
   const EmIterationCallback on_iteration = [](int iteration, double ll) {
     detail::progress_event(static_cast<std::uint64_t>(iteration), ll);
   };

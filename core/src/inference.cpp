@@ -30,6 +30,20 @@ Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
   return Eigen::Map<const Eigen::Vector4f>(gmm.mean(k)).cast<double>();
 }
 
+// The Cholesky factorisation of a covariance (or a block of one), checked:
+// validate() accepts the float32 model, yet a sub-block or a derived matrix
+// could still fail in double, and an unchecked failure would turn into NaN
+// answers silently.
+template <class M>
+Eigen::LLT<M> checked_llt(const M& c, const char* what, std::size_t k = static_cast<std::size_t>(-1)) {
+  Eigen::LLT<M> llt(c);
+  if (llt.info() != Eigen::Success)
+    throw Error(ErrorCode::Numeric, std::string(what) +
+                                        (k == static_cast<std::size_t>(-1) ? "" : " of component " + std::to_string(k)) +
+                                        " is not positive definite");
+  return llt;
+}
+
 // Per-component quantities for Gaussian densities in D dimensions (D = 3 or
 // 4): the inverse Cholesky factor and log(weight) - log det(L) - D/2 log 2 pi.
 template <int D>
@@ -46,8 +60,7 @@ struct DensityCache {
     log_const.resize(m);
     for (std::size_t k = 0; k < m; ++k) {
       const Eigen::Matrix<double, D, D> c = covariance_of(gmm, k).template topLeftCorner<D, D>();
-      Eigen::LLT<Eigen::Matrix<double, D, D>> llt(c);
-      const Eigen::Matrix<double, D, D> l = llt.matrixL();
+      const Eigen::Matrix<double, D, D> l = checked_llt(c, "covariance", k).matrixL();
       inv_l[k] = l.template triangularView<Eigen::Lower>().solve(Eigen::Matrix<double, D, D>::Identity());
       mean[k] = mean_of(gmm, k).template head<D>();
       const double w = gmm.weights[k];
@@ -160,7 +173,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
   std::size_t row = 0;
   for (std::size_t k = 0; k < m; ++k) {
     if (counts[k] == 0) continue;
-    const Mat4 l = Eigen::LLT<Mat4>(covariance_of(gmm, k)).matrixL();
+    const Mat4 l = checked_llt(covariance_of(gmm, k), "covariance", k).matrixL();
     const Eigen::Vector4d mu = mean_of(gmm, k);
     for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
       if (row % kPointsPerChunk == 0) detail::progress_at(row);
@@ -216,7 +229,7 @@ struct GrayBackground {
     gray = mu[3];
     variance = c(3, 3);
     const Mat3 cov = kBackgroundScale * kBackgroundScale * c.topLeftCorner<3, 3>();
-    const Mat3 l = Eigen::LLT<Mat3>(cov).matrixL();
+    const Mat3 l = checked_llt(cov, "the prior's spatial covariance").matrixL();
     inv_l = l.triangularView<Eigen::Lower>().solve(Mat3::Identity());
     log_const = std::log(kBackgroundWeight * w) - l.diagonal().array().log().sum() - 1.5 * kLog2Pi;
   }
@@ -240,7 +253,7 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
     const Mat4 c = covariance_of(gmm, k);
     const Mat3 sxx = c.topLeftCorner<3, 3>();
     const Eigen::Vector3d sxg = c.topRightCorner<3, 1>();
-    gain[k] = Eigen::LLT<Mat3>(sxx).solve(sxg).transpose();
+    gain[k] = checked_llt(sxx, "spatial covariance", k).solve(sxg).transpose();
     cond_var[k] = std::max(0.0, c(3, 3) - gain[k].dot(sxg));
     mean_g[k] = gmm.mean(k)[3];
   }

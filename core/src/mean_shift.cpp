@@ -211,11 +211,14 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
     if (moved2 / n < stop2) break;
   }
   // Collapse the blurred points into modes: greedy assignment to a mode within
-  // bandwidth / 2, in point order (deterministic).
+  // bandwidth / 2, in point order (deterministic). Its distance evaluations
+  // count as neighbour checks too.
   std::vector<Mode> modes;
+  std::uint64_t total = 0;
   for (std::size_t i = 0; i < n; ++i) {
     bool assigned = false;
     for (std::size_t m = 0; m < modes.size() && !assigned; ++m) {
+      ++total;
       if (std::hypot(modes[m].x - xy[2 * i], modes[m].y - xy[2 * i + 1]) <= 0.5 * bandwidth) {
         ++modes[m].strength;
         assigned = true;
@@ -223,7 +226,6 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
     }
     if (!assigned) modes.push_back({xy[2 * i], xy[2 * i + 1], 1});
   }
-  std::uint64_t total = 0;
   for (std::uint64_t c : checks) total += c;
   return suppress_near_duplicates(std::move(modes), 0.5 * bandwidth, total);
 }

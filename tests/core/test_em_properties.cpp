@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -231,18 +232,27 @@ TEST(EmProperties, EveryKernelAgrees) {
           sogmm::EmReport rep;
           sogmm::fit_em(view(pts), sogmm::kmeanspp_seeds(view(pts), 20, 8), o, &rep);
           std::FILE* f = std::fopen(file.c_str(), "w");
-          const bool ok = f != nullptr && std::fprintf(f, "%a\n", rep.log_likelihood) > 0 && std::fclose(f) == 0;
+          const bool ok = f != nullptr && std::fprintf(f, "%a %s\n", rep.log_likelihood, rep.kernel) > 0 &&
+                          std::fclose(f) == 0;
           std::exit(ok ? 0 : 1);
         },
         ::testing::ExitedWithCode(0), "");
   }
   // Read only after every child has run: a child re-executes this body up
   // to its own death test, so nothing it would see may be removed before.
+  // The kernel each child should have run, from the CPU's own flags.
+  const bool has_avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  const bool has_avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+  const std::map<std::string, std::string> expected{
+      {"sse2", "sse2"}, {"avx2", has_avx2 ? "avx2" : "sse2"},
+      {"best", has_avx512 ? "avx512" : (has_avx2 ? "avx2" : "sse2")}};
   for (const std::string isa : {"sse2", "avx2", "best"}) {
     const std::string file = ::testing::TempDir() + "sogmm_em_kernel_" + isa + ".txt";
     std::ifstream in(file);
-    std::string text;
-    ASSERT_TRUE(static_cast<bool>(in >> text)) << isa << ": no result in " << file;
+    std::string text, ran;
+    ASSERT_TRUE(static_cast<bool>(in >> text >> ran)) << isa << ": no result in " << file;
+    EXPECT_EQ(ran, expected.at(isa)) << "SOGMM_ISA=" << isa;
     ll.push_back(std::strtod(text.c_str(), nullptr));
     std::remove(file.c_str());
   }

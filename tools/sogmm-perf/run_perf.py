@@ -10,7 +10,12 @@ on our k-means++ seeds), with the ratio.
 
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--cases d5s02,d5s01,d4s02,d2s02,d1s02]
-        [--sklearn-iters 3] [--no-sklearn]
+        [--sklearn-iters 3] [--no-sklearn] [--perf BEFORE --perf AFTER]
+
+With several --perf binaries every run of a case goes through each binary in
+turn (interleaved, so a loaded machine slows them alike) and a second table
+gives, per case, each binary's median EM and total fit time and its ratio to
+the first binary's.
 """
 import argparse
 import json
@@ -30,8 +35,8 @@ CASES = {  # name: (decimation, bandwidth)
 TARGET_S = {"d5s02": 0.5, "d5s01": 1.5, "d2s02": 4.0, "d1s02": 12.0}
 
 
-def run_case(d, bw, threads, dump=None):
-    cmd = [BIN, "--depth", os.path.join(DATA, "depth", "00000.png"), "--color",
+def run_case(d, bw, threads, dump=None, binary=BIN):
+    cmd = [binary, "--depth", os.path.join(DATA, "depth", "00000.png"), "--color",
            os.path.join(DATA, "color", "00000.jpg"), "--intrinsics", os.path.join(DATA, "intrinsics.json"),
            "--decimate", str(d), "--bandwidth", str(bw), "--threads", str(threads)]
     if dump:
@@ -67,7 +72,10 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--sklearn-iters", type=int, default=3)
     ap.add_argument("--no-sklearn", action="store_true")
+    ap.add_argument("--perf", action="append", help="sogmm-perf binary (repeatable; interleaved)")
     a = ap.parse_args()
+    if a.perf:
+        return compare(a)
     if not os.path.isdir(DATA):
         sys.exit(f"run_perf: {DATA} not found (the real frames live in ../shared/data)")
     if not os.path.exists(BIN):
@@ -101,6 +109,28 @@ def main():
               f"{m['ms_per_iteration']:.2f} | {m['gflops']:.1f} | {1000*m['s_regress']:.1f} | "
               f"{1000*m['s_sample']:.1f} | {1000*m['s_metrics']:.1f} | {m['s_total_fit']:.3f}{target_txt} | "
               f"{m['peak_rss_mib']:.0f} | {em1 / m['ms_per_iteration']:.2f}x | {sk_txt} | {ratio_txt} |")
+
+def compare(a):
+    """Median EM and total fit seconds per case for each binary, runs interleaved."""
+    print("| case | binary | N | M | EM iters | EM ms | ms/iter | total fit s | EM ratio | total ratio |")
+    print("|" + "---|" * 10)
+    for name in a.cases.split(","):
+        d, bw = CASES[name]
+        runs = {b: [] for b in a.perf}
+        for _ in range(a.runs):
+            for b in a.perf:
+                runs[b].append(run_case(d, bw, 2, binary=b))
+        med = {b: {k: statistics.median(r[k] for r in rs) for k in ("n", "m", "em_iterations", "s_em",
+                                                                    "ms_per_iteration", "s_total_fit")}
+               for b, rs in runs.items()}
+        base = med[a.perf[0]]
+        for b in a.perf:
+            m = med[b]
+            print(f"| d={d}, bw {bw} | {b} | {int(m['n'])} | {int(m['m'])} | {m['em_iterations']:.0f} | "
+                  f"{1000*m['s_em']:.0f} | {m['ms_per_iteration']:.2f} | {m['s_total_fit']:.3f} | "
+                  f"{m['s_em']/base['s_em']:.2f} | {m['s_total_fit']/base['s_total_fit']:.2f} |", flush=True)
+    return 0
+
 
 if __name__ == "__main__":
     main()

@@ -55,6 +55,9 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
                  "runs of k-means++ + EM with seeds seed, seed+1, ...; the highest log-likelihood is kept")
       ->capture_default_str()
       ->check(CLI::Range(1, kMaxRuns));
+  app.add_flag("--dequantise-depth", o.dequantise_depth,
+               "floor variances along viewing rays at the depth quantisation (structured-light depth); "
+               "faster EM convergence, lower training likelihood");
   app.add_option("--threads", o.em.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();

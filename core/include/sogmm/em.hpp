@@ -6,6 +6,7 @@
 #include <functional>
 #include <vector>
 
+#include "sogmm/depth_quantisation.hpp"
 #include "sogmm/gmm.hpp"
 #include "sogmm/point_cloud.hpp"
 
@@ -35,6 +36,12 @@ struct EmOptions {
   /// the components already evaluated, so it holds from the first iteration
   /// on (the tight k-means++ start included) without any fallback.
   double truncation_nats = 0.0;
+  /// Depth quantisation of the points (empty by default: none). When set, every
+  /// M-step floors each component's variance along its viewing ray at the
+  /// quantisation bin's (DepthQuantisation::floor_covariance_at), so no
+  /// component collapses onto one depth level. fit() detects it for
+  /// camera-frame clouds.
+  DepthQuantisation quantisation;
 };
 
 /// What the EM did.
@@ -46,6 +53,9 @@ struct EmReport {
   /// Point-component pairs evaluated / (N * M * iterations): 1 for the exact
   /// E-step, less when truncation skipped pairs.
   double pair_fraction = 1.0;
+  /// The SIMD kernel that ran the E-step: "avx512", "avx2" or "sse2" (the
+  /// best the CPU supports, capped by the SOGMM_ISA environment variable).
+  const char* kernel = "";
 };
 
 /// Called after each EM iteration with the iteration number (from 1) and the

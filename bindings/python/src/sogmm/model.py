@@ -500,6 +500,11 @@ class SOGMM(GMM):
         truncation_nats: 0 (default) = exact E-step; > 0 = truncated E-step that
             skips components provably more than this many nats below every
             point's best in a block (25 is a good value for full frames).
+        dequantise_depth: False (default) = the paper's plain EM. True: when the
+            camera-frame depth sits on discrete levels (structured-light
+            sensors), floor each component's variance along its viewing ray at
+            the level's bin variance, so components do not collapse onto single
+            levels (converges in fewer iterations; lower training likelihood).
         n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
             the highest final mean log-likelihood is kept (as scikit-learn's
             GaussianMixture(n_init)). 1 (default) = the paper's single run.
@@ -509,7 +514,8 @@ class SOGMM(GMM):
 
     def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float = 1e-6,
                  max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
-                 mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1):
+                 mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1,
+                 dequantise_depth: bool = False):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -520,12 +526,13 @@ class SOGMM(GMM):
         self.mode_counter = mode_counter
         self.truncation_nats = truncation_nats
         self.n_init = n_init
+        self.dequantise_depth = dequantise_depth
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats", "n_init")
+               "truncation_nats", "n_init", "dequantise_depth")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -560,6 +567,7 @@ class SOGMM(GMM):
             _ffi.OPT_SEED: seed,
             _ffi.OPT_THREADS: int(self.n_threads),
             _ffi.OPT_N_INIT: int(self.n_init),
+            _ffi.OPT_DEQUANTISE_DEPTH: int(bool(self.dequantise_depth)),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
         }
         f64.update(extra_f64 or {})
