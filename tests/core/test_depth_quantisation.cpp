@@ -9,6 +9,7 @@
 
 #include "sogmm/depth_quantisation.hpp"
 #include "sogmm/em.hpp"
+#include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"
 #include "test_util.hpp"
 
@@ -128,4 +129,25 @@ TEST(DepthQuantisation, EmWithTheFloorDoesNotCollapseOntoLevels) {
   const double sp = sogmm_test::score(gp, seen), sd = sogmm_test::score(gd, seen);
   std::printf("held-out mean log-likelihood: plain %.4f, floored %.4f\n", sp, sd);
   EXPECT_GT(sd, sp + 0.03);
+}
+
+// fit() applies the floor only when asked (FitOptions::dequantise_depth), and
+// then exactly as fit_em with the detected quantisation does.
+TEST(DepthQuantisation, FitAppliesTheFloorOnlyWhenAsked) {
+  const std::vector<float> stored = scene(7, false);
+  sogmm::FitOptions o;
+  o.n_components = 300;
+  o.seed = 3;
+  o.em.threads = 1;
+  const sogmm::FitResult off = sogmm::fit(view(stored), o);
+  o.dequantise_depth = true;
+  const sogmm::FitResult on = sogmm::fit(view(stored), o);
+  EXPECT_GE(collapsed_along_the_ray(off.gmm, o.em.reg_covar), 2);
+  EXPECT_EQ(collapsed_along_the_ray(on.gmm, o.em.reg_covar), 0);
+
+  const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(stored), 300, 3);
+  sogmm::EmOptions floored = o.em;
+  floored.quantisation = sogmm::DepthQuantisation::detect(view(stored));
+  const sogmm::Gmm direct = sogmm::fit_em(view(stored), seeds, floored);
+  EXPECT_EQ(direct.means, on.gmm.means);
 }
