@@ -1,8 +1,9 @@
 """ctypes layer over libsogmm (the C API of capi/include/sogmm/sogmm.h).
 
-Only handles, scalars and pointers cross the boundary: no struct is mirrored
-here. Every exported function is declared in ``_DECLARATIONS`` below; a test
-parses the C header and checks that the names and arities match.
+Only handles, scalars, pointers and the map's two statistics structs
+(MapStats, MapFrameStats) cross the boundary. Every exported function is
+declared in ``_DECLARATIONS`` below; a test parses the C header and checks
+that the names and arities match.
 
 Library discovery (first match wins):
   1. the ``SOGMM_LIBRARY_PATH`` environment variable (a file path);
@@ -53,6 +54,14 @@ OPT_COMPRESS = 302
 OPT_MAX_DECODED_BYTES = 400
 OPT_VERIFY_CHECKSUMS = 401
 OPT_SAMPLE_TRUNCATION = 500
+OPT_MAP_NOVELTY = 600
+OPT_MAP_NOVELTY_THRESHOLD = 601
+OPT_MAP_BATCH_SIZE = 602
+OPT_MAP_FUSION = 603
+OPT_MAP_FUSION_METHOD = 604
+OPT_MAP_FUSION_THRESHOLD = 605
+FUSION_HELLINGER = 0
+FUSION_KL = 1
 
 COLOR_GRAY8 = 1
 COLOR_RGB8 = 2
@@ -87,6 +96,23 @@ INFO_CAMERA_DECIMATION = 10206
 INFO_CAMERA_DEPTH_SCALE = 10207
 INFO_CAMERA_DEPTH_MIN = 10208
 INFO_CAMERA_DEPTH_MAX = 10209
+
+
+
+# ---- structs (mirror sogmm.h; the only ones the API passes) ----------------
+class MapStats(ctypes.Structure):
+    """sogmm_map_stats."""
+
+    _fields_ = [("n_components", c_uint64), ("n_pending", c_uint64), ("n_frames", c_uint64),
+                ("n_flushes", c_uint64), ("n_fused", c_uint64)]
+
+
+class MapFrameStats(ctypes.Structure):
+    """sogmm_map_frame_stats."""
+
+    _fields_ = [("n_points", c_uint64), ("n_novel", c_uint64), ("n_components", c_uint64), ("flushed", c_int32),
+                ("ms_novelty", c_double), ("ms_fit", c_double), ("ms_merge", c_double), ("pose", c_double * 16)]
+
 
 # ---- argument types ------------------------------------------------------
 _C = "C_CONTIGUOUS"
@@ -152,6 +178,19 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
     "sogmm_model_save_to_memory": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
     "sogmm_model_load_from_memory": (STATUS, [HANDLE_OUT, c_void_p, c_size_t, HANDLE]),
+    "sogmm_map_create": (STATUS, [HANDLE_OUT, HANDLE]),
+    "sogmm_map_free": (None, [HANDLE]),
+    "sogmm_map_insert_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F64_IN]),
+    "sogmm_map_insert_rgbd": (
+        STATUS,
+        [HANDLE, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN],
+    ),
+    "sogmm_map_flush": (STATUS, [HANDLE]),
+    "sogmm_map_get_stats": (STATUS, [HANDLE, POINTER(MapStats)]),
+    "sogmm_map_get_frame_stats": (STATUS, [HANDLE, c_uint64, POINTER(MapFrameStats)]),
+    "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
+    "sogmm_map_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
+    "sogmm_map_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
     "sogmm_buffer_data": (POINTER(c_uint8), [HANDLE]),
     "sogmm_buffer_size": (c_size_t, [HANDLE]),
     "sogmm_buffer_free": (None, [HANDLE]),
@@ -308,6 +347,12 @@ OPTION_NAMES = {
     OPT_MAX_DECODED_BYTES: "max_decoded_bytes",
     OPT_VERIFY_CHECKSUMS: "verify_checksums",
     OPT_SAMPLE_TRUNCATION: "truncation",
+    OPT_MAP_NOVELTY: "novelty",
+    OPT_MAP_NOVELTY_THRESHOLD: "novelty_threshold",
+    OPT_MAP_BATCH_SIZE: "batch_size",
+    OPT_MAP_FUSION: "fusion",
+    OPT_MAP_FUSION_METHOD: "fusion",
+    OPT_MAP_FUSION_THRESHOLD: "fusion_threshold",
 }
 
 
