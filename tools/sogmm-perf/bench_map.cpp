@@ -9,6 +9,11 @@
 //
 // Prints one JSON object with medians over --repeats runs.
 // Usage: sogmm-bench-map [--components 50000] [--points 12288] [--repeats 21]
+//
+// With --sequence DIR (a Redwood folder: depth/, color/, intrinsics.json,
+// trajectory.log) it instead inserts --frames A:B (decimated by --decimate)
+// into an append-everything map and a novelty map, then re-inserts the first
+// frame at its pose, and prints one JSON line per insert and a summary.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +24,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_common.hpp"
+#include "image_io.hpp"
+#include "sequence.hpp"
 #include "sogmm/map.hpp"
 
 namespace {
@@ -77,6 +85,61 @@ sogmm::Model room_map(std::size_t m, std::mt19937_64& rng) {
   return model;
 }
 
+void print_frame(const char* map, const sogmm::FrameStats& f) {
+  std::printf(
+      "{\"map\": \"%s\", \"frame\": %llu, \"points\": %zu, \"novel\": %zu, \"components\": %zu, "
+      "\"ms_novelty\": %.2f, \"ms_fit\": %.1f, \"ms_merge\": %.2f}\n",
+      map, static_cast<unsigned long long>(f.index), f.n_points, f.n_novel, f.n_components, f.ms_novelty, f.ms_fit,
+      f.ms_merge);
+}
+
+int run_sequence(const std::string& dir, const std::string& range, int decimate) {
+  namespace tools = sogmm::tools;
+  const auto frames = tools::list_sequence(dir);
+  const auto poses = tools::read_trajectory(dir + "/trajectory.log");
+  const auto selected = tools::parse_frame_range(range, frames.size());
+  const sogmm::Camera camera = sogmm::read_intrinsics_json(dir + "/intrinsics.json");
+  sogmm::MapOptions append_options, novelty_options;
+  append_options.novelty = false;
+  append_options.depth.decimate = novelty_options.depth.decimate = decimate;
+  append_options.fit.em.threads = novelty_options.fit.em.threads = 2;
+  sogmm::Map append(append_options), novelty(novelty_options);
+  for (std::size_t i : selected) {
+    const tools::LoadedFrame f = tools::load_frame(frames[i].depth, frames[i].color);
+    print_frame("append", append.insert_rgbd(f.view(camera), poses[i]));
+    print_frame("novelty", novelty.insert_rgbd(f.view(camera), poses[i]));
+  }
+  novelty.flush();
+  const std::size_t before = novelty.size();
+  const tools::LoadedFrame f0 = tools::load_frame(frames[selected[0]].depth, frames[selected[0]].color);
+  {
+    // Where the first frame's points score against the map that holds them:
+    // percentiles of the local 3-D log-likelihood (the novelty threshold's scale).
+    const sogmm::PointCloud cloud = sogmm::backproject(f0.view(camera), novelty_options.depth);
+    const sogmm::Pose& p = poses[selected[0]];
+    std::vector<double> xyz(3 * cloud.size()), ll(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      for (int r = 0; r < 3; ++r)
+        xyz[3 * i + r] = p[4 * r] * cloud.xyzg[4 * i] + p[4 * r + 1] * cloud.xyzg[4 * i + 1] +
+                         p[4 * r + 2] * cloud.xyzg[4 * i + 2] + p[4 * r + 3];
+    novelty.local_log_likelihood(xyz.data(), cloud.size(), ll.data());
+    std::sort(ll.begin(), ll.end());
+    std::printf("{\"first_frame_local_loglik_percentiles\": {");
+    const int q[] = {1, 5, 10, 25, 50, 75, 90};
+    for (int k = 0; k < 7; ++k)
+      std::printf("%s\"p%d\": %.2f", k ? ", " : "", q[k], ll[ll.size() * q[k] / 100]);
+    std::printf("}}\n");
+  }
+  const sogmm::FrameStats again = novelty.insert_rgbd(f0.view(camera), poses[selected[0]]);
+  print_frame("novelty-reinsert-first", again);
+  novelty.flush();
+  std::printf("{\"append_components\": %zu, \"novelty_components\": %zu, \"ratio\": %.3f, "
+              "\"reinsert_novel\": %zu, \"reinsert_points\": %zu, \"reinsert_added_components\": %zu}\n",
+              append.size(), before, static_cast<double>(before) / static_cast<double>(append.size()),
+              again.n_novel, again.n_points, novelty.size() - before);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -86,7 +149,13 @@ int main(int argc, char** argv) {
   app.add_option("--components", components, "map components")->check(CLI::Range(1, 10000000));
   app.add_option("--points", points, "frame points")->check(CLI::Range(1, 10000000));
   app.add_option("--repeats", repeats, "timed runs per variant")->check(CLI::Range(1, 1000));
+  std::string sequence, range = "0:3";
+  int decimate = 5;
+  app.add_option("--sequence", sequence, "Redwood folder: real-frame growth instead of the synthetic benchmark");
+  app.add_option("--frames", range, "frames of --sequence, A:B");
+  app.add_option("--decimate", decimate, "decimation of --sequence frames")->check(CLI::Range(1, 64));
   CLI11_PARSE(app, argc, argv);
+  if (!sequence.empty()) return sogmm::tools::run_guarded([&] { return run_sequence(sequence, range, decimate); });
 
   std::mt19937_64 rng(18);
   const sogmm::Model model = room_map(components, rng);
