@@ -23,6 +23,15 @@ std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
   return u(x) | (u(y) << 21) | (u(z) << 42);
 }
 
+float down(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+float up(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) < v ? std::nextafter(f, INFINITY) : f;
+}
+
 }  // namespace
 
 Box3 component_box(const Gmm& gmm, std::size_t m, double sigmas) {
@@ -82,16 +91,19 @@ void ComponentIndex::insert(std::uint32_t id) {
     return;
   }
   large_flag_[id] = 0;
+  const Box3& b = boxes_[id];
+  const Entry e{{down(b.lo[0]), down(b.lo[1]), down(b.lo[2])}, {up(b.hi[0]), up(b.hi[1]), up(b.hi[2])}, id};
+  const auto by_id = [](const Entry& a, std::uint32_t v) { return a.id < v; };
   for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
     for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
       for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-        std::vector<std::uint32_t>& cell = cells_[pack(x, y, z)];
+        std::vector<Entry>& cell = cells_[pack(x, y, z)];
         // Ids arrive ascending except on update(): keep every cell sorted so
         // queries return ascending ids without a sort.
-        if (cell.empty() || cell.back() < id)
-          cell.push_back(id);
+        if (cell.empty() || cell.back().id < id)
+          cell.push_back(e);
         else
-          cell.insert(std::upper_bound(cell.begin(), cell.end(), id), id);
+          cell.insert(std::lower_bound(cell.begin(), cell.end(), id, by_id), e);
       }
 }
 
@@ -107,9 +119,10 @@ void ComponentIndex::erase(std::uint32_t id) {
       for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
         auto it = cells_.find(pack(x, y, z));
         if (it == cells_.end()) continue;
-        std::vector<std::uint32_t>& cell = it->second;
-        const auto pos = std::lower_bound(cell.begin(), cell.end(), id);
-        if (pos != cell.end() && *pos == id) cell.erase(pos);
+        std::vector<Entry>& cell = it->second;
+        const auto pos = std::lower_bound(cell.begin(), cell.end(), id,
+                                          [](const Entry& a, std::uint32_t v) { return a.id < v; });
+        if (pos != cell.end() && pos->id == id) cell.erase(pos);
         if (cell.empty()) cells_.erase(it);
       }
 }
@@ -167,12 +180,32 @@ void ComponentIndex::update(const Gmm& gmm, std::size_t m) {
 }
 
 void ComponentIndex::query_point(const double xyz[3], std::vector<std::uint32_t>& out) const {
+  Cursor fresh;
+  query_point(xyz, out, fresh);
+}
+
+void ComponentIndex::query_point(const double xyz[3], std::vector<std::uint32_t>& out, Cursor& cursor) const {
   out.clear();
   if (boxes_.empty() || !std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) return;
-  const auto it = cells_.find(pack(cell_coord(xyz[0], 0), cell_coord(xyz[1], 1), cell_coord(xyz[2], 2)));
-  if (it != cells_.end())
-    for (std::uint32_t id : it->second)
-      if (boxes_[id].contains(xyz)) out.push_back(id);
+  const CellKey key = pack(cell_coord(xyz[0], 0), cell_coord(xyz[1], 1), cell_coord(xyz[2], 2));
+  if (!cursor.valid_ || cursor.key_ != key) {
+    const auto it = cells_.find(key);
+    cursor.key_ = key;
+    cursor.cell_ = it == cells_.end() ? nullptr : &it->second;
+    cursor.valid_ = true;
+  }
+  if (cursor.cell_ != nullptr) {
+    // float32 point rounded both ways, so the float test never rejects a
+    // point inside the double box; the double box decides. The six float
+    // comparisons are combined without branches (few entries pass).
+    const float lo[3] = {down(xyz[0]), down(xyz[1]), down(xyz[2])};
+    const float hi[3] = {up(xyz[0]), up(xyz[1]), up(xyz[2])};
+    for (const Entry& e : *static_cast<const std::vector<Entry>*>(cursor.cell_)) {
+      const bool in = (hi[0] >= e.lo[0]) & (lo[0] <= e.hi[0]) & (hi[1] >= e.lo[1]) & (lo[1] <= e.hi[1]) &
+                      (hi[2] >= e.lo[2]) & (lo[2] <= e.hi[2]);
+      if (in && boxes_[e.id].contains(xyz)) out.push_back(e.id);
+    }
+  }
   if (large_.empty()) return;
   const std::size_t cell_hits = out.size();
   for (std::uint32_t id : large_)
@@ -199,8 +232,8 @@ void ComponentIndex::query_box(const Box3& box, std::vector<std::uint32_t>& out)
       for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
         const auto it = cells_.find(pack(x, y, z));
         if (it == cells_.end()) continue;
-        for (std::uint32_t id : it->second)
-          if (boxes_[id].intersects(box)) out.push_back(id);
+        for (const Entry& e : it->second)
+          if (boxes_[e.id].intersects(box)) out.push_back(e.id);
       }
   for (std::uint32_t id : large_)
     if (boxes_[id].intersects(box)) out.push_back(id);

@@ -66,9 +66,10 @@ void local_log_likelihood(const ComponentIndex& index, const std::vector<Margina
   std::vector<std::vector<std::uint32_t>> scratch(team);
   std::vector<std::vector<std::uint8_t>> touched(team, std::vector<std::uint8_t>(m, 0));
   std::vector<std::vector<double>> terms(team);
+  std::vector<ComponentIndex::Cursor> cursors(team);
   parallel_for(n, team, 256, [&](std::size_t i, int t) {
     std::vector<std::uint32_t>& ids = scratch[t];
-    index.query_point(xyz + 3 * i, ids);
+    index.query_point(xyz + 3 * i, ids, cursors[t]);
     std::vector<double>& v = terms[t];
     v.clear();
     double best = neg_inf;

@@ -128,6 +128,27 @@ HANDLE_OUT = POINTER(c_void_p)  # sogmm_xxx**
 STATUS = c_int32
 KEY = c_int32
 
+
+class MapStats(ctypes.Structure):
+    """sogmm_map_stats (sogmm.h)."""
+
+    _fields_ = [(name, c_uint64) for name in ("n_components", "n_pending", "n_frames", "n_flushes", "n_fused")]
+
+
+class MapFrameStats(ctypes.Structure):
+    """sogmm_map_frame_stats (sogmm.h)."""
+
+    _fields_ = [
+        ("n_points", c_uint64),
+        ("n_novel", c_uint64),
+        ("n_components", c_uint64),
+        ("flushed", c_int32),
+        ("ms_novelty", c_double),
+        ("ms_fit", c_double),
+        ("ms_merge", c_double),
+        ("pose", c_double * 16),
+    ]
+
 # name -> (restype, argtypes). Keep in the order of sogmm.h.
 _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_version_number": (c_uint32, []),
