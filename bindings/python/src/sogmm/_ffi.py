@@ -97,23 +97,6 @@ INFO_CAMERA_DEPTH_SCALE = 10207
 INFO_CAMERA_DEPTH_MIN = 10208
 INFO_CAMERA_DEPTH_MAX = 10209
 
-
-
-# ---- structs (mirror sogmm.h; the only ones the API passes) ----------------
-class MapStats(ctypes.Structure):
-    """sogmm_map_stats."""
-
-    _fields_ = [("n_components", c_uint64), ("n_pending", c_uint64), ("n_frames", c_uint64),
-                ("n_flushes", c_uint64), ("n_fused", c_uint64)]
-
-
-class MapFrameStats(ctypes.Structure):
-    """sogmm_map_frame_stats."""
-
-    _fields_ = [("n_points", c_uint64), ("n_novel", c_uint64), ("n_components", c_uint64), ("flushed", c_int32),
-                ("ms_novelty", c_double), ("ms_fit", c_double), ("ms_merge", c_double), ("pose", c_double * 16)]
-
-
 # ---- argument types ------------------------------------------------------
 _C = "C_CONTIGUOUS"
 F32_IN = np.ctypeslib.ndpointer(dtype=np.float32, flags=_C)
