@@ -7,10 +7,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
 
-namespace {
-
-using sogmm_capi::fail;
-using sogmm_capi::require_nonnull;
+namespace sogmm_capi {
 
 sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
   sogmm::FitOptions f;
@@ -29,6 +26,14 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
   f.em.truncation_nats = o.truncation_nats;
   return f;
 }
+
+}  // namespace sogmm_capi
+
+namespace {
+
+using sogmm_capi::fail;
+using sogmm_capi::fit_options;
+using sogmm_capi::require_nonnull;
 
 /// Runs the fit on checked points and wraps the result (fit report, fit
 /// parameters, timings) in a new handle.

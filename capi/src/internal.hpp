@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sogmm/camera.hpp"
+#include "sogmm/fit.hpp"
 #include "sogmm/model.hpp"
 #include "sogmm/point_cloud.hpp"
 #include "sogmm/progress.hpp"
@@ -50,6 +51,13 @@ struct sogmm_options {
   // progress (sogmm_options_set_progress): not a key, never stored in files
   sogmm_progress_fn progress = nullptr;
   void* progress_user_data = nullptr;
+  // incremental map (sogmm_map_*)
+  std::int64_t map_novelty = 1;
+  double map_novelty_threshold = 3.0;
+  std::int64_t map_batch_size = 12288;
+  std::int64_t map_fusion = 0;
+  std::int64_t map_fusion_method = SOGMM_FUSION_HELLINGER;
+  double map_fusion_threshold = 0.3;
 };
 
 /// Timings of a fit run in this process (not part of the file format).
@@ -127,6 +135,10 @@ struct RgbdPoints {
 RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* color, std::int32_t color_format,
                             std::uint32_t width, std::uint32_t height, double fx, double fy, double cx, double cy,
                             const sogmm_options& options);
+
+/// The fit keys of `o` as FitOptions with n_components = k (sogmm_fit_* and
+/// sogmm_map_*).
+sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k);
 
 /// Stores NULL into a handle out-pointer if it is not NULL (on failure).
 template <typename T>

@@ -102,6 +102,8 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_DEPTH_MAX: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       case SOGMM_OPT_SAMPLE_TRUNCATION: check_f64(key, v, v > 0, "> 0"); break;
       case SOGMM_OPT_TRUNCATION_NATS: check_f64(key, v, std::isfinite(v) && v >= 0, ">= 0, finite"); break;
+      case SOGMM_OPT_MAP_NOVELTY_THRESHOLD: check_f64(key, v, std::isfinite(v), "finite"); break;
+      case SOGMM_OPT_MAP_FUSION_THRESHOLD: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       default: break;
     }
     options->*spec.f64 = v;
@@ -127,7 +129,11 @@ SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_DEQUANTISE_DEPTH:
       case SOGMM_OPT_FLOAT64:
       case SOGMM_OPT_COMPRESS:
-      case SOGMM_OPT_VERIFY_CHECKSUMS: check_i64(key, v, 0, 1, "0 or 1"); break;
+      case SOGMM_OPT_VERIFY_CHECKSUMS:
+      case SOGMM_OPT_MAP_NOVELTY:
+      case SOGMM_OPT_MAP_FUSION: check_i64(key, v, 0, 1, "0 or 1"); break;
+      case SOGMM_OPT_MAP_BATCH_SIZE: check_i64(key, v, 1, std::int64_t{1} << 26, "[1, 2^26]"); break;
+      case SOGMM_OPT_MAP_FUSION_METHOD: check_i64(key, v, 0, 1, "a SOGMM_FUSION_* value"); break;
       case SOGMM_OPT_MAX_DECODED_BYTES: check_i64(key, v, 0, kI64Max, ">= 0"); break;
       default: break;
     }

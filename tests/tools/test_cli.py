@@ -10,6 +10,8 @@ Modes:
              `sogmm demo --write-frame` (no external data needed)
   sequence   fit --sequence / eval --sequence / render --trajectory on a
              3-frame synthetic sequence; support size = sum of frame points
+  map        sogmm map on a 16-frame room loop (demo --loop): CSV, plot,
+             fewer components than fit --sequence, eval, bad input
   shared     the same on ../shared/data/rgbd (prints "SKIP: ..." and exits 0
              only when that folder is absent)
 Checks parse the PNG (chunks, zlib stream, scanline filters) and PLY (header
@@ -166,7 +168,7 @@ def no_temp_files(folder):
 def mode_help(tmp):
     p = run(["--help"])
     check("Exit codes" in p.stdout and "Example" in p.stdout, "sogmm --help lacks exit codes or an example")
-    for sub in ["demo", "eval", "fit", "render", "sample"]:
+    for sub in ["demo", "eval", "fit", "map", "render", "sample"]:
         p = run([sub, "--help"])
         check("Example" in p.stdout, "sogmm %s --help has no example" % sub)
     run(["--version"])
@@ -337,6 +339,99 @@ def mode_sequence(tmp):
     exercise_sequence(tmp, d, "png", 3, 10, 0.05, [], False)
 
 
+def write_png16(path, img):
+    """A 16-bit gray PNG (filter 0 on every row)."""
+    h, w = img.shape
+    raw = b"".join(b"\x00" + img[y].astype(">u2").tobytes() for y in range(h))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)) +
+                          chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+def mode_map(tmp):
+    """sogmm map on a short room loop: CSV, plot, fewer components than
+    append-everything, eval --sequence on the result, one-line errors."""
+    d = os.path.join(tmp, "loop")
+    n = 16
+    p = run(["demo", "--write-frame", d, "--loop", "--frames", n])
+    check("Wrote %d" % n in p.stdout, "demo --loop: %r" % p.stdout)
+    traj = os.path.join(d, "trajectory.log")
+    lines = open(traj).read().split("\n")
+    first, last = [np.array(" ".join(lines[b + 1:b + 5]).split(), dtype=float) for b in (0, 5 * (n - 1))]
+    check(np.abs(first - last).max() < 1e-12, "demo --loop: the last pose is not the first")
+    base = ["--trajectory", traj, "--decimate", 10, "--bandwidth", 0.05]
+    out = os.path.join(tmp, "loop.sogmm")
+    summary, progress = run_json(["map", d] + base + ["-o", out, "--progress"], with_stderr=True)
+    check(progress.count("novel") >= n, "map --progress: one line per frame expected: %r" % progress[-500:])
+    rows = open(os.path.join(tmp, "loop.csv")).read().strip().split("\n")
+    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge",
+          "map CSV header: %r" % rows[0])
+    check(len(rows) == n + 1, "map CSV: %d rows for %d frames" % (len(rows) - 1, n))
+    table = [r.split(",") for r in rows[1:]]
+    check([int(r[0]) for r in table] == list(range(n)), "map CSV frame column")
+    check(all(int(r[2]) <= int(r[1]) for r in table), "map CSV: more novel points than points")
+    check(int(table[0][2]) == int(table[0][1]), "map CSV: the first frame is all novel")
+    # The last frame revisits the first: almost nothing of it is new.
+    check(int(table[-1][2]) < 0.2 * int(table[-1][1]), "map CSV: the loop's last frame is %s/%s novel" %
+          (table[-1][2], table[-1][1]))
+    svg = open(os.path.join(tmp, "loop.svg")).read()
+    check(svg.startswith("<svg") and svg.count("<polyline") == 5, "map plot: not an SVG with 5 lines")
+    seq = os.path.join(tmp, "append.sogmm")
+    fit = run_json(["fit", "--sequence", d, "-o", seq] + base)
+    check(0 < summary.get("n_components", 0) < fit.get("n_components", 0),
+          "map: %s components, append-everything %s" % (summary.get("n_components"), fit.get("n_components")))
+    # --no-novelty is append-everything: the same components as fit --sequence.
+    same = run_json(["map", d, "--no-novelty", "-o", os.path.join(tmp, "same.sogmm")] + base)
+    check(same.get("n_components") == fit.get("n_components") and same.get("support_size") == fit.get("support_size"),
+          "map --no-novelty %s vs fit --sequence %s" % (same, fit))
+    # The map scores each frame about as well as append-everything does.
+    ev_map, ev_all = [run_json(["eval", m, "--sequence", d, "--trajectory", traj, "--frames", "0:%d:5" % n])
+                      .get("frames", []) for m in (out, seq)]
+    check(len(ev_map) == 4 and len(ev_all) == 4, "eval --sequence on the map: %d rows" % len(ev_map))
+    for r, a in zip(ev_map, ev_all):
+        check(r["psnr"] > a["psnr"] - 2.0 and r["fscore"] > 0.6 * a["fscore"],
+              "eval --sequence frame %d: map PSNR %.2f F %.3f, append-everything PSNR %.2f F %.3f" %
+              (r["frame"], r["psnr"], r["fscore"], a["psnr"], a["fscore"]))
+    no_temp_files(tmp)
+
+    def err(args, code, names):
+        p = run(args, expect=code)
+        check(len(p.stderr.strip().splitlines()) == 1, "sogmm %s: expected one error line, got %r" %
+              (" ".join(map(str, args)), p.stderr))
+        check(names in p.stderr, "sogmm %s: error does not name %s: %r" % (" ".join(map(str, args)), names, p.stderr))
+
+    bad = os.path.join(tmp, "bad")
+    os.makedirs(bad)
+    for sub in ("depth", "color"):
+        os.makedirs(os.path.join(bad, sub))
+        for k in range(3):
+            name = "%05d.png" % k
+            open(os.path.join(bad, sub, name), "wb").write(open(os.path.join(d, sub, name), "rb").read())
+    open(os.path.join(bad, "intrinsics.json"), "w").write(open(os.path.join(d, "intrinsics.json")).read())
+    m = os.path.join(tmp, "bad.sogmm")
+    badargs = ["--decimate", 10, "--bandwidth", 0.05, "-o", m]
+    nan = os.path.join(tmp, "nan.log")
+    open(nan, "w").write("0 0 1\n1 0 0 nan\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    err(["map", bad, "--trajectory", nan] + badargs, 3, "nan.log")
+    scaled = os.path.join(tmp, "scaled.log")
+    open(scaled, "w").write("0 0 1\n2 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    err(["map", bad, "--trajectory", scaled] + badargs, 3, "scaled.log")
+    err(["map", bad, "--trajectory", os.path.join(tmp, "none.log")] + badargs, 4, "none.log")
+    err(["map", bad, "--trajectory", traj, "--threshold", "nan"] + badargs, 2, "threshold")
+    err(["map", bad, "--trajectory", traj, "--batch", 0] + badargs, 2, "batch")
+    write_png16(os.path.join(bad, "depth", "00001.png"), np.zeros((480, 640), np.uint16))
+    err(["map", bad, "--trajectory", traj] + badargs, 3, "00001.png")  # empty frame
+    write_png16(os.path.join(bad, "depth", "00001.png"), np.full((240, 320), 1500, np.uint16))
+    err(["map", bad, "--trajectory", traj] + badargs, 3, "00001.png")  # another size
+    os.remove(os.path.join(bad, "color", "00002.png"))
+    err(["map", bad, "--trajectory", traj] + badargs, 3, "color")  # 3 depth images, 2 color
+    check(not os.path.exists(m), "a failed map run wrote %s" % m)
+    no_temp_files(tmp)
+
+
 def mode_errors(tmp):
     d = write_synthetic(tmp, 1)
     intr = ["--intrinsics", os.path.join(d, "intrinsics.json")]
@@ -431,7 +526,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sogmm", required=True)
     ap.add_argument("--data", required=True)
-    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "shared"])
+    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "shared"])
     a = ap.parse_args()
     SOGMM = a.sogmm
     with tempfile.TemporaryDirectory(prefix="sogmm_cli_test_") as tmp:
@@ -443,6 +538,8 @@ def main():
             mode_synthetic(tmp)
         elif a.mode == "sequence":
             mode_sequence(tmp)
+        elif a.mode == "map":
+            mode_map(tmp)
         elif mode_shared(tmp, a.data) == "skip":
             return 0
     if FAILURES:

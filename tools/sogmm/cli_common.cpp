@@ -145,11 +145,17 @@ void ProgressPrinter::finish() {
   }
 }
 
+void ProgressPrinter::status(const std::string& text) { show(text, mode_ != ProgressMode::Live); }
+
 void ProgressPrinter::em_done(const std::string& label, const FitResult& r) {
+  em_done(label, r.seconds_em, r.em.iterations, r.em.log_likelihood);
+}
+
+void ProgressPrinter::em_done(const std::string& label, double seconds_em, int iterations, double log_likelihood) {
   if (mode_ != ProgressMode::Lines) return;
   char buf[160];
-  std::snprintf(buf, sizeof buf, "EM done in %.3f s: %d iterations, mean log-likelihood %.4f", r.seconds_em,
-                r.em.iterations, r.em.log_likelihood);
+  std::snprintf(buf, sizeof buf, "EM done in %.3f s: %d iterations, mean log-likelihood %.4f", seconds_em, iterations,
+                log_likelihood);
   show(label + ": " + buf, true);
 }
 

@@ -81,6 +81,7 @@ struct Command {
 Command add_demo_command(CLI::App& root);
 Command add_eval_command(CLI::App& root);
 Command add_fit_command(CLI::App& root);
+Command add_map_command(CLI::App& root);
 Command add_render_command(CLI::App& root);
 Command add_sample_command(CLI::App& root);
 
@@ -113,6 +114,10 @@ class ProgressPrinter {
   void line(const std::string& text);
   /// "EM done in T s: I iterations, mean log-likelihood L" after a fit (Lines mode).
   void em_done(const std::string& label, const FitResult& r);
+  /// The same from its parts (a fit run inside the core Map).
+  void em_done(const std::string& label, double seconds_em, int iterations, double log_likelihood);
+  /// A line the next one replaces on a terminal (Live); printed in Lines mode.
+  void status(const std::string& text);
   /// Clears a pending live line.
   void finish();
 

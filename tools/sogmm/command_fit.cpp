@@ -8,6 +8,7 @@
 
 #include "cli_common.hpp"
 #include "file_util.hpp"
+#include "map_run.hpp"
 #include "model_io.hpp"
 #include "sequence.hpp"
 #include "sigint_cancel.hpp"
@@ -50,6 +51,14 @@ struct Totals {
     seed += r.seconds_seeding;
     em += r.seconds_em;
     total += r.seconds_total;
+  }
+  void add(std::size_t n_points, const FitRecord& r, double seconds_total) {
+    points += n_points;
+    iterations += r.em_iterations;
+    mode += r.seconds_mode_count;
+    seed += r.seconds_seeding;
+    em += r.seconds_em;
+    total += seconds_total;
   }
 };
 
@@ -126,65 +135,46 @@ int run_single(const FitState& s) {
   return 0;
 }
 
+// Append everything: the core Map with novelty and fusion off fits each
+// frame on its own, moves it with its pose and merges it (map_run.hpp).
 int run_sequence(const FitState& s) {
-  const std::vector<SequenceFrame> frames = list_sequence(s.src.sequence);
-  const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
-  const std::vector<std::size_t> selected =
-      parse_frame_range(s.src.frames.empty() ? std::string(":") : s.src.frames, frames.size());
-  require(poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
-          s.src.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
-              std::to_string(selected.back()) + " is selected");
-  CameraFlags camera_flags = s.camera;
-  if (!camera_flags_given(camera_flags)) {
-    const std::string guess = (std::filesystem::path(s.src.sequence) / "intrinsics.json").string();
-    require(std::filesystem::is_regular_file(guess), ErrorCode::InvalidArgument,
-            "no camera: give --intrinsics FILE (or put intrinsics.json in " + s.src.sequence + ")");
-    camera_flags.intrinsics = guess;
-  }
+  const SequenceInput in = resolve_sequence(s.src, s.camera);
+  MapOptions options;
+  options.novelty = false;
+  options.fusion = false;
+  options.fit = s.fit;
+  options.depth = s.depth_options;
+  Map map(options);
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
-  Model merged;  // spec/format.md section 2.2: merge() keeps the fit record's defined meaning
   Totals t;
-  Camera camera;
   nlohmann::json frames_json = nlohmann::json::array();
-  std::string frame_list;
-  for (std::size_t k = 0; k < selected.size(); ++k) {
-    const SequenceFrame& f = frames[selected[k]];
-    const LoadedFrame frame = load_frame(f.depth, f.color);
-    camera = resolve_camera(camera_flags, frame);
-    const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, f.depth);
-    const std::string label = "frame " + std::to_string(k + 1) + "/" + std::to_string(selected.size()) + " (" +
-                              base_name(f.depth) + ")";
-    FitResult r = fit(cloud.view(), s.fit, progress.fit_callback(label));
-    progress.em_done(label, r);
-    t.add(r);
-    const std::size_t m = r.gmm.size();
-    Model world = make_model(transform(r.gmm, poses[f.index]), s.fit, r.em, camera, s.depth_options,
-                             {{kCoordinateFrameKey, "world"}});
-    merged = k == 0 ? std::move(world) : merge(merged, world);
+  std::size_t before = 0;
+  run_map_over_sequence(map, in, s.depth_options, progress, [&](const MapRunFrame& f) {
+    const std::size_t m = f.stats.n_components - before;
+    before = f.stats.n_components;
+    t.add(f.stats.n_points, f.fit, f.stats.ms_fit / 1000.0);
+    progress.em_done(f.label, f.fit.seconds_em, f.fit.em_iterations, f.fit.log_likelihood);
     char buf[256];
     std::snprintf(buf, sizeof buf, "%s: %zu points, %zu components, %d EM iterations, %.2f s; map %zu components",
-                  label.c_str(), r.n_points, m, r.em.iterations, r.seconds_total, merged.gmm.size());
+                  f.label.c_str(), f.stats.n_points, m, f.fit.em_iterations, f.stats.ms_fit / 1000.0,
+                  f.stats.n_components);
     progress.line(buf);
-    frames_json.push_back({{"frame", f.index},
-                           {"depth", f.depth},
-                           {"n_points", r.n_points},
+    frames_json.push_back({{"frame", f.file.index},
+                           {"depth", f.file.depth},
+                           {"n_points", f.stats.n_points},
                            {"n_components", m},
-                           {"em_iterations", r.em.iterations},
-                           {"seconds_total", r.seconds_total}});
-    frame_list += (frame_list.empty() ? "" : ",") + std::to_string(f.index);
-  }
+                           {"em_iterations", f.fit.em_iterations},
+                           {"seconds_total", f.stats.ms_fit / 1000.0}});
+  });
   progress.finish();
-  Model model = std::move(merged);
-  model.producer_version = version_string();
-  model.created_unix_ms = unix_ms_now();
-  model.key_values.insert(model.key_values.end(),
-                          {{"sequence", s.src.sequence}, {"trajectory", s.src.trajectory}, {"frames", frame_list}});
+  const Model model = with_sequence_metadata(map.model(), in);
   const std::uint64_t bytes = save_model(s.output, model);
+  const std::string frames = frame_list(in);
   char what[512];
   std::snprintf(what, sizeof what,
                 "Fitted %zu frames of %s (frames %s, decimated by %d, %s): %zu points in total, merged in the world "
                 "frame of %s into %zu components (support size %llu), %d EM iterations in total.",
-                selected.size(), s.src.sequence.c_str(), frame_list.c_str(), s.depth_options.decimate,
+                in.selected.size(), s.src.sequence.c_str(), frames.c_str(), s.depth_options.decimate,
                 fit_kind(s.fit).c_str(), t.points, s.src.trajectory.c_str(), model.gmm.size(),
                 static_cast<unsigned long long>(model.gmm.support_size), t.iterations);
   print_summary(s, model, t, bytes, frames_json, what);

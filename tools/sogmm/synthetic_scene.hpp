@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 
 #include "image_io.hpp"
 #include "sogmm/camera.hpp"
@@ -18,5 +19,13 @@ LoadedFrame synthetic_frame();
 LoadedFrame synthetic_frame_at(const std::array<double, 16>& pose);
 /// The camera of synthetic_frame().
 Camera synthetic_camera();
+
+/// The nearest surface along the world ray o + t d (t > 0): returns t, or
+/// +infinity for none, and sets `gray` in [0, 1] for a hit.
+using NearestHit = std::function<double(const double o[3], const double d[3], double& gray)>;
+/// Ray-casts a frame of synthetic_camera() from a camera-to-world pose. Each
+/// pixel's ray has camera z component 1, so t is its depth (stored in mm,
+/// rounded; pixels without a hit within 60 m stay 0).
+LoadedFrame ray_cast_frame(const std::array<double, 16>& pose, const NearestHit& nearest);
 
 }  // namespace sogmm::tools

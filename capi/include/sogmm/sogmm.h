@@ -126,6 +126,7 @@ SOGMM_API const char* sogmm_last_error(void);
 typedef struct sogmm_model sogmm_model;     /* a fitted 4-D GMM + metadata */
 typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, save, load, sample */
 typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
+typedef struct sogmm_map sogmm_map;         /* an incremental world map (sogmm_map_*) */
 
 /* ---- options ---------------------------------------------------------- */
 /* Key of a parameter (SOGMM_OPT_*, below 10000) or of a model's information
@@ -182,6 +183,20 @@ typedef int32_t sogmm_key;
 
 /* Sampling (sogmm_model_sample_f32). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
+
+/* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
+ * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
+ * and the RGB-D keys (sogmm_map_insert_rgbd). */
+#define SOGMM_OPT_MAP_NOVELTY 600           /* i64, 0 or 1; default 1. 0: every point is novel and each
+                                             * insert fits its whole frame (append everything) */
+#define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601 /* f64, finite; default 3.0 nats: points whose 3-D log-likelihood
+                                             * under the local submap is below it are novel */
+#define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
+#define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
+#define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default HELLINGER */
+#define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
+#define SOGMM_FUSION_HELLINGER 0 /* Hellinger distance of the 4-D Gaussians, in [0, 1] */
+#define SOGMM_FUSION_KL 1        /* symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, nats */
 
 /* Option keys 1000 to 9999 are experimental and may change in any release. */
 
@@ -460,6 +475,90 @@ SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogm
  * sogmm_model_load without SOGMM_E_IO; size == 0 -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_model_load_from_memory(sogmm_model** out, const void* data, size_t size,
                                                     const sogmm_options* options);
+
+/* ---- incremental map -------------------------------------------------- */
+/* A world-frame map that grows only where the scene is new (issue 18; the
+ * algorithm is documented in core/include/sogmm/map.hpp). Each insert scores
+ * the frame's points, moved to the world by the camera-to-world `pose` (16
+ * doubles, row-major rigid [R t; 0 0 0 1], rules as sogmm_model_set_pose),
+ * with the 3-D log-likelihood of the map's local submap; points below
+ * SOGMM_OPT_MAP_NOVELTY_THRESHOLD are pending, and once
+ * SOGMM_OPT_MAP_BATCH_SIZE points are pending they are fitted and merged in
+ * the world frame (optionally fused). With novelty and fusion off the map is
+ * exactly the merge of every frame's own fit moved by its pose. */
+
+/* Creates an empty map with the map, fit and RGB-D keys of `options` (NULL =
+ * defaults). A depth range with DEPTH_MIN >= DEPTH_MAX -> SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* options);
+/* Releases `map`. NULL is a no-op. */
+SOGMM_API void sogmm_map_free(sogmm_map* map);
+
+/* Inserts a frame of n points (x, y, z, gray; n * 4 floats) in the camera
+ * frame with its camera-to-world `pose`. Errors (the map is unchanged):
+ * n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA; pose not finite or not rigid ->
+ * SOGMM_E_INVALID_ARG; n > 2^26 -> SOGMM_E_LIMIT; a fit this insert triggers
+ * fails -> its status (the frame's novel points then stay pending). */
+SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
+                                                   const double* pose);
+/* Inserts an RGB-D frame (arguments as sogmm_fit_rgbd; decimation and depth
+ * range from the options the map was created with) with its camera-to-world
+ * `pose`. The first RGB-D frame fixes the camera: a frame of another size or
+ * other intrinsics -> SOGMM_E_INVALID_ARG; a frame without a valid pixel ->
+ * SOGMM_E_INVALID_DATA; other errors as sogmm_fit_rgbd and
+ * sogmm_map_insert_points_f32. */
+SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
+                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
+                                             double fy, double cx, double cy, const double* pose);
+/* Fits the pending points now (no-op when none are pending). A failed fit
+ * leaves the map and the pending points unchanged. */
+SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map);
+
+/* Totals of a map. */
+typedef struct sogmm_map_stats {
+  uint64_t n_components; /* components in the map */
+  uint64_t n_pending;    /* novel points waiting for a fit */
+  uint64_t n_frames;     /* frames inserted (a loaded map counts the frames of its file) */
+  uint64_t n_flushes;    /* fits run by this handle */
+  uint64_t n_fused;      /* new components fused into existing ones instead of appended */
+} sogmm_map_stats;
+/* What one insert did (frames of a loaded map have zero times). */
+typedef struct sogmm_map_frame_stats {
+  uint64_t n_points;     /* points of the frame */
+  uint64_t n_novel;      /* of which novel */
+  uint64_t n_components; /* map components after the insert */
+  int32_t flushed;       /* 1 if the insert ran a fit */
+  double ms_novelty;     /* novelty test, milliseconds */
+  double ms_fit;         /* fit run by the insert */
+  double ms_merge;       /* transform, merge, fusion and index update run by the insert */
+  double pose[16];       /* camera-to-world pose given with the frame */
+} sogmm_map_frame_stats;
+SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out);
+/* Statistics of frame `frame` (insertion order, from 0); frame >= n_frames ->
+ * SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame,
+                                                 sogmm_map_frame_stats* out);
+
+/* New world-frame model (key "coordinate_frame" = "world") of the whole map
+ * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:
+ * x_min, y_min, z_min, x_max, y_max, z_max; weights renormalised over them).
+ * Score, sample and regress in the world frame with the sogmm_model_*
+ * functions on it. Errors: an empty map or no component in the box ->
+ * SOGMM_E_INVALID_DATA; a box with min > max or NaN/Inf ->
+ * SOGMM_E_INVALID_ARG. Pending points are not in it. */
+SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map, const float* box);
+
+/* Writes the map as a world-frame .sogmm file, atomically as
+ * sogmm_model_save (write keys of `options` apply), with the provenance keys
+ * "map_frames" and "map_options" (spec/format.md section 2.3). Errors as
+ * sogmm_model_save; points pending (call sogmm_map_flush first) or an empty
+ * map -> SOGMM_E_INVALID_ARG / SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, const sogmm_options* options);
+/* Reads a map saved by sogmm_map_save (or any world-frame .sogmm model: then
+ * without frame provenance). Read keys of `options` apply, and its map, fit
+ * and RGB-D keys govern later inserts (NULL = defaults). Errors as
+ * sogmm_model_load; a camera-frame model -> SOGMM_E_INVALID_ARG; malformed
+ * "map_frames" -> SOGMM_E_FORMAT. */
+SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

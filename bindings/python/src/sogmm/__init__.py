@@ -29,6 +29,7 @@ from .errors import (
     SogmmIOError,
     SogmmMemoryError,
 )
+from .map import Map
 from .model import GMM, SOGMM, from_bytes, load
 from .ply import read_ply, write_ply
 
@@ -59,6 +60,7 @@ __all__ = [
     "InvalidArgumentError",
     "InvalidDataError",
     "LimitError",
+    "Map",
     "NotFittedError",
     "NotFoundError",
     "NullArgumentError",

@@ -1,8 +1,9 @@
 """ctypes layer over libsogmm (the C API of capi/include/sogmm/sogmm.h).
 
-Only handles, scalars and pointers cross the boundary: no struct is mirrored
-here. Every exported function is declared in ``_DECLARATIONS`` below; a test
-parses the C header and checks that the names and arities match.
+Only handles, scalars, pointers and the map's two statistics structs
+(MapStats, MapFrameStats) cross the boundary. Every exported function is
+declared in ``_DECLARATIONS`` below; a test parses the C header and checks
+that the names and arities match.
 
 Library discovery (first match wins):
   1. the ``SOGMM_LIBRARY_PATH`` environment variable (a file path);
@@ -54,6 +55,14 @@ OPT_COMPRESS = 302
 OPT_MAX_DECODED_BYTES = 400
 OPT_VERIFY_CHECKSUMS = 401
 OPT_SAMPLE_TRUNCATION = 500
+OPT_MAP_NOVELTY = 600
+OPT_MAP_NOVELTY_THRESHOLD = 601
+OPT_MAP_BATCH_SIZE = 602
+OPT_MAP_FUSION = 603
+OPT_MAP_FUSION_METHOD = 604
+OPT_MAP_FUSION_THRESHOLD = 605
+FUSION_HELLINGER = 0
+FUSION_KL = 1
 
 COLOR_GRAY8 = 1
 COLOR_RGB8 = 2
@@ -106,6 +115,26 @@ KEY = c_int32
 # sogmm_progress_fn: (stage, step, total, log_likelihood, user_data) -> 0 / non-zero = cancel.
 PROGRESS_FN = ctypes.CFUNCTYPE(c_int32, c_int32, c_uint64, c_uint64, c_double, c_void_p)
 
+class MapStats(ctypes.Structure):
+    """sogmm_map_stats (sogmm.h)."""
+
+    _fields_ = [(name, c_uint64) for name in ("n_components", "n_pending", "n_frames", "n_flushes", "n_fused")]
+
+
+class MapFrameStats(ctypes.Structure):
+    """sogmm_map_frame_stats (sogmm.h)."""
+
+    _fields_ = [
+        ("n_points", c_uint64),
+        ("n_novel", c_uint64),
+        ("n_components", c_uint64),
+        ("flushed", c_int32),
+        ("ms_novelty", c_double),
+        ("ms_fit", c_double),
+        ("ms_merge", c_double),
+        ("pose", c_double * 16),
+    ]
+
 # name -> (restype, argtypes). Keep in the order of sogmm.h.
 _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_version_number": (c_uint32, []),
@@ -157,6 +186,19 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
     "sogmm_model_save_to_memory": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
     "sogmm_model_load_from_memory": (STATUS, [HANDLE_OUT, c_void_p, c_size_t, HANDLE]),
+    "sogmm_map_create": (STATUS, [HANDLE_OUT, HANDLE]),
+    "sogmm_map_free": (None, [HANDLE]),
+    "sogmm_map_insert_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F64_IN]),
+    "sogmm_map_insert_rgbd": (
+        STATUS,
+        [HANDLE, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN],
+    ),
+    "sogmm_map_flush": (STATUS, [HANDLE]),
+    "sogmm_map_get_stats": (STATUS, [HANDLE, POINTER(MapStats)]),
+    "sogmm_map_get_frame_stats": (STATUS, [HANDLE, c_uint64, POINTER(MapFrameStats)]),
+    "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
+    "sogmm_map_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
+    "sogmm_map_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
     "sogmm_buffer_data": (POINTER(c_uint8), [HANDLE]),
     "sogmm_buffer_size": (c_size_t, [HANDLE]),
     "sogmm_buffer_free": (None, [HANDLE]),
@@ -314,6 +356,12 @@ OPTION_NAMES = {
     OPT_MAX_DECODED_BYTES: "max_decoded_bytes",
     OPT_VERIFY_CHECKSUMS: "verify_checksums",
     OPT_SAMPLE_TRUNCATION: "truncation",
+    OPT_MAP_NOVELTY: "novelty",
+    OPT_MAP_NOVELTY_THRESHOLD: "novelty_threshold",
+    OPT_MAP_BATCH_SIZE: "batch_size",
+    OPT_MAP_FUSION: "fusion",
+    OPT_MAP_FUSION_METHOD: "fusion",
+    OPT_MAP_FUSION_THRESHOLD: "fusion_threshold",
 }
 
 

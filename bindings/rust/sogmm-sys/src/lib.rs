@@ -31,6 +31,13 @@ pub struct sogmm_buffer {
     _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
 }
 
+/// Opaque handle: an incremental world map (sogmm_map_*).
+#[repr(C)]
+pub struct sogmm_map {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+
 pub type sogmm_status = i32;
 pub type sogmm_key = i32;
 /// Progress callback: (stage, step, total, log_likelihood, user_data) -> 0 to
@@ -85,6 +92,14 @@ pub const SOGMM_OPT_COMPRESS: sogmm_key = 302;
 pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
 pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
 pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
+pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
+pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
+pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
+pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
+pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
+pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
+pub const SOGMM_FUSION_HELLINGER: i64 = 0;
+pub const SOGMM_FUSION_KL: i64 = 1;
 
 // ---- progress stages --------------------------------------------------------
 pub const SOGMM_STAGE_MODE_COUNT: i32 = 1;
@@ -127,6 +142,31 @@ pub const SOGMM_INFO_CAMERA_DECIMATION: sogmm_key = 10206;
 pub const SOGMM_INFO_CAMERA_DEPTH_SCALE: sogmm_key = 10207;
 pub const SOGMM_INFO_CAMERA_DEPTH_MIN: sogmm_key = 10208;
 pub const SOGMM_INFO_CAMERA_DEPTH_MAX: sogmm_key = 10209;
+
+
+/// Totals of a map (sogmm_map_get_stats).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct sogmm_map_stats {
+    pub n_components: u64,
+    pub n_pending: u64,
+    pub n_frames: u64,
+    pub n_flushes: u64,
+    pub n_fused: u64,
+}
+/// What one insert did (sogmm_map_get_frame_stats).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct sogmm_map_frame_stats {
+    pub n_points: u64,
+    pub n_novel: u64,
+    pub n_components: u64,
+    pub flushed: i32,
+    pub ms_novelty: f64,
+    pub ms_fit: f64,
+    pub ms_merge: f64,
+    pub pose: [f64; 16],
+}
 
 extern "C" {
     pub fn sogmm_version_number() -> u32;
@@ -266,6 +306,41 @@ extern "C" {
         out: *mut *mut sogmm_model,
         data: *const c_void,
         size: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_map_create(out: *mut *mut sogmm_map, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_map_free(map: *mut sogmm_map);
+    pub fn sogmm_map_insert_points_f32(
+        map: *mut sogmm_map,
+        points: *const f32,
+        n: usize,
+        pose: *const f64,
+    ) -> sogmm_status;
+    pub fn sogmm_map_insert_rgbd(
+        map: *mut sogmm_map,
+        depth: *const u16,
+        color: *const u8,
+        color_format: i32,
+        width: u32,
+        height: u32,
+        fx: f64,
+        fy: f64,
+        cx: f64,
+        cy: f64,
+        pose: *const f64,
+    ) -> sogmm_status;
+    pub fn sogmm_map_flush(map: *mut sogmm_map) -> sogmm_status;
+    pub fn sogmm_map_get_stats(map: *const sogmm_map, out: *mut sogmm_map_stats) -> sogmm_status;
+    pub fn sogmm_map_get_frame_stats(
+        map: *const sogmm_map,
+        frame: u64,
+        out: *mut sogmm_map_frame_stats,
+    ) -> sogmm_status;
+    pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
+    pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
+    pub fn sogmm_map_load(
+        out: *mut *mut sogmm_map,
+        path: *const c_char,
         options: *const sogmm_options,
     ) -> sogmm_status;
     pub fn sogmm_buffer_data(buffer: *const sogmm_buffer) -> *const u8;

@@ -1,0 +1,175 @@
+package sogmm
+
+// #include <stdlib.h>
+// #include "sogmm/sogmm.h"
+import "C"
+
+import (
+	"runtime"
+	"unsafe"
+)
+
+// Map option keys (sogmm.h): novelty test, batch size and fusion of an
+// incremental map; a map also uses the fit and RGB-D keys.
+const (
+	OptMapNovelty          Key = C.SOGMM_OPT_MAP_NOVELTY
+	OptMapNoveltyThreshold Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
+	OptMapBatchSize        Key = C.SOGMM_OPT_MAP_BATCH_SIZE
+	OptMapFusion           Key = C.SOGMM_OPT_MAP_FUSION
+	OptMapFusionMethod     Key = C.SOGMM_OPT_MAP_FUSION_METHOD
+	OptMapFusionThreshold  Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
+	FusionHellinger            = C.SOGMM_FUSION_HELLINGER
+	FusionKL                   = C.SOGMM_FUSION_KL
+)
+
+// Map is an owned sogmm_map: an incremental world map that fits only the
+// parts of each posed frame it does not yet explain (core/include/sogmm/map.hpp).
+// Poses are row-major 4 x 4 camera-to-world rigid transforms. Not safe for
+// concurrent use.
+type Map struct {
+	ptr *C.sogmm_map
+}
+
+// MapStats are the totals of a map.
+type MapStats struct {
+	Components, Pending, Frames, Flushes, Fused uint64
+}
+
+// MapFrameStats is what one insert did.
+type MapFrameStats struct {
+	Points, Novel, Components uint64 // Components: map size after the insert
+	Flushed                   bool
+	MsNovelty, MsFit, MsMerge float64
+	Pose                      [16]float64
+}
+
+func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status) (*Map, error) {
+	if err := abiOnce(); err != nil {
+		return nil, err
+	}
+	op, err := o.raw()
+	if err != nil {
+		return nil, err
+	}
+	defer runtime.KeepAlive(o)
+	m := &Map{}
+	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+		return nil, err
+	}
+	runtime.SetFinalizer(m, (*Map).Close)
+	return m, nil
+}
+
+// NewMap creates an empty map with the map, fit and RGB-D keys of o (nil = defaults).
+func NewMap(o *Options) (*Map, error) {
+	return wrapMap(o, func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status { return C.sogmm_map_create(out, op) })
+}
+
+// LoadMap reads a map file (or any world-frame model); o's keys govern later inserts.
+func LoadMap(path string, o *Options) (*Map, error) {
+	cp := C.CString(path)
+	defer C.free(unsafe.Pointer(cp))
+	return wrapMap(o, func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status { return C.sogmm_map_load(out, cp, op) })
+}
+
+// Close frees the map; idempotent.
+func (m *Map) Close() {
+	if m == nil || m.ptr == nil {
+		return
+	}
+	runtime.SetFinalizer(m, nil)
+	C.sogmm_map_free(m.ptr)
+	m.ptr = nil
+}
+
+func (m *Map) do(f func(p *C.sogmm_map) C.sogmm_status) error {
+	if m == nil || m.ptr == nil {
+		return ErrClosed
+	}
+	defer runtime.KeepAlive(m)
+	return call(func() C.sogmm_status { return f(m.ptr) })
+}
+
+// InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the
+// frame's camera-to-world pose.
+func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
+	n, err := rowsOf(points, 4, "points")
+	if err != nil {
+		return err
+	}
+	if n == 0 { // C sees a nil slice as a NULL pointer; the problem is the empty frame
+		return &Error{Status: ErrInvalidData, Message: "points: an empty frame (no point)"}
+	}
+	return m.do(func(p *C.sogmm_map) C.sogmm_status {
+		return C.sogmm_map_insert_points_f32(p, floats(points), C.size_t(n), (*C.double)(&pose[0]))
+	})
+}
+
+// InsertRGBD inserts an RGB-D frame (decimation and depth range from the
+// options the map was created with) with its camera-to-world pose.
+func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
+	color, format, err := f.colorArgs()
+	if err != nil {
+		return err
+	}
+	return m.do(func(p *C.sogmm_map) C.sogmm_status {
+		return C.sogmm_map_insert_rgbd(p, (*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format,
+			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy),
+			(*C.double)(&pose[0]))
+	})
+}
+
+// Flush fits the pending novel points now.
+func (m *Map) Flush() error {
+	return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
+}
+
+// Stats returns the map's totals.
+func (m *Map) Stats() (MapStats, error) {
+	var s C.sogmm_map_stats
+	err := m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_stats(p, &s) })
+	return MapStats{uint64(s.n_components), uint64(s.n_pending), uint64(s.n_frames), uint64(s.n_flushes),
+		uint64(s.n_fused)}, err
+}
+
+// FrameStats returns what the insert of frame i (insertion order) did.
+func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
+	var s C.sogmm_map_frame_stats
+	err := m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s) })
+	out := MapFrameStats{Points: uint64(s.n_points), Novel: uint64(s.n_novel), Components: uint64(s.n_components),
+		Flushed: s.flushed != 0, MsNovelty: float64(s.ms_novelty), MsFit: float64(s.ms_fit),
+		MsMerge: float64(s.ms_merge)}
+	for k := range out.Pose {
+		out.Pose[k] = float64(s.pose[k])
+	}
+	return out, err
+}
+
+// Export returns the map (box nil) or the components whose 3-sigma box meets
+// box (x_min, y_min, z_min, x_max, y_max, z_max) as a world-frame Model.
+func (m *Map) Export(box *[6]float32) (*Model, error) {
+	if m == nil || m.ptr == nil {
+		return nil, ErrClosed
+	}
+	defer runtime.KeepAlive(m)
+	var b *C.float
+	if box != nil {
+		b = (*C.float)(&box[0])
+	}
+	return newModel(nil, func(out **C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_map_export(out, m.ptr, b)
+	})
+}
+
+// Save writes the map as a world-frame .sogmm file with frame provenance
+// (atomically; o's write keys apply). Flush pending points first.
+func (m *Map) Save(path string, o *Options) error {
+	cp := C.CString(path)
+	defer C.free(unsafe.Pointer(cp))
+	op, err := o.raw()
+	if err != nil {
+		return err
+	}
+	defer runtime.KeepAlive(o)
+	return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_save(p, cp, op) })
+}

@@ -1,0 +1,104 @@
+package sogmm
+
+import (
+	"errors"
+	"math"
+	"path/filepath"
+	"slices"
+	"testing"
+)
+
+func yawPose(deg float64, tx, ty, tz float64) [16]float64 {
+	a := deg * math.Pi / 180
+	return [16]float64{math.Cos(a), 0, math.Sin(a), tx, 0, 1, 0, ty, -math.Sin(a), 0, math.Cos(a), tz, 0, 0, 0, 1}
+}
+
+// With novelty off the map is each frame's own fit moved by its pose and
+// merged, component for component (computed here with Fit/Transform/Merge).
+func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
+	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapNovelty, 0))
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	m, err := NewMap(o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer m.Close()
+	poses := [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)}
+	var want *Model
+	for k, pose := range poses {
+		pts := twoBlobs(200 + 50*k)
+		if err := m.InsertPoints(pts, pose); err != nil {
+			t.Fatal(err)
+		}
+		f, err := Fit(pts, o)
+		if err != nil {
+			t.Fatal(err)
+		}
+		moved, err := f.Transform(pose)
+		if err != nil {
+			t.Fatal(err)
+		}
+		if want == nil {
+			want = moved
+		} else if want, err = want.Merge(moved); err != nil {
+			t.Fatal(err)
+		}
+		fs, err := m.FrameStats(uint64(k))
+		if err != nil || fs.Pose != pose || fs.Novel != fs.Points || !fs.Flushed {
+			t.Fatalf("frame %d stats %+v (%v)", k, fs, err)
+		}
+	}
+	got, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	gw, _ := got.Weights()
+	ww, _ := want.Weights()
+	gm, _ := got.Means()
+	wm, _ := want.Means()
+	if !slices.Equal(gw, ww) || !slices.Equal(gm, wm) {
+		t.Fatalf("map differs from the merged fits: %d vs %d components", len(gw), len(ww))
+	}
+	path := filepath.Join(t.TempDir(), "map.sogmm")
+	if err := m.Save(path, nil); err != nil {
+		t.Fatal(err)
+	}
+	back, err := LoadMap(path, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer back.Close()
+	if s, err := back.Stats(); err != nil || s.Frames != 2 || s.Components != uint64(len(gw)) {
+		t.Fatalf("loaded map stats %+v (%v)", s, err)
+	}
+}
+
+func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
+	m, err := NewMap(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer m.Close()
+	scaled := yawPose(0, 0, 0, 0)
+	scaled[0] = 2
+	if err := m.InsertPoints(twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("scaled pose: %v", err)
+	}
+	nan := yawPose(0, math.NaN(), 0, 0)
+	if err := m.InsertPoints(twoBlobs(50), nan); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("NaN pose: %v", err)
+	}
+	if err := m.InsertPoints(nil, yawPose(0, 0, 0, 0)); !errors.Is(err, ErrInvalidData) {
+		t.Fatalf("empty frame: %v", err)
+	}
+	if s, err := m.Stats(); err != nil || s.Frames != 0 || s.Pending != 0 {
+		t.Fatalf("a failed insert changed the map: %+v (%v)", s, err)
+	}
+	m.Close()
+	if err := m.Flush(); !errors.Is(err, ErrClosed) {
+		t.Fatalf("closed map: %v", err)
+	}
+}

@@ -1,0 +1,246 @@
+"""Map: an incremental world map over libsogmm's ``sogmm_map_*`` (issue 18).
+
+Frames go in with their camera-to-world pose; only points the map does not
+yet explain (3-D log-likelihood under the local submap below
+``novelty_threshold``) are kept, batched and fitted, and the new components
+are merged in the world frame (optionally fused into close ones). The
+algorithm is documented in core/include/sogmm/map.hpp.
+"""
+
+from __future__ import annotations
+
+import os
+import weakref
+from ctypes import byref, c_int64, c_void_p
+
+import numpy as np
+
+from . import _ffi
+from ._ffi import check, lib
+from .camera import Camera, prepare_frame
+from .errors import InvalidArgumentError
+from .model import GMM, SOGMM, _pose, _read_options, _rows, _write_options
+
+__all__ = ["Map"]
+
+_FUSION = {None: None, "off": None, "hellinger": _ffi.FUSION_HELLINGER, "kl": _ffi.FUSION_KL}
+
+
+def _frame_dict(s: _ffi.MapFrameStats) -> dict:
+    return {
+        "n_points": int(s.n_points),
+        "n_novel": int(s.n_novel),
+        "n_components": int(s.n_components),
+        "flushed": bool(s.flushed),
+        "ms_novelty": float(s.ms_novelty),
+        "ms_fit": float(s.ms_fit),
+        "ms_merge": float(s.ms_merge),
+        "pose": np.array(list(s.pose), dtype=np.float64).reshape(4, 4),
+    }
+
+
+class Map:
+    """An incremental world map of posed frames.
+
+    Args:
+        novelty: False fits every inserted frame whole (append everything).
+        novelty_threshold: nats; points whose 3-D log-likelihood under the
+            local map is below it are new (default 3.0, the authors').
+        batch_size: new points that trigger a fit (default 12288: one frame
+            decimated by 5).
+        fusion: None/"off", "hellinger" or "kl": fuse new components into
+            close existing ones (distance below ``fusion_threshold``).
+        fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
+        depth_scale, depth_min, depth_trunc, decimate: back-projection of
+            :meth:`insert_rgbd` frames (as :func:`sogmm.rgbd_to_points`).
+        **fit_params: parameters of each batch's fit, as :class:`sogmm.SOGMM`
+            (bandwidth, seed, n_threads, ...).
+
+    Errors raise the :class:`sogmm.SogmmError` subclasses: a pose that is not
+    a finite rigid transform -> InvalidArgumentError, an empty frame ->
+    InvalidDataError, a frame of another size than the first RGB-D frame ->
+    InvalidArgumentError. A failed insert leaves the map unchanged.
+    """
+
+    def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
+                 fusion: str | None = None, fusion_threshold: float = 0.3, depth_scale: float = 1000.0,
+                 depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1, **fit_params):
+        self._ptr = None
+        self._finalizer = None
+        self._depth = (depth_scale, depth_min, depth_trunc, decimate)
+        with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, fit_params) as o:
+            out = c_void_p()
+            check(lib.sogmm_map_create(byref(out), o.ptr))
+        self._attach(out)
+
+    def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, fit_params) -> _ffi.Options:
+        if fusion not in _FUSION:
+            raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
+        if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
+            raise InvalidArgumentError(f"batch_size must be an int, got {batch_size!r}")
+        for k in fit_params:
+            if k not in SOGMM._PARAMS:
+                raise InvalidArgumentError(f"unknown parameter {k!r} for Map")
+        depth_scale, depth_min, depth_trunc, decimate = self._depth
+        if isinstance(decimate, bool) or int(decimate) != decimate or int(decimate) < 1:
+            raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer >= 1")
+        f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
+               _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
+        i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
+               _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate)}
+        if _FUSION[fusion] is not None:
+            i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
+        # The fit keys exactly as SOGMM sets them (same checks and messages).
+        return SOGMM(**fit_params)._fit_options(f64, i64)
+
+    # ---- handle management ----------------------------------------------
+    def _attach(self, ptr: c_void_p) -> None:
+        self._ptr = int(ptr.value)
+        self._finalizer = weakref.finalize(self, lib.sogmm_map_free, c_void_p(self._ptr))
+
+    def _h(self) -> c_void_p:
+        if self._ptr is None:
+            raise InvalidArgumentError("this Map is closed")
+        return c_void_p(self._ptr)
+
+    def close(self) -> None:
+        """Releases the C map now (otherwise done when the object is collected)."""
+        if self._finalizer is not None:
+            self._finalizer()
+        self._finalizer = None
+        self._ptr = None
+
+    def __enter__(self) -> "Map":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ---- inserting ---------------------------------------------------------
+    def insert_points(self, points, pose) -> dict:
+        """Inserts (n, 4) points (x, y, z, gray) in the camera frame with the
+        4 x 4 camera-to-world ``pose``; returns that frame's statistics
+        (see :meth:`frame_stats`)."""
+        x = _rows(points, (4,), "points")
+        p = _pose(pose)
+        check(lib.sogmm_map_insert_points_f32(self._h(), x, x.shape[0], p))
+        return self.frame_stats(-1)
+
+    def insert_rgbd(self, depth, color, camera: Camera, pose) -> dict:
+        """Inserts an RGB-D frame (depth and color as :meth:`sogmm.SOGMM.fit_rgbd`;
+        back-projection options from the constructor) with its 4 x 4
+        camera-to-world ``pose``; returns that frame's statistics."""
+        f = prepare_frame(depth, color, camera, *self._depth)
+        p = _pose(pose)
+        check(lib.sogmm_map_insert_rgbd(self._h(), *f.frame_args(), p))
+        return self.frame_stats(-1)
+
+    def flush(self) -> int:
+        """Fits the pending points now; returns the number of components added."""
+        before = self.n_components_
+        check(lib.sogmm_map_flush(self._h()))
+        return self.n_components_ - before
+
+    # ---- statistics ----------------------------------------------------------
+    def stats(self) -> dict:
+        """n_components, n_pending, n_frames, n_flushes, n_fused."""
+        s = _ffi.MapStats()
+        check(lib.sogmm_map_get_stats(self._h(), byref(s)))
+        return {name: int(getattr(s, name)) for name, _ in _ffi.MapStats._fields_}
+
+    @property
+    def n_components_(self) -> int:
+        return self.stats()["n_components"]
+
+    @property
+    def n_pending_(self) -> int:
+        """Novel points waiting for a fit."""
+        return self.stats()["n_pending"]
+
+    def __len__(self) -> int:
+        return self.stats()["n_frames"]
+
+    def frame_stats(self, frame: int) -> dict:
+        """What the insert of ``frame`` (insertion order; negative counts from
+        the end) did: n_points, n_novel, n_components (after it), flushed,
+        ms_novelty, ms_fit, ms_merge and its pose (4 x 4)."""
+        n = len(self)
+        if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not -n <= frame < n:
+            raise InvalidArgumentError(f"frame {frame!r} does not exist ({n} frames)")
+        s = _ffi.MapFrameStats()
+        check(lib.sogmm_map_get_frame_stats(self._h(), int(frame) % n, byref(s)))
+        return _frame_dict(s)
+
+    def frames(self) -> list[dict]:
+        """frame_stats of every frame, in insertion order."""
+        return [self.frame_stats(i) for i in range(len(self))]
+
+    # ---- the map as a model ----------------------------------------------------
+    def export(self, box=None) -> GMM:
+        """The map (or the components whose 3-sigma box meets ``box`` =
+        (x_min, y_min, z_min, x_max, y_max, z_max)) as a world-frame
+        :class:`sogmm.GMM`; score, sample and regress with it."""
+        out = c_void_p()
+        if box is None:
+            check(lib.sogmm_map_export(byref(out), self._h(), None))
+        else:
+            b = np.ascontiguousarray(np.asarray(box, dtype=np.float32))
+            if b.shape != (6,):
+                raise InvalidArgumentError(f"box must hold 6 numbers (min xyz, max xyz), got shape {b.shape}")
+            check(lib.sogmm_map_export(byref(out), self._h(), b.ctypes.data_as(c_void_p)))
+        return GMM._wrap(out)
+
+    def score_samples(self, X) -> np.ndarray:
+        """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
+        with self.export() as g:
+            return g.score_samples(X)
+
+    def regress_gray(self, xyz) -> tuple[np.ndarray, np.ndarray]:
+        """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
+        with self.export() as g:
+            return g.regress_gray(xyz)
+
+    def sample(self, n_samples: int = 1, seed: int | None = None, **kwargs) -> np.ndarray:
+        """(n, 4) world samples of the map (see GMM.sample)."""
+        with self.export() as g:
+            return g.sample(n_samples, seed, **kwargs)
+
+    # ---- files -------------------------------------------------------------------
+    def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,
+             zstd_level: int = 19) -> None:
+        """Writes the map as a world-frame .sogmm file with its frame provenance
+        (atomically). Pending points must be flushed first (InvalidArgumentError)."""
+        with _write_options(float64, compress, zstd_level) as o:
+            check(lib.sogmm_map_save(self._h(), os.fsencode(path), o.ptr))
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = True, max_decoded_bytes: int = 0,
+             **options) -> "Map":
+        """Reads a map file (or any world-frame model). ``options`` (as the
+        constructor's) govern later inserts."""
+        obj = cls.__new__(cls)
+        obj._ptr = None
+        obj._finalizer = None
+        obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
+                      options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
+        map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3)
+        for k in list(map_keys):
+            if k in options:
+                map_keys[k] = options.pop(k)
+        with obj._options(fit_params=options, **map_keys) as o, _read_options(verify_checksums,
+                                                                               max_decoded_bytes) as r:
+            # One options handle carries both: copy the read keys over.
+            for key in (_ffi.OPT_VERIFY_CHECKSUMS, _ffi.OPT_MAX_DECODED_BYTES):
+                v = c_int64()
+                check(lib.sogmm_options_get_i64(r.ptr, key, byref(v)))
+                check(lib.sogmm_options_set_i64(o.ptr, key, v.value))
+            out = c_void_p()
+            check(lib.sogmm_map_load(byref(out), os.fsencode(path), o.ptr))
+        obj._attach(out)
+        return obj
+
+    def __repr__(self) -> str:
+        if self._ptr is None:
+            return "Map(closed)"
+        s = self.stats()
+        return f"Map(frames={s['n_frames']}, components={s['n_components']}, pending={s['n_pending']})"

@@ -1,0 +1,141 @@
+"""sogmm.Map (the C API's sogmm_map_*): append-everything equals per-frame fits
+merged by hand, revisits add nothing, bad input raises, files round-trip."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import sogmm
+
+from conftest import blobs, synthetic_rgbd
+
+
+def rigid(yaw_deg: float, t) -> np.ndarray:
+    a = math.radians(yaw_deg)
+    p = np.eye(4)
+    p[:3, :3] = [[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]]
+    p[:3, 3] = t
+    return p
+
+
+FIT = dict(bandwidth=0.08, seed=3, n_threads=1)
+POSES = [rigid(0, [0, 0, 0]), rigid(20, [0.3, -0.1, 0.2])]
+
+
+def frames():
+    return [blobs(n_per=300, seed=0), blobs(n_per=300, seed=1)]
+
+
+def test_append_everything_is_the_merge_of_each_frames_fit():
+    # Independent truth: fit each frame alone, move it by its pose, merge (GMM API).
+    expected = None
+    for pts, pose in zip(frames(), POSES):
+        g = sogmm.SOGMM(**FIT).fit(pts).transform(pose)
+        expected = g if expected is None else expected.merge(g)
+    with sogmm.Map(novelty=False, **FIT) as m:
+        for pts, pose in zip(frames(), POSES):
+            st = m.insert_points(pts, pose)
+            assert st["n_points"] == len(pts) and st["n_novel"] == len(pts) and st["flushed"]
+            np.testing.assert_array_equal(st["pose"], pose)
+        assert m.n_pending_ == 0 and len(m) == 2
+        got = m.export()
+    assert got.n_components_ == expected.n_components_
+    np.testing.assert_array_equal(got.weights_, expected.weights_)
+    np.testing.assert_array_equal(got.means_, expected.means_)
+    np.testing.assert_array_equal(got.covariances_, expected.covariances_)
+    assert got.support_size_ == sum(len(p) for p in frames())
+    assert got.metadata.get("coordinate_frame") == "world"
+
+
+def test_a_revisited_frame_is_not_novel():
+    # Four equal blobs of sigma 3 cm: at a blob's centre log p(x) = -1.5 log(2 pi)
+    # - 3 log 0.03 - log 4 = 6.37 nats, so a point is novel (< 3 nats) when its
+    # squared Mahalanobis distance exceeds 6.74: P(chi2_3 > 6.74) = 8%.
+    pts = blobs(n_per=300, seed=0)
+    with sogmm.Map(batch_size=len(pts), **FIT) as m:
+        first = m.insert_points(pts, POSES[1])
+        assert first["n_novel"] == len(pts) and first["flushed"]
+        k = m.n_components_
+        again = m.insert_points(blobs(n_per=300, seed=5), POSES[1])  # same scene, new noise
+        assert 0.03 * len(pts) < again["n_novel"] < 0.15 * len(pts), again
+        # Only the novel tail points are fitted and appended.
+        assert m.flush() > 0 and m.n_components_ > k
+        assert m.export().support_size_ == len(pts) + again["n_novel"]
+        # Points 1 m away from everything are novel.
+        far = pts.copy()
+        far[:, 0] += 3.0
+        assert m.insert_points(far, POSES[1])["n_novel"] == len(pts)
+
+
+def test_novel_points_wait_for_a_full_batch():
+    pts = blobs(n_per=100, seed=0)
+    with sogmm.Map(batch_size=1000, **FIT) as m:
+        st = m.insert_points(pts, POSES[0])
+        assert not st["flushed"] and m.n_pending_ == len(pts) and m.n_components_ == 0
+        with pytest.raises(sogmm.SogmmError):
+            m.export()  # nothing fitted yet
+        assert m.flush() > 0 and m.n_pending_ == 0
+
+
+@pytest.mark.parametrize(
+    "pose, why",
+    [(np.diag([2.0, 1, 1, 1]), "scaled"), (np.full((4, 4), np.nan), "nan"),
+     (np.array([[1, 0, 0, np.inf], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]), "inf")],
+)
+def test_a_bad_pose_raises_and_changes_nothing(pose, why):
+    with sogmm.Map(**FIT) as m:
+        with pytest.raises(sogmm.InvalidArgumentError):
+            m.insert_points(blobs(n_per=50), pose)
+        assert len(m) == 0 and m.n_pending_ == 0
+
+
+def test_bad_frames_raise():
+    with sogmm.Map(decimate=2, **FIT) as m:
+        with pytest.raises(sogmm.InvalidDataError):
+            m.insert_points(np.zeros((0, 4), np.float32), np.eye(4))
+        with pytest.raises(sogmm.InvalidArgumentError):
+            m.insert_points(np.zeros((5, 3), np.float32), np.eye(4))  # 3 columns
+        depth, color, cam = synthetic_rgbd()
+        m.insert_rgbd(depth, color, cam, np.eye(4))
+        depth2, color2, cam2 = synthetic_rgbd(width=90, height=77)
+        with pytest.raises(sogmm.InvalidArgumentError):
+            m.insert_rgbd(depth2, color2, cam2, np.eye(4))  # another frame size
+        with pytest.raises(sogmm.InvalidDataError):
+            m.insert_rgbd(np.zeros_like(depth), color, cam, np.eye(4))  # no valid pixel
+        assert len(m) == 1
+    with pytest.raises(sogmm.InvalidArgumentError):
+        sogmm.Map(fusion="average")
+    with pytest.raises(sogmm.InvalidArgumentError):
+        sogmm.Map(batch_size=0)
+
+
+def test_save_load_and_box(tmp_path):
+    path = tmp_path / "map.sogmm"
+    with sogmm.Map(novelty=False, **FIT) as m:
+        for pts, pose in zip(frames(), POSES):
+            m.insert_points(pts, pose)
+        m.save(path)
+        whole = m.export()
+        # The box around the first blob of frame 0 keeps fewer components, renormalised.
+        part = m.export([-0.1, -0.1, 0.9, 0.1, 0.1, 1.1])
+        assert 0 < part.n_components_ < whole.n_components_
+        assert abs(float(part.weights_.sum()) - 1.0) < 1e-4
+        with pytest.raises(sogmm.InvalidArgumentError):
+            m.export([1, 1, 1, 0, 0, 0])  # min > max
+    with sogmm.Map.load(path) as back:
+        assert len(back) == 2
+        np.testing.assert_array_equal(back.frame_stats(1)["pose"], POSES[1])
+        got = back.export()
+        np.testing.assert_array_equal(got.weights_, whole.weights_)
+        np.testing.assert_array_equal(got.means_, whole.means_)
+        # World-frame queries are those of the exported model.
+        x = whole.means_[:5, :3]
+        np.testing.assert_allclose(back.score_samples(x), whole.score_samples(x))
+    pending = sogmm.Map(batch_size=10_000, **FIT)
+    pending.insert_points(blobs(n_per=50), np.eye(4))
+    with pytest.raises(sogmm.SogmmError):
+        pending.save(tmp_path / "pending.sogmm")  # flush first
+    assert not (tmp_path / "pending.sogmm").exists()

@@ -1,0 +1,182 @@
+// sogmm_map_*: the incremental world map (sogmm::Map) behind a handle.
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "internal.hpp"
+#include "sogmm/map.hpp"
+
+struct sogmm_map {
+  sogmm::Map map;
+  sogmm_options options;  ///< the creation options: RGB-D keys of later inserts
+};
+
+namespace {
+
+using sogmm_capi::fail;
+using sogmm_capi::require_nonnull;
+
+sogmm::MapOptions map_options(const sogmm_options& o) {
+  sogmm::MapOptions m;
+  m.novelty = o.map_novelty != 0;
+  m.novelty_threshold = o.map_novelty_threshold;
+  m.batch_size = static_cast<std::size_t>(o.map_batch_size);
+  m.fusion = o.map_fusion != 0;
+  m.fusion_method = o.map_fusion_method == SOGMM_FUSION_KL ? sogmm::FusionMethod::KL : sogmm::FusionMethod::Hellinger;
+  m.fusion_threshold = o.map_fusion_threshold;
+  m.fit = sogmm_capi::fit_options(o, static_cast<std::size_t>(o.n_components));
+  m.depth.depth_scale = o.depth_scale;
+  m.depth.depth_min = o.depth_min;
+  m.depth.depth_max = o.depth_max;
+  m.depth.decimate = static_cast<int>(o.decimation);
+  if (!(o.depth_min < o.depth_max))
+    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + std::to_string(o.depth_min) +
+                                  " must be < SOGMM_OPT_DEPTH_MAX = " + std::to_string(o.depth_max));
+  return m;
+}
+
+sogmm::Pose pose_of(const double* pose) { return sogmm_capi::require_rigid(pose, "pose"); }
+
+}  // namespace
+
+extern "C" {
+
+SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* options) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    const sogmm_options& o = sogmm_capi::opts_or_default(options);
+    *out = new sogmm_map{sogmm::Map(map_options(o)), o};
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API void sogmm_map_free(sogmm_map* map) { delete map; }
+
+SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
+                                                   const double* pose) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(points, "points");
+    require_nonnull(pose, "pose");
+    const sogmm::Pose p = pose_of(pose);
+    if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: the frame has no point");
+    if (n > sogmm::kMaxPoints)
+      fail(SOGMM_E_LIMIT, "n = " + std::to_string(n) + " points exceeds the limit of " +
+                              std::to_string(sogmm::kMaxPoints) + " per frame");
+    sogmm_capi::require_finite(points, 4 * n, "points");
+    map->map.insert_points(sogmm::PointsView{points, n}, p);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
+                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
+                                             double fy, double cx, double cy, const double* pose) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(pose, "pose");
+    const sogmm::Pose p = pose_of(pose);
+    const sogmm_capi::RgbdPoints r =
+        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, map->options);
+    map->map.insert_backprojected(r.cloud.view(), r.camera, p);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    map->map.flush();
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(out, "out");
+    const sogmm::MapStats s = map->map.stats();
+    out->n_components = s.n_components;
+    out->n_pending = s.n_pending;
+    out->n_frames = s.n_frames;
+    out->n_flushes = s.n_flushes;
+    out->n_fused = s.n_fused;
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame, sogmm_map_frame_stats* out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(out, "out");
+    const auto& frames = map->map.frames();
+    if (frame >= frames.size())
+      fail(SOGMM_E_INVALID_ARG, "frame " + std::to_string(frame) + " does not exist (" +
+                                    std::to_string(frames.size()) + " frames)");
+    const sogmm::FrameStats& f = frames[static_cast<std::size_t>(frame)];
+    out->n_points = f.n_points;
+    out->n_novel = f.n_novel;
+    out->n_components = f.n_components;
+    out->flushed = f.flushed ? 1 : 0;
+    out->ms_novelty = f.ms_novelty;
+    out->ms_fit = f.ms_fit;
+    out->ms_merge = f.ms_merge;
+    std::memcpy(out->pose, f.pose.data(), sizeof out->pose);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map, const float* box) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    require_nonnull(map, "map");
+    auto handle = std::make_unique<sogmm_model>();
+    if (box == nullptr) {
+      handle->model = map->map.model();
+    } else {
+      sogmm::Box3 b;
+      for (int i = 0; i < 3; ++i) {
+        b.lo[i] = box[i];
+        b.hi[i] = box[3 + i];
+        if (!(b.lo[i] <= b.hi[i]))  // also NaN
+          fail(SOGMM_E_INVALID_ARG, "box axis " + std::to_string(i) + ": min " + std::to_string(box[i]) +
+                                        " is not <= max " + std::to_string(box[3 + i]));
+      }
+      handle->model = map->map.extract(b);
+    }
+    *out = handle.release();
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, const sogmm_options* options) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(path, "path");
+    // The model save path (atomic, same checks and errors) on the map's model.
+    sogmm_model file;
+    file.model = map->map.to_model();
+    file.model.created_unix_ms = sogmm_capi::creation_time_now();
+    const sogmm_status status = sogmm_model_save(&file, path, options);
+    if (status != SOGMM_OK) return status;  // message already set
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    sogmm_model* loaded = nullptr;
+    const sogmm_status status = sogmm_model_load(&loaded, path, options);
+    if (status != SOGMM_OK) return status;
+    const std::unique_ptr<sogmm_model> owned(loaded);
+    const sogmm_options& o = sogmm_capi::opts_or_default(options);
+    *out = new sogmm_map{sogmm::Map::from_model(owned->model, map_options(o)), o};
+  }
+  SOGMM_CATCH
+}
+
+}  // extern "C"

@@ -1,0 +1,194 @@
+// An incremental world map: frames are inserted with their camera-to-world
+// pose; only the part of each frame that the map does not yet explain is
+// fitted and added (issue 18).
+//
+// Pipeline of one insert:
+// 1. novelty (option): every point, moved to the world frame, is scored with
+//    the 3-D marginal log-likelihood of the local submap: the components
+//    whose sigma box (ComponentIndex) holds any point of the frame, weights
+//    renormalised over that submap (the authors' incremental scripts). Each
+//    point's sum runs over the components whose box holds it; a component
+//    outside its box is beyond Mahalanobis distance 3 and contributes at most
+//    exp(-4.5) of its peak, which is left out. Points scoring below the
+//    threshold are novel and become pending; the others are dropped.
+// 2. flush: once batch_size points are pending (or at flush()), the pending
+//    points are fitted with the usual self-organizing fit (sogmm/fit.hpp) in
+//    the camera frame of the latest frame that contributed to the batch, moved
+//    to the world frame by its pose and merged into the map (merge() of
+//    sogmm/model.hpp: weights by support size, metadata by spec/format.md 2.2).
+// 3. fusion (option): each new component whose distance (Hellinger or
+//    symmetric KL, full 4-D) to an overlapping map component is below the
+//    threshold is merged into the nearest such component by moment matching
+//    (mass, mean and covariance of the pair kept) instead of being appended.
+//    Effect on likelihood: the fused Gaussian keeps the pair's mass and first
+//    two moments, so samples and the mixture's total mean and covariance do
+//    not change (to float rounding), while two peaks become one: the
+//    likelihood of points between and on them changes little when the pair is
+//    close. Measured in tests/core/test_map.cpp
+//    (MapTest.FusionKeepsMomentsAndCostsLittleLikelihood; the same surfaces
+//    seen twice 3 mm apart): 410 -> 227 components (Hellinger < 0.3) or 250
+//    (symmetric KL < 0.2) at a mean 4-D log-likelihood of held-out points of
+//    6.6965 -> 6.6975 / 6.6969 nats: no loss there; a loose pair (large
+//    threshold) loses more.
+//
+// With novelty and fusion off, every insert fits its whole frame on its own in
+// the camera frame, moves it with the pose and merges it: exactly what `sogmm
+// fit --sequence` did (append everything), component for component.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sogmm/camera.hpp"
+#include "sogmm/component_index.hpp"
+#include "sogmm/fit.hpp"
+#include "sogmm/model.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// Row-major 4 x 4 rigid transform [R t; 0 0 0 1] (camera-to-world).
+using Pose = std::array<double, 16>;
+
+/// How fusion measures the distance of two components (full 4-D Gaussians).
+enum class FusionMethod {
+  Hellinger,  ///< H = sqrt(1 - BC), BC the Bhattacharyya coefficient; in [0, 1]
+  KL,         ///< symmetric KL, (KL(a||b) + KL(b||a)) / 2, in nats; >= 0
+};
+
+/// Parameters of a map. The defaults are the authors' (novelty 3.0, batch of
+/// one decimated frame, 12,288 points at d = 5 on 640 x 480), fusion off.
+struct MapOptions {
+  bool novelty = true;              ///< false: every point is novel (append everything)
+  double novelty_threshold = 3.0;   ///< nats; points with 3-D log-likelihood below it are novel
+  std::size_t batch_size = 12288;   ///< pending points that trigger a flush, in [1, kMaxPoints]
+  FitOptions fit;                   ///< the fit of each batch (fit.em.threads also runs the novelty test)
+  DepthOptions depth;               ///< back-projection of insert_rgbd frames
+  bool fusion = false;              ///< fuse new components into close map components
+  FusionMethod fusion_method = FusionMethod::Hellinger;
+  double fusion_threshold = 0.3;    ///< fuse when the distance is below this (method's unit), > 0
+  double index_sigmas = ComponentIndex::kDefaultSigmas;  ///< box radius of the index, (0, 100]
+};
+
+/// Throws Error(InvalidArgument) naming the field unless every option is in
+/// range: finite threshold, batch_size in [1, kMaxPoints], fusion_threshold
+/// finite and > 0, index_sigmas in (0, 100], fit bandwidth usable, a valid
+/// DepthOptions (validate in sogmm/camera.hpp).
+void validate(const MapOptions& options);
+
+/// What happened to one inserted frame.
+struct FrameStats {
+  std::uint64_t index = 0;          ///< insertion order, from 0
+  Pose pose{};                      ///< camera-to-world pose given with the frame
+  std::size_t n_points = 0;         ///< points of the frame (after back-projection)
+  std::size_t n_novel = 0;          ///< of which novel (all of them with novelty off)
+  std::size_t n_components = 0;     ///< map components after this insert (and any flush it ran)
+  bool flushed = false;             ///< this insert ran a flush
+  double ms_novelty = 0.0;          ///< novelty test, milliseconds
+  double ms_fit = 0.0;              ///< fit of a flush this insert ran
+  double ms_merge = 0.0;            ///< transform + merge + fusion (+ index) of that flush
+};
+
+/// Totals of a map.
+struct MapStats {
+  std::size_t n_components = 0;
+  std::size_t n_pending = 0;        ///< novel points waiting for a flush
+  std::uint64_t n_frames = 0;       ///< frames inserted (including loaded provenance)
+  std::uint64_t n_flushes = 0;      ///< fits run
+  std::uint64_t n_fused = 0;        ///< new components fused instead of appended
+};
+
+/// Metadata keys of a saved map (Map::to_model / Map::from_model; listed in
+/// spec/format.md section 2.3). Values are ASCII text.
+inline constexpr const char* kMapFramesKey = "map_frames";    ///< per-frame provenance, one line per frame
+inline constexpr const char* kMapOptionsKey = "map_options";  ///< the options the map was built with
+
+/// The incremental world map. Not thread-safe: one writer at a time; const
+/// members may run concurrently.
+class Map {
+ public:
+  /// An empty map. Throws as validate(options).
+  explicit Map(const MapOptions& options = {});
+  ~Map();
+  Map(Map&&) noexcept;
+  Map& operator=(Map&&) noexcept;
+  Map(const Map&) = delete;
+  Map& operator=(const Map&) = delete;
+
+  const MapOptions& options() const;
+
+  /// Inserts one frame of n points (x, y, z, gray) in the camera frame with
+  /// its camera-to-world pose. Errors (nothing changes): empty frame or
+  /// non-finite point -> Error(InvalidData); pose not rigid
+  /// (rigid_pose_error) -> Error(InvalidArgument) naming the problem; more
+  /// than kMaxPoints points -> Error(Limit). A flush it triggers throws as
+  /// flush(). `progress` reports that fit.
+  FrameStats insert_points(const PointsView& points, const Pose& camera_to_world, const ProgressSink& progress = {});
+
+  /// Inserts an RGB-D frame: back-projected with options().depth
+  /// (backproject() of sogmm/camera.hpp), then as insert_points. The first
+  /// RGB-D frame fixes the camera; a frame whose size or intrinsics differ
+  /// -> Error(InvalidArgument) naming both. A frame without a valid pixel ->
+  /// Error(InvalidData). The map's model records the camera (CameraInfo).
+  FrameStats insert_rgbd(const RgbdView& frame, const Pose& camera_to_world, const ProgressSink& progress = {});
+
+  /// insert_rgbd for a frame already back-projected (e.g. by the C API, which
+  /// converts color formats first): `points` are backproject() of an image of
+  /// `camera` with options().depth. Same camera rule and errors.
+  FrameStats insert_backprojected(const PointsView& points, const Camera& camera, const Pose& camera_to_world,
+                                  const ProgressSink& progress = {});
+
+  /// Fits the pending points (if any) and merges them into the map; returns
+  /// the number of components added (0 when nothing was pending). A fit error
+  /// (sogmm::fit) propagates and leaves the map and the pending points as
+  /// they were.
+  std::size_t flush(const ProgressSink& progress = {});
+
+  /// Components in the map.
+  std::size_t size() const;
+  /// Novel points waiting for a flush.
+  std::size_t pending() const;
+  MapStats stats() const;
+  /// One entry per inserted frame, in order.
+  const std::vector<FrameStats>& frames() const;
+  /// The index over the map's components (ids are component indices of model()).
+  const ComponentIndex& index() const;
+
+  /// The whole map as a world-frame model (key coordinate_frame "world").
+  /// Pending points are not in it. Throws Error(InvalidData) when the map
+  /// has no component yet.
+  const Model& model() const;
+  /// The components whose index box meets `box`, weights renormalised over
+  /// them and support size the map's times their weight share (rounded, at
+  /// least 1). Metadata as model(). Throws Error(InvalidData) when no
+  /// component meets the box (or the map is empty), Error(InvalidArgument)
+  /// for a box with lo > hi or a non-finite bound.
+  Model extract(const Box3& box) const;
+
+  /// log p(x) of each point's 3-D marginal under the local submap, as the
+  /// novelty test computes it (see the header comment): `xyz` holds n world
+  /// points (3 doubles each), `out` receives n values; -inf where no
+  /// component's box holds the point. Uses fit.em.threads threads.
+  void local_log_likelihood(const double* xyz, std::size_t n, double* out) const;
+
+  /// model() with the provenance keys kMapFramesKey and kMapOptionsKey added
+  /// (what a map file stores). Throws Error(InvalidArgument) when points are
+  /// pending (flush first: a file holds components only) and as model().
+  Model to_model() const;
+  /// A map holding `model`'s components (which must be a world-frame model,
+  /// else Error(InvalidArgument)) and, when present, the frame provenance of
+  /// kMapFramesKey (malformed -> Error(Format) naming the line). `options`
+  /// govern later inserts.
+  static Map from_model(const Model& model, const MapOptions& options = {});
+
+  struct State;  ///< the implementation (core/src/map_state.hpp)
+
+ private:
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace sogmm

@@ -1,0 +1,327 @@
+// sogmm::Map: insert (novelty), flush (fit, move, merge, fuse), export
+// (sogmm/map.hpp).
+#include "sogmm/map.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "map_state.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/error.hpp"
+#include "sogmm/inference.hpp"
+#include "sogmm/mean_shift.hpp"
+
+namespace sogmm {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void require_rigid(const Pose& pose) {
+  const std::string problem = rigid_pose_error(pose);
+  require(problem.empty(), ErrorCode::InvalidArgument, "map: the camera-to-world pose is not a rigid transform: " + problem);
+}
+
+// a * b of two rigid transforms (row-major).
+Pose compose(const Pose& a, const Pose& b) {
+  Pose c{};
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 4; ++k) {
+      double v = 0.0;
+      for (int j = 0; j < 4; ++j) v += a[4 * r + j] * b[4 * j + k];
+      c[4 * r + k] = v;
+    }
+  return c;
+}
+
+Pose inverse_rigid(const Pose& p) {
+  Pose q{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) q[4 * r + c] = p[4 * c + r];
+    q[4 * r + 3] = -(p[r] * p[3] + p[4 + r] * p[7] + p[8 + r] * p[11]);
+  }
+  q[15] = 1.0;
+  return q;
+}
+
+// x, y, z of each point moved by `pose`, in double.
+std::vector<double> to_world(const PointsView& points, const Pose& pose) {
+  std::vector<double> out(3 * points.size);
+  for (std::size_t i = 0; i < points.size; ++i) {
+    const float* p = points[i];
+    for (int r = 0; r < 3; ++r)
+      out[3 * i + r] = pose[4 * r] * p[0] + pose[4 * r + 1] * p[1] + pose[4 * r + 2] * p[2] + pose[4 * r + 3];
+  }
+  return out;
+}
+
+std::string camera_text(const Camera& c) {
+  return std::to_string(c.width) + " x " + std::to_string(c.height) + ", fx " + checked::exact(c.fx) + ", fy " +
+         checked::exact(c.fy) + ", cx " + checked::exact(c.cx) + ", cy " + checked::exact(c.cy);
+}
+
+bool same_camera(const Camera& a, const Camera& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy;
+}
+
+}  // namespace
+
+void validate(const MapOptions& o) {
+  require(std::isfinite(o.novelty_threshold), ErrorCode::InvalidArgument,
+          "map: novelty_threshold " + checked::exact(o.novelty_threshold) + " is not finite");
+  require(o.batch_size >= 1 && o.batch_size <= kMaxPoints, ErrorCode::InvalidArgument,
+          "map: batch_size " + std::to_string(o.batch_size) + " is not in [1, " + std::to_string(kMaxPoints) + "]");
+  require(std::isfinite(o.fusion_threshold) && o.fusion_threshold > 0, ErrorCode::InvalidArgument,
+          "map: fusion_threshold " + checked::exact(o.fusion_threshold) + " is not finite and > 0");
+  require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
+          "map: index_sigmas " + checked::exact(o.index_sigmas) + " is not in (0, 100]");
+  require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
+          ErrorCode::InvalidArgument, "map: unknown fusion method");
+  require_usable_bandwidth(o.fit.bandwidth);
+  validate(o.depth);
+}
+
+Map::Map(const MapOptions& options) {
+  validate(options);
+  s_ = std::make_unique<State>(options);
+}
+Map::~Map() = default;
+Map::Map(Map&&) noexcept = default;
+Map& Map::operator=(Map&&) noexcept = default;
+
+const MapOptions& Map::options() const { return s_->options; }
+std::size_t Map::size() const { return s_->model.gmm.size(); }
+std::size_t Map::pending() const { return s_->n_pending; }
+const std::vector<FrameStats>& Map::frames() const { return s_->frames; }
+const ComponentIndex& Map::index() const { return s_->index; }
+
+MapStats Map::stats() const {
+  MapStats t;
+  t.n_components = size();
+  t.n_pending = s_->n_pending;
+  t.n_frames = s_->frames.size();
+  t.n_flushes = s_->n_flushes;
+  t.n_fused = s_->n_fused;
+  return t;
+}
+
+const Model& Map::model() const {
+  require(size() > 0, ErrorCode::InvalidData, "map: the map has no component yet (insert and flush a frame first)");
+  return s_->model;
+}
+
+void Map::local_log_likelihood(const double* xyz, std::size_t n, double* out) const {
+  detail::local_log_likelihood(s_->index, s_->marginals, s_->options.fit.em.threads, xyz, n, out);
+}
+
+namespace {
+
+// The checks of a frame's points, before anything changes.
+void check_frame(const PointsView& points) {
+  require(points.size > 0, ErrorCode::InvalidData, "map: the frame has no point");
+  require(points.size <= kMaxPoints, ErrorCode::Limit,
+          "map: the frame has " + std::to_string(points.size) + " points, more than the limit of " +
+              std::to_string(kMaxPoints));
+  require_finite_points(points, "map frame");
+}
+
+FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const Pose& pose, bool from_rgbd,
+                        const ProgressSink& progress) {
+  check_frame(points);
+  FrameStats f;
+  f.index = s.frames.size();
+  f.pose = pose;
+  f.n_points = points.size;
+  const auto t0 = std::chrono::steady_clock::now();
+  detail::PendingFrame novel;
+  novel.pose = pose;
+  novel.from_rgbd = from_rgbd;
+  if (!s.options.novelty || s.model.gmm.size() == 0) {
+    novel.xyzg.assign(points.data, points.data + 4 * points.size);
+  } else {
+    const std::vector<double> world = to_world(points, pose);
+    std::vector<double> ll(points.size);
+    map.local_log_likelihood(world.data(), points.size, ll.data());
+    for (std::size_t i = 0; i < points.size; ++i)
+      if (ll[i] < s.options.novelty_threshold) novel.xyzg.insert(novel.xyzg.end(), points[i], points[i] + 4);
+  }
+  f.ms_novelty = ms_since(t0);
+  f.n_novel = novel.xyzg.size() / 4;
+  require(s.n_pending <= kMaxPoints - f.n_novel, ErrorCode::Limit,
+          "map: more than " + std::to_string(kMaxPoints) + " points pending");
+  if (f.n_novel > 0) {
+    s.pending.push_back(std::move(novel));
+    s.n_pending += f.n_novel;
+  }
+  s.frames.push_back(f);
+  // Novelty off: each frame is its own batch (append everything).
+  // flush() records its fit and merge times on this frame's stats.
+  if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) map.flush(progress);
+  s.frames.back().n_components = s.model.gmm.size();
+  return s.frames.back();
+}
+
+}  // namespace
+
+FrameStats Map::insert_points(const PointsView& points, const Pose& camera_to_world, const ProgressSink& progress) {
+  require_rigid(camera_to_world);
+  return insert_frame(*s_, *this, points, camera_to_world, false, progress);
+}
+
+namespace {
+void require_map_camera(const Map::State& s, const Camera& camera) {
+  if (s.camera)
+    require(same_camera(*s.camera, camera), ErrorCode::InvalidArgument,
+            "map: frame camera (" + camera_text(camera) + ") differs from the map's first frame (" +
+                camera_text(*s.camera) + ")");
+}
+}  // namespace
+
+FrameStats Map::insert_rgbd(const RgbdView& frame, const Pose& camera_to_world, const ProgressSink& progress) {
+  require_rigid(camera_to_world);
+  require(frame.depth != nullptr && frame.gray != nullptr, ErrorCode::InvalidArgument,
+          "map: the RGB-D frame has no depth or gray image");
+  require_map_camera(*s_, frame.camera);  // before the work of back-projecting
+  const PointCloud cloud = backproject(frame, s_->options.depth);
+  return insert_backprojected(cloud.view(), frame.camera, camera_to_world, progress);
+}
+
+FrameStats Map::insert_backprojected(const PointsView& points, const Camera& camera, const Pose& camera_to_world,
+                                     const ProgressSink& progress) {
+  require_rigid(camera_to_world);
+  require_map_camera(*s_, camera);
+  require(points.size > 0, ErrorCode::InvalidData,
+          "map: the RGB-D frame has no valid depth pixel (depth range " + checked::exact(s_->options.depth.depth_min) +
+              " to " + checked::exact(s_->options.depth.depth_max) + " m)");
+  check_frame(points);
+  // Set before the insert: a flush it runs records the camera in the model.
+  if (!s_->camera) s_->camera = camera;
+  return insert_frame(*s_, *this, points, camera_to_world, true, progress);
+}
+
+std::size_t Map::flush(const ProgressSink& progress) {
+  State& s = *s_;
+  if (s.n_pending == 0) return 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  // The batch is fitted in the camera frame of its latest frame: a batch of
+  // one frame is then fitted exactly on that frame's points, as `sogmm fit
+  // --sequence` does, and coordinates stay near the origin in float32.
+  const Pose& last = s.pending.back().pose;
+  const Pose to_last = inverse_rigid(last);
+  PointCloud cloud;
+  cloud.xyzg.reserve(4 * s.n_pending);
+  bool from_rgbd = false;
+  for (std::size_t g = 0; g < s.pending.size(); ++g) {
+    const detail::PendingFrame& p = s.pending[g];
+    from_rgbd = from_rgbd || p.from_rgbd;
+    if (g + 1 == s.pending.size()) {
+      cloud.xyzg.insert(cloud.xyzg.end(), p.xyzg.begin(), p.xyzg.end());
+      continue;
+    }
+    const Pose rel = compose(to_last, p.pose);
+    for (std::size_t i = 0; i < p.xyzg.size(); i += 4) {
+      const float* q = p.xyzg.data() + i;
+      for (int r = 0; r < 3; ++r)
+        cloud.xyzg.push_back(static_cast<float>(rel[4 * r] * q[0] + rel[4 * r + 1] * q[1] + rel[4 * r + 2] * q[2] +
+                                                rel[4 * r + 3]));
+      cloud.xyzg.push_back(q[3]);
+    }
+  }
+  FitResult r = fit(cloud.view(), s.options.fit, progress);
+  const double ms_fit = ms_since(t0);
+  const auto t1 = std::chrono::steady_clock::now();
+
+  // The batch as a world-frame model with its fit record, as the CLI's
+  // make_model() builds it (the seed recorded is the options' seed).
+  Model batch;
+  batch.gmm = transform(r.gmm, last);
+  batch.fit.known = true;
+  const FitOptions& fo = s.options.fit;
+  batch.fit.bandwidth = fo.n_components > 0 ? 0.0 : fo.bandwidth;
+  batch.fit.n_components_requested = fo.n_components;
+  batch.fit.tol = fo.em.tol;
+  batch.fit.reg_covar = fo.em.reg_covar;
+  batch.fit.max_iter = fo.em.max_iter;
+  batch.fit.n_iter = r.em.iterations;
+  batch.fit.converged = r.em.converged;
+  batch.fit.log_likelihood = r.em.log_likelihood;
+  batch.fit.seed = fo.seed;
+  if (from_rgbd && s.camera) {
+    batch.camera.known = true;
+    batch.camera.camera = *s.camera;
+    batch.camera.decimation = s.options.depth.decimate;
+    batch.camera.depth_scale = s.options.depth.depth_scale;
+    batch.camera.depth_min = s.options.depth.depth_min;
+    batch.camera.depth_max = s.options.depth.depth_max;
+  }
+  batch.key_values.emplace_back(kCoordinateFrameKey, "world");
+
+  const std::size_t first = s.model.gmm.size();
+  Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);
+  std::vector<std::size_t> changed;
+  if (s.options.fusion && first > 0) changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
+  const std::size_t added = merged.gmm.size() - first;
+  const std::size_t fused = r.gmm.size() - added;
+  // Marginals of the changed and new components before anything is committed
+  // (the only step here that can throw on the data).
+  std::vector<detail::Marginal3> fresh;
+  for (std::size_t k = first; k < merged.gmm.size(); ++k) fresh.push_back(detail::marginal3(merged.gmm, k));
+  std::vector<detail::Marginal3> updated;
+  for (std::size_t k : changed) updated.push_back(detail::marginal3(merged.gmm, k));
+
+  // Commit.
+  s.model = std::move(merged);
+  for (std::size_t i = 0; i < changed.size(); ++i) {
+    s.marginals[changed[i]] = updated[i];
+    s.index.update(s.model.gmm, changed[i]);
+  }
+  s.marginals.insert(s.marginals.end(), fresh.begin(), fresh.end());
+  s.index.add(s.model.gmm, first);
+  s.pending.clear();
+  s.n_pending = 0;
+  ++s.n_flushes;
+  s.n_fused += fused;
+  if (!s.frames.empty()) {
+    FrameStats& f = s.frames.back();
+    f.flushed = true;
+    f.ms_fit += ms_fit;
+    f.ms_merge += ms_since(t1);
+    f.n_components = s.model.gmm.size();
+  }
+  return added;
+}
+
+Model Map::extract(const Box3& box) const {
+  for (int i = 0; i < 3; ++i)
+    require(std::isfinite(box.lo[i]) && std::isfinite(box.hi[i]) && box.lo[i] <= box.hi[i],
+            ErrorCode::InvalidArgument,
+            "map: box axis " + std::to_string(i) + " is [" + checked::exact(box.lo[i]) + ", " +
+                checked::exact(box.hi[i]) + "], not finite with min <= max");
+  const Model& all = model();
+  std::vector<std::uint32_t> ids;
+  s_->index.query_box(box, ids);
+  require(!ids.empty(), ErrorCode::InvalidData, "map: no component meets the box");
+  Model out;
+  out.fit = all.fit;
+  out.camera = all.camera;
+  out.key_values = all.key_values;
+  out.producer_name = all.producer_name;
+  out.gmm.resize(ids.size());
+  double total = 0.0;
+  for (std::uint32_t id : ids) total += all.gmm.weights[id];
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t id = ids[k];
+    out.gmm.weights[k] = static_cast<float>(total > 0 ? all.gmm.weights[id] / total : 1.0 / ids.size());
+    std::copy_n(all.gmm.mean(id), 4, out.gmm.means.data() + 4 * k);
+    std::copy_n(all.gmm.covariance(id), 16, out.gmm.covariances.data() + 16 * k);
+  }
+  const double support = std::round(static_cast<double>(all.gmm.support_size) * std::min(total, 1.0));
+  out.gmm.support_size = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(support));
+  return out;
+}
+
+}  // namespace sogmm

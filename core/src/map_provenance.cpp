@@ -1,0 +1,107 @@
+// What a map file stores beyond its components: the provenance keys
+// kMapFramesKey and kMapOptionsKey (sogmm/map.hpp, spec/format.md 2.3).
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "map_state.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/error.hpp"
+
+namespace sogmm {
+namespace {
+
+// One line per frame: index, points, novel points, then the 12 entries of the
+// pose's first three rows (the last row of a rigid pose is 0 0 0 1), each at
+// round-trip precision.
+std::string frames_text(const std::vector<FrameStats>& frames) {
+  std::string text;
+  char buf[64];
+  for (const FrameStats& f : frames) {
+    std::snprintf(buf, sizeof buf, "%" PRIu64 " %zu %zu", f.index, f.n_points, f.n_novel);
+    text += buf;
+    for (int i = 0; i < 12; ++i) text += " " + checked::exact(f.pose[i]);
+    text += "\n";
+  }
+  return text;
+}
+
+std::string options_text(const MapOptions& o) {
+  return "novelty=" + std::to_string(o.novelty ? 1 : 0) + " novelty_threshold=" + checked::exact(o.novelty_threshold) +
+         " batch_size=" + std::to_string(o.batch_size) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
+         " fusion_method=" + (o.fusion_method == FusionMethod::Hellinger ? "hellinger" : "kl") +
+         " fusion_threshold=" + checked::exact(o.fusion_threshold) + " index_sigmas=" + checked::exact(o.index_sigmas) +
+         " bandwidth=" + checked::exact(o.fit.bandwidth);
+}
+
+std::vector<FrameStats> parse_frames(const std::string& text) {
+  std::vector<FrameStats> frames;
+  std::istringstream in(text);
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    auto bad = [&](const std::string& why) {
+      return Error(ErrorCode::Format, std::string("map: key ") + kMapFramesKey + ", line " + std::to_string(line_no) +
+                                          ": " + why);
+    };
+    std::istringstream row(line);
+    std::uint64_t index = 0;
+    std::size_t n_points = 0, n_novel = 0;
+    if (!(row >> index >> n_points >> n_novel)) throw bad("expected 'index points novel' and 12 pose entries");
+    if (index != frames.size()) throw bad("frame index " + std::to_string(index) + ", expected " + std::to_string(frames.size()));
+    if (n_novel > n_points) throw bad("more novel points than points");
+    FrameStats f;
+    f.index = index;
+    f.n_points = n_points;
+    f.n_novel = n_novel;
+    for (int i = 0; i < 12; ++i)
+      if (!(row >> f.pose[i])) throw bad("expected 12 pose entries");
+    std::string rest;
+    if (row >> rest) throw bad("unexpected '" + rest + "' after the pose");
+    f.pose[15] = 1.0;
+    const std::string problem = rigid_pose_error(f.pose);
+    if (!problem.empty()) throw bad("pose is not rigid: " + problem);
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+}  // namespace
+
+Model Map::to_model() const {
+  require(s_->n_pending == 0, ErrorCode::InvalidArgument,
+          "map: " + std::to_string(s_->n_pending) + " points are pending; flush first (a map file holds components only)");
+  Model m = model();
+  for (auto it = m.key_values.begin(); it != m.key_values.end();)
+    it = it->first == kMapFramesKey || it->first == kMapOptionsKey ? m.key_values.erase(it) : it + 1;
+  m.key_values.emplace_back(kMapFramesKey, frames_text(s_->frames));
+  m.key_values.emplace_back(kMapOptionsKey, options_text(s_->options));
+  return m;
+}
+
+Map Map::from_model(const Model& model, const MapOptions& options) {
+  require(coordinate_frame(model) == "world", ErrorCode::InvalidArgument,
+          "map: the model is in the " + coordinate_frame(model) + " frame; a map holds a world-frame model");
+  validate(model.gmm);
+  Map map(options);
+  State& s = *map.s_;
+  s.model = model;
+  for (const auto& kv : model.key_values)
+    if (kv.first == kMapFramesKey) {
+      s.frames = parse_frames(kv.second);
+      break;
+    }
+  // The provenance lives in s.frames now; to_model() writes it afresh.
+  for (auto it = s.model.key_values.begin(); it != s.model.key_values.end();)
+    it = it->first == kMapFramesKey || it->first == kMapOptionsKey ? s.model.key_values.erase(it) : it + 1;
+  if (model.camera.known) s.camera = model.camera.camera;
+  s.marginals.reserve(model.gmm.size());
+  for (std::size_t k = 0; k < model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(model.gmm, k));
+  s.index.build(model.gmm);
+  return map;
+}
+
+}  // namespace sogmm

@@ -1,0 +1,78 @@
+// Internals of sogmm::Map shared by map.cpp (insert, flush), map_novelty.cpp
+// (the local 3-D likelihood), map_fusion.cpp (component fusion) and
+// map_provenance.cpp (file keys). Never installed.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "sogmm/map.hpp"
+
+namespace sogmm::detail {
+
+/// The 3-D marginal of one component, prepared for log N(x | mu, Sigma_xx):
+/// log N = log_norm - |Linv (x - mu)|^2 / 2 with Linv the inverse of the
+/// Cholesky factor of Sigma_xx (lower triangle, row-major: l00 l10 l11 l20
+/// l21 l22). log_count = log(weight x support size): invariant under merge(),
+/// which rescales old weights by S_old / S_new, so entries stay valid as the
+/// map grows.
+struct Marginal3 {
+  double mu[3];
+  double linv[6];
+  double log_norm;
+  double log_count;
+};
+
+/// Marginal3 of component m of `gmm` (Error(Numeric) if Sigma_xx is not
+/// positive definite in double, which validate(Gmm) rules out).
+Marginal3 marginal3(const Gmm& gmm, std::size_t m);
+
+/// log N(x | component) of a world point.
+inline double log_density(const Marginal3& c, const double x[3]) {
+  const double d0 = x[0] - c.mu[0], d1 = x[1] - c.mu[1], d2 = x[2] - c.mu[2];
+  const double z0 = c.linv[0] * d0;
+  const double z1 = c.linv[1] * d0 + c.linv[2] * d1;
+  const double z2 = c.linv[3] * d0 + c.linv[4] * d1 + c.linv[5] * d2;
+  return c.log_norm - 0.5 * (z0 * z0 + z1 * z1 + z2 * z2);
+}
+
+/// Local submap log-likelihood (map.hpp, header comment) of n world points
+/// (3 doubles each) into out (n doubles).
+void local_log_likelihood(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
+                          const double* xyz, std::size_t n, double* out);
+
+/// Fuses the components [first, gmm.size()) of `gmm` into the close
+/// components of [0, first) (found through `index`, which covers exactly
+/// those) as MapOptions say; removes the fused ones from `gmm`. Returns the
+/// ids (< first) of the components that changed, ascending and unique.
+std::vector<std::size_t> fuse_new_components(Gmm& gmm, std::size_t first, const ComponentIndex& index,
+                                             const MapOptions& options);
+
+/// Novel points of one frame waiting for a fit, in that frame's camera frame.
+struct PendingFrame {
+  Pose pose{};
+  bool from_rgbd = false;
+  std::vector<float> xyzg;
+};
+
+}  // namespace sogmm::detail
+
+namespace sogmm {
+
+struct Map::State {
+  MapOptions options;
+  Model model;                 ///< world-frame map; gmm empty until the first flush
+  ComponentIndex index;
+  std::vector<detail::Marginal3> marginals;  ///< one per component of model.gmm
+  std::vector<detail::PendingFrame> pending;
+  std::size_t n_pending = 0;
+  std::vector<FrameStats> frames;
+  std::uint64_t n_flushes = 0;
+  std::uint64_t n_fused = 0;
+  std::optional<Camera> camera;  ///< fixed by the first RGB-D frame
+  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {}
+};
+
+}  // namespace sogmm

@@ -1,0 +1,336 @@
+// The incremental map (sogmm/map.hpp): append-everything equivalence,
+// novelty, fusion, bad input, export and provenance round trip.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <vector>
+
+#include "sogmm/inference.hpp"
+#include "sogmm/map.hpp"
+#include "test_util.hpp"
+
+namespace {
+using namespace sogmm_test;
+
+using sogmm::ErrorCode;
+using sogmm::Map;
+using sogmm::MapOptions;
+using sogmm::Pose;
+
+constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+// Rotation about y by `angle` and translation t (a camera turning and moving).
+Pose pose_y(double angle, double tx, double ty, double tz) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c, 0, s, tx, 0, 1, 0, ty, -s, 0, c, tz, 0, 0, 0, 1};
+}
+
+// A camera-frame frame of n points on two textured planar patches (a wall at
+// z ~ 1.5 m and a floor strip), 2 mm depth noise, offset by `shift` along x.
+std::vector<float> make_frame(std::size_t n, std::uint64_t seed, double shift = 0.0) {
+  TestRng rng(seed);
+  std::vector<float> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    double x, y, z;
+    if (i % 3 == 2) {  // floor: y = 0.4, z in [1, 1.5]
+      x = shift + 0.6 * rng.uniform() - 0.3;
+      z = 1.0 + 0.5 * rng.uniform();
+      y = 0.4 + 0.002 * rng.normal();
+    } else {  // wall
+      x = shift + 0.6 * rng.uniform() - 0.3;
+      y = 0.6 * rng.uniform() - 0.2;
+      z = 1.5 + 0.002 * rng.normal();
+    }
+    const double gray = 0.5 + 0.3 * std::sin(8.0 * (x - shift)) + 0.02 * rng.normal();
+    p.insert(p.end(), {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z), static_cast<float>(gray)});
+  }
+  return p;
+}
+
+sogmm::PointsView view(const std::vector<float>& p) { return {p.data(), p.size() / 4}; }
+
+MapOptions options(bool novelty, bool fusion) {
+  MapOptions o;
+  o.novelty = novelty;
+  o.fusion = fusion;
+  o.batch_size = 100000;  // flushes are explicit in these tests
+  o.fit.em.threads = 2;
+  return o;
+}
+
+// The points moved to the world frame (rows of 4 floats).
+std::vector<float> to_world(const std::vector<float>& p, const Pose& pose) {
+  std::vector<float> w(p);
+  for (std::size_t i = 0; i < p.size(); i += 4)
+    for (int r = 0; r < 3; ++r)
+      w[i + r] = static_cast<float>(pose[4 * r] * p[i] + pose[4 * r + 1] * p[i + 1] + pose[4 * r + 2] * p[i + 2] +
+                                    pose[4 * r + 3]);
+  return w;
+}
+
+// Mixture mean and covariance (4-D) of a model, in double.
+void total_moments(const sogmm::Gmm& g, Eigen::Vector4d* mean, Eigen::Matrix4d* cov) {
+  *mean = Eigen::Vector4d::Zero();
+  for (std::size_t k = 0; k < g.size(); ++k) *mean += g.weights[k] * mean_of(g, k);
+  *cov = Eigen::Matrix4d::Zero();
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const Eigen::Vector4d d = mean_of(g, k) - *mean;
+    *cov += g.weights[k] * (cov_of(g, k) + d * d.transpose());
+  }
+}
+
+TEST(MapTest, NoveltyAndFusionOffReproduceAppendEverything) {
+  const std::vector<std::vector<float>> frames = {make_frame(2000, 1), make_frame(2400, 2, 0.5),
+                                                  make_frame(1800, 3, -0.4)};
+  const std::vector<Pose> poses = {kIdentity, pose_y(0.3, 0.2, 0.0, -0.1), pose_y(-0.5, -0.3, 0.05, 0.2)};
+  MapOptions o = options(false, false);
+  o.batch_size = 12288;  // novelty off: every insert fits its own frame whatever the batch size
+  Map map(o);
+  sogmm::Model expected;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const sogmm::FrameStats s = map.insert_points(view(frames[f]), poses[f]);
+    EXPECT_TRUE(s.flushed);
+    EXPECT_EQ(s.n_novel, s.n_points);
+    // What `sogmm fit --sequence` does per frame: fit, move, merge.
+    sogmm::FitResult r = sogmm::fit(view(frames[f]), o.fit);
+    sogmm::Model world;
+    world.gmm = sogmm::transform(r.gmm, poses[f]);
+    world.fit.known = true;
+    world.fit.bandwidth = o.fit.bandwidth;
+    world.fit.tol = o.fit.em.tol;
+    world.fit.reg_covar = o.fit.em.reg_covar;
+    world.fit.max_iter = o.fit.em.max_iter;
+    world.fit.n_iter = r.em.iterations;
+    world.fit.converged = r.em.converged;
+    world.fit.log_likelihood = r.em.log_likelihood;
+    world.key_values = {{sogmm::kCoordinateFrameKey, "world"}};
+    expected = f == 0 ? world : sogmm::merge(expected, world);
+    EXPECT_EQ(s.n_components, expected.gmm.size());
+  }
+  const sogmm::Model& got = map.model();
+  EXPECT_EQ(got.gmm.weights, expected.gmm.weights);
+  EXPECT_EQ(got.gmm.means, expected.gmm.means);
+  EXPECT_EQ(got.gmm.covariances, expected.gmm.covariances);
+  EXPECT_EQ(got.gmm.support_size, expected.gmm.support_size);
+  EXPECT_EQ(got.fit.n_iter, expected.fit.n_iter);
+  EXPECT_EQ(got.fit.log_likelihood, expected.fit.log_likelihood);
+  EXPECT_EQ(got.key_values, expected.key_values);
+  EXPECT_EQ(map.stats().n_flushes, 3u);
+  EXPECT_EQ(map.pending(), 0u);
+}
+
+TEST(MapTest, ReinsertingAFrameAddsAlmostNothingANewRegionAdds) {
+  const std::vector<float> frame = make_frame(3000, 5);
+  const Pose pose = pose_y(0.2, 0.1, 0.0, 0.3);
+  Map map(options(true, false));
+  const sogmm::FrameStats first = map.insert_points(view(frame), pose);
+  EXPECT_EQ(first.n_novel, first.n_points);  // empty map: everything is new
+  EXPECT_EQ(map.pending(), 3000u);
+  map.flush();
+  const std::size_t m1 = map.size();
+  ASSERT_GT(m1, 2u);
+
+  // The same frame at the same pose: the map already explains it.
+  const sogmm::FrameStats again = map.insert_points(view(frame), pose);
+  EXPECT_LT(again.n_novel, again.n_points / 50) << again.n_novel << " of " << again.n_points << " novel";
+  map.flush();
+  EXPECT_LE(map.size(), m1 + m1 / 10);
+
+  // A fresh draw of the same surfaces: mostly explained (what is novel lies in
+  // the thin tails of the noise and at the patch borders: 8 % here).
+  const sogmm::FrameStats redraw = map.insert_points(view(make_frame(3000, 6)), pose);
+  EXPECT_LT(redraw.n_novel, redraw.n_points / 8);
+
+  // A region 3 m away: all of it is novel and it adds components.
+  const std::size_t m2 = map.size();
+  const sogmm::FrameStats elsewhere = map.insert_points(view(frame), pose_y(0.2, 3.1, 0.0, 0.3));
+  EXPECT_EQ(elsewhere.n_novel, elsewhere.n_points);
+  map.flush();
+  EXPECT_GE(map.size(), m2 + m1 / 2);
+  EXPECT_EQ(map.frames().size(), 4u);
+}
+
+TEST(MapTest, BatchSizeTriggersTheFlush) {
+  MapOptions o = options(true, false);
+  o.batch_size = 5000;
+  Map map(o);
+  const sogmm::FrameStats a = map.insert_points(view(make_frame(3000, 8)), kIdentity);
+  EXPECT_FALSE(a.flushed);
+  EXPECT_EQ(map.size(), 0u);
+  // A second, disjoint region: 6000 pending points >= 5000, one fit of both.
+  const sogmm::FrameStats b = map.insert_points(view(make_frame(3000, 9)), pose_y(0.0, 2.0, 0.0, 0.0));
+  EXPECT_TRUE(b.flushed);
+  EXPECT_EQ(map.pending(), 0u);
+  EXPECT_GT(map.size(), 0u);
+  EXPECT_EQ(map.model().gmm.support_size, 6000u);
+  EXPECT_EQ(b.n_components, map.size());
+  // The batch was fitted in the latest frame's camera frame and moved to the
+  // world: the map explains both regions.
+  std::vector<double> ll(2);
+  const double xyz[6] = {0.0, 0.1, 1.5, 2.0, 0.1, 1.5};
+  map.local_log_likelihood(xyz, 2, ll.data());
+  EXPECT_GT(ll[0], 3.0);
+  EXPECT_GT(ll[1], 3.0);
+}
+
+TEST(MapTest, FusionKeepsMomentsAndCostsLittleLikelihood) {
+  // The same surfaces seen twice, 3 mm apart: with fusion the second frame's
+  // components fold into the first's.
+  const Pose p1 = kIdentity, p2 = pose_y(0.0, 0.003, 0.0, 0.0);
+  for (sogmm::FusionMethod method : {sogmm::FusionMethod::Hellinger, sogmm::FusionMethod::KL}) {
+    SCOPED_TRACE(method == sogmm::FusionMethod::Hellinger ? "Hellinger" : "KL");
+    MapOptions fo = options(false, true);
+    fo.fusion_method = method;
+    fo.fusion_threshold = method == sogmm::FusionMethod::Hellinger ? 0.3 : 0.2;
+    Map fused(fo);
+    Map append(options(false, false));
+    for (const Pose& p : {p1, p2}) {
+      append.insert_points(view(make_frame(3000, 12)), p);
+      fused.insert_points(view(make_frame(3000, 12)), p);
+    }
+    const sogmm::Gmm& a = append.model().gmm;
+    const sogmm::Gmm& f = fused.model().gmm;
+    EXPECT_LT(f.size(), a.size() * 3 / 4) << "fused " << fused.stats().n_fused << " of " << a.size();
+    EXPECT_EQ(fused.stats().n_fused, a.size() - f.size());
+    EXPECT_TRUE(model_is_valid(f));
+    // Moment matching keeps the mixture's total mean and covariance.
+    Eigen::Vector4d ma, mf;
+    Eigen::Matrix4d ca, cf;
+    total_moments(a, &ma, &ca);
+    total_moments(f, &mf, &cf);
+    EXPECT_LT((ma - mf).norm(), 1e-5);
+    EXPECT_LT((ca - cf).norm(), 1e-5 * ca.norm());
+    // The likelihood of the points (joint, 4-D) drops by little.
+    const std::vector<float> pts = to_world(make_frame(3000, 13), p1);
+    const double la = score(a, pts), lf = score(f, pts);
+    EXPECT_GT(lf, la - 0.25) << "append " << la << ", fused " << lf;
+    RecordProperty("loglik_append", std::to_string(la));
+    RecordProperty("loglik_fused", std::to_string(lf));
+    std::printf("fusion %s: %zu -> %zu components, mean log-likelihood %.4f -> %.4f\n",
+                method == sogmm::FusionMethod::Hellinger ? "Hellinger" : "KL", a.size(), f.size(), la, lf);
+  }
+}
+
+TEST(MapTest, BadInputIsRejectedAndLeavesTheMapUnchanged) {
+  Map map(options(true, false));
+  const std::vector<float> frame = make_frame(500, 21);
+  map.insert_points(view(frame), kIdentity);
+  const std::size_t pending = map.pending();
+  Pose nan_pose = kIdentity;
+  nan_pose[3] = std::nan("");
+  expect_error([&] { map.insert_points(view(frame), nan_pose); }, ErrorCode::InvalidArgument, {"not finite"},
+               "NaN pose");
+  Pose scaled = kIdentity;
+  scaled[0] = scaled[5] = scaled[10] = 2.0;
+  expect_error([&] { map.insert_points(view(frame), scaled); }, ErrorCode::InvalidArgument, {"orthonormal"},
+               "scaled pose");
+  Pose mirror = kIdentity;
+  mirror[0] = -1.0;
+  expect_error([&] { map.insert_points(view(frame), mirror); }, ErrorCode::InvalidArgument, {"reflection"},
+               "mirror pose");
+  Pose last_row = kIdentity;
+  last_row[14] = 0.5;
+  expect_error([&] { map.insert_points(view(frame), last_row); }, ErrorCode::InvalidArgument, {"last row"},
+               "projective pose");
+  expect_error([&] { map.insert_points(sogmm::PointsView{frame.data(), 0}, kIdentity); }, ErrorCode::InvalidData,
+               {"no point"}, "empty frame");
+  std::vector<float> bad = frame;
+  bad[41] = INFINITY;
+  expect_error([&] { map.insert_points(view(bad), kIdentity); }, ErrorCode::InvalidData, {"finite"},
+               "non-finite point");
+  EXPECT_EQ(map.pending(), pending);
+  EXPECT_EQ(map.frames().size(), 1u);
+
+  // RGB-D: the first frame fixes the camera.
+  sogmm::Camera cam{64, 48, 60.0, 60.0, 32.0, 24.0};
+  std::vector<std::uint16_t> depth(64 * 48, 1500);
+  std::vector<float> gray(64 * 48, 0.5f);
+  map.insert_rgbd({depth.data(), gray.data(), cam}, kIdentity);
+  sogmm::Camera other = cam;
+  other.width = 32;
+  expect_error([&] { map.insert_rgbd({depth.data(), gray.data(), other}, kIdentity); }, ErrorCode::InvalidArgument,
+               {"differs"}, "frame of another size");
+  std::vector<std::uint16_t> empty_depth(64 * 48, 0);
+  expect_error([&] { map.insert_rgbd({empty_depth.data(), gray.data(), cam}, kIdentity); }, ErrorCode::InvalidData,
+               {"no valid depth"}, "frame without a valid pixel");
+  EXPECT_EQ(map.frames().size(), 2u);
+
+  MapOptions o;
+  o.batch_size = 0;
+  expect_error([&] { Map m(o); }, ErrorCode::InvalidArgument, {"batch_size"}, "batch size 0");
+  o = MapOptions();
+  o.novelty_threshold = NAN;
+  expect_error([&] { Map m(o); }, ErrorCode::InvalidArgument, {"novelty_threshold"}, "NaN threshold");
+  o = MapOptions();
+  o.fusion_threshold = 0;
+  expect_error([&] { Map m(o); }, ErrorCode::InvalidArgument, {"fusion_threshold"}, "fusion threshold 0");
+  Map empty(options(true, false));
+  expect_error([&] { empty.model(); }, ErrorCode::InvalidData, {"no component"}, "empty map export");
+}
+
+TEST(MapTest, ExtractBoxHoldsTheComponentsWhoseBoxesMeetIt) {
+  Map map(options(true, false));
+  map.insert_points(view(make_frame(3000, 31)), kIdentity);
+  map.insert_points(view(make_frame(3000, 32)), pose_y(0.0, 2.0, 0.0, 0.0));
+  map.flush();
+  sogmm::Box3 box;
+  box.lo = {-0.5, -0.5, 0.5};
+  box.hi = {0.5, 0.5, 2.0};
+  const sogmm::Model part = map.extract(box);
+  const sogmm::Gmm& all = map.model().gmm;
+  std::size_t expected = 0;
+  for (std::size_t k = 0; k < all.size(); ++k)
+    expected += sogmm::component_box(all, k, 3.0).intersects(box) ? 1 : 0;
+  EXPECT_EQ(part.gmm.size(), expected);
+  EXPECT_LT(part.gmm.size(), all.size());
+  EXPECT_TRUE(model_is_valid(part.gmm));
+  EXPECT_EQ(sogmm::coordinate_frame(part), "world");
+  EXPECT_NEAR(static_cast<double>(part.gmm.support_size), 3000.0, 300.0);
+  sogmm::Box3 bad = box;
+  bad.lo[1] = 1.0;
+  expect_error([&] { map.extract(bad); }, ErrorCode::InvalidArgument, {"min <= max"}, "inverted box");
+  sogmm::Box3 nowhere;
+  nowhere.lo = {50, 50, 50};
+  nowhere.hi = {51, 51, 51};
+  expect_error([&] { map.extract(nowhere); }, ErrorCode::InvalidData, {"no component"}, "empty box");
+}
+
+TEST(MapTest, ProvenanceRoundTrip) {
+  Map map(options(true, false));
+  map.insert_points(view(make_frame(2000, 41)), kIdentity);
+  map.insert_points(view(make_frame(2000, 42)), pose_y(0.4, 1.0, 0.0, 0.0));
+  expect_error([&] { map.to_model(); }, ErrorCode::InvalidArgument, {"flush"}, "pending points");
+  map.flush();
+  const sogmm::Model saved = map.to_model();
+  const Map loaded = Map::from_model(saved, options(true, false));
+  EXPECT_EQ(loaded.model().gmm.means, map.model().gmm.means);
+  EXPECT_EQ(loaded.model().gmm.weights, map.model().gmm.weights);
+  ASSERT_EQ(loaded.frames().size(), 2u);
+  for (std::size_t f = 0; f < 2; ++f) {
+    EXPECT_EQ(loaded.frames()[f].pose, map.frames()[f].pose);
+    EXPECT_EQ(loaded.frames()[f].n_points, map.frames()[f].n_points);
+    EXPECT_EQ(loaded.frames()[f].n_novel, map.frames()[f].n_novel);
+  }
+  const double xyz[3] = {0.0, 0.1, 1.5};
+  double a = 0, b = 0;
+  map.local_log_likelihood(xyz, 1, &a);
+  loaded.local_log_likelihood(xyz, 1, &b);
+  EXPECT_EQ(a, b);
+  // The saved model holds each provenance key once, also after a reload.
+  const sogmm::Model again = loaded.to_model();
+  std::size_t frames_keys = 0;
+  for (const auto& kv : again.key_values) frames_keys += kv.first == sogmm::kMapFramesKey ? 1 : 0;
+  EXPECT_EQ(frames_keys, 1u);
+
+  sogmm::Model camera_frame = saved;
+  camera_frame.key_values.clear();
+  expect_error([&] { Map::from_model(camera_frame); }, ErrorCode::InvalidArgument, {"camera frame"},
+               "camera-frame model");
+  sogmm::Model broken = saved;
+  for (auto& kv : broken.key_values)
+    if (kv.first == sogmm::kMapFramesKey) kv.second = "0 10 5 1 0 0 0 0 1 0 0 0 0 1\n";
+  expect_error([&] { Map::from_model(broken); }, ErrorCode::Format, {"map_frames"}, "truncated provenance");
+}
+
+}  // namespace

@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""Incremental map vs append-everything (issue 18): size, accuracy, insert time.
+
+For each sequence (the synthetic room loop of `sogmm demo --write-frame
+--loop`, and livingroom frames 0-2 of ../shared/data when present):
+  1. append everything: `sogmm fit --sequence` (components M_append);
+  2. the map: `sogmm map` with the given options (components M_map, per-frame
+     CSV); ratio M_map / M_append (target <= 0.30);
+  3. accuracy: `sogmm eval MAP --sequence` per frame vs `sogmm eval` of that
+     frame's own fit (every --accuracy-step-th frame): worst PSNR loss (target
+     <= 0.5 dB) and worst MRE increase (target <= 1 mm); also vs the
+     append-everything map evaluated the same way (eval --sequence);
+  4. insert time: median of novelty + fit + merge ms over frames 290-299 vs
+     10-19 of the CSV (target ratio <= 1.5; only for sequences of >= 300 frames).
+Prints a table and one JSON line per sequence.
+
+Usage (from the repository root):
+    python3 tools/sogmm-perf/map_loop.py [--sogmm build/tools/sogmm/sogmm] [--loop-dir /tmp/sogmm_loop]
+        [--frames 300] [--decimate 5] [--bandwidth 0.02] [--accuracy-step 10] [-- MAP FLAGS...]
+Anything after `--` goes to `sogmm map` (e.g. -- --fusion hellinger --threshold 3).
+"""
+import argparse
+import csv
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def run_json(sogmm, args):
+    p = subprocess.run([sogmm] + [str(a) for a in args] + ["--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    if p.returncode != 0:
+        sys.exit("sogmm %s failed (%d): %s" % (" ".join(map(str, args)), p.returncode, p.stderr.strip()))
+    return json.loads(p.stdout)
+
+
+def median_ms(rows, lo, hi):
+    v = [float(r["ms_novelty"]) + float(r["ms_fit"]) + float(r["ms_merge"]) for r in rows if lo <= int(r["frame"]) < hi]
+    return statistics.median(v) if v else float("nan")
+
+
+def measure(name, sogmm, seq, frames, a, map_flags, work):
+    traj = os.path.join(seq, "trajectory.log")
+    common = ["--trajectory", traj, "--frames", frames, "--decimate", a.decimate, "--bandwidth", a.bandwidth]
+    append = run_json(sogmm, ["fit", "--sequence", seq, "-o", os.path.join(work, name + "_append.sogmm")] + common)
+    out = os.path.join(work, name + "_map.sogmm")
+    csv_path = os.path.join(work, name + "_map.csv")
+    m = run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + common + map_flags)
+    rows = list(csv.DictReader(open(csv_path)))
+    selected = [int(r["frame"]) for r in rows]
+    check = selected[:: a.accuracy_step]
+    if selected[-1] not in check:
+        check.append(selected[-1])
+    worst_dpsnr, worst_dmre, worst_app_dpsnr, worst_app_dmre, per = -1e9, -1e9, -1e9, -1e9, []
+    for k in check:
+        ev = run_json(sogmm, ["eval", out, "--sequence", seq, "--trajectory", traj, "--frames", k])
+        # The same evaluation (world model moved into the frame, frustum
+        # samples) of the append-everything map: separates what the map loses
+        # from what any world-frame model scores against a single frame.
+        app = run_json(sogmm, ["eval", os.path.join(work, name + "_append.sogmm"), "--sequence", seq,
+                               "--trajectory", traj, "--frames", k])["frames"][0]
+        own = run_json(sogmm, ["eval", "--depth", os.path.join(seq, "depth", "%05d.png" % k), "--color",
+                               own_color(seq, k), "--intrinsics", os.path.join(seq, "intrinsics.json"), "--decimate",
+                               a.decimate, "--bandwidth", a.bandwidth])
+        r = ev["frames"][0]
+        dpsnr = own["psnr"] - r["psnr"]  # dB lost by the map
+        dmre = (r["mre"] - own["mre"]) * 1000.0  # mm added by the map
+        worst_dpsnr, worst_dmre = max(worst_dpsnr, dpsnr), max(worst_dmre, dmre)
+        worst_app_dpsnr = max(worst_app_dpsnr, app["psnr"] - r["psnr"])
+        worst_app_dmre = max(worst_app_dmre, (r["mre"] - app["mre"]) * 1000.0)
+        per.append({"frame": k, "psnr_map": r["psnr"], "psnr_own": own["psnr"], "psnr_append": app["psnr"],
+                    "mre_map": r["mre"], "mre_own": own["mre"], "mre_append": app["mre"]})
+    early, late = median_ms(rows, 10, 20), median_ms(rows, 290, 300)
+    return {
+        "sequence": name,
+        "frames": len(rows),
+        "components_append": append["n_components"],
+        "components_map": m["n_components"],
+        "ratio": m["n_components"] / append["n_components"],
+        "novel_fraction": m["n_novel"] / max(1, m["n_points"]),
+        "worst_psnr_loss_db": worst_dpsnr,
+        "worst_mre_increase_mm": worst_dmre,
+        "worst_psnr_loss_vs_append_db": worst_app_dpsnr,
+        "worst_mre_increase_vs_append_mm": worst_app_dmre,
+        "median_insert_ms_10_20": early,
+        "median_insert_ms_290_300": late,
+        "insert_time_ratio": late / early if early > 0 else float("nan"),
+        "per_frame": per,
+    }
+
+
+def own_color(seq, k):
+    for ext in ("png", "jpg", "jpeg"):
+        p = os.path.join(seq, "color", "%05d.%s" % (k, ext))
+        if os.path.isfile(p):
+            return p
+    return os.path.join(seq, "color", "%05d.png" % k)
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(here))
+    argv = sys.argv[1:]
+    map_flags = argv[argv.index("--") + 1:] if "--" in argv else []
+    argv = argv[: argv.index("--")] if "--" in argv else argv
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sogmm", default=os.path.join(root, "build", "tools", "sogmm", "sogmm"))
+    ap.add_argument("--loop-dir", default=os.path.join(tempfile.gettempdir(), "sogmm_room_loop"))
+    ap.add_argument("--frames", type=int, default=300, help="frames of the synthetic loop")
+    ap.add_argument("--data", default=os.path.join(os.path.dirname(root), "shared", "data", "rgbd"))
+    ap.add_argument("--decimate", type=int, default=5)
+    ap.add_argument("--bandwidth", type=float, default=0.02)
+    ap.add_argument("--accuracy-step", type=int, default=10, help="evaluate every N-th frame against its own fit")
+    a = ap.parse_args(argv)
+    traj = os.path.join(a.loop_dir, "trajectory.log")
+    if not os.path.isfile(traj) or sum(1 for _ in open(traj)) != 5 * a.frames:
+        subprocess.run([a.sogmm, "demo", "--write-frame", a.loop_dir, "--loop", "--frames", str(a.frames)], check=True)
+    results = []
+    with tempfile.TemporaryDirectory(prefix="sogmm_map_loop_") as work:
+        results.append(measure("room_loop", a.sogmm, a.loop_dir, ":", a, map_flags, work))
+        room = os.path.join(a.data, "livingroom")
+        if os.path.isdir(room):
+            results.append(measure("livingroom_0_3", a.sogmm, room, "0:3", a, map_flags, work))
+        else:
+            print("SKIP livingroom: %s is absent" % room)
+    print("map flags: %s" % (" ".join(map_flags) or "(defaults)"))
+    print("| sequence | frames | M append | M map | ratio (<=0.30) | novel | worst PSNR loss dB vs own fit (<=0.5) "
+          "/ vs append | worst MRE +mm vs own fit (<=1) / vs append | insert ms 10-20 | 290-300 | ratio (<=1.5) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        print("| %s | %d | %d | %d | %.3f | %.1f%% | %.2f / %.2f | %.2f / %.2f | %.1f | %.1f | %.2f |" % (
+            r["sequence"], r["frames"], r["components_append"], r["components_map"], r["ratio"],
+            100 * r["novel_fraction"], r["worst_psnr_loss_db"], r["worst_psnr_loss_vs_append_db"],
+            r["worst_mre_increase_mm"], r["worst_mre_increase_vs_append_mm"], r["median_insert_ms_10_20"],
+            r["median_insert_ms_290_300"], r["insert_time_ratio"]))
+    for r in results:
+        print(json.dumps(r))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

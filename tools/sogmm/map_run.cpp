@@ -1,0 +1,107 @@
+#include "map_run.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+
+#include "sogmm/error.hpp"
+
+namespace sogmm::tools {
+
+namespace {
+std::string base_name(const std::string& p) { return std::filesystem::path(p).filename().string(); }
+
+// Wraps the printer's sink and records, per fit, the time spent in each
+// stage (the time between two reports belongs to the earlier one's stage)
+// and the last EM iteration.
+ProgressSink recording(ProgressSink inner, FitRecord& record) {
+  using clock = std::chrono::steady_clock;
+  struct Clock {
+    clock::time_point last = clock::now();
+    Stage stage = Stage::Run;
+    bool running = false;
+  };
+  auto c = std::make_shared<Clock>();
+  return [inner = std::move(inner), &record, c](const Progress& p) {
+    const auto now = clock::now();
+    const double s = std::chrono::duration<double>(now - c->last).count();
+    if (c->running && c->stage == Stage::ModeCount) record.seconds_mode_count += s;
+    if (c->running && c->stage == Stage::Seeding) record.seconds_seeding += s;
+    if (c->running && c->stage == Stage::Em) record.seconds_em += s;
+    c->last = now;
+    c->stage = p.stage;
+    c->running = true;
+    if (p.stage == Stage::Em) {
+      record.em_iterations = static_cast<int>(p.step);
+      record.log_likelihood = p.log_likelihood;
+    }
+    return inner ? inner(p) : false;
+  };
+}
+
+// Rethrows an error of the library with the file it concerns in front.
+[[noreturn]] void rethrow_naming(const Error& e, const std::string& path) { throw Error(e.code(), path + ": " + e.what()); }
+}  // namespace
+
+SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera) {
+  SequenceInput in;
+  in.dir = src.sequence;
+  in.trajectory = src.trajectory;
+  in.frames = list_sequence(src.sequence);
+  in.poses = read_trajectory(src.trajectory);
+  in.selected = parse_frame_range(src.frames.empty() ? std::string(":") : src.frames, in.frames.size());
+  require(in.poses.size() >= in.selected.back() + 1, ErrorCode::InvalidData,
+          src.trajectory + ": has " + std::to_string(in.poses.size()) + " poses but frame " +
+              std::to_string(in.selected.back()) + " is selected");
+  in.camera = camera;
+  if (!camera_flags_given(in.camera)) {
+    const std::string guess = (std::filesystem::path(src.sequence) / "intrinsics.json").string();
+    require(std::filesystem::is_regular_file(guess), ErrorCode::InvalidArgument,
+            "no camera: give --intrinsics FILE (or put intrinsics.json in " + src.sequence + ")");
+    in.camera.intrinsics = guess;
+  }
+  return in;
+}
+
+Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
+                             const std::function<void(const MapRunFrame&)>& after) {
+  Camera camera;
+  for (std::size_t k = 0; k < in.selected.size(); ++k) {
+    MapRunFrame r;
+    r.file = in.frames[in.selected[k]];
+    r.label = "frame " + std::to_string(k + 1) + "/" + std::to_string(in.selected.size()) + " (" +
+              base_name(r.file.depth) + ")";
+    const LoadedFrame frame = load_frame(r.file.depth, r.file.color);
+    try {
+      camera = resolve_camera(in.camera, frame);
+    } catch (const Error& e) {  // e.g. a frame of another size than the camera
+      rethrow_naming(e, r.file.depth);
+    }
+    // The tool's check first: its message names the file and the depth range.
+    backproject_nonempty(frame, camera, depth, r.file.depth);
+    try {
+      r.stats = map.insert_rgbd(frame.view(camera), in.poses[r.file.index],
+                                recording(progress.fit_callback(r.label), r.fit));
+    } catch (const Error& e) {
+      rethrow_naming(e, r.file.depth);
+    }
+    if (after) after(r);
+  }
+  return camera;
+}
+
+std::string frame_list(const SequenceInput& in) {
+  std::string out;
+  for (std::size_t i : in.selected) out += (out.empty() ? "" : ",") + std::to_string(in.frames[i].index);
+  return out;
+}
+
+Model with_sequence_metadata(Model model, const SequenceInput& in) {
+  model.producer_version = version_string();
+  model.created_unix_ms = unix_ms_now();
+  model.key_values.insert(model.key_values.end(),
+                          {{"sequence", in.dir}, {"trajectory", in.trajectory}, {"frames", frame_list(in)}});
+  return model;
+}
+
+}  // namespace sogmm::tools

@@ -1,0 +1,62 @@
+// Feeding a posed RGB-D sequence into the core's incremental Map: the one
+// code path behind `sogmm fit --sequence` (novelty and fusion off: append
+// everything) and `sogmm map`.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "sequence.hpp"
+#include "sogmm/map.hpp"
+
+namespace sogmm::tools {
+
+/// Stage times and EM iterations of the fits one insert ran, taken from the
+/// fit's progress callback (the Map reports only the total fit time).
+struct FitRecord {
+  int em_iterations = 0;      ///< iterations of the last EM run (the kept one when n_init is 1)
+  double log_likelihood = 0;  ///< mean log-likelihood of its last iteration
+  double seconds_mode_count = 0, seconds_seeding = 0, seconds_em = 0;
+};
+
+/// One inserted frame: which file, what the Map did, what its fit did.
+struct MapRunFrame {
+  SequenceFrame file;
+  std::string label;  ///< "frame k/N (00012.png)"
+  FrameStats stats;
+  FitRecord fit;
+};
+
+/// A sequence resolved from the command line: frame files, poses, the
+/// selection and the camera flags (intrinsics.json of DIR when none given).
+struct SequenceInput {
+  std::string dir, trajectory;
+  std::vector<SequenceFrame> frames;
+  std::vector<Pose> poses;
+  std::vector<std::size_t> selected;
+  CameraFlags camera;
+};
+/// Lists, reads and checks them (errors name the file; more selected
+/// frames than poses -> Error(InvalidData)).
+SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera);
+
+/// Inserts every selected frame into `map` in order: loads it (a missing or
+/// unreadable file -> Error(Io) naming it), checks the camera against the
+/// frame size (another size -> Error(InvalidData)), back-projects it (no valid
+/// pixel -> Error(InvalidData) naming the file) and inserts it with its pose.
+/// `progress` shows each fit's stages; `after` is called after each insert.
+/// Returns the camera of the frames.
+Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
+                             const std::function<void(const MapRunFrame&)>& after);
+
+/// Comma-separated frame indices of the selection ("0,1,2").
+std::string frame_list(const SequenceInput& in);
+
+/// The model with this tool's producer, the creation time now and the keys
+/// "sequence", "trajectory" and "frames" (frame_list) appended.
+Model with_sequence_metadata(Model model, const SequenceInput& in);
+
+}  // namespace sogmm::tools
