@@ -1,0 +1,168 @@
+// Warm start: keep the components the new cloud still supports, seed new ones
+// where it is poorly explained, then EM.
+#include "sogmm/warm_start.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "parallel.hpp"
+#include "point_scores.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/error.hpp"
+#include "sogmm/kmeanspp.hpp"
+#include "sogmm/mean_shift.hpp"
+
+namespace sogmm {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The caller's OpenMP thread count is restored on every exit (as fit()).
+class ScopedThreads {
+ public:
+  explicit ScopedThreads(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
+  ~ScopedThreads() { omp_set_num_threads(saved_); }
+  ScopedThreads(const ScopedThreads&) = delete;
+  ScopedThreads& operator=(const ScopedThreads&) = delete;
+
+ private:
+  int saved_;
+};
+
+double median(std::vector<double> v) {
+  const std::size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + h, v.end());
+  return v[h];
+}
+
+// Appends component k of `from` to `to` with weight `w` (normalised later).
+void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
+  to.weights.push_back(static_cast<float>(w));
+  to.means.insert(to.means.end(), from.mean(k), from.mean(k) + 4);
+  to.covariances.insert(to.covariances.end(), from.covariance(k), from.covariance(k) + 16);
+}
+
+}  // namespace
+
+FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOptions& options,
+                   const FitProgress& progress, const WarmStartOptions& warm, WarmStartReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  require(points.size <= kMaxPoints, ErrorCode::Limit,
+          "N = " + std::to_string(points.size) + " points exceeds the limit of " + std::to_string(kMaxPoints) +
+              " points per fit");
+  require_finite_points(points, "point cloud");
+  validate(initial);
+  require(options.n_init == 1, ErrorCode::InvalidArgument,
+          "a warm start is one run: n_init must be 1, got " + std::to_string(options.n_init));
+  require(std::isfinite(warm.min_mass) && warm.min_mass >= 0, ErrorCode::InvalidArgument,
+          "warm start min_mass must be finite and >= 0, got " + checked::exact(warm.min_mass));
+  require(std::isfinite(warm.novelty_nats) && warm.novelty_nats >= 0, ErrorCode::InvalidArgument,
+          "warm start novelty_nats must be finite and >= 0, got " + checked::exact(warm.novelty_nats));
+  require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
+  const bool fixed_k = options.n_components > 0;
+  if (fixed_k)
+    require(options.n_components == initial.size(), ErrorCode::InvalidArgument,
+            "a fixed-K warm start needs an initial model of K = " + std::to_string(options.n_components) +
+                " components, got " + std::to_string(initial.size()));
+  else
+    require_usable_bandwidth(options.bandwidth);
+  const int threads = detail::team_size(options.em.threads);
+  const ScopedThreads scoped(threads);
+  EmOptions em = options.em;
+  em.threads = threads;
+
+  FitResult result;
+  result.n_points = points.size;
+  WarmStartReport rep;
+  Gmm start;
+  if (fixed_k) {
+    start = initial;
+    rep.kept = initial.size();
+  } else {
+    auto t = std::chrono::steady_clock::now();
+    // Pass 1: every point's log-likelihood, which decides the novel points.
+    const std::vector<double> ll = detail::score_points(points, initial, threads).log_likelihood;
+    const double cut = median(ll) - warm.novelty_nats;
+    std::vector<char> explained(points.size);
+    for (std::size_t i = 0; i < points.size; ++i) explained[i] = ll[i] >= cut;
+    // Pass 2: masses over the explained points only; a novel point far from
+    // every component would otherwise lend its whole responsibility to the
+    // least distant one, e.g. to a component of a surface no longer seen.
+    const std::vector<double> mass = detail::score_points(points, initial, threads, &explained).mass;
+    rep.seconds_score = seconds_since(t);
+    for (std::size_t k = 0; k < initial.size(); ++k) {
+      if (mass[k] >= warm.min_mass && start.size() < kMaxComponents) append_component(start, initial, k, mass[k]);
+    }
+    rep.kept = start.size();
+    rep.removed = initial.size() - rep.kept;
+
+    // Novel points: all of them when nothing was kept (a cold fit).
+    PointCloud novel;
+    for (std::size_t i = 0; i < points.size; ++i)
+      if (rep.kept == 0 || !explained[i]) novel.xyzg.insert(novel.xyzg.end(), points[i], points[i] + 4);
+    rep.novel_points = novel.size();
+    if (novel.size() > 0) {
+      const PointsView nv = novel.view();
+      if (progress) progress(FitStage::ModeCount, 0, 0.0);
+      t = std::chrono::steady_clock::now();
+      const std::vector<double> features = range_gray_features(nv);
+      const MeanShiftResult modes = options.mode_counter == ModeCounter::FlatBinned
+                                        ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
+                                        : mean_shift_gaussian_blurring(features, options.bandwidth);
+      const std::size_t room = kMaxComponents - start.size();
+      const std::size_t k_new = std::min({std::max<std::size_t>(modes.size(), 1), novel.size()});
+      require(k_new <= room, ErrorCode::Limit,
+              "the warm start would hold " + std::to_string(start.size() + k_new) + " components, over the limit of " +
+                  std::to_string(kMaxComponents) + " components per fit: use a larger bandwidth");
+      result.seconds_mode_count = seconds_since(t);
+      if (progress) progress(FitStage::Seeding, static_cast<int>(k_new), 0.0);
+      t = std::chrono::steady_clock::now();
+      const std::vector<std::size_t> seeds = kmeanspp_seeds(nv, k_new, options.seed);
+      // A cold start's seed covariance, reg_covar I; with reg_covar = 0 a
+      // floor relative to the novel points' extent keeps it positive definite.
+      float lo[4], hi[4];
+      for (int j = 0; j < 4; ++j) lo[j] = hi[j] = nv[0][j];
+      for (std::size_t i = 1; i < novel.size(); ++i)
+        for (int j = 0; j < 4; ++j) {
+          lo[j] = std::min(lo[j], nv[i][j]);
+          hi[j] = std::max(hi[j], nv[i][j]);
+        }
+      double extent = 0.0;
+      for (int j = 0; j < 4; ++j) extent = std::max(extent, static_cast<double>(hi[j]) - lo[j]);
+      const double seed_var = std::max({em.reg_covar, 1e-12 * extent * extent, 1e-30});
+      Gmm fresh;
+      fresh.resize(seeds.size());
+      std::fill(fresh.covariances.begin(), fresh.covariances.end(), 0.0f);
+      for (std::size_t s = 0; s < seeds.size(); ++s) {
+        std::copy(nv[seeds[s]], nv[seeds[s]] + 4, &fresh.means[4 * s]);
+        for (int i = 0; i < 4; ++i) fresh.covariances[16 * s + 5 * i] = static_cast<float>(seed_var);
+        append_component(start, fresh, s, 1.0);
+      }
+      rep.added = seeds.size();
+      result.seconds_seeding = seconds_since(t);
+    }
+    double total = 0.0;
+    for (float w : start.weights) total += w;
+    for (float& w : start.weights) w = static_cast<float>(w / total);
+  }
+
+  if (progress) progress(FitStage::Em, 0, 0.0);
+  EmIterationCallback on_iteration;
+  if (progress) on_iteration = [&progress](int iteration, double ll) { progress(FitStage::Em, iteration, ll); };
+  const auto t_em = std::chrono::steady_clock::now();
+  result.gmm = fit_em_from(points, start, em, &result.em, on_iteration);
+  result.seconds_em = seconds_since(t_em);
+  result.run_log_likelihoods.push_back(result.em.log_likelihood);
+  validate(result.gmm);
+  result.seconds_total = seconds_since(t0);
+  if (report) *report = rep;
+  return result;
+}
+
+}  // namespace sogmm
