@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "parallel.hpp"
@@ -46,6 +47,59 @@ void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
   to.weights.push_back(static_cast<float>(w));
   to.means.insert(to.means.end(), from.mean(k), from.mean(k) + 4);
   to.covariances.insert(to.covariances.end(), from.covariance(k), from.covariance(k) + 16);
+}
+
+// New components from k-means++ seeds among the novel points: one hard
+// k-means assignment (each point to its nearest seed), then per cluster its
+// mean, its per-coordinate variance + reg_covar on a diagonal covariance and
+// its size as weight. A cold start's needles (reg_covar I, one point each)
+// would lose every novel point in the first E-step to the least distant kept
+// component, which then stretches over the new surface; a diagonal covariance
+// is positive definite in float32 whatever the cluster's shape.
+Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, double reg_covar) {
+  const std::size_t k = seeds.size();
+  std::vector<double> sum(5 * k, 0.0), sq(4 * k, 0.0);
+  float lo[4], hi[4];
+  for (int j = 0; j < 4; ++j) lo[j] = hi[j] = nv[0][j];
+  for (std::size_t i = 0; i < nv.size; ++i) {
+    std::size_t best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < k; ++c) {
+      double d = 0.0;
+      for (int j = 0; j < 4; ++j) {
+        const double e = static_cast<double>(nv[i][j]) - nv[seeds[c]][j];
+        d += e * e;
+      }
+      if (d < best_d) best_d = d, best = c;
+    }
+    sum[5 * best] += 1.0;
+    for (int j = 0; j < 4; ++j) {
+      lo[j] = std::min(lo[j], nv[i][j]);
+      hi[j] = std::max(hi[j], nv[i][j]);
+      // Relative to the seed, so the variance does not cancel at an offset.
+      const double e = static_cast<double>(nv[i][j]) - nv[seeds[best]][j];
+      sum[5 * best + 1 + j] += e;
+      sq[4 * best + j] += e * e;
+    }
+  }
+  // With reg_covar = 0, a floor relative to the novel points' extent keeps a
+  // one-point cluster positive definite.
+  double extent = 0.0;
+  for (int j = 0; j < 4; ++j) extent = std::max(extent, static_cast<double>(hi[j]) - lo[j]);
+  const double floor = std::max({reg_covar, 1e-12 * extent * extent, 1e-30});
+  Gmm g;
+  g.resize(k);
+  std::fill(g.covariances.begin(), g.covariances.end(), 0.0f);
+  for (std::size_t c = 0; c < k; ++c) {
+    const double n = sum[5 * c];  // >= 1: the seed is its own nearest
+    g.weights[c] = static_cast<float>(n);
+    for (int j = 0; j < 4; ++j) {
+      const double m = sum[5 * c + 1 + j] / n;
+      g.means[4 * c + j] = static_cast<float>(nv[seeds[c]][j] + m);
+      g.covariances[16 * c + 5 * j] = static_cast<float>(std::max(sq[4 * c + j] / n - m * m, 0.0) + floor);
+    }
+  }
+  return g;
 }
 
 }  // namespace
@@ -124,26 +178,8 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
       if (progress) progress(FitStage::Seeding, static_cast<int>(k_new), 0.0);
       t = std::chrono::steady_clock::now();
       const std::vector<std::size_t> seeds = kmeanspp_seeds(nv, k_new, options.seed);
-      // A cold start's seed covariance, reg_covar I; with reg_covar = 0 a
-      // floor relative to the novel points' extent keeps it positive definite.
-      float lo[4], hi[4];
-      for (int j = 0; j < 4; ++j) lo[j] = hi[j] = nv[0][j];
-      for (std::size_t i = 1; i < novel.size(); ++i)
-        for (int j = 0; j < 4; ++j) {
-          lo[j] = std::min(lo[j], nv[i][j]);
-          hi[j] = std::max(hi[j], nv[i][j]);
-        }
-      double extent = 0.0;
-      for (int j = 0; j < 4; ++j) extent = std::max(extent, static_cast<double>(hi[j]) - lo[j]);
-      const double seed_var = std::max({em.reg_covar, 1e-12 * extent * extent, 1e-30});
-      Gmm fresh;
-      fresh.resize(seeds.size());
-      std::fill(fresh.covariances.begin(), fresh.covariances.end(), 0.0f);
-      for (std::size_t s = 0; s < seeds.size(); ++s) {
-        std::copy(nv[seeds[s]], nv[seeds[s]] + 4, &fresh.means[4 * s]);
-        for (int i = 0; i < 4; ++i) fresh.covariances[16 * s + 5 * i] = static_cast<float>(seed_var);
-        append_component(start, fresh, s, 1.0);
-      }
+      const Gmm fresh = seed_components(nv, seeds, em.reg_covar);
+      for (std::size_t c = 0; c < fresh.size(); ++c) append_component(start, fresh, c, fresh.weights[c]);
       rep.added = seeds.size();
       result.seconds_seeding = seconds_since(t);
     }

@@ -205,6 +205,23 @@ SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* poin
 SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
                                                     size_t k, const sogmm_options* options);
 
+/* Warm start: fits n points starting from `initial`, a model of an earlier,
+ * overlapping cloud already moved into these points' frame (e.g. the previous
+ * frame's model moved by the relative pose with sogmm_model_transform).
+ * Self-organizing (SOGMM_OPT_N_COMPONENTS = 0): components of `initial`
+ * whose responsibility mass on the well-explained points is below 2 points
+ * are removed; points more than 10 nats below the median log-likelihood under
+ * `initial` are novel, and the mode count (SOGMM_OPT_BANDWIDTH) and k-means++
+ * (SOGMM_OPT_SEED) on the novel points only add that many new components; EM
+ * then runs from kept + new. With N_COMPONENTS = K > 0, EM runs from `initial`
+ * as given, which must have K components. The model records the fit like
+ * sogmm_fit_points_f32; `initial` is not modified and may be freed
+ * afterwards. Errors as sogmm_fit_points_f32, plus: initial NULL ->
+ * SOGMM_E_NULL_ARG; SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
+ * SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
+                                                 const sogmm_model* initial, const sogmm_options* options);
+
 /* Layout of the color image given to sogmm_fit_rgbd and sogmm_rgbd_to_points_f32. */
 #define SOGMM_COLOR_GRAY8 1    /* width * height bytes, gray 0..255 */
 #define SOGMM_COLOR_RGB8 2     /* width * height * 3 bytes, interleaved R, G, B */

@@ -47,9 +47,11 @@ struct WarmStartReport {
 ///  3. the mode count (options.bandwidth, options.mode_counter) runs on the
 ///     novel points only and k-means++ (options.seed) picks that many seeds
 ///     among them (none when no point is novel);
-///  4. EM (options.em) runs from the kept components (weights: their masses)
-///     plus the new ones (mean = seed point, covariance reg_covar I, weight
-///     one point each, as a cold start's seeds).
+///  4. each novel point joins its nearest seed (one hard k-means step); a new
+///     component per seed takes its cluster's mean, a diagonal covariance of
+///     the cluster's variances + reg_covar and its size as weight; EM
+///     (options.em) then runs from the kept components (weights: their
+///     masses) plus the new ones.
 /// Fixed K (options.n_components > 0): EM from `initial` as given, which
 /// must then have exactly n_components components.
 /// FitResult's timings: seconds_mode_count and seconds_seeding are those of

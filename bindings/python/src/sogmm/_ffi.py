@@ -118,6 +118,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_options_get_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
     "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
     "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
+    "sogmm_fit_points_warm_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE, HANDLE]),
     "sogmm_fit_rgbd": (
         STATUS,
         [HANDLE_OUT, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, HANDLE],

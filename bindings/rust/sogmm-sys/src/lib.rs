@@ -140,6 +140,13 @@ extern "C" {
         k: usize,
         options: *const sogmm_options,
     ) -> sogmm_status;
+    pub fn sogmm_fit_points_warm_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        initial: *const sogmm_model,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_fit_rgbd(
         out: *mut *mut sogmm_model,
         depth: *const u16,
