@@ -13,6 +13,7 @@
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/metadata_string.hpp"
+#include "sogmm/warm_start.hpp"
 
 namespace sogmm::tools {
 
@@ -25,6 +26,7 @@ struct FitState {
   DepthOptions depth_options;
   FitOptions fit;
   bool json = false, progress = false, quiet = false;
+  bool warm_start = false;  ///< sequence: start each frame from the previous frame's model
 };
 
 std::string base_name(const std::string& p) { return std::filesystem::path(p).filename().string(); }
@@ -145,6 +147,8 @@ int run_sequence(const FitState& s) {
   Camera camera;
   nlohmann::json frames_json = nlohmann::json::array();
   std::string frame_list;
+  Gmm previous;  // the last frame's model in its camera frame (--warm-start)
+  std::size_t previous_index = 0;
   for (std::size_t k = 0; k < selected.size(); ++k) {
     const SequenceFrame& f = frames[selected[k]];
     const LoadedFrame frame = load_frame(f.depth, f.color);
@@ -152,9 +156,16 @@ int run_sequence(const FitState& s) {
     const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, f.depth);
     const std::string label = "frame " + std::to_string(k + 1) + "/" + std::to_string(selected.size()) + " (" +
                               base_name(f.depth) + ")";
-    FitResult r = fit(cloud.view(), s.fit, progress.fit_callback(label));
+    // Warm start: the previous model moved from its camera into this one
+    // (world <- previous camera, then this camera <- world).
+    FitResult r = s.warm_start && k > 0
+                      ? fit_warm(cloud.view(),
+                                 transform(transform(previous, poses[previous_index]), inverse_rigid(poses[f.index])),
+                                 s.fit, progress.fit_callback(label))
+                      : fit(cloud.view(), s.fit, progress.fit_callback(label));
     progress.em_done(label, r);
     t.add(r);
+    if (s.warm_start) previous = r.gmm, previous_index = f.index;
     const std::size_t m = r.gmm.size();
     Model world = make_model(transform(r.gmm, poses[f.index]), s.fit, r.em, camera, s.depth_options,
                              {{kCoordinateFrameKey, "world"}});
@@ -213,6 +224,10 @@ Command add_fit_command(CLI::App& root) {
   app->add_flag("--progress", s->progress, "print progress lines on stderr even when it is not a terminal");
   app->add_flag("-q,--quiet", s->quiet, "no progress output");
   app->add_flag("--json", s->json, "print the summary as one JSON object");
+  app->add_flag("--warm-start", s->warm_start,
+                "with --sequence: start each frame's fit from the previous frame's model moved by the relative pose "
+                "(components without support removed, new ones seeded where the frame is poorly explained; needs "
+                "--n-init 1)");
   CLI::App* a = app;
   return {app, [s, a]() {
             check_output_path(s->output);
@@ -222,8 +237,8 @@ Command add_fit_command(CLI::App& root) {
             if (single) {
               require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                       "fit: --depth and --color go together");
-              require(s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
-                      "fit: --trajectory and --frames need --sequence");
+              require(s->src.trajectory.empty() && s->src.frames.empty() && !s->warm_start,
+                      ErrorCode::InvalidArgument, "fit: --trajectory, --frames and --warm-start need --sequence");
               return run_single(*s);
             }
             require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument,
