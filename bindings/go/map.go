@@ -18,6 +18,7 @@ const (
 	OptMapFusion           Key = C.SOGMM_OPT_MAP_FUSION
 	OptMapFusionMethod     Key = C.SOGMM_OPT_MAP_FUSION_METHOD
 	OptMapFusionThreshold  Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
+	OptMapWarmStart        Key = C.SOGMM_OPT_MAP_WARM_START
 	FusionHellinger            = C.SOGMM_FUSION_HELLINGER
 	FusionKL                   = C.SOGMM_FUSION_KL
 )

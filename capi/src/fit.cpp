@@ -6,6 +6,7 @@
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
+#include "sogmm/warm_start.hpp"
 
 namespace sogmm_capi {
 
@@ -35,9 +36,10 @@ using sogmm_capi::fail;
 using sogmm_capi::fit_options;
 using sogmm_capi::require_nonnull;
 
-/// Runs the fit on checked points and wraps the result (fit report, fit
-/// parameters, timings) in a new handle.
-sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o) {
+/// Runs the fit on checked points (a warm start from `initial` if not null)
+/// and wraps the result (fit report, fit parameters, timings) in a new handle.
+sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o,
+                           const sogmm::Gmm* initial = nullptr) {
   if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: nothing to fit");
   const std::size_t count = sogmm::checked::mul<std::size_t>(n, 4, "points");
   // The size limit first, so an oversized input is refused before it is read.
@@ -53,7 +55,8 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   sogmm::PointsView view;
   view.data = points;
   view.size = n;
-  sogmm::FitResult r = sogmm::fit(view, fo, sogmm_capi::progress_sink(o));
+  sogmm::FitResult r = initial ? sogmm::fit_warm(view, *initial, fo, sogmm_capi::progress_sink(o))
+                                : sogmm::fit(view, fo, sogmm_capi::progress_sink(o));
 
   auto handle = std::make_unique<sogmm_model>();
   sogmm::Model& m = handle->model;
@@ -105,6 +108,19 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
     require_nonnull(points, "points");
     if (k == 0) fail(SOGMM_E_INVALID_ARG, "k is 0: a fixed-K fit needs k >= 1");
     *out = fit_to_handle(points, n, k, sogmm_capi::opts_or_default(options));
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
+                                                 const sogmm_model* initial, const sogmm_options* options) {
+  SOGMM_TRY {
+    sogmm_capi::reset_out(out);
+    require_nonnull(out, "out");
+    require_nonnull(points, "points");
+    require_nonnull(initial, "initial");
+    const sogmm_options& o = sogmm_capi::opts_or_default(options);
+    *out = fit_to_handle(points, n, static_cast<std::size_t>(o.n_components), o, &initial->model.gmm);
   }
   SOGMM_CATCH
 }

@@ -58,6 +58,7 @@ struct sogmm_options {
   std::int64_t map_fusion = 0;
   std::int64_t map_fusion_method = SOGMM_FUSION_HELLINGER;
   double map_fusion_threshold = 0.3;
+  std::int64_t map_warm_start = 0;
 };
 
 /// Timings of a fit run in this process (not part of the file format).

@@ -24,6 +24,7 @@ sogmm::MapOptions map_options(const sogmm_options& o) {
   m.fusion = o.map_fusion != 0;
   m.fusion_method = o.map_fusion_method == SOGMM_FUSION_KL ? sogmm::FusionMethod::KL : sogmm::FusionMethod::Hellinger;
   m.fusion_threshold = o.map_fusion_threshold;
+  m.warm_start = o.map_warm_start != 0;
   m.fit = sogmm_capi::fit_options(o, static_cast<std::size_t>(o.n_components));
   m.depth.depth_scale = o.depth_scale;
   m.depth.depth_min = o.depth_min;

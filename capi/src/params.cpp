@@ -131,6 +131,7 @@ SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_COMPRESS:
       case SOGMM_OPT_VERIFY_CHECKSUMS:
       case SOGMM_OPT_MAP_NOVELTY:
+      case SOGMM_OPT_MAP_WARM_START:
       case SOGMM_OPT_MAP_FUSION: check_i64(key, v, 0, 1, "0 or 1"); break;
       case SOGMM_OPT_MAP_BATCH_SIZE: check_i64(key, v, 1, std::int64_t{1} << 26, "[1, 2^26]"); break;
       case SOGMM_OPT_MAP_FUSION_METHOD: check_i64(key, v, 0, 1, "a SOGMM_FUSION_* value"); break;

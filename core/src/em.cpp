@@ -143,27 +143,65 @@ struct SoaPoints {
 // interval arithmetic gives from B; the squared distance of each interval from
 // 0 bounds y_j^2 below. This follows the component's orientation, so thin
 // planar components are bounded tightly too.
-double log_density_upper_bound(const float* q, const float* box) {
-  double lo[4], hi[4];
-  for (int i = 0; i < 4; ++i) {
-    lo[i] = static_cast<double>(box[i]) - q[i];
-    hi[i] = static_cast<double>(box[4 + i]) - q[i];
+//
+// The components' parameters are held as columns (BoundParams) so that the
+// loop over components vectorizes; each bound is the same sequence of double
+// operations as a scalar loop, so the bounds, and with them the evaluated
+// lists and the fit, do not depend on the vector width.
+struct BoundParams {
+  std::size_t m = 0;
+  std::vector<double> col;  // 15 columns of m: mean (4), U row-major upper (10), log constant (1)
+  void load(const std::vector<float>& params) {
+    m = params.size() / kParamStride;
+    col.resize(15 * m);
+    for (std::size_t k = 0; k < m; ++k)
+      for (int i = 0; i < 15; ++i) col[i * m + k] = params[k * kParamStride + i];
   }
-  // Column j of U (upper triangular, packed row-major from q[4]): U_ij, i <= j.
-  static constexpr int kIndex[4][4] = {{4, 5, 6, 7}, {-1, 8, 9, 10}, {-1, -1, 11, 12}, {-1, -1, -1, 13}};
-  double q_min = 0.0;
-  for (int j = 0; j < 4; ++j) {
-    double ylo = 0.0, yhi = 0.0;
-    for (int i = 0; i <= j; ++i) {
-      const double u = q[kIndex[i][j]];
-      const double a = u * lo[i], b = u * hi[i];
-      ylo += std::min(a, b);
-      yhi += std::max(a, b);
-    }
-    const double gap = ylo > 0 ? ylo : (yhi < 0 ? -yhi : 0.0);
-    q_min += gap * gap;
+};
+
+void log_density_upper_bounds(const BoundParams& bp, const float* box, double* upper) {
+  const std::size_t m = bp.m;
+  const double* c = bp.col.data();
+  const double b0 = box[0], b1 = box[1], b2 = box[2], b3 = box[3];
+  const double t0 = box[4], t1 = box[5], t2 = box[6], t3 = box[7];
+  auto lohi = [](double u, double lo, double hi, double& ylo, double& yhi) {
+    const double a = u * lo, b = u * hi;
+    ylo += std::min(a, b);
+    yhi += std::max(a, b);
+  };
+  // The distance of [ylo, yhi] from 0 (ylo <= yhi): ylo if > 0, -yhi if
+  // yhi < 0, else 0; one of the two terms is always exactly 0, so the sum is
+  // that distance bit for bit, without a branch.
+  auto gap2 = [](double ylo, double yhi) {
+    const double gap = std::max(ylo, 0.0) + std::max(-yhi, 0.0);
+    return gap * gap;
+  };
+#pragma omp simd
+  for (std::size_t k = 0; k < m; ++k) {
+    const double l0 = b0 - c[k], l1 = b1 - c[m + k], l2 = b2 - c[2 * m + k], l3 = b3 - c[3 * m + k];
+    const double h0 = t0 - c[k], h1 = t1 - c[m + k], h2 = t2 - c[2 * m + k], h3 = t3 - c[3 * m + k];
+    // Column j of U: U_ij for i <= j (packed row-major: U00 U01 U02 U03 U11 U12 U13 U22 U23 U33).
+    const double* u = c + 4 * m;
+    double lo = 0.0, hi = 0.0, q_min = 0.0;
+    lohi(u[k], l0, h0, lo, hi);
+    q_min += gap2(lo, hi);
+    lo = hi = 0.0;
+    lohi(u[m + k], l0, h0, lo, hi);
+    lohi(u[4 * m + k], l1, h1, lo, hi);
+    q_min += gap2(lo, hi);
+    lo = hi = 0.0;
+    lohi(u[2 * m + k], l0, h0, lo, hi);
+    lohi(u[5 * m + k], l1, h1, lo, hi);
+    lohi(u[7 * m + k], l2, h2, lo, hi);
+    q_min += gap2(lo, hi);
+    lo = hi = 0.0;
+    lohi(u[3 * m + k], l0, h0, lo, hi);
+    lohi(u[6 * m + k], l1, h1, lo, hi);
+    lohi(u[8 * m + k], l2, h2, lo, hi);
+    lohi(u[9 * m + k], l3, h3, lo, hi);
+    q_min += gap2(lo, hi);
+    upper[k] = c[14 * m + k] - 0.5 * q_min;
   }
-  return q[14] - 0.5 * q_min;
 }
 
 // Chooses and evaluates the components of one block for the truncated E-step.
@@ -175,13 +213,14 @@ double log_density_upper_bound(const float* q, const float* box) {
 // `list` (warm first, then the additions in ascending order) and its
 // log-density rows in `rows`.
 void truncated_log_density(const detail::EmKernels& kernels, const detail::Block& block, const float* box,
-                           const std::vector<float>& params, double nats, const std::vector<std::uint32_t>& warm,
+                           const std::vector<float>& params, const BoundParams& bounds, double nats,
+                           const std::vector<std::uint32_t>& warm,
                            std::vector<double>& upper, std::vector<char>& taken, std::vector<std::uint32_t>& list,
                            float* rows, float* row_lp_max, float* max_lp) {
   constexpr std::size_t kFirst = 32;
   const std::size_t m = params.size() / kParamStride;
   upper.resize(m);
-  for (std::size_t k = 0; k < m; ++k) upper[k] = log_density_upper_bound(&params[k * kParamStride], box);
+  log_density_upper_bounds(bounds, box, upper.data());
   list = warm;
   if (list.empty()) {
     std::vector<std::uint32_t> idx(m);
@@ -322,6 +361,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   const detail::EmKernels& kernels = detail::em_kernels();
 
   std::vector<float> params;
+  BoundParams bounds;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
   // Per chunk of a wave: its partial sums, reduced in chunk order afterwards
@@ -343,6 +383,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   double previous = -std::numeric_limits<double>::infinity();
   for (int iter = 1; iter <= options.max_iter; ++iter) {
     pack_all(w, options.reg_covar, data_scale2, params);
+    if (truncated) bounds.load(params);
     std::fill(stats.begin(), stats.end(), 0.0);
     double total_ll = 0.0;
     for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
@@ -366,7 +407,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
           std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
           const std::vector<std::uint32_t>* evaluated = &all;
           if (truncated) {
-            truncated_log_density(kernels, block, &soa.box[8 * b], params, options.truncation_nats, warm[b],
+            truncated_log_density(kernels, block, &soa.box[8 * b], params, bounds, options.truncation_nats, warm[b],
                                   upper, taken, list, scratch, row_max, max_lp);
             evaluated = &list;
           } else {

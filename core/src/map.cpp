@@ -11,6 +11,7 @@
 #include "map_state.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/warm_start.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/mean_shift.hpp"
 
@@ -82,6 +83,8 @@ void validate(const MapOptions& o) {
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
           ErrorCode::InvalidArgument, "map: unknown fusion method");
   require_usable_bandwidth(o.fit.bandwidth);
+  require(!o.warm_start || o.fit.n_init == 1, ErrorCode::InvalidArgument,
+          "map: a warm start is one run: fit.n_init must be 1, got " + std::to_string(o.fit.n_init));
   validate(o.depth);
 }
 
@@ -231,7 +234,12 @@ std::size_t Map::flush(const ProgressSink& progress) {
       cloud.xyzg.push_back(q[3]);
     }
   }
-  FitResult r = fit(cloud.view(), s.options.fit, progress);
+  // Warm start: the last fit moved from its camera to this batch's
+  // (world <- previous camera, then this camera <- world).
+  const bool warm = s.options.warm_start && s.previous_fit.size() > 0;
+  FitResult r = warm ? fit_warm(cloud.view(), transform(transform(s.previous_fit, s.previous_pose), to_last),
+                                s.options.fit, progress)
+                     : fit(cloud.view(), s.options.fit, progress);
   const double ms_fit = ms_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
 
@@ -283,6 +291,10 @@ std::size_t Map::flush(const ProgressSink& progress) {
   s.index.add(s.model.gmm, first);
   s.pending.clear();
   s.n_pending = 0;
+  if (s.options.warm_start) {
+    s.previous_fit = std::move(r.gmm);
+    s.previous_pose = last;
+  }
   ++s.n_flushes;
   s.n_fused += fused;
   if (!s.frames.empty()) {

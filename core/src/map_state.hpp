@@ -72,6 +72,10 @@ struct Map::State {
   std::uint64_t n_flushes = 0;
   std::uint64_t n_fused = 0;
   std::optional<Camera> camera;  ///< fixed by the first RGB-D frame
+  /// options.warm_start: the last flush's fit in its camera frame, and that
+  /// camera's pose (empty before the first flush).
+  Gmm previous_fit;
+  Pose previous_pose{};
   explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {}
 };
 

@@ -337,6 +337,18 @@ def mode_synthetic(tmp):
 def mode_sequence(tmp):
     d = write_synthetic(tmp, 3)
     exercise_sequence(tmp, d, "png", 3, 10, 0.05, [], False)
+    # --warm-start: each frame starts from the previous one moved by the
+    # relative pose; the map scores every frame about as well as the cold map.
+    traj = os.path.join(d, "trajectory.log")
+    scores = []
+    for extra in ([], ["--warm-start"]):
+        out = os.path.join(tmp, "seq%d.sogmm" % len(extra))
+        run(["fit", "--sequence", d, "--trajectory", traj, "--decimate", 10, "--bandwidth", 0.05, "-o", out,
+             "--quiet"] + extra)
+        ev = run_json(["eval", out, "--sequence", d, "--trajectory", traj])
+        scores.append([r["psnr"] for r in ev.get("frames", [])])
+    check(len(scores[1]) == 3 and all(w > c - 1.0 for w, c in zip(scores[1], scores[0])),
+          "fit --sequence --warm-start: per-frame PSNR %r vs cold %r" % (scores[1], scores[0]))
 
 
 def write_png16(path, img):
@@ -457,6 +469,7 @@ def mode_errors(tmp):
     err(["fit", "--sequence", d, "-o", model], 2, "--trajectory")
     err(["fit", "--sequence", d, "--trajectory", os.path.join(d, "trajectory.log"), "--frames", "3:9", "-o", model],
         2, "--frames")
+    err(["fit"] + fa + intr + ["--warm-start", "-o", model], 2, "--warm-start")
     err(["eval", model] + fa + ["--bandwidth", 0.02], 2, "--bandwidth")
     err(["eval", model] + fa + ["--n-init", 3], 2, "--n-init")
     err(["eval", model], 2, "--depth")

@@ -1,21 +1,21 @@
 #!/usr/bin/env python3
-"""Performance benchmark of SOGMM (issue 8), with scikit-learn as a fixed peer.
+"""Performance benchmark of SOGMM (issues 8 and 17): the issue 17 table.
 
-Runs `sogmm-perf` on livingroom frame 00000 for the issue's cases, several
-times each, and prints a markdown table of medians: N, M, ms per stage, EM
-iterations, ms per EM iteration, GFLOP/s of the EM passes, peak RSS, the EM
-scaling from 1 to 2 threads, and scikit-learn's GaussianMixture time per EM
-iteration on the same points and the same initial responsibilities (one-hot
-on our k-means++ seeds), with the ratio.
+Runs `sogmm-perf` (one fit and its queries, JSON) on livingroom frame 00000
+and `sogmm-bench-warm` (frame 00001 warm-started from 00000's model moved by
+the relative pose, against a cold fit of 00001) for every case, with 2 threads
+(--runs times) and 1 thread (--runs times), and prints the issue's table of
+medians: today's figures (a baseline build, e.g. main at d0d1d93 in its own
+worktree, given by --baseline-root) and the new ones from the same run, the
+runs of both builds interleaved so that machine load hits both alike. Then one
+roofline line per stage: pairs per second achieved (N x M x iterations x pair
+fraction for EM, N x M for regress and score) against the EM kernel's measured
+peak (ten exact E+M passes from the fitted model, in the same process).
 
 Usage (from the repository root, after tools/setup.sh):
-    python3 tools/sogmm-perf/run_perf.py [--runs 5] [--cases d5s02,d5s01,d4s02,d2s02,d1s02]
-        [--sklearn-iters 3] [--no-sklearn] [--perf BEFORE --perf AFTER]
-
-With several --perf binaries every run of a case goes through each binary in
-turn (interleaved, so a loaded machine slows them alike) and a second table
-gives, per case, each binary's median EM and total fit time and its ratio to
-the first binary's.
+    python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
+        [--cases d5s02,d5s01,d1s02,d1s02t20] [--no-warm]
+The baseline root is a checkout whose build/tools/sogmm-perf/sogmm-perf exists.
 """
 import argparse
 import json
@@ -23,113 +23,150 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
-import time
-import warnings
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DATA = os.path.join(ROOT, "..", "shared", "data", "rgbd", "livingroom")
-BIN = os.path.join(ROOT, "build", "tools", "sogmm-perf", "sogmm-perf")
-CASES = {  # name: (decimation, bandwidth)
-    "d5s02": (5, 0.02), "d5s01": (5, 0.01), "d4s02": (4, 0.02), "d2s02": (2, 0.02), "d1s02": (1, 0.02)}
-TARGET_S = {"d5s02": 0.5, "d5s01": 1.5, "d2s02": 4.0, "d1s02": 12.0}
+CASES = {  # name: (decimation, bandwidth, truncation nats)
+    "d5s02": (5, 0.02, 0), "d5s01": (5, 0.01, 0), "d1s02": (1, 0.02, 0), "d1s02t20": (1, 0.02, 20)}
+# The authors' published code on frame 00000 (issue 17, same machine kind).
+AUTHORS_S = {"d5s02": 9.57, "d5s01": 33.8}
 
 
-def run_case(d, bw, threads, dump=None, binary=BIN):
+def perf_bin(root):
+    return os.path.join(root, "build", "tools", "sogmm-perf", "sogmm-perf")
+
+
+def run_fit(binary, case, threads):
+    d, bw, trunc = CASES[case]
     cmd = [binary, "--depth", os.path.join(DATA, "depth", "00000.png"), "--color",
            os.path.join(DATA, "color", "00000.jpg"), "--intrinsics", os.path.join(DATA, "intrinsics.json"),
            "--decimate", str(d), "--bandwidth", str(bw), "--threads", str(threads)]
-    if dump:
-        cmd += ["--dump-points", dump]
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    return json.loads(out)
+    if trunc:
+        cmd += ["--truncate", str(trunc)]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
 
 
-def sklearn_ms_per_iter(dump, iters):
-    import numpy as np
-    from sklearn.exceptions import ConvergenceWarning
-    from sklearn.mixture import GaussianMixture
-    with open(dump, "rb") as f:
-        n, m = np.frombuffer(f.read(16), dtype=np.uint64)
-        x = np.frombuffer(f.read(int(n) * 16), dtype=np.float32).reshape(int(n), 4).astype(np.float64)
-        seeds = np.frombuffer(f.read(int(m) * 8), dtype=np.uint64).astype(np.int64)
-    k = len(seeds)
-    # One-hot responsibilities on the seeds give means = seed points,
-    # covariances = reg_covar I and equal weights: the same start as our EM.
-    gm = GaussianMixture(k, covariance_type="full", tol=0.0, reg_covar=1e-6, max_iter=iters,
-                         weights_init=np.full(k, 1.0 / k), means_init=x[seeds],
-                         precisions_init=np.repeat(np.eye(4)[None] / 1e-6, k, axis=0))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        t = time.perf_counter()
-        gm.fit(x)
-        return 1000.0 * (time.perf_counter() - t) / gm.n_iter_
+def run_warm(threads, repeat, max_iter=0):
+    cmd = [os.path.join(ROOT, "build", "tools", "sogmm-perf", "sogmm-bench-warm"), "--sequence", DATA,
+           "--trajectory", os.path.join(DATA, "trajectory.log"), "--from", "0", "--to", "1", "--decimate", "5",
+           "--bandwidth", "0.02", "--threads", str(threads), "--repeat", str(repeat), "--warm-max-iter", str(max_iter)]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+
+
+def medians(runs):
+    keys = [k for k in runs[0] if isinstance(runs[0][k], (int, float))]
+    return {k: statistics.median(r[k] for r in runs) for k in keys}
+
+
+def fmt(v, unit):
+    if v is None:
+        return "n/a"
+    return f"{1000 * v:.0f} ms" if unit == "ms" else (f"{v:.3f} s" if unit == "s" else
+                                                      (f"{100 * v:.0f}%" if unit == "%" else f"{v:.0f} MiB"))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--cases", default=",".join(CASES))
-    ap.add_argument("--sklearn-iters", type=int, default=3)
-    ap.add_argument("--no-sklearn", action="store_true")
-    ap.add_argument("--perf", action="append", help="sogmm-perf binary (repeatable; interleaved)")
+    ap.add_argument("--baseline-root", default=None, help="checkout with today's build (e.g. main at d0d1d93)")
+    ap.add_argument("--no-warm", action="store_true")
     a = ap.parse_args()
-    if a.perf:
-        return compare(a)
     if not os.path.isdir(DATA):
         sys.exit(f"run_perf: {DATA} not found (the real frames live in ../shared/data)")
-    if not os.path.exists(BIN):
-        sys.exit(f"run_perf: {BIN} not built (run tools/setup.sh)")
-    rows = []
-    for name in a.cases.split(","):
-        d, bw = CASES[name]
-        runs2 = [run_case(d, bw, 2) for _ in range(a.runs)]
-        runs1 = [run_case(d, bw, 1) for _ in range(max(1, a.runs // 2))]
-        med = {k: statistics.median(r[k] for r in runs2) for k in runs2[0] if isinstance(runs2[0][k], (int, float))}
-        em1 = statistics.median(r["ms_per_iteration"] for r in runs1)
-        sk = None
-        if not a.no_sklearn:
-            with tempfile.TemporaryDirectory() as tmp:
-                dump = os.path.join(tmp, "points.bin")
-                run_case(d, bw, 2, dump)
-                sk = sklearn_ms_per_iter(dump, a.sklearn_iters)
-        rows.append((name, d, bw, med, em1, sk))
-        print(f"{name}: done", file=sys.stderr)
-    print("| case | N | M | mode count ms | seeding ms | EM ms | EM iters | ms/iter | GFLOP/s | "
-          "regress ms | sample ms | metrics ms | total fit s (target) | peak RSS MiB | EM 1->2 threads | "
-          "sklearn ms/iter | speed-up vs sklearn (per iter) |")
-    print("|" + "---|" * 17)
-    for name, d, bw, m, em1, sk in rows:
-        target = TARGET_S.get(name)
-        target_txt = f" (<= {target})" if target else ""
-        sk_txt = "" if sk is None else f"{sk:.0f}"
-        ratio_txt = "" if sk is None else f"{sk / m['ms_per_iteration']:.0f}x"
-        print(f"| d={d}, bw {bw} | {int(m['n'])} | {int(m['m'])} | {1000*m['s_mode_count']:.1f} | "
-              f"{1000*m['s_seeding']:.1f} | {1000*m['s_em']:.0f} | {int(m['em_iterations'])} | "
-              f"{m['ms_per_iteration']:.2f} | {m['gflops']:.1f} | {1000*m['s_regress']:.1f} | "
-              f"{1000*m['s_sample']:.1f} | {1000*m['s_metrics']:.1f} | {m['s_total_fit']:.3f}{target_txt} | "
-              f"{m['peak_rss_mib']:.0f} | {em1 / m['ms_per_iteration']:.2f}x | {sk_txt} | {ratio_txt} |")
+    builds = {"new": perf_bin(ROOT)}
+    if a.baseline_root:
+        builds["today"] = perf_bin(a.baseline_root)
+    for b in builds.values():
+        if not os.path.exists(b):
+            sys.exit(f"run_perf: {b} not built (cmake --build build --target sogmm_perf)")
+    cases = a.cases.split(",")
+    res = {}  # (build, case, threads) -> medians
+    for case in cases:
+        for threads in (2, 1):
+            runs = {b: [] for b in builds}
+            for _ in range(a.runs):  # interleaved: both builds see the same load
+                for b, binary in builds.items():
+                    runs[b].append(run_fit(binary, case, threads))
+            for b in builds:
+                res[(b, case, threads)] = medians(runs[b])
+        print(f"{case}: done", file=sys.stderr)
+    warm, warm6 = {}, {}
+    if not a.no_warm:
+        for threads in (2, 1):
+            warm[threads] = run_warm(threads, a.runs)
+            warm6[threads] = run_warm(threads, a.runs, 6)
+        print("warm: done", file=sys.stderr)
 
-def compare(a):
-    """Median EM and total fit seconds per case for each binary, runs interleaved."""
-    print("| case | binary | N | M | EM iters | EM ms | ms/iter | total fit s | EM ratio | total ratio |")
-    print("|" + "---|" * 10)
-    for name in a.cases.split(","):
-        d, bw = CASES[name]
-        runs = {b: [] for b in a.perf}
-        for _ in range(a.runs):
-            for b in a.perf:
-                runs[b].append(run_case(d, bw, 2, binary=b))
-        med = {b: {k: statistics.median(r[k] for r in rs) for k in ("n", "m", "em_iterations", "s_em",
-                                                                    "ms_per_iteration", "s_total_fit")}
-               for b, rs in runs.items()}
-        base = med[a.perf[0]]
-        for b in a.perf:
-            m = med[b]
-            print(f"| d={d}, bw {bw} | {b} | {int(m['n'])} | {int(m['m'])} | {m['em_iterations']:.0f} | "
-                  f"{1000*m['s_em']:.0f} | {m['ms_per_iteration']:.2f} | {m['s_total_fit']:.3f} | "
-                  f"{m['s_em']/base['s_em']:.2f} | {m['s_total_fit']/base['s_total_fit']:.2f} |", flush=True)
-    return 0
+    def get(b, case, key, threads=2):
+        r = res.get((b, case, threads))
+        return None if r is None or key not in r else r[key]
+
+    def share(b, case, threads=2):
+        s = get(b, case, "s_seeding", threads)
+        return None if s is None else s / get(b, case, "s_total_fit", threads)
+
+    # (label, target text, target value, unit, value(build, threads))
+    rows = []
+    for case, label, target in (("d5s02", "d=5, bandwidth 0.02, cold fit", 0.08),
+                                ("d5s01", "d=5, bandwidth 0.01, cold fit", 0.2),
+                                ("d1s02t20", "d=1 full frame, truncated E-step", 1.5),
+                                ("d1s02", "d=1 full frame, exact", 3.5)):
+        if case in cases:
+            rows.append((label, target, "s", lambda b, t, c=case: get(b, c, "s_total_fit", t), case))
+    if warm:
+        rows.insert(2, ("d=5, bandwidth 0.02, next frame warm-started (00000 -> 00001)", 0.033, "s",
+                        lambda b, t: warm[t]["s_warm"] if b == "new" else None, None))
+        rows.insert(3, ("same, warm EM capped at 6 iterations (--max-iter 6)", 0.033, "s",
+                        lambda b, t: warm6[t]["s_warm"] if b == "new" else None, None))
+    if "d1s02" in cases:
+        rows.append(("d=1 regress all points (exact fit)", 0.2, "s", lambda b, t: get(b, "d1s02", "s_regress", t), None))
+    if "d1s02t20" in cases:
+        rows.append(("d=1 regress all points (truncated fit)", 0.2, "s",
+                     lambda b, t: get(b, "d1s02t20", "s_regress", t), None))
+    if "d5s02" in cases:
+        n, m = int(get("new", "d5s02", "n")), int(get("new", "d5s02", "m"))
+        rows.append((f"regress gray {n} points, {m} components", 0.02, "ms",
+                     lambda b, t: get(b, "d5s02", "s_regress", t), None))
+        rows.append(("score_samples, same", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_score", t), None))
+        rows.append(("seeding share of a fit (bw 0.02)", 0.10, "%", lambda b, t: share(b, "d5s02", t), None))
+    if "d5s01" in cases:
+        rows.append(("seeding share of a fit (bw 0.01)", 0.10, "%", lambda b, t: share(b, "d5s01", t), None))
+    if "d1s02" in cases:
+        rows.append(("peak RSS, d=1", 100, "MiB", lambda b, t: get(b, "d1s02", "peak_rss_mib", t), None))
+
+    print("| case | today (d0d1d93) | new | target | met | new, 1 thread | 1 -> 2 threads | authors' code |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, target, unit, value, case in rows:
+        now, new, one = value("today", 2), value("new", 2), value("new", 1)
+        met = "" if new is None else ("yes" if new <= target else "no")
+        scal = "" if unit in ("%", "MiB") or not new or not one else f"{one / new:.2f}x"
+        authors = ""
+        if case in AUTHORS_S and new:
+            authors = f"{AUTHORS_S[case]} s ({AUTHORS_S[case] / new:.0f}x)"
+        one_txt = fmt(one, unit) if unit not in ("MiB",) else ""
+        print(f"| {label} | {fmt(now, unit)} | {fmt(new, unit)} | <= {fmt(target, unit)} | {met} | {one_txt} | "
+              f"{scal} | {authors} |")
+    for name, w in (("", warm.get(2)), (", EM capped at 6", warm6.get(2))):
+        if w:
+            print(f"\nWarm start quality{name} (00001, same run): mean log-likelihood warm {w['ll_warm']:.3f} vs "
+                  f"cold {w['ll_cold']:.3f} nats/point; PSNR warm {w['psnr_warm']:.2f} vs cold {w['psnr_cold']:.2f} "
+                  f"dB; M {w['m_warm']} vs {w['m_cold']} (kept {w['kept']}, removed {w['removed']}, added "
+                  f"{w['added']}); EM iterations {w['iter_warm']} vs {w['iter_cold']}; cold fit of 00001 "
+                  f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
+
+    print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
+    for case in cases:
+        peak = get("new", case, "peak_pairs_per_s")
+        n, m = get("new", case, "n"), get("new", case, "m")
+        em_pairs = n * m * get("new", case, "em_iterations") * get("new", case, "pair_fraction")
+        parts = [f"EM {em_pairs / get('new', case, 's_em'):.3g} ({100 * em_pairs / get('new', case, 's_em') / peak:.0f}%)",
+                 f"regress {n * m / get('new', case, 's_regress'):.3g} ({100 * n * m / get('new', case, 's_regress') / peak:.0f}%)",
+                 f"score {n * m / get('new', case, 's_score'):.3g} ({100 * n * m / get('new', case, 's_score') / peak:.0f}%)"]
+        total = get("new", case, "s_total_fit")
+        print(f"- {case} (N {int(n)}, M {int(m)}): peak {peak:.3g} pairs/s; " + ", ".join(parts) +
+              f"; mode count {100 * get('new', case, 's_mode_count') / total:.0f}% and seeding "
+              f"{100 * get('new', case, 's_seeding') / total:.0f}% of the fit (not pair work)")
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ struct FitState {
   DepthOptions depth_options;
   FitOptions fit;
   bool json = false, progress = false, quiet = false;
+  bool warm_start = false;  ///< sequence: start each frame from the previous frame's model
 };
 
 std::string base_name(const std::string& p) { return std::filesystem::path(p).filename().string(); }
@@ -144,6 +145,7 @@ int run_sequence(const FitState& s) {
   options.fusion = false;
   options.fit = s.fit;
   options.depth = s.depth_options;
+  options.warm_start = s.warm_start;
   Map map(options);
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
   Totals t;
@@ -205,6 +207,10 @@ Command add_fit_command(CLI::App& root) {
   app->add_flag("--progress", s->progress, "print progress lines on stderr even when it is not a terminal");
   app->add_flag("-q,--quiet", s->quiet, "no progress output");
   app->add_flag("--json", s->json, "print the summary as one JSON object");
+  app->add_flag("--warm-start", s->warm_start,
+                "with --sequence: start each frame's fit from the previous frame's model moved by the relative pose "
+                "(components without support removed, new ones seeded where the frame is poorly explained; needs "
+                "--n-init 1)");
   CLI::App* a = app;
   return {app, [s, a]() {
             check_output_path(s->output);
@@ -215,8 +221,8 @@ Command add_fit_command(CLI::App& root) {
             if (single) {
               require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                       "fit: --depth and --color go together");
-              require(s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
-                      "fit: --trajectory and --frames need --sequence");
+              require(s->src.trajectory.empty() && s->src.frames.empty() && !s->warm_start,
+                      ErrorCode::InvalidArgument, "fit: --trajectory, --frames and --warm-start need --sequence");
               return run_single(*s);
             }
             require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument,

@@ -195,6 +195,9 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default HELLINGER */
 #define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
+#define SOGMM_OPT_MAP_WARM_START 606        /* i64, 0 or 1; default 0. 1: each batch's fit starts from the
+                                             * previous batch's model moved into its camera (as
+                                             * sogmm_fit_points_warm_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
 #define SOGMM_FUSION_HELLINGER 0 /* Hellinger distance of the 4-D Gaussians, in [0, 1] */
 #define SOGMM_FUSION_KL 1        /* symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, nats */
 
@@ -263,6 +266,23 @@ SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* poin
  * overriding SOGMM_OPT_N_COMPONENTS. */
 SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
                                                     size_t k, const sogmm_options* options);
+
+/* Warm start: fits n points starting from `initial`, a model of an earlier,
+ * overlapping cloud already moved into these points' frame (e.g. the previous
+ * frame's model moved by the relative pose with sogmm_model_transform).
+ * Self-organizing (SOGMM_OPT_N_COMPONENTS = 0): components of `initial`
+ * whose responsibility mass on the well-explained points is below 2 points
+ * are removed; points more than 10 nats below the median log-likelihood under
+ * `initial` are novel, and the mode count (SOGMM_OPT_BANDWIDTH) and k-means++
+ * (SOGMM_OPT_SEED) on the novel points only add that many new components; EM
+ * then runs from kept + new. With N_COMPONENTS = K > 0, EM runs from `initial`
+ * as given, which must have K components. The model records the fit like
+ * sogmm_fit_points_f32; `initial` is not modified and may be freed
+ * afterwards. Errors as sogmm_fit_points_f32, plus: initial NULL ->
+ * SOGMM_E_NULL_ARG; SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
+ * SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
+                                                 const sogmm_model* initial, const sogmm_options* options);
 
 /* Layout of the color image given to sogmm_fit_rgbd and sogmm_rgbd_to_points_f32. */
 #define SOGMM_COLOR_GRAY8 1    /* width * height bytes, gray 0..255 */

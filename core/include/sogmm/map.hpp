@@ -72,6 +72,11 @@ struct MapOptions {
   FusionMethod fusion_method = FusionMethod::Hellinger;
   double fusion_threshold = 0.3;    ///< fuse when the distance is below this (method's unit), > 0
   double index_sigmas = ComponentIndex::kDefaultSigmas;  ///< box radius of the index, (0, 100]
+  /// Warm-start each flush's fit from the previous flush's model moved into
+  /// this batch's camera frame (fit_warm, sogmm/warm_start.hpp) instead of a
+  /// cold fit. Meant for novelty off, where a batch is one whole frame and
+  /// consecutive frames overlap; needs fit.n_init == 1.
+  bool warm_start = false;
 };
 
 /// Throws Error(InvalidArgument) naming the field unless every option is in

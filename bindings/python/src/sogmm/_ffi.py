@@ -61,6 +61,7 @@ OPT_MAP_BATCH_SIZE = 602
 OPT_MAP_FUSION = 603
 OPT_MAP_FUSION_METHOD = 604
 OPT_MAP_FUSION_THRESHOLD = 605
+OPT_MAP_WARM_START = 606
 FUSION_HELLINGER = 0
 FUSION_KL = 1
 
@@ -152,6 +153,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_options_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
     "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
     "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
+    "sogmm_fit_points_warm_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE, HANDLE]),
     "sogmm_fit_rgbd": (
         STATUS,
         [HANDLE_OUT, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, HANDLE],
@@ -362,6 +364,7 @@ OPTION_NAMES = {
     OPT_MAP_FUSION: "fusion",
     OPT_MAP_FUSION_METHOD: "fusion",
     OPT_MAP_FUSION_THRESHOLD: "fusion_threshold",
+    OPT_MAP_WARM_START: "warm_start",
 }
 
 

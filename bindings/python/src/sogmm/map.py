@@ -51,6 +51,9 @@ class Map:
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
+        warm_start: True starts each batch's fit from the previous batch's
+            model moved into its camera (as ``SOGMM.fit(init=...)``); meant for
+            ``novelty=False``, needs ``n_init=1``.
         depth_scale, depth_min, depth_trunc, decimate: back-projection of
             :meth:`insert_rgbd` frames (as :func:`sogmm.rgbd_to_points`).
         **fit_params: parameters of each batch's fit, as :class:`sogmm.SOGMM`
@@ -63,17 +66,20 @@ class Map:
     """
 
     def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
-                 fusion: str | None = None, fusion_threshold: float = 0.3, depth_scale: float = 1000.0,
-                 depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1, **fit_params):
+                 fusion: str | None = None, fusion_threshold: float = 0.3, warm_start: bool = False,
+                 depth_scale: float = 1000.0, depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1,
+                 **fit_params):
         self._ptr = None
         self._finalizer = None
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
-        with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, fit_params) as o:
+        with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
+                           fit_params) as o:
             out = c_void_p()
             check(lib.sogmm_map_create(byref(out), o.ptr))
         self._attach(out)
 
-    def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, fit_params) -> _ffi.Options:
+    def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
+                 fit_params) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
@@ -87,7 +93,8 @@ class Map:
         f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
-               _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate)}
+               _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
+               _ffi.OPT_MAP_WARM_START: int(bool(warm_start))}
         if _FUSION[fusion] is not None:
             i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
         # The fit keys exactly as SOGMM sets them (same checks and messages).
@@ -223,7 +230,8 @@ class Map:
         obj._finalizer = None
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
-        map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3)
+        map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,
+                        warm_start=False)
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

@@ -577,7 +577,7 @@ class SOGMM(GMM):
                 raise InvalidArgumentError(f"option {key} must be a number, got {v!r}")
         return _ffi.Options(f64=f64, i64=i64)
 
-    def fit(self, X, y=None, progress: ProgressArg = None) -> "SOGMM":
+    def fit(self, X, y=None, progress: ProgressArg = None, init: GMM | None = None) -> "SOGMM":
         """Fits the model to (n, 4) points (x, y, z, gray). Returns self.
 
         progress: None, True (a tqdm bar per stage) or a callable(stage, step,
@@ -585,11 +585,22 @@ class SOGMM(GMM):
         sogmm.progress.STAGE_*); a truthy return cancels the fit with
         CancelledError, an exception it raises cancels and is re-raised. Ctrl-C
         cancels the fit and raises KeyboardInterrupt. A cancelled fit leaves
-        the estimator as it was."""
+        the estimator as it was.
+
+        ``init``: warm start from a model of an earlier, overlapping cloud,
+        already in these points' frame (e.g. ``prev.transform(relative_pose)``);
+        the rule for keeping, removing and adding components is that of
+        ``sogmm_fit_points_warm_f32`` (needs ``n_init == 1``)."""
         x = _rows(X, (4,), "X")
+        if init is not None and not isinstance(init, GMM):
+            raise InvalidArgumentError(f"init must be a fitted GMM or SOGMM, got {type(init).__name__}")
         out = c_void_p()
         with self._fit_options() as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
+            if init is None:
+                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
+            else:
+                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_warm_f32(byref(out), x, x.shape[0],
+                                                                                       init._h(), o.ptr))
         self._attach(out)
         return self
 

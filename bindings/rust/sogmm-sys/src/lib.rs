@@ -98,6 +98,7 @@ pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
 pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
 pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
+pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
 pub const SOGMM_FUSION_HELLINGER: i64 = 0;
 pub const SOGMM_FUSION_KL: i64 = 1;
 
@@ -197,6 +198,13 @@ extern "C" {
         points: *const f32,
         n: usize,
         k: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_fit_points_warm_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        initial: *const sogmm_model,
         options: *const sogmm_options,
     ) -> sogmm_status;
     pub fn sogmm_fit_rgbd(

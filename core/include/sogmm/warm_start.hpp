@@ -1,0 +1,68 @@
+// Warm start: fit a cloud starting from a model of an overlapping earlier
+// cloud (the previous frame of a sequence, moved by the relative pose),
+// instead of from scratch.
+#pragma once
+
+#include <cstddef>
+
+#include "sogmm/fit.hpp"
+#include "sogmm/gmm.hpp"
+#include "sogmm/point_cloud.hpp"
+
+namespace sogmm {
+
+/// The thresholds of the keep / add / remove rule of a self-organizing warm start.
+struct WarmStartOptions {
+  /// A component of the initial model whose responsibility mass on the new
+  /// cloud (sum of its responsibilities over the explained, i.e. not novel,
+  /// points) is below
+  /// this many points is removed: it models what the new cloud no longer sees,
+  /// and EM would only shrink it to a needle on a handful of points.
+  double min_mass = 2.0;
+  /// A point is poorly explained when its log-likelihood under the initial
+  /// model is more than this many nats below the median point's. For a point
+  /// near one component this is a squared Mahalanobis distance about
+  /// 2 x 10 + 3.4 = 23.4 from it (beyond ~4.8 sigma), where a cold fit would
+  /// put a component of its own.
+  double novelty_nats = 10.0;
+};
+
+/// What a warm start did with the initial model.
+struct WarmStartReport {
+  std::size_t kept = 0;     ///< initial components kept
+  std::size_t removed = 0;  ///< initial components removed (mass < min_mass)
+  std::size_t added = 0;    ///< new components seeded on poorly explained points
+  std::size_t novel_points = 0;  ///< points poorly explained by the initial model
+  double seconds_score = 0.0;    ///< the E-step that scores the initial model
+};
+
+/// Fits `points` starting from `initial`, which must already be in the
+/// points' frame (move it with transform() by the relative pose first).
+/// Self-organizing (options.n_components == 0):
+///  1. an exact E-step of `initial` gives every point's log-likelihood; points
+///     more than warm.novelty_nats below the median are "novel";
+///  2. a second E-step sums each component's responsibility over the other
+///     (explained) points; components with less than warm.min_mass are
+///     removed (if all would be, the fit is a cold one: every point novel);
+///  3. the mode count (options.bandwidth, options.mode_counter) runs on the
+///     novel points only and k-means++ (options.seed) picks that many seeds
+///     among them (none when no point is novel);
+///  4. each novel point joins its nearest seed (one hard k-means step); a new
+///     component per seed takes its cluster's mean, a diagonal covariance of
+///     the cluster's variances + reg_covar and its size as weight; EM
+///     (options.em) then runs from the kept components (weights: their
+///     masses) plus the new ones.
+/// Fixed K (options.n_components > 0): EM from `initial` as given, which
+/// must then have exactly n_components components.
+/// FitResult's timings: seconds_mode_count and seconds_seeding are those of
+/// step 3, the scoring of steps 1-2 is in report->seconds_score and in
+/// seconds_total. The result depends on the seed only through the new
+/// components, and is the same for any thread count.
+/// Errors as fit(), plus Error(InvalidArgument) for n_init != 1, a K that is
+/// not the initial model's size or warm thresholds that are not finite and
+/// >= 0, and the errors of validate() for an invalid initial model.
+FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOptions& options,
+                   const ProgressSink& progress = {}, const WarmStartOptions& warm = {},
+                   WarmStartReport* report = nullptr);
+
+}  // namespace sogmm
