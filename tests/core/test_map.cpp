@@ -8,6 +8,7 @@
 
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/warm_start.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -118,6 +119,50 @@ TEST(MapTest, NoveltyAndFusionOffReproduceAppendEverything) {
   EXPECT_EQ(got.key_values, expected.key_values);
   EXPECT_EQ(map.stats().n_flushes, 3u);
   EXPECT_EQ(map.pending(), 0u);
+}
+
+// The inverse of a rigid pose: (R^T, -R^T t), computed here independently of
+// the map's own.
+Pose inverse_of(const Pose& p) {
+  Pose q{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) q[4 * r + c] = p[4 * c + r];
+    q[4 * r + 3] = -(p[r] * p[3] + p[4 + r] * p[7] + p[8 + r] * p[11]);
+  }
+  q[15] = 1;
+  return q;
+}
+
+// MapOptions::warm_start with novelty off: the first frame is a cold fit, each
+// later one fit_warm from the previous fit moved from its camera into this
+// frame's (world <- previous camera, then this camera <- world).
+TEST(MapTest, WarmStartFitsEachFrameFromThePreviousOne) {
+  const std::vector<std::vector<float>> frames = {make_frame(2000, 1), make_frame(2000, 2, 0.1),
+                                                  make_frame(2000, 3, 0.2)};
+  const std::vector<Pose> poses = {kIdentity, pose_y(0.05, 0.02, 0.0, 0.0), pose_y(0.1, 0.04, 0.0, 0.01)};
+  MapOptions o = options(false, false);
+  o.warm_start = true;
+  Map map(o);
+  sogmm::Gmm previous;
+  std::vector<float> expected_means;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    map.insert_points(view(frames[f]), poses[f]);
+    const sogmm::FitResult r =
+        f == 0 ? sogmm::fit(view(frames[f]), o.fit)
+               : sogmm::fit_warm(view(frames[f]),
+                                 sogmm::transform(sogmm::transform(previous, poses[f - 1]), inverse_of(poses[f])),
+                                 o.fit);
+    previous = r.gmm;
+    const sogmm::Gmm world = sogmm::transform(r.gmm, poses[f]);
+    expected_means.insert(expected_means.end(), world.means.begin(), world.means.end());
+  }
+  // The map's means are the frames' world-frame means, appended in order
+  // (the same arithmetic, so bitwise).
+  EXPECT_EQ(map.model().gmm.means, expected_means);
+
+  MapOptions runs = o;
+  runs.fit.n_init = 2;
+  EXPECT_THROW({ Map bad(runs); }, sogmm::Error);
 }
 
 TEST(MapTest, ReinsertingAFrameAddsAlmostNothingANewRegionAdds) {
