@@ -139,3 +139,29 @@ def test_save_load_and_box(tmp_path):
     with pytest.raises(sogmm.SogmmError):
         pending.save(tmp_path / "pending.sogmm")  # flush first
     assert not (tmp_path / "pending.sogmm").exists()
+
+
+def test_warm_start_fits_each_frame_from_the_previous_fit():
+    # Independent truth: fit frame 0 cold, frame 1 warm from frame 0's fit moved
+    # into frame 1's camera (SOGMM.fit(init=)), each moved to the world, appended.
+    def inverse(p):  # (R^T, -R^T t), summed in the same order as the library
+        q = np.eye(4)
+        q[:3, :3] = p[:3, :3].T
+        for r in range(3):
+            q[r, 3] = -(p[0, r] * p[0, 3] + p[1, r] * p[1, 3] + p[2, r] * p[2, 3])
+        return q
+
+    f0, f1 = frames()
+    g0 = sogmm.SOGMM(**FIT).fit(f0)
+    g1 = sogmm.SOGMM(**FIT).fit(f1, init=g0.transform(POSES[0]).transform(inverse(POSES[1])))
+    cold1 = sogmm.SOGMM(**FIT).fit(f1)
+    with sogmm.Map(novelty=False, warm_start=True, **FIT) as m:
+        m.insert_points(f0, POSES[0])
+        m.insert_points(f1, POSES[1])
+        got = m.export()
+    expected = np.vstack([g0.transform(POSES[0]).means_, g1.transform(POSES[1]).means_])
+    np.testing.assert_array_equal(got.means_, expected)
+    assert got.n_components_ != g0.n_components_ + cold1.n_components_ or not np.array_equal(
+        got.means_[g0.n_components_:], cold1.transform(POSES[1]).means_)  # the warm start did something
+    with pytest.raises(sogmm.InvalidArgumentError):
+        sogmm.Map(novelty=False, warm_start=True, n_init=2, **FIT)

@@ -280,3 +280,24 @@ def test_non_contiguous_and_float64_input_give_the_same_fit(points):
     a = sogmm.SOGMM(bandwidth=0.08).fit(points)
     b = sogmm.SOGMM(bandwidth=0.08).fit(np.asfortranarray(points.astype(np.float64)))
     np.testing.assert_array_equal(a.means_, b.means_)
+
+
+def test_dequantise_depth_reaches_the_fit():
+    # Two tilted planes 1.6-1.8 m away whose depth sits on Kinect-style levels
+    # 1 / (0.0036 k) (as tests/core/test_depth_quantisation.cpp): the floor
+    # along the viewing rays changes the fit only when asked for.
+    rng = np.random.default_rng(5)
+    u, v = rng.uniform(-0.5, 0.5, 6000), rng.uniform(-0.5, 0.5, 6000)
+    plane = np.arange(6000) % 2
+    x = np.where(plane, 0.8 * u, 0.9 * u + 0.2)
+    y = np.where(plane, 0.6 * v, 0.5 * v)
+    z = np.where(plane, 1.8 + 0.5 * u + 0.3 * v, 1.6 - 0.35 * u + 0.1 * v)
+    zq = 1.0 / (0.0036 * np.round(1.0 / (0.0036 * z)))
+    pts = np.column_stack([x * zq / z, y * zq / z, zq, 0.5 + 0.3 * u]).astype(np.float32)
+    params = dict(n_components=60, seed=3, n_threads=1)
+    assert sogmm.SOGMM(dequantise_depth=True).get_params()["dequantise_depth"] is True
+    plain = sogmm.SOGMM(**params).fit(pts)
+    again = sogmm.SOGMM(dequantise_depth=False, **params).fit(pts)
+    floored = sogmm.SOGMM(dequantise_depth=True, **params).fit(pts)
+    np.testing.assert_array_equal(plain.means_, again.means_)
+    assert not np.array_equal(plain.means_, floored.means_)
