@@ -27,28 +27,6 @@ void require_rigid(const Pose& pose) {
   require(problem.empty(), ErrorCode::InvalidArgument, "map: the camera-to-world pose is not a rigid transform: " + problem);
 }
 
-// a * b of two rigid transforms (row-major).
-Pose compose(const Pose& a, const Pose& b) {
-  Pose c{};
-  for (int r = 0; r < 4; ++r)
-    for (int k = 0; k < 4; ++k) {
-      double v = 0.0;
-      for (int j = 0; j < 4; ++j) v += a[4 * r + j] * b[4 * j + k];
-      c[4 * r + k] = v;
-    }
-  return c;
-}
-
-Pose inverse_rigid(const Pose& p) {
-  Pose q{};
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) q[4 * r + c] = p[4 * c + r];
-    q[4 * r + 3] = -(p[r] * p[3] + p[4 + r] * p[7] + p[8 + r] * p[11]);
-  }
-  q[15] = 1.0;
-  return q;
-}
-
 // x, y, z of each point moved by `pose`, in double.
 std::vector<double> to_world(const PointsView& points, const Pose& pose) {
   std::vector<double> out(3 * points.size);
@@ -225,7 +203,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
       cloud.xyzg.insert(cloud.xyzg.end(), p.xyzg.begin(), p.xyzg.end());
       continue;
     }
-    const Pose rel = compose(to_last, p.pose);
+    const Pose rel = compose_poses(to_last, p.pose);
     for (std::size_t i = 0; i < p.xyzg.size(); i += 4) {
       const float* q = p.xyzg.data() + i;
       for (int r = 0; r < 3; ++r)

@@ -39,4 +39,25 @@ std::string rigid_pose_error(const std::array<double, 16>& p) {
   return {};
 }
 
+std::array<double, 16> compose_poses(const std::array<double, 16>& a, const std::array<double, 16>& b) {
+  std::array<double, 16> c{};
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 4; ++k) {
+      double v = 0.0;
+      for (int j = 0; j < 4; ++j) v += a[4 * r + j] * b[4 * j + k];
+      c[4 * r + k] = v;
+    }
+  return c;
+}
+
+std::array<double, 16> inverse_rigid(const std::array<double, 16>& p) {
+  std::array<double, 16> q{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) q[4 * r + c] = p[4 * c + r];
+    q[4 * r + 3] = -(p[r] * p[3] + p[4 + r] * p[7] + p[8 + r] * p[11]);
+  }
+  q[15] = 1.0;
+  return q;
+}
+
 }  // namespace sogmm

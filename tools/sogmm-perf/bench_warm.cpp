@@ -27,14 +27,6 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
-// Row-major product of two 4x4 matrices.
-sogmm::tools::Pose compose(const sogmm::tools::Pose& a, const sogmm::tools::Pose& b) {
-  sogmm::tools::Pose c{};
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j)
-      for (int k = 0; k < 4; ++k) c[4 * i + j] += a[4 * i + k] * b[4 * k + j];
-  return c;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,11 +62,11 @@ int main(int argc, char** argv) {
   };
   const PointCloud a = cloud_of(from), b = cloud_of(to);
   // Camera A -> world -> camera B.
-  const Gmm moved = transform(fit(a.view(), fo).gmm, compose(tools::inverse_rigid(poses.at(to)), poses.at(from)));
+  const Gmm moved = transform(fit(a.view(), fo).gmm, sogmm::compose_poses(tools::inverse_rigid(poses.at(to)), poses.at(from)));
 
   if (std::getenv("SOGMM_POSECHECK")) {
     const Gmm ga = fit(a.view(), fo).gmm;
-    const tools::Pose rel = compose(tools::inverse_rigid(poses.at(to)), poses.at(from));
+    const tools::Pose rel = sogmm::compose_poses(tools::inverse_rigid(poses.at(to)), poses.at(from));
     const tools::Pose id{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     std::printf("A on A %.4f; rel %.4f; id %.4f; inv rel %.4f\n", mean_log_likelihood(ga, a.xyzg.data(), a.size(), 4),
                 mean_log_likelihood(transform(ga, rel), b.xyzg.data(), b.size(), 4),

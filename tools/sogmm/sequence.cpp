@@ -128,16 +128,6 @@ std::vector<Pose> read_trajectory(const std::string& path) {
   return poses;
 }
 
-Pose inverse_rigid(const Pose& p) {
-  Pose q{};
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) q[4 * r + c] = p[4 * c + r];
-    q[4 * r + 3] = -(p[r] * p[3] + p[4 + r] * p[7] + p[8 + r] * p[11]);
-  }
-  q[15] = 1.0;
-  return q;
-}
-
 void write_trajectory(const std::string& path, const std::vector<Pose>& poses) {
   std::string text;
   char buf[256];

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "sogmm/model.hpp"
+
 namespace sogmm::tools {
 
 /// Row-major 4x4 rigid transform.
@@ -35,8 +37,8 @@ std::vector<std::size_t> parse_frame_range(const std::string& text, std::size_t 
 /// malformed or a matrix is not a rigid transform.
 std::vector<Pose> read_trajectory(const std::string& path);
 
-/// Inverse of a rigid transform [R t; 0 1] -> [R^T -R^T t; 0 1].
-Pose inverse_rigid(const Pose& pose);
+/// Inverse of a rigid transform (the core's, sogmm/model.hpp).
+using sogmm::inverse_rigid;
 
 /// Writes a trajectory in the same format (atomically).
 void write_trajectory(const std::string& path, const std::vector<Pose>& poses);

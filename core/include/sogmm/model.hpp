@@ -66,6 +66,13 @@ inline constexpr double kPoseTolerance = 1e-3;
 /// offending value at round-trip precision.
 std::string rigid_pose_error(const std::array<double, 16>& pose);
 
+/// The row-major product a * b of two 4x4 poses (a after b).
+std::array<double, 16> compose_poses(const std::array<double, 16>& a, const std::array<double, 16>& b);
+
+/// The inverse of a rigid pose [R t; 0 0 0 1]: [R^T -R^T t; 0 0 0 1]. The
+/// pose is not checked (see rigid_pose_error()).
+std::array<double, 16> inverse_rigid(const std::array<double, 16>& pose);
+
 /// Key of Model::key_values naming the frame of the means: absent or
 /// "camera" (the camera frame), "world" (spec/format.md section 2.1).
 inline constexpr const char* kCoordinateFrameKey = "coordinate_frame";
