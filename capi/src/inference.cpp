@@ -19,29 +19,6 @@ void require_dims(int32_t dims) {
     fail(SOGMM_E_INVALID_ARG, "dims = " + std::to_string(dims) + " (must be 3 or 4)");
 }
 
-/// a * b for row-major 4x4 matrices.
-std::array<double, 16> mul4(const std::array<double, 16>& a, const std::array<double, 16>& b) {
-  std::array<double, 16> c{};
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {
-      double s = 0.0;
-      for (int k = 0; k < 4; ++k) s += a[4 * i + k] * b[4 * k + j];
-      c[4 * i + j] = s;
-    }
-  return c;
-}
-
-/// Inverse of a rigid transform [R t; 0 1]: [R^T -R^T t; 0 1].
-std::array<double, 16> rigid_inverse(const std::array<double, 16>& p) {
-  std::array<double, 16> q{};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) q[4 * i + j] = p[4 * j + i];
-    q[4 * i + 3] = -(p[0 * 4 + i] * p[3] + p[1 * 4 + i] * p[7] + p[2 * 4 + i] * p[11]);
-  }
-  q[15] = 1.0;
-  return q;
-}
-
 }  // namespace
 
 extern "C" {
@@ -122,7 +99,7 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
     handle->model.gmm = sogmm::transform(model->model.gmm, t);
     if (handle->model.pose) {
       // P * pose^-1 of two valid poses is finite unless a translation overflows.
-      const std::array<double, 16> moved = mul4(*handle->model.pose, rigid_inverse(t));
+      const std::array<double, 16> moved = sogmm::compose_poses(*handle->model.pose, sogmm::inverse_rigid(t));
       const std::string problem = sogmm::rigid_pose_error(moved);
       if (!problem.empty()) fail(SOGMM_E_INVALID_ARG, "the model's pose moved by pose: " + problem);
       handle->model.pose = moved;
