@@ -1,7 +1,14 @@
-"""python -m sogmm.distributed: `sogmm fit --sequence` on a Ray cluster.
+"""python -m sogmm.distributed: `sogmm fit --sequence` or `sogmm map` on a Ray cluster.
 
     python -m sogmm.distributed --sequence DIR --trajectory LOG --workers N -o map.sogmm [--decimate 5 ...]
     python -m sogmm.distributed --address HEAD:6379 --sequence DIR --trajectory LOG -o map.sogmm
+    python -m sogmm.distributed --reduce map --fusion hellinger --sequence DIR --trajectory LOG -o map.sogmm
+
+--reduce merge (default): every frame is fitted whole and the fits are merged in
+the world frame (the model of `sogmm fit --sequence`). --reduce map: one
+incremental map per tile, with the map flags of `sogmm map` (--threshold,
+--batch, --no-novelty, --fusion, --fusion-threshold); --tile-size 0 gives the
+`sogmm map` of the whole sequence (one task), smaller tiles more parallelism.
 
 Exit status 0 on success, 1 with one line on stderr on bad input or a failed job.
 """
@@ -17,6 +24,7 @@ from pathlib import Path
 from ..camera import Camera
 from ..errors import SogmmError
 from .frame_fit import FitSettings
+from .map_tile import MapSettings
 from .runner import build_map
 from .sequence import load_frames
 
@@ -38,6 +46,21 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--on-error", choices=("skip", "fail"), default="skip",
                     help="a bad frame is skipped (and reported) or fails the job (default %(default)s)")
     ap.add_argument("--max-retries", type=int, default=3, help="Ray retries of a task whose worker died")
+    ap.add_argument("--frames-per-task", default="auto",
+                    help="--reduce merge: consecutive frames fitted per Ray task (amortises Ray's per-task cost); "
+                         "auto = at least 4 tasks per CPU, at most 8 frames (default %(default)s)")
+    ap.add_argument("--reduce", choices=("merge", "map"), default="merge",
+                    help="merge: world-frame merge of every frame's fit; map: one sogmm.Map per tile "
+                         "(default %(default)s)")
+    m = MapSettings()
+    mg = ap.add_argument_group("map flags (as `sogmm map`; with --reduce map)")
+    mg.add_argument("--threshold", type=float, default=m.novelty_threshold,
+                    help="novelty threshold (nats): points whose 3-D log-likelihood is below it are new")
+    mg.add_argument("--batch", type=int, default=m.batch_size, help="novel points that trigger a fit")
+    mg.add_argument("--no-novelty", action="store_true", help="every point is new: fit each frame whole")
+    mg.add_argument("--fusion", choices=("off", "hellinger", "kl"), default=m.fusion, help="fuse close components")
+    mg.add_argument("--fusion-threshold", type=float, default=m.fusion_threshold,
+                    help="fuse below this distance (Hellinger in [0, 1]; KL in nats)")
     g = ap.add_argument_group("fit and depth flags (as `sogmm fit`)")
     g.add_argument("--bandwidth", type=float, default=d.bandwidth)
     g.add_argument("--components", type=int, default=None, help="fixed number of components K")
@@ -48,7 +71,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--max-iter", type=int, default=d.max_iter)
     g.add_argument("--reg-covar", type=float, default=d.reg_covar)
     g.add_argument("--truncate", type=float, default=d.truncate)
-    g.add_argument("--decimate", type=int, default=d.decimate)
+    g.add_argument("--decimate", type=int, default=None, help="default 1, 5 with --reduce map (as sogmm map)")
     g.add_argument("--depth-scale", type=float, default=d.depth_scale)
     g.add_argument("--depth-min", type=float, default=d.depth_min)
     g.add_argument("--depth-max", type=float, default=d.depth_max)
@@ -57,9 +80,29 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _frames_per_task(text: str) -> int | None:
+    if text == "auto":
+        return None
+    if not text.isdigit() or int(text) < 1:
+        raise SogmmError(f"--frames-per-task {text}: expected an integer >= 1 or auto")
+    return int(text)
+
+
 def main(argv=None) -> int:
     a = _parser().parse_args(argv)
+    map_flags = [f for f, v in (("--threshold", a.threshold != MapSettings.novelty_threshold),
+                                ("--batch", a.batch != MapSettings.batch_size), ("--no-novelty", a.no_novelty),
+                                ("--fusion", a.fusion != MapSettings.fusion),
+                                ("--fusion-threshold", a.fusion_threshold != MapSettings.fusion_threshold)) if v]
+    if a.decimate is None:
+        a.decimate = 5 if a.reduce == "map" else FitSettings.decimate
     try:
+        if a.reduce != "map" and map_flags:
+            raise SogmmError(f"{map_flags[0]} is a map flag: give --reduce map")
+        map_settings = None if a.reduce != "map" else MapSettings(
+            novelty=not a.no_novelty, novelty_threshold=a.threshold, batch_size=a.batch, fusion=a.fusion,
+            fusion_threshold=a.fusion_threshold)
+        frames_per_task = _frames_per_task(a.frames_per_task)
         settings = FitSettings(bandwidth=a.bandwidth, n_components=a.components, seed=a.seed, n_init=a.n_init,
                                threads=a.threads, tol=a.tol, max_iter=a.max_iter, reg_covar=a.reg_covar,
                                truncate=a.truncate, decimate=a.decimate, depth_scale=a.depth_scale,
@@ -72,7 +115,7 @@ def main(argv=None) -> int:
         meta = {"sequence": a.sequence, "trajectory": a.trajectory, **settings.metadata()}
         r = build_map(frames, settings, camera, workers=a.workers, address=a.address, fan_in=a.fan_in,
                       tile_size=a.tile_size, on_error=a.on_error, max_retries=a.max_retries, progress=not a.quiet,
-                      metadata=meta)
+                      metadata=meta, map=map_settings, frames_per_task=frames_per_task)
         r.model.save(a.output)
     except (SogmmError, OSError) as e:
         print(f"sogmm.distributed: {e}", file=sys.stderr)
@@ -81,7 +124,8 @@ def main(argv=None) -> int:
         print(f"sogmm.distributed: skipped frame {frame}: {message}", file=sys.stderr)
     summary = {"output": a.output, "frames": r.n_frames, "skipped": [f for f, _ in r.skipped],
                "n_components": r.model.n_components_, "seconds_wall": r.seconds_wall, "seconds_fit": r.seconds_fit,
-               "seconds_merge": r.seconds_merge, "bytes_moved_per_frame": r.bytes_moved / max(len(frames), 1)}
+               "seconds_merge": r.seconds_merge, "bytes_moved_per_frame": r.bytes_moved / max(len(frames), 1),
+               "tasks": r.tasks, "merge_tasks": r.merges}
     if a.json:
         print(json.dumps(summary))
     else:

@@ -15,7 +15,7 @@ import numpy as np
 from ..camera import Camera
 from ..errors import SogmmError
 from ..model import SOGMM
-from .partial import leaf, size_bytes
+from .partial import leaf, reduce_partials, size_bytes
 from .sequence import Frame
 
 
@@ -43,7 +43,7 @@ class FitSettings:
         return {f"fit_{k}": repr(v) for k, v in dataclasses.asdict(self).items() if k != "threads"}
 
 
-def _read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     from PIL import Image  # the `ray` extra installs Pillow
 
     with Image.open(frame.depth) as im:
@@ -56,7 +56,7 @@ def _read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     return depth, color
 
 
-def _test_hold(frame: int) -> None:
+def test_hold(frame: int) -> None:
     """Test hook (tests_ray kills a worker mid-task): with SOGMM_DISTRIBUTED_PID_DIR
     set, a frame listed in the file PID_DIR/hold (comma-separated ids) writes its
     worker's pid to PID_DIR/<frame>.pid on its first attempt and then waits up to
@@ -81,11 +81,11 @@ def _test_hold(frame: int) -> None:
 def fit_frame(frame: Frame, settings: FitSettings, camera: dict) -> tuple[dict, dict | None]:
     """(info, leaf partial map) of one frame; a bad frame gives (info with
     ``error``, None) instead of raising, so Ray retries only worker deaths."""
-    _test_hold(frame.index)
+    test_hold(frame.index)
     start = time.perf_counter()
     info = {"frame": frame.index, "pid": os.getpid(), "error": None}
     try:
-        depth, color = _read_images(frame)
+        depth, color = read_images(frame)
         model = SOGMM(bandwidth=settings.bandwidth, seed=settings.seed, tol=settings.tol, reg_covar=settings.reg_covar,
                       max_iter=settings.max_iter, n_components=settings.n_components, n_threads=settings.threads,
                       truncation_nats=settings.truncate, n_init=settings.n_init)
@@ -97,6 +97,28 @@ def fit_frame(frame: Frame, settings: FitSettings, camera: dict) -> tuple[dict, 
         return info, None
     info.update(seconds=time.perf_counter() - start, bytes=size_bytes(part), n_components=model.n_components_)
     return info, part
+
+
+def fit_chunk(frames: list[Frame], settings: FitSettings, camera: dict) -> tuple[list[dict], dict | None]:
+    """(per-frame infos, the union of their leaf partial maps or None): the
+    work of one Ray task over a chunk of frames. Chunking amortises the
+    per-task cost of Ray (scheduling, two object-store entries per task, the
+    driver's bookkeeping) over several fits; the union is the tree's own
+    reduce, so the canonical map does not depend on the chunking. The union's
+    time is recorded as ``merge_seconds`` on the last info."""
+    infos, leaves = [], []
+    for f in sorted(frames, key=lambda f: f.index):
+        info, part = fit_frame(f, settings, camera)
+        infos.append(info)
+        if part is not None:
+            leaves.append(part)
+    start = time.perf_counter()
+    part = reduce_partials(leaves)
+    infos[-1]["merge_seconds"] = time.perf_counter() - start
+    for info in infos:
+        info["bytes"] = 0
+    infos[-1]["bytes"] = size_bytes(part)
+    return infos, part
 
 
 def camera_dict(camera: Camera) -> dict:

@@ -1,14 +1,22 @@
 """Partial maps: what the merge tree of :mod:`sogmm.distributed` passes around.
 
-A partial map is a dict of plain bytes and ints (Ray moves it without pickling
-any sogmm object):
+A partial map is a dict of plain bytes, ints, strings and lists (Ray moves it
+without pickling any sogmm object). Its unit is a *row*: one fitted frame
+(the plain merge) or one tile's map (``sogmm.Map``, see
+:mod:`sogmm.distributed.map_tile`):
 
 - ``model``: a world-frame ``.sogmm`` file (uncompressed: zstd level 19 costs
   more than the bytes it saves between tasks) holding the components of its
-  frames, frame by frame in the order of ``table``;
-- ``table``: one :data:`TABLE` row per frame (id, support size, components,
-  the fit's mean log-likelihood, EM iterations, converged);
-- ``weights``: each frame's own fitted weights (float32), in model order.
+  rows, row by row in the order of ``table``;
+- ``table``: one :data:`TABLE` row per unit (its first frame id, which orders
+  the rows; support size, components, the fit's mean log-likelihood, EM
+  iterations, converged);
+- ``weights``: each row's own weights (float32, summing to 1 per row), in
+  model order;
+- ``frames``: per row, the frame ids it holds in insertion order;
+- ``map_frames``: per row, its map's ``map_frames`` provenance text
+  (spec/format.md 2.3), "" for a fitted frame; ``map_options``: the maps'
+  ``map_options`` text (the same for every tile), "" for fitted frames.
 
 :func:`reduce_partials` is the one reduce function of the tree (today a plain
 world-frame merge, ``sogmm_model_merge``; a map with fusion plugs in here), and
@@ -39,20 +47,24 @@ from ..model import GMM
 
 #: Per-frame provenance row of a partial map.
 TABLE = np.dtype([("frame", "<i8"), ("support", "<u8"), ("n", "<i8"), ("log_likelihood", "<f8"),
-                  ("n_iter", "<i8"), ("converged", "<i8")])
+                  ("n_iter", "<i8"), ("converged", "<i8"), ("fits", "<i8")])
 
 
 def leaf(frame: int, world: GMM) -> dict:
     """The partial map of one fitted frame already moved to the world frame."""
     row = np.array([(frame, world.support_size_, world.n_components_, world.lower_bound_ or 0.0,
-                     world.n_iter_ or 0, int(bool(world.converged_)))], dtype=TABLE)
+                     world.n_iter_ or 0, int(bool(world.converged_)), 1)], dtype=TABLE)
     return {"model": world.to_bytes(compress=False), "table": row.tobytes(),
-            "weights": world.weights_.astype("<f4").tobytes()}
+            "weights": world.weights_.astype("<f4").tobytes(), "frames": [[frame]], "map_frames": [""],
+            "map_options": ""}
 
 
 def size_bytes(part: dict | None) -> int:
     """Bytes a partial map occupies in the object store (its three buffers)."""
-    return 0 if part is None else len(part["model"]) + len(part["table"]) + len(part["weights"])
+    if part is None:
+        return 0
+    return (len(part["model"]) + len(part["table"]) + len(part["weights"]) + 8 * sum(map(len, part["frames"]))
+            + sum(map(len, part["map_frames"])))
 
 
 def reduce_partials(parts: list) -> dict | None:
@@ -69,7 +81,8 @@ def reduce_partials(parts: list) -> dict | None:
     for p in parts[1:]:
         model = model.merge(GMM.from_bytes(p["model"]))
     return {"model": model.to_bytes(compress=False), "table": b"".join(p["table"] for p in parts),
-            "weights": b"".join(p["weights"] for p in parts)}
+            "weights": b"".join(p["weights"] for p in parts), "frames": [f for p in parts for f in p["frames"]],
+            "map_frames": [t for p in parts for t in p["map_frames"]], "map_options": parts[0]["map_options"]}
 
 
 def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
@@ -97,10 +110,16 @@ def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
     out = GMM.from_arrays(weights, model.means_[index], model.covariances_[index], support_size=total)
     t = table[order]
     ll = math.fsum(float(s) * l for s, l in zip(t["support"], t["log_likelihood"])) / total
-    values = {"coordinate_frame": "world", "frames": ",".join(str(int(f)) for f in t["frame"]), "log_likelihood": repr(ll),
+    frames = [f for i in order for f in part["frames"][i]]
+    values = {"coordinate_frame": "world", "frames": ",".join(str(int(f)) for f in frames), "log_likelihood": repr(ll),
               "n_iter": str(int(t["n_iter"].sum())), "converged": "true" if t["converged"].all() else "false"}
-    if len(t) >= 2:  # spec/format.md 2.2: written only for a merge (>= 2)
-        values["merged_fits"] = str(len(t))
+    if int(t["fits"].sum()) >= 2:  # spec/format.md 2.2: written only for a merge (>= 2)
+        values["merged_fits"] = str(int(t["fits"].sum()))
+    texts = [part["map_frames"][i] for i in order]
+    if any(texts):  # maps: one provenance line per frame, renumbered in the canonical insertion order
+        lines = [line.split(" ", 1)[1] for text in texts for line in text.splitlines()]
+        values["map_frames"] = "".join(f"{k} {rest}\n" for k, rest in enumerate(lines))
+        values["map_options"] = part["map_options"]
     values.update(metadata or {})
     for k, v in values.items():
         out.set_metadata(k, v)
