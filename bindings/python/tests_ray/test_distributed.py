@@ -16,13 +16,17 @@ import numpy as np
 import pytest
 
 import sogmm
-from sogmm.distributed import (FitSettings, FrameError, build_map, finalize, fit_frame, load_frames, merge_tree,
-                               reduce_partials, sequential_build)
+from sogmm.distributed import (FitSettings, FrameError, MapSettings, build_map, finalize, fit_frame, load_frames,
+                               map_tile, merge_tree, reduce_partials, sequential_build, tiles_of)
 from sogmm.distributed.frame_fit import camera_dict
 
 from conftest import BAD_FRAME, N_FRAMES
 
 SETTINGS = FitSettings(bandwidth=0.05, decimate=2, seed=3)
+# A batch below one frame's 1728 points: every insert fits, later frames are
+# scored against the map (novelty), and fusion has neighbours to fuse into.
+MAP = MapSettings(batch_size=1000, novelty_threshold=4.0, fusion="hellinger", fusion_threshold=0.3)
+TILE = 0.5  # the 12 orbit cameras fall into 4 tiles (quadrants) of 2 to 4 frames
 
 
 def _camera(seq):
@@ -50,6 +54,13 @@ def reference(sequence):
     return r.model
 
 
+@pytest.fixture(scope="module")
+def map_reference(sequence):
+    r = sequential_build(_frames(sequence), SETTINGS, _camera(sequence), map=MAP, tile_size=TILE)
+    assert [f for f, _ in r.skipped] == [BAD_FRAME]
+    return r.model
+
+
 # Runs first, before the session's 2-CPU Ray exists: build_map starts (and stops) its own.
 def test_one_worker_equals_sequential(sequence, reference):
     import ray
@@ -59,9 +70,11 @@ def test_one_worker_equals_sequential(sequence, reference):
     assert_same_map(r.model, reference)
 
 
-@pytest.mark.parametrize("fan_in,tile_size", [(2, 0.0), (3, 0.5), (16, 2.0)])
-def test_two_workers_equal_sequential_for_any_fan_in_and_tiling(local_ray, sequence, reference, fan_in, tile_size):
-    r = build_map(_frames(sequence), SETTINGS, _camera(sequence), fan_in=fan_in, tile_size=tile_size, progress=False)
+@pytest.mark.parametrize("fan_in,tile_size,frames_per_task", [(2, 0.0, 1), (3, 0.5, 3), (16, 2.0, None)])
+def test_two_workers_equal_sequential_for_any_fan_in_tiling_and_chunking(local_ray, sequence, reference, fan_in,
+                                                                          tile_size, frames_per_task):
+    r = build_map(_frames(sequence), SETTINGS, _camera(sequence), fan_in=fan_in, tile_size=tile_size, progress=False,
+                  frames_per_task=frames_per_task)
     assert [f for f, _ in r.skipped] == [BAD_FRAME]
     assert r.n_frames == N_FRAMES - 1 and r.bytes_moved > 0
     assert_same_map(r.model, reference)
@@ -83,10 +96,13 @@ def test_any_merge_order_gives_the_canonical_model(sequence, reference):
     assert len(raw) > 1, "the raw tree weights were expected to differ in the last bits"
 
 
-def test_killed_worker_is_retried_and_the_map_is_identical(local_ray, sequence, reference, pid_dir):
+@pytest.mark.parametrize("reduce", ["merge", "map"])
+def test_killed_worker_is_retried_and_the_map_is_identical(local_ray, sequence, reference, map_reference, pid_dir,
+                                                           reduce):
     victim = 4
     (pid_dir / "hold").write_text(str(victim))
     marker = pid_dir / f"{victim}.pid"
+    marker.unlink(missing_ok=True)  # left by the other parametrization
     killed = []
 
     def killer():
@@ -101,7 +117,8 @@ def test_killed_worker_is_retried_and_the_map_is_identical(local_ray, sequence, 
     t = threading.Thread(target=killer)
     t.start()
     try:
-        r = build_map(_frames(sequence), SETTINGS, _camera(sequence), fan_in=4, max_retries=3, progress=False)
+        r = build_map(_frames(sequence), SETTINGS, _camera(sequence), fan_in=4, max_retries=3, progress=False,
+                      map=MAP if reduce == "map" else None, tile_size=TILE)
     finally:
         t.join()
         (pid_dir / "hold").unlink()
@@ -109,7 +126,7 @@ def test_killed_worker_is_retried_and_the_map_is_identical(local_ray, sequence, 
     with pytest.raises(ProcessLookupError):
         os.kill(killed[0], 0)  # that worker is gone
     assert [f for f, _ in r.skipped] == [BAD_FRAME]
-    assert_same_map(r.model, reference)
+    assert_same_map(r.model, map_reference if reduce == "map" else reference)
 
 
 def test_fail_policy_names_the_bad_frame(local_ray, sequence):
@@ -180,3 +197,87 @@ def test_matches_the_cli_sequential_fit_up_to_weight_rounding(sequence, tmp_path
     x = ours.sample(5000, seed=1)
     assert abs(chain.score(x) - ours.score(x)) <= 1e-9
     assert abs(chain.lower_bound_ - float(ours.metadata["log_likelihood"])) <= 1e-12 * abs(chain.lower_bound_)
+
+
+# ---- the map-building reduce (--reduce map) --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("fan_in", [2, 16])
+def test_map_reduce_equals_the_sequential_map_build_for_any_fan_in(local_ray, sequence, map_reference, fan_in):
+    r = build_map(_frames(sequence), SETTINGS, _camera(sequence), fan_in=fan_in, tile_size=TILE, map=MAP,
+                  progress=False)
+    assert [f for f, _ in r.skipped] == [BAD_FRAME]
+    assert r.tasks == 4  # one task per tile
+    assert_same_map(r.model, map_reference)
+
+
+def test_map_reduce_in_any_tile_order_gives_the_canonical_model(sequence, map_reference, reference):
+    """Without Ray: tile maps united in shuffled orders and tree shapes give
+    the same model; its provenance lists every fitted frame once, tile by tile
+    in the order of their first frame, frames in id order inside a tile."""
+    frames = _frames(sequence)
+    cam = camera_dict(_camera(sequence))
+    tiles = tiles_of(frames, TILE)
+    parts = [map_tile(t, SETTINGS, MAP, cam)[1] for t in tiles]
+    rng = np.random.default_rng(7)
+    for fan_in in (2, 3):
+        order = rng.permutation(len(parts))
+        root = merge_tree([parts[i] for i in order], fan_in, lambda *p: reduce_partials(list(p)))
+        assert_same_map(finalize(root), map_reference)
+    expected = [f.index for t in sorted(tiles, key=lambda t: t[0].index) for f in t if f.index != BAD_FRAME]
+    assert map_reference.metadata["frames"] == ",".join(map(str, expected))
+    lines = map_reference.metadata["map_frames"].splitlines()
+    assert [int(line.split()[0]) for line in lines] == list(range(len(expected)))
+    poses = [np.array([float(v) for v in line.split()[3:]]).reshape(3, 4) for line in lines]
+    by_id = {f.index: np.array(f.pose).reshape(4, 4)[:3] for f in frames}
+    assert all(np.array_equal(p, by_id[i]) for p, i in zip(poses, expected))
+    # Novelty did its work: points the tile's map already explained were not fitted again.
+    assert map_reference.support_size_ < reference.support_size_
+
+
+def test_one_tile_map_is_the_sogmm_map_of_the_sequence(local_ray, sequence, tmp_path):
+    """--tile-size 0: one task builds the map over every frame, as `sogmm map`
+    (the C++ tool, an independent front end) does: the same components bit for
+    bit and the same frame provenance."""
+    cli = os.environ.get("SOGMM_CLI")
+    if not cli or not os.path.isfile(cli):
+        pytest.skip("SOGMM_CLI (the sogmm tool) not given; ctest sets it")
+    out = tmp_path / "map.sogmm"
+    subprocess.run([cli, "map", str(sequence), "--trajectory", str(sequence / "trajectory.log"),
+                    "--frames", f"0:{BAD_FRAME}", "--bandwidth", "0.05", "--decimate", "2", "--seed", "3",
+                    "--threads", "1", "--batch", "1000", "--threshold", "4", "--fusion", "hellinger",
+                    "--fusion-threshold", "0.3", "-q", "-o", str(out)], check=True, stdout=subprocess.DEVNULL,
+                   timeout=300)
+    tool = sogmm.load(out)
+    frames = [f for f in _frames(sequence) if f.index < BAD_FRAME]
+    ours = build_map(frames, SETTINGS, _camera(sequence), tile_size=0.0, map=MAP, progress=False).model
+    for name in ("weights_", "means_", "covariances_"):
+        assert getattr(tool, name).tobytes() == getattr(ours, name).tobytes(), name
+    for key in ("map_frames", "map_options", "frames", "coordinate_frame"):
+        assert tool.metadata[key] == ours.metadata[key], key
+    assert tool.support_size_ == ours.support_size_
+
+
+def test_command_line_map_reduce(local_ray, sequence, map_reference, tmp_path):
+    out = tmp_path / "map.sogmm"
+    address = local_ray.get_runtime_context().gcs_address
+    cmd = [sys.executable, "-m", "sogmm.distributed", "--address", address, "--sequence", str(sequence),
+           "--trajectory", str(sequence / "trajectory.log"), "-o", str(out), "--bandwidth", "0.05", "--decimate", "2",
+           "--seed", "3", "--reduce", "map", "--tile-size", str(TILE), "--batch", "1000", "--threshold", "4",
+           "--fusion", "hellinger", "--fusion-threshold", "0.3", "-q", "--json"]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    m = sogmm.load(out)
+    for name in ("weights_", "means_", "covariances_"):
+        assert getattr(m, name).tobytes() == getattr(map_reference, name).tobytes(), name
+    assert m.metadata["map_frames"] == map_reference.metadata["map_frames"]
+    with sogmm.Map.load(out) as reopened:  # the core Map reads the provenance back
+        assert len(reopened) == N_FRAMES - 1
+
+
+def test_map_flags_need_the_map_reduce(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "sogmm.distributed", "--sequence", str(tmp_path), "--trajectory",
+                        str(tmp_path / "t.log"), "-o", str(tmp_path / "m.sogmm"), "--fusion", "kl"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1
+    assert p.stderr.strip() == "sogmm.distributed: --fusion is a map flag: give --reduce map"
