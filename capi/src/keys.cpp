@@ -86,7 +86,7 @@ const char* type_name(KeyType t) { return t == KeyType::F64 ? "f64" : "i64"; }
 // The function that takes a key of this kind and type.
 std::string function_for(KeyKind kind, KeyType type, const char* verb) {
   return kind == KeyKind::Option ? std::string("sogmm_options_") + verb + "_" + type_name(type)
-                                 : std::string("sogmm_model_get_info_") + type_name(type);
+                                 : std::string("sogmm_model_") + verb + "_info_" + type_name(type);
 }
 
 }  // namespace

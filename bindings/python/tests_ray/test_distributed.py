@@ -155,7 +155,7 @@ def test_command_line_on_an_existing_cluster(local_ray, sequence, reference, tmp
     for name in ("weights_", "means_", "covariances_"):
         assert getattr(m, name).tobytes() == getattr(reference, name).tobytes(), name
     assert m.metadata["frames"] == reference.metadata["frames"]
-    assert m.metadata["fit_bandwidth"] == "0.05" and m.metadata["sequence"] == str(sequence)
+    assert m.info()["fit_bandwidth"] == 0.05 and m.metadata["sequence"] == str(sequence)
 
 
 def test_command_line_bad_input_is_one_line(tmp_path):
@@ -196,7 +196,13 @@ def test_matches_the_cli_sequential_fit_up_to_weight_rounding(sequence, tmp_path
     assert ulps.max() <= len(frames) - 1
     x = ours.sample(5000, seed=1)
     assert abs(chain.score(x) - ours.score(x)) <= 1e-9
-    assert abs(chain.lower_bound_ - float(ours.metadata["log_likelihood"])) <= 1e-12 * abs(chain.lower_bound_)
+    # The same provenance: fit record (settings, EM sums, camera) and key/values.
+    ci, oi = chain.info(), ours.info()
+    del ci["created_unix_ms"], oi["created_unix_ms"]
+    assert abs(ci.pop("fit_log_likelihood") - oi.pop("fit_log_likelihood")) <= 1e-12 * abs(chain.lower_bound_)
+    assert ci == oi
+    for key in ("coordinate_frame", "frames", "merged_fits"):
+        assert chain.metadata[key] == ours.metadata[key], key
 
 
 # ---- the map-building reduce (--reduce map) --------------------------------------------------------------------
@@ -256,6 +262,9 @@ def test_one_tile_map_is_the_sogmm_map_of_the_sequence(local_ray, sequence, tmp_
     for key in ("map_frames", "map_options", "frames", "coordinate_frame"):
         assert tool.metadata[key] == ours.metadata[key], key
     assert tool.support_size_ == ours.support_size_
+    ti, oi = tool.info(), ours.info()
+    del ti["created_unix_ms"], oi["created_unix_ms"]
+    assert ti == oi  # the fit record and camera of the map, as the tool writes them
 
 
 def test_command_line_map_reduce(local_ray, sequence, map_reference, tmp_path):

@@ -393,6 +393,18 @@ SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model,
 
 SOGMM_API sogmm_status sogmm_model_get_info_f64(const sogmm_model* model, sogmm_key key, double* out);
 SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_key key, int64_t* out);
+/* Sets an information key that .sogmm files store: the fit record
+ * (SOGMM_INFO_FIT_ITERATIONS to SOGMM_INFO_FIT_SEED) or the camera
+ * (SOGMM_INFO_CAMERA_*), e.g. to give a model rebuilt from arrays the
+ * provenance of the fits it came from. A model without that record gets one
+ * holding the format's defaults (spec/format.md 4.2) before the key is set.
+ * Types as with get. Errors (SOGMM_E_INVALID_ARG naming the key, the model
+ * unchanged): a key not stored in files (support size, creation time,
+ * timings), a non-finite double, FIT_CONVERGED not 0 or 1, a negative
+ * N_COMPONENTS_REQUESTED, an int32 field out of range, CAMERA_WIDTH/HEIGHT
+ * < 0, CAMERA_DECIMATION < 1. FIT_SEED takes the uint64's bits (cast). */
+SOGMM_API sogmm_status sogmm_model_set_info_f64(sogmm_model* model, sogmm_key key, double value);
+SOGMM_API sogmm_status sogmm_model_set_info_i64(sogmm_model* model, sogmm_key key, int64_t value);
 
 /* Pose of the model's frame in the world: 16 doubles, row-major 4 x 4 rigid
  * transform [R t; 0 0 0 1] (camera-to-world for a fitted frame).

@@ -172,6 +172,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_get_covariances_f32": (STATUS, [HANDLE, F32_OUT, c_size_t]),
     "sogmm_model_get_info_f64": (STATUS, [HANDLE, KEY, POINTER(c_double)]),
     "sogmm_model_get_info_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
+    "sogmm_model_set_info_f64": (STATUS, [HANDLE, KEY, c_double]),
+    "sogmm_model_set_info_i64": (STATUS, [HANDLE, KEY, c_int64]),
     "sogmm_model_get_pose": (STATUS, [HANDLE, F64_OUT]),
     "sogmm_model_set_pose": (STATUS, [HANDLE, F64_IN]),
     "sogmm_model_clear_pose": (STATUS, [HANDLE]),

@@ -270,6 +270,30 @@ class GMM:
                 out[name] = v
         return out
 
+    def set_info(self, **values) -> None:
+        """Sets fit-record and camera values by their :meth:`info` names (e.g.
+        ``fit_bandwidth=0.02, fit_iterations=40, camera_decimation=5``), the
+        ones .sogmm files store; a model without that record gets one with the
+        format's defaults first. Other names, or values the format cannot hold,
+        raise InvalidArgumentError (earlier values of the call stay set)."""
+        for name, value in values.items():
+            if name not in self._INFO_KEYS:
+                raise InvalidArgumentError(f"unknown info name {name!r}")
+            key, kind = self._INFO_KEYS[name]
+            if kind == "i":
+                if isinstance(value, (bool, np.bool_)):
+                    value = int(value)
+                if not isinstance(value, (int, np.integer)):
+                    raise InvalidArgumentError(f"{name} must be an int, got {value!r}")
+                v = int(value)
+                if name == "fit_seed" and (1 << 63) <= v < (1 << 64):
+                    v -= 1 << 64  # the uint64's bits, as the getter returns them
+                if not -(1 << 63) <= v < (1 << 63):
+                    raise InvalidArgumentError(f"{name} = {value} does not fit in 64 bits")
+                check(lib.sogmm_model_set_info_i64(self._h(), key, v))
+            else:
+                check(lib.sogmm_model_set_info_f64(self._h(), key, float(value)))
+
     # ---- pose and key/values -----------------------------------------------
     @property
     def pose(self) -> np.ndarray | None:

@@ -251,6 +251,8 @@ extern "C" {
     pub fn sogmm_model_get_covariances_f32(model: *const sogmm_model, out: *mut f32, capacity: usize) -> sogmm_status;
     pub fn sogmm_model_get_info_f64(model: *const sogmm_model, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_model_get_info_i64(model: *const sogmm_model, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_model_set_info_f64(model: *mut sogmm_model, key: sogmm_key, value: f64) -> sogmm_status;
+    pub fn sogmm_model_set_info_i64(model: *mut sogmm_model, key: sogmm_key, value: i64) -> sogmm_status;
     pub fn sogmm_model_get_pose(model: *const sogmm_model, pose_out: *mut f64) -> sogmm_status;
     pub fn sogmm_model_set_pose(model: *mut sogmm_model, pose: *const f64) -> sogmm_status;
     pub fn sogmm_model_clear_pose(model: *mut sogmm_model) -> sogmm_status;

@@ -112,7 +112,7 @@ def main(argv=None) -> int:
             raise SogmmError(f"no camera: give --intrinsics FILE (or put intrinsics.json in {a.sequence})")
         camera = Camera.from_json(intrinsics)
         frames = load_frames(a.sequence, a.trajectory, a.frames)
-        meta = {"sequence": a.sequence, "trajectory": a.trajectory, **settings.metadata()}
+        meta = {"sequence": a.sequence, "trajectory": a.trajectory}  # as sogmm fit --sequence and sogmm map
         r = build_map(frames, settings, camera, workers=a.workers, address=a.address, fan_in=a.fan_in,
                       tile_size=a.tile_size, on_error=a.on_error, max_retries=a.max_retries, progress=not a.quiet,
                       metadata=meta, map=map_settings, frames_per_task=frames_per_task)

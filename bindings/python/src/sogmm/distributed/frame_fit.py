@@ -38,10 +38,6 @@ class FitSettings:
     depth_min: float = 0.1
     depth_max: float = 3.0
 
-    def metadata(self) -> dict[str, str]:
-        """The settings as model key/values (the fit record is not settable from Python)."""
-        return {f"fit_{k}": repr(v) for k, v in dataclasses.asdict(self).items() if k != "threads"}
-
 
 def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
     from PIL import Image  # the `ray` extra installs Pillow

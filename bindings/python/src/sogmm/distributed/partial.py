@@ -88,10 +88,13 @@ def reduce_partials(parts: list) -> dict | None:
 def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
     """The canonical world-frame model of a root partial map (see the module doc).
 
-    The fit settings, camera and pose of the frames' records are not carried
-    (the Python binding cannot set them); ``metadata`` key/values are added, and
-    ``coordinate_frame`` = world, ``merged_fits``, ``frames`` and
-    ``log_likelihood`` (mean per point of all frames, as spec/format.md 2.2)."""
+    Provenance as the sequential tools write it (spec/format.md 2.2 and 2.3):
+    the fit record (the settings and camera shared by every unit, as
+    ``sogmm_model_merge`` keeps them, with ``n_iter`` the sum, ``converged``
+    the conjunction and ``log_likelihood`` the support-weighted mean of the
+    units', summed exactly), and the key/values ``coordinate_frame`` = world,
+    ``frames``, ``merged_fits`` and, for maps, ``map_frames`` and
+    ``map_options``; then ``metadata`` (e.g. ``sequence``, ``trajectory``)."""
     if part is None:
         raise InvalidDataError("no frame was fitted: the map is empty")
     table = np.frombuffer(part["table"], TABLE)
@@ -109,10 +112,17 @@ def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
     weights = (w0[index].astype(np.float64) * share).astype(np.float32)
     out = GMM.from_arrays(weights, model.means_[index], model.covariances_[index], support_size=total)
     t = table[order]
-    ll = math.fsum(float(s) * l for s, l in zip(t["support"], t["log_likelihood"])) / total
+    # The tree's merges kept the settings and camera where every unit agrees
+    # (a pure function of the set of units); the sums are recomputed exactly.
+    shared = {k: v for k, v in model.info().items() if k.startswith(("fit_", "camera_")) and k in _STORED}
+    if "fit_bandwidth" in shared and len(t) >= 2:  # one unit keeps its own record as it is
+        shared.update(fit_iterations=min(int(np.maximum(t["n_iter"], 0).sum()), 2**31 - 1),
+                      fit_converged=int(t["converged"].all()),
+                      fit_log_likelihood=math.fsum(float(s) * l for s, l in zip(t["support"], t["log_likelihood"]))
+                      / total)
+    out.set_info(**shared)
     frames = [f for i in order for f in part["frames"][i]]
-    values = {"coordinate_frame": "world", "frames": ",".join(str(int(f)) for f in frames), "log_likelihood": repr(ll),
-              "n_iter": str(int(t["n_iter"].sum())), "converged": "true" if t["converged"].all() else "false"}
+    values = {"coordinate_frame": "world", "frames": ",".join(str(int(f)) for f in frames)}
     if int(t["fits"].sum()) >= 2:  # spec/format.md 2.2: written only for a merge (>= 2)
         values["merged_fits"] = str(int(t["fits"].sum()))
     texts = [part["map_frames"][i] for i in order]
@@ -124,6 +134,13 @@ def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
     for k, v in values.items():
         out.set_metadata(k, v)
     return out
+
+
+#: The info names a .sogmm file stores (GMM.set_info accepts them).
+_STORED = ("fit_iterations", "fit_converged", "fit_log_likelihood", "fit_bandwidth", "fit_n_components_requested",
+           "fit_tol", "fit_reg_covar", "fit_max_iter", "fit_seed", "camera_width", "camera_height", "camera_fx",
+           "camera_fy", "camera_cx", "camera_cy", "camera_decimation", "camera_depth_scale", "camera_depth_min",
+           "camera_depth_max")
 
 
 def sequential_partial(leaves: list) -> dict | None:
