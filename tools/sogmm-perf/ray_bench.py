@@ -1,17 +1,21 @@
 #!/usr/bin/env python3
 """Benchmark of sogmm.distributed (issue 19): throughput of 1 and 2 Ray workers,
-Ray's overhead per frame against the fit time, bytes moved per frame, and the
-per-frame fit and per-component merge costs that the paper estimate in
-bindings/python/README.md is computed from.
+Ray's overhead per frame against the fit time (with the default chunking of
+several frames per task, and with one frame per task as before), bytes moved
+per frame, the map-building reduce, and the per-frame fit and per-component
+merge costs that the paper estimate in bindings/python/README.md is computed
+from.
 
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
       python3 tools/sogmm-perf/ray_bench.py --sogmm build/tools/sogmm/sogmm [--frames 200] [--repeats 1]
 
-The sequence is `sogmm demo --write-frame` (640 x 480, fitted at d = 5). The demo
-writes at most 100 frames, so a longer sequence repeats them (frame i + 100 is
-frame i's images with the next poses of the same camera path). Runs are
-interleaved (in-process sequential, Ray 1 worker, Ray 2 workers, repeated) and
-medians are reported with the load average, since the machine is shared.
+The sequence is the first --frames frames of the 300-frame synthetic room loop
+(`sogmm demo --write-frame DIR --loop`, 640 x 480, fitted at d = 5). Runs are
+interleaved (in-process sequential, Ray 1 worker with one frame per task and
+with the default chunking, Ray 2 workers, the map reduce in process and on 2
+workers; repeated) and medians are reported with the load average, since the
+machine is shared. Every Ray map is checked bitwise against its sequential
+build.
 """
 
 from __future__ import annotations
@@ -34,43 +38,21 @@ import numpy as np
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import sogmm  # noqa: E402
-from sogmm.distributed import (FitSettings, build_map, fit_frame, load_frames,  # noqa: E402
+from sogmm.distributed import (FitSettings, MapSettings, build_map, fit_frame, load_frames,  # noqa: E402
                                reduce_partials, sequential_build)
 from sogmm.distributed.frame_fit import camera_dict  # noqa: E402
 from sogmm.distributed.partial import finalize  # noqa: E402
 
 
+LOOP_FRAMES = 300  # `sogmm demo --loop`'s default length
+
+
 def write_sequence(sogmm_cli: str, folder: Path, n: int) -> Path:
-    """n demo frames; beyond the demo's 100, frames repeat with poses continued."""
-    demo = folder / "demo"
-    made = min(n, 100)
-    subprocess.run([sogmm_cli, "demo", "--write-frame", str(demo), "--frames", str(made)], check=True,
-                   stdout=subprocess.DEVNULL)
-    if n == made:
-        return demo
-    seq = folder / "seq"
-    (seq / "depth").mkdir(parents=True)
-    (seq / "color").mkdir()
-    poses = [np.array(p).reshape(4, 4) for p in _poses(demo / "trajectory.log")]
-    step = np.linalg.inv(poses[0]) @ poses[-1]  # the camera path of frames 0..99, continued
-    log = []
-    for i in range(n):
-        src = i % made
-        for kind in ("depth", "color"):
-            os.symlink(demo / kind / f"{src:05d}.png", seq / kind / f"{i:05d}.png")
-        pose = poses[src]
-        for _ in range(i // made):
-            pose = pose @ step
-        log.append(f"{i} {i + 1} {n}")
-        log += [" ".join(f"{x:.17g}" for x in row) for row in pose]
-    (seq / "trajectory.log").write_text("\n".join(log) + "\n")
-    shutil.copy(demo / "intrinsics.json", seq / "intrinsics.json")
-    return seq
-
-
-def _poses(log: Path):
-    from sogmm.distributed.sequence import read_trajectory
-    return read_trajectory(str(log))
+    """The synthetic room loop (max(n, 300) frames: the loop's path depends on its length)."""
+    loop = folder / "loop"
+    subprocess.run([sogmm_cli, "demo", "--write-frame", str(loop), "--loop", "--frames", str(max(n, LOOP_FRAMES))],
+                   check=True, stdout=subprocess.DEVNULL)
+    return loop
 
 
 def merge_cost(leaves: list, fan_in: int, target: int = 60_000) -> tuple[float, float, int]:
@@ -149,6 +131,8 @@ def main(argv=None) -> int:
     ap.add_argument("--decimate", type=int, default=5)
     ap.add_argument("--repeats", type=int, default=1, help="interleaved rounds (medians over them)")
     ap.add_argument("--fan-in", type=int, default=8)
+    ap.add_argument("--tile-size", type=float, default=2.0, help="metres (the loop's 4 quadrants at 2)")
+    ap.add_argument("--no-map", action="store_true", help="skip the map-reduce runs")
     ap.add_argument("--json", help="also write the numbers to this JSON file")
     a = ap.parse_args(argv)
     import ray
@@ -157,48 +141,71 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="sogmm_ray_bench_"))
     try:
         seq = write_sequence(a.sogmm, tmp, a.frames)
-        frames = load_frames(str(seq), str(seq / "trajectory.log"))
+        frames = load_frames(str(seq), str(seq / "trajectory.log"), f"0:{a.frames}")
         cam = sogmm.Camera.from_json(seq / "intrinsics.json")
         settings = FitSettings(decimate=a.decimate)
+        map_settings = MapSettings()
         load = [os.getloadavg()]
-        runs = {"sequential": [], "ray1": [], "ray2": []}
+        # (name, workers, frames per task (None = auto), map settings or None)
+        ray_runs = [("ray1_1pertask", 1, 1, None), ("ray1", 1, None, None), ("ray2", 2, None, None)]
+        if not a.no_map:
+            ray_runs.append(("ray2_map", 2, None, map_settings))
+        runs = {k: [] for k in ["sequential", "sequential_map"] + [r[0] for r in ray_runs]}
         startup = []
-        ref = None
+        ref = {}
         for _ in range(a.repeats):
-            r = sequential_build(frames, settings, cam)
-            runs["sequential"].append(r)
-            ref = ref or r.model
-            for w in (1, 2):
+            runs["sequential"].append(sequential_build(frames, settings, cam))
+            if not a.no_map:
+                runs["sequential_map"].append(sequential_build(frames, settings, cam, map=map_settings,
+                                                               tile_size=a.tile_size))
+            ref = ref or {None: runs["sequential"][0].model,
+                          "map": runs["sequential_map"][0].model if not a.no_map else None}
+            for name, w, per_task, ms in ray_runs:
                 ray.init(num_cpus=w, include_dashboard=False, log_to_driver=False)
                 try:
                     startup.append(_warm(ray, w))
-                    r = build_map(frames, settings, cam, fan_in=a.fan_in, progress=False)
+                    r = build_map(frames, settings, cam, fan_in=a.fan_in, progress=False, frames_per_task=per_task,
+                                  map=ms, tile_size=a.tile_size)
                 finally:
                     ray.shutdown()
-                runs[f"ray{w}"].append(r)
-                same = all(getattr(r.model, k).tobytes() == getattr(ref, k).tobytes()
-                           for k in ("weights_", "means_", "covariances_")) and r.model.metadata == ref.metadata
+                runs[name].append(r)
+                want = ref["map" if ms else None]
+                same = all(getattr(r.model, k).tobytes() == getattr(want, k).tobytes()
+                           for k in ("weights_", "means_", "covariances_")) and r.model.metadata == want.metadata
                 if not same:
-                    print(f"ERROR: the {w}-worker map differs from the sequential one", file=sys.stderr)
+                    print(f"ERROR: the {name} map differs from the sequential one", file=sys.stderr)
                     return 1
             load.append(os.getloadavg())
-        med = {k: statistics.median(x.seconds_wall for x in v) for k, v in runs.items()}
+        med = {k: statistics.median(x.seconds_wall for x in v) for k, v in runs.items() if v}
         n = len(frames)
-        fit_per_frame = statistics.median(x.seconds_fit for x in runs["ray1"]) / n
-        r1 = runs["ray1"][0]
+
+        def per_frame(name: str, fn) -> float:
+            return statistics.median(fn(x) for x in runs[name]) / n
+
+        fit_per_frame = per_frame("ray1", lambda x: x.seconds_fit)
         # Ray's overhead: the 1-worker job's wall time beyond the work it did
-        # (fit and merge tasks, timed inside the tasks), per frame, with the
-        # workers already started (_warm).
-        overhead = statistics.median(x.seconds_wall - x.seconds_fit - x.seconds_merge for x in runs["ray1"]) / n
+        # (fits, and merges: in-task unions and merge tasks, all timed inside
+        # the tasks), per frame, with the workers already started (_warm).
+        overhead = per_frame("ray1", lambda x: x.seconds_wall - x.seconds_fit - x.seconds_merge)
+        overhead_1 = per_frame("ray1_1pertask", lambda x: x.seconds_wall - x.seconds_fit - x.seconds_merge)
+        r1 = runs["ray1"][0]
+        ref = ref[None]
         leaves = [fit_frame(f, settings, camera_dict(cam))[1] for f in frames[:8]]
         c_merge, c_final, m_merge = merge_cost(leaves, a.fan_in)
         out = {
             "frames": n, "decimate": a.decimate, "components_per_frame": ref.n_components_ / n,
             "map_components": ref.n_components_,
-            "seconds_sequential": med["sequential"], "seconds_ray1": med["ray1"], "seconds_ray2": med["ray2"],
+            **{f"seconds_{k}": v for k, v in med.items()},
             "throughput_ratio_2_over_1": med["ray1"] / med["ray2"],
+            "frames_per_task_ray1": -(-n // r1.tasks), "frames_per_task_ray2": -(-n // runs["ray2"][0].tasks),
             "fit_seconds_per_frame": fit_per_frame,  # inside the 1-worker job's tasks
             "ray_overhead_seconds_per_frame": overhead, "ray_overhead_over_fit": overhead / fit_per_frame,
+            # The same with one frame per task (the previous scheduling), in this run.
+            "ray_overhead_seconds_per_frame_1pertask": overhead_1,
+            "ray_overhead_over_fit_1pertask": overhead_1 / per_frame("ray1_1pertask", lambda x: x.seconds_fit),
+            # Wall beyond the fits alone (merges counted as overhead too).
+            "ray_overhead_incl_merge_over_fit": per_frame("ray1", lambda x: x.seconds_wall - x.seconds_fit)
+            / fit_per_frame,
             "ray_startup_seconds_median": statistics.median(startup),  # workers + import, once per job
             "ray1_over_sequential": med["ray1"] / med["sequential"],
             # Fit time per frame inside the tasks: when it grows from 1 to 2
@@ -206,6 +213,11 @@ def main(argv=None) -> int:
             "fit_seconds_per_frame_ray1": statistics.median(x.seconds_fit for x in runs["ray1"]) / n,
             "fit_seconds_per_frame_ray2": statistics.median(x.seconds_fit for x in runs["ray2"]) / n,
             "bytes_moved_per_frame": r1.bytes_moved / n, "merge_tasks": r1.merges,
+            "bytes_moved_per_frame_1pertask": runs["ray1_1pertask"][0].bytes_moved / n,
+            **({} if a.no_map else {
+                "map_reduce_components": runs["ray2_map"][0].model.n_components_,
+                "map_reduce_tasks": runs["ray2_map"][0].tasks,
+                "map_reduce_2_workers_over_sequential": med["ray2_map"] / med["sequential_map"]}),
             "merge_seconds_per_component": c_merge, "merge_timed_components": m_merge,
             "finalize_seconds_per_component": c_final, **real_frame_cost(settings),
             "loadavg_1min": [round(l[0], 2) for l in load], "cpus": os.cpu_count(),
