@@ -290,3 +290,9 @@ def test_map_flags_need_the_map_reduce(tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 1
     assert p.stderr.strip() == "sogmm.distributed: --fusion is a map flag: give --reduce map"
+
+
+def test_auto_chunking_keeps_four_tasks_per_cpu_and_at_most_eight_frames():
+    from sogmm.distributed import auto_frames_per_task
+    assert [auto_frames_per_task(n, c) for n, c in [(200, 1), (200, 2), (24, 2), (5, 2), (2870, 128), (0, 0)]] == \
+        [8, 8, 3, 1, 5, 1]
