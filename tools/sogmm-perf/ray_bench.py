@@ -31,8 +31,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 # As in a Ray worker (Ray sets OMP_NUM_THREADS to the task's CPUs): without it
 # the in-process baseline's one-thread fits ran ~1.8x slower on a loaded machine.
 os.environ.setdefault("OMP_NUM_THREADS", "1")
