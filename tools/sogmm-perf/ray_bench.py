@@ -228,7 +228,7 @@ def main(argv=None) -> int:
             print(f"{k:34s} {v:.6g}" if isinstance(v, float) else f"{k:34s} {v}")
         for p, e in out.get("estimate_2870_frames", {}).items():  # the rows of bindings/python/README.md's table
             print(f"| {p} | {2 * p} | {e['fit_s']:.0f} s | {e['merge_s']:.1f} s | {e['finalize_s']:.1f} s | "
-                  f"{e['total_s'] / 60:.1f} min |")
+                  + (f"{e['total_s']:.0f} s |" if e["total_s"] < 120 else f"{e['total_s'] / 60:.1f} min |"))
         if a.json:
             Path(a.json).write_text(json.dumps(out, indent=1))
         return 0
