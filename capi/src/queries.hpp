@@ -1,0 +1,44 @@
+// Argument checks and output handling shared by the model queries
+// (inference.cpp) and the map queries (map_queries.cpp) of the C API, so that
+// both refuse the same inputs with the same statuses. Never installed.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "internal.hpp"
+#include "sogmm/checked.hpp"
+
+namespace sogmm_capi {
+
+inline void require_dims(int32_t dims) {
+  if (dims != 3 && dims != 4) fail(SOGMM_E_INVALID_ARG, "dims = " + std::to_string(dims) + " (must be 3 or 4)");
+}
+
+/// Checks `n` rows of `width` floats at `in` for a query writing to `out`
+/// (both required): SOGMM_E_NULL_ARG, SOGMM_E_LIMIT when n * width
+/// overflows, SOGMM_E_INVALID_DATA for NaN/Inf. Call only for n > 0.
+inline void require_query_input(const float* in, std::size_t n, std::size_t width, const char* in_name,
+                                const void* out, const char* out_name) {
+  require_nonnull(in, in_name);
+  require_nonnull(out, out_name);
+  require_finite(in, sogmm::checked::mul<std::size_t>(n, width, in_name), in_name);
+}
+
+/// Runs write(dst) for an output of `count` values: straight into `out`, or,
+/// when `progress` is set, into a temporary copied to `out` only on success,
+/// so that a cancelled call leaves `out` untouched (sogmm_progress_fn).
+template <class T, class Write>
+void write_on_success(bool progress, T* out, std::size_t count, const Write& write) {
+  if (!progress || out == nullptr) {
+    write(out);
+    return;
+  }
+  std::vector<T> tmp(count);
+  write(tmp.data());
+  std::copy(tmp.begin(), tmp.end(), out);
+}
+
+}  // namespace sogmm_capi
