@@ -56,6 +56,18 @@ def _count(n, name: str) -> int:
     return int(n)
 
 
+def _sample_args(n_samples, seed, spatial_only: bool) -> tuple[int, int, int, np.ndarray]:
+    """Checked (n, seed as uint64 bits, dims, output array) of a sample call;
+    seed=None draws a fresh seed."""
+    n = _count(n_samples, "n_samples")
+    if seed is None:
+        seed = secrets.randbits(64)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
+    dims = 3 if spatial_only else 4
+    return n, int(seed) & 0xFFFFFFFFFFFFFFFF, dims, np.empty((n, dims), dtype=np.float32)
+
+
 def _write_options(float64: bool, compress: bool, zstd_level: int) -> _ffi.Options:
     return _ffi.Options(
         i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level}
@@ -340,14 +352,7 @@ class GMM:
         samples; seed=None draws a fresh one. ``truncation`` (in standard
         deviations, may be inf) bounds each draw."""
         h = self._h()
-        n = _count(n_samples, "n_samples")
-        if seed is None:
-            seed = secrets.randbits(64)
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-            raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
-        seed = int(seed) & 0xFFFFFFFFFFFFFFFF
-        dims = 3 if spatial_only else 4
-        out = np.empty((n, dims), dtype=np.float32)
+        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
         with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
             check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
         return out
