@@ -4,6 +4,7 @@ package sogmm
 #include <stdint.h>
 #include "sogmm/sogmm.h"
 sogmm_status sogmm_go_set_progress(sogmm_options* options, uintptr_t handle);
+sogmm_status sogmm_go_map_set_progress(sogmm_map* map, uintptr_t handle);
 */
 import "C"
 
@@ -17,11 +18,13 @@ import (
 type Stage int32
 
 const (
-	StageModeCount Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
-	StageSeeding   Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
-	StageEM        Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
-	StageRun       Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
-	StageSampling  Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
+	StageModeCount  Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
+	StageSeeding    Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
+	StageEM         Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
+	StageRun        Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
+	StageSampling   Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
+	StageScoring    Stage = C.SOGMM_STAGE_SCORING    // scoring on a map; Step/Total: points scored / requested
+	StageRegression Stage = C.SOGMM_STAGE_REGRESSION // gray regression on a map; Step/Total: points done / requested
 )
 
 // Progress is one report. Total is 0 when unknown; LogLikelihood is the mean
@@ -81,8 +84,9 @@ func sogmmGoProgress(stage C.int32_t, step, total C.uint64_t, ll C.double, handl
 // withProgress runs create with a private copy of o (nil = defaults) that
 // reports to fn and watches ctx; ctx's error or fn's becomes the Cause of
 // the ErrCancelled error, and a panic in fn is raised again here.
-func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
-	create func(private *Options) (*Model, error)) (*Model, error) {
+func withProgress[T any](ctx context.Context, o *Options, fn ProgressFunc,
+	create func(private *Options) (T, error)) (T, error) {
+	var zero T
 	var private *Options
 	var err error
 	if o == nil {
@@ -91,7 +95,7 @@ func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
 		private, err = o.Clone()
 	}
 	if err != nil {
-		return nil, err
+		return zero, err
 	}
 	defer private.Close()
 	state := &progressState{ctx: ctx, fn: fn}
@@ -100,16 +104,41 @@ func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
 	if err := private.do(func(p *C.sogmm_options) C.sogmm_status {
 		return C.sogmm_go_set_progress(p, C.uintptr_t(h))
 	}); err != nil {
-		return nil, err
+		return zero, err
 	}
-	m, err := create(private)
-	if state.panicked {
-		panic(state.panicVal)
+	r, err := create(private)
+	return r, state.finish(err)
+}
+
+// finish raises a panic of the progress func again and gives a cancelled
+// call's error its Cause.
+func (s *progressState) finish(err error) error {
+	if s.panicked {
+		panic(s.panicVal)
 	}
 	if e, ok := err.(*Error); ok && e.Status == ErrCancelled {
-		e.Cause = state.cause
+		e.Cause = s.cause
 	}
-	return m, err
+	return err
+}
+
+// withMapProgress runs run with the progress callback of m set to report to
+// fn and watch ctx (sogmm_map_set_progress) and removed again afterwards;
+// errors and panics as withProgress. The caller must have exclusive use of
+// m, as for any insert.
+func withMapProgress(ctx context.Context, m *Map, fn ProgressFunc, run func() error) error {
+	state := &progressState{ctx: ctx, fn: fn}
+	h := cgo.NewHandle(state)
+	defer h.Delete()
+	if err := m.do(func(p *C.sogmm_map) C.sogmm_status {
+		return C.sogmm_go_map_set_progress(p, C.uintptr_t(h))
+	}); err != nil {
+		return err
+	}
+	err := run()
+	// Removed before the handle is deleted; cannot fail on an open map.
+	_ = m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
+	return state.finish(err)
 }
 
 // FitContext is Fit with cancellation: it stops within about 50 ms once ctx

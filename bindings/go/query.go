@@ -148,10 +148,8 @@ func checkDims(dims int) error {
 	return nil
 }
 
-// Sample draws n points as n rows of dims floats (4: x, y, z, gray; 3: x, y,
-// z), grouped by component. Same seed, same samples. o (may be nil) gives
-// the truncation.
-func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, error) {
+// sampleBuffer checks a sample request and allocates its n * dims floats.
+func sampleBuffer(n, dims int) ([]float32, error) {
 	if err := checkDims(dims); err != nil {
 		return nil, err
 	}
@@ -161,8 +159,18 @@ func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, err
 	if n > math.MaxInt/dims {
 		return nil, &Error{Status: ErrLimit, Message: fmt.Sprintf("%d samples of %d floats overflow int", n, dims)}
 	}
-	out := make([]float32, n*dims)
-	err := m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+	return make([]float32, n*dims), nil
+}
+
+// Sample draws n points as n rows of dims floats (4: x, y, z, gray; 3: x, y,
+// z), grouped by component. Same seed, same samples. o (may be nil) gives
+// the truncation.
+func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, error) {
+	out, err := sampleBuffer(n, dims)
+	if err != nil {
+		return nil, err
+	}
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
 		return C.sogmm_model_sample_f32(p, C.size_t(n), C.uint64_t(seed), C.int32_t(dims), op, floats(out))
 	})
 	if err != nil {

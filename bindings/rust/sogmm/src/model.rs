@@ -52,7 +52,7 @@ pub struct Frame<'a> {
 impl Frame<'_> {
     /// The color pointer and SOGMM_COLOR_* format, after checking every slice
     /// length against width and height (C cannot see them).
-    fn color_args(&self) -> Result<(*const u8, i32)> {
+    pub(crate) fn color_args(&self) -> Result<(*const u8, i32)> {
         let pixels = len_of(self.width as usize, self.height as usize, "image size")?;
         if self.depth.len() != pixels {
             return Err(invalid(format!(
@@ -109,12 +109,12 @@ impl Frame<'_> {
     }
 }
 
-fn invalid(msg: String) -> Error {
+pub(crate) fn invalid(msg: String) -> Error {
     Error::new(Status::InvalidArg, msg)
 }
 
 /// Number of `cols`-wide rows in `data`, refusing a ragged slice.
-fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
+pub(crate) fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     if data.len() % cols != 0 {
         return Err(invalid(format!(
             "{what} has {} floats, not a multiple of {cols}",
@@ -124,7 +124,7 @@ fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     Ok(data.len() / cols)
 }
 
-fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
+pub(crate) fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
     n.checked_mul(per)
         .ok_or_else(|| Error::new(Status::Limit, format!("{what}: {n} x {per} overflows usize")))
 }
@@ -133,7 +133,7 @@ fn c_string(s: &str, what: &str) -> Result<CString> {
     CString::new(s).map_err(|_| invalid(format!("{what} contains a NUL byte")))
 }
 
-fn c_path(p: &Path) -> Result<CString> {
+pub(crate) fn c_path(p: &Path) -> Result<CString> {
     use std::os::unix::ffi::OsStrExt;
     CString::new(p.as_os_str().as_bytes()).map_err(|_| invalid(format!("path {p:?} contains a NUL byte")))
 }
@@ -147,7 +147,7 @@ fn owned(p: *const sys::c_char) -> String {
 
 impl Model {
     /// Runs a C constructor taking an out-pointer first.
-    fn make(f: impl FnOnce(*mut *mut sys::sogmm_model) -> i32) -> Result<Model> {
+    pub(crate) fn make(f: impl FnOnce(*mut *mut sys::sogmm_model) -> i32) -> Result<Model> {
         crate::ensure_abi()?;
         let mut out = ptr::null_mut();
         check(f(&mut out))?;
@@ -156,7 +156,7 @@ impl Model {
         })
     }
 
-    fn raw(&self) -> *const sys::sogmm_model {
+    pub(crate) fn raw(&self) -> *const sys::sogmm_model {
         self.ptr.as_ptr()
     }
 
@@ -194,6 +194,36 @@ impl Model {
     ) -> Result<Model> {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| Model::fit_rgbd_raw(frame, o))
+    }
+
+    /// Warm start: fits n points starting from `initial`, a model of an
+    /// earlier, overlapping cloud already moved into these points' frame
+    /// (e.g. the previous frame's model moved with `transform`). Self-
+    /// organizing: components `initial` no longer explains are dropped and
+    /// new ones are added for the novel points; with SOGMM_OPT_N_COMPONENTS
+    /// = K, EM runs from `initial` as given (K must be its size). Needs
+    /// n_init 1. `initial` is not changed.
+    pub fn fit_warm(points: &[f32], initial: &Model, options: Option<&Options>) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
+        Model::make(|out| unsafe {
+            sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
+        })
+    }
+
+    /// As `fit_warm`, with progress and cancel as `fit_with_progress`.
+    pub fn fit_warm_with_progress(
+        points: &[f32],
+        initial: &Model,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        crate::ensure_abi()?;
+        with_progress(options, on_progress, |o| {
+            // SAFETY: as fit_warm; `o` is a valid options handle for the call.
+            Model::make(|out| unsafe { sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), o) })
+        })
     }
 
     /// Fits exactly `k` components (1 <= k <= n).
