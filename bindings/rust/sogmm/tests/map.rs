@@ -25,7 +25,12 @@ fn blobs(n: usize, seed: u64) -> Vec<f32> {
 }
 
 fn map_options(novelty: bool) -> Options {
-    Options::builder().map_novelty(novelty).map_batch_size(100_000).threads(2).build().unwrap()
+    Options::builder()
+        .map_novelty(novelty)
+        .map_batch_size(100_000)
+        .threads(2)
+        .build()
+        .unwrap()
 }
 
 /// Two posed copies of the blobs, flushed.
@@ -69,8 +74,14 @@ fn inserts_stats_export_and_files() {
     assert_eq!(loaded.frame_stats(2).unwrap().pose[3], 2.0);
     assert_eq!(loaded.export().unwrap().means().unwrap(), all.means().unwrap());
     // Bad input: ragged rows, an empty frame, a pose that is not rigid.
-    assert_eq!(map.insert_points(&pts[..7], &IDENTITY).unwrap_err().status(), Status::InvalidArg);
-    assert_eq!(map.insert_points(&[], &IDENTITY).unwrap_err().status(), Status::InvalidData);
+    assert_eq!(
+        map.insert_points(&pts[..7], &IDENTITY).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    assert_eq!(
+        map.insert_points(&[], &IDENTITY).unwrap_err().status(),
+        Status::InvalidData
+    );
     let mut scaled = IDENTITY;
     scaled[0] = 2.0;
     let e = map.insert_points(&pts, &scaled).unwrap_err();
@@ -105,7 +116,8 @@ fn queries_equal_the_exported_model_bitwise() {
     }
     assert_eq!(map.regress_gray(&q3).unwrap(), model.regress_gray(&q3).unwrap());
     assert_eq!(
-        map.regress_gray_with_progress(&q3, |_| ControlFlow::Continue(())).unwrap(),
+        map.regress_gray_with_progress(&q3, |_| ControlFlow::Continue(()))
+            .unwrap(),
         model.regress_gray(&q3).unwrap()
     );
     assert_eq!(map.sample(4000, 3, 4, None).unwrap(), model.sample(4000, 3, 4).unwrap());
@@ -115,7 +127,9 @@ fn queries_equal_the_exported_model_bitwise() {
         model.sample_with(4000, 3, 3, Some(&trunc)).unwrap()
     );
     // Cancel and bad input.
-    let e = map.regress_gray_with_progress(&q3, |_| ControlFlow::Break(())).unwrap_err();
+    let e = map
+        .regress_gray_with_progress(&q3, |_| ControlFlow::Break(()))
+        .unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
     assert_eq!(map.score_samples(&q3, 5).unwrap_err().status(), Status::InvalidArg);
     assert_eq!(map.score_samples(&q3[..4], 3).unwrap_err().status(), Status::InvalidArg);
@@ -145,7 +159,9 @@ fn a_cancelled_insert_or_flush_leaves_the_map_as_it_was() {
     .unwrap();
     assert_eq!(stages.last(), Some(&Stage::Em));
     let before = (map.stats().unwrap(), map.export().unwrap().means().unwrap());
-    let e = map.insert_points_with_progress(&pts, &shifted(3.0), |_| ControlFlow::Break(())).unwrap_err();
+    let e = map
+        .insert_points_with_progress(&pts, &shifted(3.0), |_| ControlFlow::Break(()))
+        .unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
     assert_eq!((map.stats().unwrap(), map.export().unwrap().means().unwrap()), before);
     // A panic cancels too, resumes here, and leaves the map as it was.
@@ -184,12 +200,21 @@ fn warm_start_from_a_fit_of_the_same_points() {
     assert_eq!(warm.n_components(), 3);
     let ll = |m: &Model| m.score_samples(&pts, 4).unwrap().iter().sum::<f64>() / 3000.0;
     assert!(ll(&warm) >= ll(&cold) - 1e-6, "{} < {}", ll(&warm), ll(&cold));
-    assert_eq!(Model::fit_warm(&pts, &cold, Some(&fixed)).unwrap().means().unwrap(), warm.means().unwrap());
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&fixed)).unwrap().means().unwrap(),
+        warm.means().unwrap()
+    );
     // K must be the initial model's size; a warm start is one run.
     let k4 = Options::builder().n_components(4).build().unwrap();
-    assert_eq!(Model::fit_warm(&pts, &cold, Some(&k4)).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&k4)).unwrap_err().status(),
+        Status::InvalidArg
+    );
     let two_runs = Options::builder().n_init(2).build().unwrap();
-    assert_eq!(Model::fit_warm(&pts, &cold, Some(&two_runs)).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&two_runs)).unwrap_err().status(),
+        Status::InvalidArg
+    );
     let e = Model::fit_warm_with_progress(&pts, &cold, None, |_| ControlFlow::Break(())).unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
 }
