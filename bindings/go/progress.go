@@ -135,10 +135,9 @@ func withMapProgress(ctx context.Context, m *Map, fn ProgressFunc, run func() er
 	}); err != nil {
 		return err
 	}
-	err := run()
-	// Removed before the handle is deleted; cannot fail on an open map.
-	_ = m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
-	return state.finish(err)
+	// Removed (before the handle is deleted) on every path; cannot fail on an open map.
+	defer m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
+	return state.finish(run())
 }
 
 // FitContext is Fit with cancellation: it stops within about 50 ms once ctx
