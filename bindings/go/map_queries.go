@@ -24,20 +24,12 @@ func (m *Map) ScoreSamplesContext(ctx context.Context, points []float32, dims in
 }
 
 func (m *Map) scoreSamples(points []float32, dims int, o *Options) ([]float64, error) {
-	if err := checkDims(dims); err != nil {
-		return nil, err
-	}
-	n, err := rowsOf(points, dims, "points")
+	n, out, err := scoreBuffer(points, dims)
 	if err != nil {
 		return nil, err
 	}
-	out := make([]float64, n)
-	var dst *C.double
-	if n > 0 {
-		dst = (*C.double)(&out[0])
-	}
 	err = m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_map_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), op, dst)
+		return C.sogmm_map_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
 	})
 	if err != nil {
 		return nil, err

@@ -148,6 +148,27 @@ func checkDims(dims int) error {
 	return nil
 }
 
+// scoreBuffer checks a score request (rows of dims floats) and allocates its
+// n doubles.
+func scoreBuffer(points []float32, dims int) (int, []float64, error) {
+	if err := checkDims(dims); err != nil {
+		return 0, nil, err
+	}
+	n, err := rowsOf(points, dims, "points")
+	if err != nil {
+		return 0, nil, err
+	}
+	return n, make([]float64, n), nil
+}
+
+// doubles is floats for a float64 slice (nil when empty).
+func doubles(s []float64) *C.double {
+	if len(s) == 0 {
+		return nil
+	}
+	return (*C.double)(&s[0])
+}
+
 // sampleBuffer checks a sample request and allocates its n * dims floats.
 func sampleBuffer(n, dims int) ([]float32, error) {
 	if err := checkDims(dims); err != nil {
@@ -199,20 +220,12 @@ func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error)
 // ScoreSamples is the log-density of rows of dims floats (4: joint; 3:
 // marginal over gray).
 func (m *Model) ScoreSamples(points []float32, dims int) ([]float64, error) {
-	if err := checkDims(dims); err != nil {
-		return nil, err
-	}
-	n, err := rowsOf(points, dims, "points")
+	n, out, err := scoreBuffer(points, dims)
 	if err != nil {
 		return nil, err
 	}
-	out := make([]float64, n)
-	var o *C.double
-	if n > 0 {
-		o = (*C.double)(&out[0])
-	}
 	err = m.do(nil, func(p *C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), o)
+		return C.sogmm_model_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), doubles(out))
 	})
 	if err != nil {
 		return nil, err
