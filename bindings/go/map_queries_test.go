@@ -207,3 +207,34 @@ func TestFitWarm(t *testing.T) {
 		t.Fatalf("nil initial: %v", err)
 	}
 }
+
+// The model's context queries give the same values and report points.
+func TestModelQueryContexts(t *testing.T) {
+	m := twoFrameMap(t)
+	defer m.Close()
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer model.Close()
+	q := twoBlobs(5000)
+	want, _ := model.ScoreSamples(q, 4)
+	var last Progress
+	got, err := model.ScoreSamplesContext(context.Background(), q, 4, func(p Progress) error { last = p; return nil })
+	if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
+		t.Fatalf("score with context: err %v, last %+v", err, last)
+	}
+	xyz := make([]float32, 0, 3*5000)
+	for i := 0; i < len(q); i += 4 {
+		xyz = append(xyz, q[i:i+3]...)
+	}
+	wm, _, _ := model.RegressGray(xyz)
+	gm, _, err := model.RegressGrayContext(context.Background(), xyz, func(p Progress) error { last = p; return nil })
+	if err != nil || !slices.Equal(gm, wm) || last.Stage != StageRegression {
+		t.Fatalf("regress with context: err %v, last %+v", err, last)
+	}
+	stop := errors.New("stop")
+	if _, err := model.ScoreSamplesContext(context.Background(), q, 4, func(Progress) error { return stop }); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
+		t.Fatalf("cancelled score: %v", err)
+	}
+}

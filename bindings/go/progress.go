@@ -147,6 +147,22 @@ func FitContext(ctx context.Context, points []float32, o *Options, fn ProgressFu
 	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return Fit(points, p) })
 }
 
+// ScoreSamplesContext is ScoreSamples with cancellation and progress
+// (StageScoring) as FitContext; the same values.
+func (m *Model) ScoreSamplesContext(ctx context.Context, points []float32, dims int, fn ProgressFunc) ([]float64, error) {
+	return withProgress(ctx, nil, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
+}
+
+// RegressGrayContext is RegressGray with cancellation and progress
+// (StageRegression) as FitContext; the same values.
+func (m *Model) RegressGrayContext(ctx context.Context, xyz []float32, fn ProgressFunc) (mean, variance []float32, err error) {
+	both, err := withProgress(ctx, nil, fn, func(p *Options) ([2][]float32, error) {
+		mean, variance, err := m.regressGray(xyz, p)
+		return [2][]float32{mean, variance}, err
+	})
+	return both[0], both[1], err
+}
+
 // FitRGBDContext is FitRGBD with cancellation and progress as FitContext.
 func FitRGBDContext(ctx context.Context, f Frame, o *Options, fn ProgressFunc) (*Model, error) {
 	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return FitRGBD(f, p) })

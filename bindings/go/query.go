@@ -203,13 +203,17 @@ func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, err
 // RegressGray gives the expected gray and its conditional variance at n
 // points (xyz: n rows of 3).
 func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error) {
+	return m.regressGray(xyz, nil)
+}
+
+func (m *Model) regressGray(xyz []float32, o *Options) (mean, variance []float32, err error) {
 	n, err := rowsOf(xyz, 3, "xyz")
 	if err != nil {
 		return nil, nil, err
 	}
 	mean, variance = make([]float32, n), make([]float32, n)
-	err = m.do(nil, func(p *C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_regress_gray_f32(p, floats(xyz), C.size_t(n), floats(mean), floats(variance))
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_model_regress_gray_f32_v2(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
 	})
 	if err != nil {
 		return nil, nil, err
@@ -220,12 +224,16 @@ func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error)
 // ScoreSamples is the log-density of rows of dims floats (4: joint; 3:
 // marginal over gray).
 func (m *Model) ScoreSamples(points []float32, dims int) ([]float64, error) {
+	return m.scoreSamples(points, dims, nil)
+}
+
+func (m *Model) scoreSamples(points []float32, dims int, o *Options) ([]float64, error) {
 	n, out, err := scoreBuffer(points, dims)
 	if err != nil {
 		return nil, err
 	}
-	err = m.do(nil, func(p *C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), doubles(out))
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_model_score_samples_f32_v2(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
 	})
 	if err != nil {
 		return nil, err

@@ -40,25 +40,12 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
 
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
                                                     float* mean_out, float* variance_out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    if (n == 0) return SOGMM_OK;
-    sogmm_capi::require_query_input(xyz, n, 3, "xyz", mean_out, "mean_out");
-    sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out);
-  }
-  SOGMM_CATCH
+  return sogmm_model_regress_gray_f32_v2(model, xyz, n, nullptr, mean_out, variance_out);
 }
 
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_dims(dims);
-    if (n == 0) return SOGMM_OK;
-    sogmm_capi::require_query_input(points, n, static_cast<std::size_t>(dims), "points", out, "out");
-    sogmm::score_samples(model->model.gmm, points, n, dims, out);
-  }
-  SOGMM_CATCH
+  return sogmm_model_score_samples_f32_v2(model, points, n, dims, nullptr, out);
 }
 
 SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b) {

@@ -30,11 +30,8 @@ SOGMM_API sogmm_status sogmm_map_score_samples_f32(const sogmm_map* map, const f
     require_nonnull(map, "map");
     require_dims(dims);
     require_map_with_components(map);
-    if (n == 0) return SOGMM_OK;
-    sogmm_capi::require_query_input(points, n, static_cast<std::size_t>(dims), "points", out, "out");
-    const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    sogmm_capi::write_on_success(o.progress != nullptr, out, n, [&](double* dst) {
-      sogmm::score_samples(map->map, points, n, dims, dst, sogmm_capi::progress_sink(o));
+    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::ProgressSink& sink) {
+      sogmm::score_samples(map->map, points, n, dims, dst, sink);
     });
   }
   SOGMM_CATCH
@@ -45,15 +42,10 @@ SOGMM_API sogmm_status sogmm_map_regress_gray_f32(const sogmm_map* map, const fl
                                                   float* variance_out) {
   SOGMM_TRY {
     require_map_with_components(map);
-    if (n == 0) return SOGMM_OK;
-    sogmm_capi::require_query_input(xyz, n, 3, "xyz", mean_out, "mean_out");
-    const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    // Both outputs are written only on success; the variance is optional.
-    sogmm_capi::write_on_success(o.progress != nullptr, mean_out, n, [&](float* mean) {
-      sogmm_capi::write_on_success(o.progress != nullptr, variance_out, n, [&](float* variance) {
-        sogmm::regress_gray(map->map, xyz, n, mean, variance, sogmm_capi::progress_sink(o));
-      });
-    });
+    sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
+                                  [&](float* mean, float* variance, const sogmm::ProgressSink& sink) {
+                                    sogmm::regress_gray(map->map, xyz, n, mean, variance, sink);
+                                  });
   }
   SOGMM_CATCH
 }

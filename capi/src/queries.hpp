@@ -41,4 +41,31 @@ void write_on_success(bool progress, T* out, std::size_t count, const Write& wri
   std::copy(tmp.begin(), tmp.end(), out);
 }
 
+/// The body of a score query (model or map) after the handle and dims
+/// checks: n == 0 writes nothing; then require_query_input; then
+/// score(dst, sink) with the options' progress sink, through
+/// write_on_success.
+template <class Score>
+void run_score_query(const float* points, std::size_t n, int32_t dims, const sogmm_options* options, double* out,
+                     const Score& score) {
+  if (n == 0) return;
+  require_query_input(points, n, static_cast<std::size_t>(dims), "points", out, "out");
+  const sogmm_options& o = opts_or_default(options);
+  write_on_success(o.progress != nullptr, out, n, [&](double* dst) { score(dst, progress_sink(o)); });
+}
+
+/// The same for a gray regression: regress(mean, variance, sink), the
+/// variance optional (NULL stays NULL).
+template <class Regress>
+void run_regress_query(const float* xyz, std::size_t n, const sogmm_options* options, float* mean_out,
+                       float* variance_out, const Regress& regress) {
+  if (n == 0) return;
+  require_query_input(xyz, n, 3, "xyz", mean_out, "mean_out");
+  const sogmm_options& o = opts_or_default(options);
+  write_on_success(o.progress != nullptr, mean_out, n, [&](float* mean) {
+    write_on_success(o.progress != nullptr, variance_out, n,
+                     [&](float* variance) { regress(mean, variance, progress_sink(o)); });
+  });
+}
+
 }  // namespace sogmm_capi

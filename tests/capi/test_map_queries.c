@@ -1,6 +1,6 @@
 /* Map queries (sogmm_map_score_samples_f32, _regress_gray_f32, _sample_f32):
  * bitwise equal to the same query on the exported map, with and without a
- * progress callback; a cancel writes nothing; a status and message for every
+ * progress callback (and the model's _v2 queries, which take one); a cancel writes nothing; a status and message for every
  * bad input. Progress and cancel of inserts and flushes
  * (sogmm_map_set_progress): a cancelled insert or flush leaves the map as it
  * was. */
@@ -310,11 +310,70 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   sogmm_options_free(o);
 }
 
+/* The model queries with options (_v2): the same bits as without, reports
+ * of SCORING / REGRESSION up to n, a cancel leaves the outputs untouched. */
+static void model_v2(const sogmm_map* map, const float* pts, size_t n) {
+  sogmm_model* model = NULL;
+  sogmm_options* po = NULL;
+  Recorder rec;
+  float* q3 = query_points(pts, n, 3);
+  double* want = (double*)malloc(n * sizeof(double));
+  double* got = (double*)malloc(n * sizeof(double));
+  float* mean_w = (float*)malloc(n * sizeof(float));
+  float* var_w = (float*)malloc(n * sizeof(float));
+  float* mean_g = (float*)malloc(n * sizeof(float));
+  float* var_g = (float*)malloc(n * sizeof(float));
+  if (!want || !got || !mean_w || !var_w || !mean_g || !var_g) exit(2);
+  REQUIRE_OK(sogmm_map_export(&model, map, NULL));
+  REQUIRE_OK(sogmm_options_create(&po));
+  REQUIRE_OK(sogmm_options_set_progress(po, record, &rec));
+
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, want));
+  memset(&rec, 0, sizeof rec);
+  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got));
+  EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
+  EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_SCORING && rec.last_step == n && rec.last_total == n);
+  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, NULL, got));
+  EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
+
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, mean_w, var_w));
+  memset(&rec, 0, sizeof rec);
+  REQUIRE_OK(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, var_g));
+  EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
+  EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_REGRESSION && rec.last_step == n && !rec.decreasing);
+
+  rec.cancel = 1;
+  memset(got, 0x7f, n * sizeof(double));
+  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
+  EXPECT_TRUE(((const unsigned char*)got)[8 * n - 1] == 0x7f);
+  memset(mean_g, 0x7f, n * sizeof(float));
+  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
+  EXPECT_TRUE(((const unsigned char*)mean_g)[0] == 0x7f);
+  /* Bad input as without _v2. */
+  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
+  EXPECT_OK(sogmm_model_regress_gray_f32_v2(model, NULL, 0, po, NULL, NULL));
+  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
+  q3[4] = NAN;
+  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
+
+  sogmm_options_free(po);
+  sogmm_model_free(model);
+  free(q3);
+  free(want);
+  free(got);
+  free(mean_w);
+  free(var_w);
+  free(mean_g);
+  free(var_g);
+}
+
 int main(void) {
   const size_t n = 10000; /* more than one progress chunk (4096 points) */
   float* pts = make_clusters(n, 42);
   sogmm_map* map = make_map(pts, 3000);
   equals_exported_model(map, pts, n);
+  model_v2(map, pts, n);
   bad_input(map, pts);
   insert_progress_and_cancel(pts, 3000);
   sogmm_map_free(map);

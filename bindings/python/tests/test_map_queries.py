@@ -104,3 +104,16 @@ def test_a_cancelled_insert_or_flush_leaves_the_map_as_it_was():
             m.flush(progress=lambda *_: True)
         assert m.n_pending_ == len(pts) and m.n_components_ == 0
         assert m.flush(progress=lambda *_: None) > 0
+
+
+def test_gmm_queries_take_progress(two_frames):
+    g = two_frames.export()
+    q = queries(3)
+    seen = []
+    np.testing.assert_array_equal(g.score_samples(q, progress=lambda *r: seen.append(r)), g.score_samples(q))
+    assert seen[0][0] == STAGE_SCORING and seen[-1][1] == len(q)
+    seen.clear()
+    np.testing.assert_array_equal(g.regress_gray(q, progress=lambda *r: seen.append(r))[1], g.regress_gray(q)[1])
+    assert seen[-1][0] == STAGE_REGRESSION
+    with pytest.raises(sogmm.CancelledError):
+        g.regress_gray(q, progress=lambda *_: True)

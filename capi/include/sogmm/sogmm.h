@@ -225,9 +225,9 @@ SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm
 #define SOGMM_STAGE_RUN 4        /* SOGMM_OPT_N_INIT > 1 only: run `step` (from 1) of `total` starts;
                                   * log_likelihood: the best final value of the runs before (0 at first) */
 #define SOGMM_STAGE_SAMPLING 5   /* sogmm_model_sample_f32; step/total: points drawn / requested */
-#define SOGMM_STAGE_SCORING 6    /* sogmm_map_score_samples_f32; step/total: points scored / requested
+#define SOGMM_STAGE_SCORING 6    /* sogmm_*_score_samples_f32*; step/total: points scored / requested
                                   * (the last report has step = total) */
-#define SOGMM_STAGE_REGRESSION 7 /* sogmm_map_regress_gray_f32; step/total as SCORING */
+#define SOGMM_STAGE_REGRESSION 7 /* sogmm_*_regress_gray_f32*; step/total as SCORING */
 
 /* Progress callback. Return 0 to continue; any non-zero value cancels: the
  * call stops within one report interval, frees everything it allocated,
@@ -251,7 +251,8 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
  * is passed through and not owned. sogmm_options_clone copies the pair.
  * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
  * sogmm_fit_points_warm_f32, sogmm_fit_rgbd (from the mode count on),
- * sogmm_model_sample_f32 and the map queries sogmm_map_score_samples_f32,
+ * sogmm_model_sample_f32, sogmm_model_regress_gray_f32_v2,
+ * sogmm_model_score_samples_f32_v2 and the map queries sogmm_map_score_samples_f32,
  * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
  * a temporary buffer: as much memory again as their output); the map's
  * inserts and flushes use the callback of sogmm_map_set_progress. Other
@@ -449,6 +450,20 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, co
  * SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out);
+
+/* sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32 with
+ * options (NULL = defaults), for their progress callback
+ * (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION, SOGMM_STAGE_SCORING):
+ * the same bits; a cancel returns SOGMM_E_CANCELLED with the outputs
+ * untouched (they are then written through a temporary buffer: as much
+ * memory again as the output). Arguments and errors otherwise as the
+ * functions without _v2. */
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
+                                                       const sogmm_options* options, float* mean_out,
+                                                       float* variance_out);
+SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
+                                                        size_t n, int32_t dims, const sogmm_options* options,
+                                                        double* out);
 
 /* New model with the components of a and b, weights re-weighted by support
  * size; support size a + b. Both must be in the same frame (key

@@ -23,8 +23,7 @@ namespace sogmm {
 /// dims 4 = rows (x, y, z, gray), joint; dims 3 = rows (x, y, z), marginal.
 /// Errors: the map has no component -> Error(InvalidData) (checked first);
 /// then as score_samples. `progress` (optional) receives Stage::Scoring
-/// reports (step = points scored; the first at 0, the last at n) and may
-/// cancel (Error(Cancelled); `out` may then be partly written).
+/// reports and may cancel, as in sogmm/query_progress.hpp.
 void score_samples(const Map& map, const float* points, std::size_t n, int dims, double* out,
                    const ProgressSink& progress = {});
 

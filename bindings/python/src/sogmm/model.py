@@ -332,13 +332,16 @@ class GMM:
         check(lib.sogmm_model_set_value(self._h(), k, v))
 
     # ---- inference -------------------------------------------------------
-    def score_samples(self, X) -> np.ndarray:
+    def score_samples(self, X, progress: ProgressArg = None) -> np.ndarray:
         """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
-        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,)."""
+        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,).
+        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_SCORING, points done)."""
         h = self._h()
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
-        check(lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], out))
+        with _ffi.Options() as o:
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
 
     def score(self, X) -> float:
@@ -357,13 +360,16 @@ class GMM:
             check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
         return out
 
-    def regress_gray(self, xyz) -> tuple[np.ndarray, np.ndarray]:
-        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays."""
+    def regress_gray(self, xyz, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray]:
+        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays.
+        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
         h = self._h()
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
         var = np.empty(x.shape[0], dtype=np.float32)
-        check(lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], mean, var))
+        with _ffi.Options() as o:
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
     def merge(self, other: "GMM") -> "GMM":

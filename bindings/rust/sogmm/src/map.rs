@@ -8,7 +8,7 @@ use std::ptr::{self, NonNull};
 use sogmm_sys as sys;
 
 use crate::error::{check, Result};
-use crate::model::{c_path, invalid, len_of, rows, Frame, Model};
+use crate::model::{c_path, dims_ok, len_of, regress_with, rows, score_with, Frame, Model};
 use crate::options::{opt_ptr, Options};
 use crate::progress::{with_map_progress, with_progress, Progress};
 
@@ -59,14 +59,6 @@ pub struct Map {
 // thread affinity, so moving it between threads is fine.
 unsafe impl Send for Map {}
 unsafe impl Sync for Map {}
-
-fn dims_ok(dims: i32) -> Result<usize> {
-    if dims == 3 || dims == 4 {
-        Ok(dims as usize)
-    } else {
-        Err(invalid(format!("dims must be 3 or 4, got {dims}")))
-    }
-}
 
 impl Map {
     fn make(f: impl FnOnce(*mut *mut sys::sogmm_map) -> i32) -> Result<Map> {
@@ -227,11 +219,10 @@ impl Map {
     }
 
     fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
-        let n = rows(points, dims_ok(dims)?, "points")?;
-        let mut out = vec![0.0f64; n];
-        // SAFETY: n rows in, n doubles of room out.
-        check(unsafe { sys::sogmm_map_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out.as_mut_ptr()) })?;
-        Ok(out)
+        // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
+        score_with(points, dims, |n, out| unsafe {
+            sys::sogmm_map_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
+        })
     }
 
     /// Expected gray and its variance at world points (`xyz`: rows of 3).
@@ -249,13 +240,10 @@ impl Map {
     }
 
     fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
-        let n = rows(xyz, 3, "xyz")?;
-        let (mut mean, mut var) = (vec![0.0f32; n], vec![0.0f32; n]);
-        // SAFETY: n rows in, n floats of room in each output.
-        check(unsafe {
-            sys::sogmm_map_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean.as_mut_ptr(), var.as_mut_ptr())
-        })?;
-        Ok((mean, var))
+        // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
+        regress_with(xyz, |n, mean, var| unsafe {
+            sys::sogmm_map_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
+        })
     }
 
     /// Draws n world points (rows of `dims` floats, grouped by component);
