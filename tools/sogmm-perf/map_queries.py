@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """World-frame queries on a map (issue 18): Map.score_samples / regress_gray
 through sogmm_map_*_f32 against the previous path, export() then the GMM
-query (a copy of every component per call). Both give the same bits (checked
-here). Builds a synthetic map (novelty off, fixed K per frame), then times
+query (a copy of every component per call), and the same with a progress
+callback (chunked). All give the same bits (checked here). Builds a synthetic map (novelty off, fixed K per frame), then times
 the two paths interleaved in the same process and prints medians and ratios:
 
   SOGMM_LIBRARY_PATH=build/capi/libsogmm.so python3 tools/sogmm-perf/map_queries.py
@@ -55,20 +55,26 @@ def main() -> None:
     rng = np.random.default_rng(5)
     for n in (100, 10000):
         q = np.column_stack([rng.uniform(0, 2.5 * args.frames, n), rng.uniform(-1, 1, (n, 2))]).astype(np.float32)
-        for name, old, new in (
-            ("score_samples", lambda: m.export().score_samples(q), lambda: m.score_samples(q)),
-            ("regress_gray", lambda: m.export().regress_gray(q)[0], lambda: m.regress_gray(q)[0]),
+        quiet = lambda *_: None  # noqa: E731 - a progress callback that never cancels
+        for name, old, new, with_progress in (
+            ("score_samples", lambda: m.export().score_samples(q), lambda: m.score_samples(q),
+             lambda: m.score_samples(q, progress=quiet)),
+            ("regress_gray", lambda: m.export().regress_gray(q)[0], lambda: m.regress_gray(q)[0],
+             lambda: m.regress_gray(q, progress=quiet)[0]),
         ):
-            t_old, t_new = [], []
-            for _ in range(args.repeats):  # interleaved: the same load on both
+            t_old, t_new, t_prog = [], [], []
+            for _ in range(args.repeats):  # interleaved: the same load on all three
                 a, ra = timed(old)
                 b, rb = timed(new)
+                c, rc = timed(with_progress)
                 t_old.append(a)
                 t_new.append(b)
-                assert np.array_equal(ra, rb), "the map query differs from export + query"
-            mo, mn = statistics.median(t_old), statistics.median(t_new)
-            print(f"{name:14s} n={n:6d}: export+query {1e3 * mo:8.2f} ms, map query {1e3 * mn:8.2f} ms, "
-                  f"ratio {mo / mn:5.2f}x (medians of {args.repeats})")
+                t_prog.append(c)
+                assert np.array_equal(ra, rb) and np.array_equal(ra, rc), "the map query differs from export + query"
+            mo, mn, mp = (statistics.median(t) for t in (t_old, t_new, t_prog))
+            print(f"{name:14s} n={n:6d}: export+query {1e3 * mo:8.2f} ms, map query {1e3 * mn:8.2f} ms "
+                  f"(ratio {mo / mn:4.2f}x), with progress {1e3 * mp:8.2f} ms (ratio {mp / mn:4.2f}x) "
+                  f"(medians of {args.repeats})")
 
 
 if __name__ == "__main__":
