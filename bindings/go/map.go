@@ -25,8 +25,10 @@ const (
 
 // Map is an owned sogmm_map: an incremental world map that fits only the
 // parts of each posed frame it does not yet explain (core/include/sogmm/map.hpp).
-// Poses are row-major 4 x 4 camera-to-world rigid transforms. Not safe for
-// concurrent use.
+// Poses are row-major 4 x 4 camera-to-world rigid transforms. Inserts,
+// flushes and Close need exclusive use; the queries (Stats, Export,
+// ScoreSamples, RegressGray, Sample, Save) only read the map and may run
+// concurrently with each other.
 type Map struct {
 	ptr *C.sogmm_map
 }
@@ -84,11 +86,22 @@ func (m *Map) Close() {
 }
 
 func (m *Map) do(f func(p *C.sogmm_map) C.sogmm_status) error {
+	return m.doWith(nil, func(p *C.sogmm_map, _ *C.sogmm_options) C.sogmm_status { return f(p) })
+}
+
+// doWith runs one C call on m's handle and o's (nil o = defaults), keeping
+// both alive until it returns.
+func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status) error {
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
+	op, err := o.raw()
+	if err != nil {
+		return err
+	}
 	defer runtime.KeepAlive(m)
-	return call(func() C.sogmm_status { return f(m.ptr) })
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return f(m.ptr, op) })
 }
 
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the

@@ -4,6 +4,7 @@ package sogmm
 #include <stdint.h>
 #include "sogmm/sogmm.h"
 sogmm_status sogmm_go_set_progress(sogmm_options* options, uintptr_t handle);
+sogmm_status sogmm_go_map_set_progress(sogmm_map* map, uintptr_t handle);
 */
 import "C"
 
@@ -17,11 +18,13 @@ import (
 type Stage int32
 
 const (
-	StageModeCount Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
-	StageSeeding   Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
-	StageEM        Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
-	StageRun       Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
-	StageSampling  Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
+	StageModeCount  Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
+	StageSeeding    Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
+	StageEM         Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
+	StageRun        Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
+	StageSampling   Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
+	StageScoring    Stage = C.SOGMM_STAGE_SCORING    // scoring on a map; Step/Total: points scored / requested
+	StageRegression Stage = C.SOGMM_STAGE_REGRESSION // gray regression on a map; Step/Total: points done / requested
 )
 
 // Progress is one report. Total is 0 when unknown; LogLikelihood is the mean
@@ -81,8 +84,9 @@ func sogmmGoProgress(stage C.int32_t, step, total C.uint64_t, ll C.double, handl
 // withProgress runs create with a private copy of o (nil = defaults) that
 // reports to fn and watches ctx; ctx's error or fn's becomes the Cause of
 // the ErrCancelled error, and a panic in fn is raised again here.
-func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
-	create func(private *Options) (*Model, error)) (*Model, error) {
+func withProgress[T any](ctx context.Context, o *Options, fn ProgressFunc,
+	create func(private *Options) (T, error)) (T, error) {
+	var zero T
 	var private *Options
 	var err error
 	if o == nil {
@@ -91,7 +95,7 @@ func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
 		private, err = o.Clone()
 	}
 	if err != nil {
-		return nil, err
+		return zero, err
 	}
 	defer private.Close()
 	state := &progressState{ctx: ctx, fn: fn}
@@ -100,16 +104,40 @@ func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
 	if err := private.do(func(p *C.sogmm_options) C.sogmm_status {
 		return C.sogmm_go_set_progress(p, C.uintptr_t(h))
 	}); err != nil {
-		return nil, err
+		return zero, err
 	}
-	m, err := create(private)
-	if state.panicked {
-		panic(state.panicVal)
+	r, err := create(private)
+	return r, state.finish(err)
+}
+
+// finish raises a panic of the progress func again and gives a cancelled
+// call's error its Cause.
+func (s *progressState) finish(err error) error {
+	if s.panicked {
+		panic(s.panicVal)
 	}
 	if e, ok := err.(*Error); ok && e.Status == ErrCancelled {
-		e.Cause = state.cause
+		e.Cause = s.cause
 	}
-	return m, err
+	return err
+}
+
+// withMapProgress runs run with the progress callback of m set to report to
+// fn and watch ctx (sogmm_map_set_progress) and removed again afterwards;
+// errors and panics as withProgress. The caller must have exclusive use of
+// m, as for any insert.
+func withMapProgress(ctx context.Context, m *Map, fn ProgressFunc, run func() error) error {
+	state := &progressState{ctx: ctx, fn: fn}
+	h := cgo.NewHandle(state)
+	defer h.Delete()
+	if err := m.do(func(p *C.sogmm_map) C.sogmm_status {
+		return C.sogmm_go_map_set_progress(p, C.uintptr_t(h))
+	}); err != nil {
+		return err
+	}
+	// Removed (before the handle is deleted) on every path; cannot fail on an open map.
+	defer m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
+	return state.finish(run())
 }
 
 // FitContext is Fit with cancellation: it stops within about 50 ms once ctx
@@ -117,6 +145,22 @@ func withProgress(ctx context.Context, o *Options, fn ProgressFunc,
 // errors.Is(err, ctx.Err())) and reports progress to fn (may be nil).
 func FitContext(ctx context.Context, points []float32, o *Options, fn ProgressFunc) (*Model, error) {
 	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return Fit(points, p) })
+}
+
+// ScoreSamplesContext is ScoreSamples with cancellation and progress
+// (StageScoring) as FitContext; the same values.
+func (m *Model) ScoreSamplesContext(ctx context.Context, points []float32, dims int, fn ProgressFunc) ([]float64, error) {
+	return withProgress(ctx, nil, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
+}
+
+// RegressGrayContext is RegressGray with cancellation and progress
+// (StageRegression) as FitContext; the same values.
+func (m *Model) RegressGrayContext(ctx context.Context, xyz []float32, fn ProgressFunc) (mean, variance []float32, err error) {
+	both, err := withProgress(ctx, nil, fn, func(p *Options) ([2][]float32, error) {
+		mean, variance, err := m.regressGray(xyz, p)
+		return [2][]float32{mean, variance}, err
+	})
+	return both[0], both[1], err
 }
 
 // FitRGBDContext is FitRGBD with cancellation and progress as FitContext.

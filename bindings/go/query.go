@@ -148,10 +148,29 @@ func checkDims(dims int) error {
 	return nil
 }
 
-// Sample draws n points as n rows of dims floats (4: x, y, z, gray; 3: x, y,
-// z), grouped by component. Same seed, same samples. o (may be nil) gives
-// the truncation.
-func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, error) {
+// scoreBuffer checks a score request (rows of dims floats) and allocates its
+// n doubles.
+func scoreBuffer(points []float32, dims int) (int, []float64, error) {
+	if err := checkDims(dims); err != nil {
+		return 0, nil, err
+	}
+	n, err := rowsOf(points, dims, "points")
+	if err != nil {
+		return 0, nil, err
+	}
+	return n, make([]float64, n), nil
+}
+
+// doubles is floats for a float64 slice (nil when empty).
+func doubles(s []float64) *C.double {
+	if len(s) == 0 {
+		return nil
+	}
+	return (*C.double)(&s[0])
+}
+
+// sampleBuffer checks a sample request and allocates its n * dims floats.
+func sampleBuffer(n, dims int) ([]float32, error) {
 	if err := checkDims(dims); err != nil {
 		return nil, err
 	}
@@ -161,8 +180,18 @@ func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, err
 	if n > math.MaxInt/dims {
 		return nil, &Error{Status: ErrLimit, Message: fmt.Sprintf("%d samples of %d floats overflow int", n, dims)}
 	}
-	out := make([]float32, n*dims)
-	err := m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+	return make([]float32, n*dims), nil
+}
+
+// Sample draws n points as n rows of dims floats (4: x, y, z, gray; 3: x, y,
+// z), grouped by component. Same seed, same samples. o (may be nil) gives
+// the truncation.
+func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, error) {
+	out, err := sampleBuffer(n, dims)
+	if err != nil {
+		return nil, err
+	}
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
 		return C.sogmm_model_sample_f32(p, C.size_t(n), C.uint64_t(seed), C.int32_t(dims), op, floats(out))
 	})
 	if err != nil {
@@ -174,13 +203,17 @@ func (m *Model) Sample(n int, seed uint64, dims int, o *Options) ([]float32, err
 // RegressGray gives the expected gray and its conditional variance at n
 // points (xyz: n rows of 3).
 func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error) {
+	return m.regressGray(xyz, nil)
+}
+
+func (m *Model) regressGray(xyz []float32, o *Options) (mean, variance []float32, err error) {
 	n, err := rowsOf(xyz, 3, "xyz")
 	if err != nil {
 		return nil, nil, err
 	}
 	mean, variance = make([]float32, n), make([]float32, n)
-	err = m.do(nil, func(p *C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_regress_gray_f32(p, floats(xyz), C.size_t(n), floats(mean), floats(variance))
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_model_regress_gray_f32_v2(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
 	})
 	if err != nil {
 		return nil, nil, err
@@ -191,20 +224,16 @@ func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error)
 // ScoreSamples is the log-density of rows of dims floats (4: joint; 3:
 // marginal over gray).
 func (m *Model) ScoreSamples(points []float32, dims int) ([]float64, error) {
-	if err := checkDims(dims); err != nil {
-		return nil, err
-	}
-	n, err := rowsOf(points, dims, "points")
+	return m.scoreSamples(points, dims, nil)
+}
+
+func (m *Model) scoreSamples(points []float32, dims int, o *Options) ([]float64, error) {
+	n, out, err := scoreBuffer(points, dims)
 	if err != nil {
 		return nil, err
 	}
-	out := make([]float64, n)
-	var o *C.double
-	if n > 0 {
-		o = (*C.double)(&out[0])
-	}
-	err = m.do(nil, func(p *C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), o)
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_model_score_samples_f32_v2(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
 	})
 	if err != nil {
 		return nil, err

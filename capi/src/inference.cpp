@@ -6,18 +6,15 @@
 #include <vector>
 
 #include "internal.hpp"
+#include "queries.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/inference.hpp"
 
 namespace {
 
 using sogmm_capi::fail;
+using sogmm_capi::require_dims;
 using sogmm_capi::require_nonnull;
-
-void require_dims(int32_t dims) {
-  if (dims != 3 && dims != 4)
-    fail(SOGMM_E_INVALID_ARG, "dims = " + std::to_string(dims) + " (must be 3 or 4)");
-}
 
 }  // namespace
 
@@ -32,45 +29,23 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
     require_nonnull(out, "out");
     sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "samples");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    if (!o.progress) {
-      sogmm::sample(model->model.gmm, n, seed, dims, out, o.sample_truncation);
-    } else {
-      // A cancel must leave `out` untouched: draw into a buffer, copy on success.
-      std::vector<float> drawn(n * static_cast<std::size_t>(dims));
+    // With a callback, draw into a buffer (a cancel leaves `out` untouched).
+    sogmm_capi::write_on_success(o.progress != nullptr, out, n * static_cast<std::size_t>(dims), [&](float* dst) {
       const sogmm::ProgressScope scope(sogmm_capi::progress_sink(o));
-      sogmm::sample(model->model.gmm, n, seed, dims, drawn.data(), o.sample_truncation);
-      std::copy(drawn.begin(), drawn.end(), out);
-    }
+      sogmm::sample(model->model.gmm, n, seed, dims, dst, o.sample_truncation);
+    });
   }
   SOGMM_CATCH
 }
 
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
                                                     float* mean_out, float* variance_out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    if (n == 0) return SOGMM_OK;
-    require_nonnull(xyz, "xyz");
-    require_nonnull(mean_out, "mean_out");
-    sogmm_capi::require_finite(xyz, sogmm::checked::mul<std::size_t>(n, 3, "xyz"), "xyz");
-    sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out);
-  }
-  SOGMM_CATCH
+  return sogmm_model_regress_gray_f32_v2(model, xyz, n, nullptr, mean_out, variance_out);
 }
 
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_dims(dims);
-    if (n == 0) return SOGMM_OK;
-    require_nonnull(points, "points");
-    require_nonnull(out, "out");
-    sogmm_capi::require_finite(points, sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "points"),
-                               "points");
-    sogmm::score_samples(model->model.gmm, points, n, dims, out);
-  }
-  SOGMM_CATCH
+  return sogmm_model_score_samples_f32_v2(model, points, n, dims, nullptr, out);
 }
 
 SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b) {

@@ -4,12 +4,8 @@
 #include <string>
 
 #include "internal.hpp"
+#include "map_handle.hpp"
 #include "sogmm/map.hpp"
-
-struct sogmm_map {
-  sogmm::Map map;
-  sogmm_options options;  ///< the creation options: RGB-D keys of later inserts
-};
 
 namespace {
 
@@ -66,7 +62,7 @@ SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* 
       fail(SOGMM_E_LIMIT, "n = " + std::to_string(n) + " points exceeds the limit of " +
                               std::to_string(sogmm::kMaxPoints) + " per frame");
     sogmm_capi::require_finite(points, 4 * n, "points");
-    map->map.insert_points(sogmm::PointsView{points, n}, p);
+    map->map.insert_points(sogmm::PointsView{points, n}, p, sogmm_capi::progress_sink(map->options));
   }
   SOGMM_CATCH
 }
@@ -80,7 +76,7 @@ SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* dep
     const sogmm::Pose p = pose_of(pose);
     const sogmm_capi::RgbdPoints r =
         sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, map->options);
-    map->map.insert_backprojected(r.cloud.view(), r.camera, p);
+    map->map.insert_backprojected(r.cloud.view(), r.camera, p, sogmm_capi::progress_sink(map->options));
   }
   SOGMM_CATCH
 }
@@ -88,7 +84,16 @@ SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* dep
 SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    map->map.flush();
+    map->map.flush(sogmm_capi::progress_sink(map->options));
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    map->options.progress = fn;
+    map->options.progress_user_data = user_data;
   }
   SOGMM_CATCH
 }

@@ -141,7 +141,20 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   s.frames.push_back(f);
   // Novelty off: each frame is its own batch (append everything).
   // flush() records its fit and merge times on this frame's stats.
-  if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) map.flush(progress);
+  if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) {
+    try {
+      map.flush(progress);
+    } catch (...) {
+      // A failed or cancelled fit leaves the map as it was before this insert
+      // (flush() itself commits nothing on failure): undo the frame.
+      s.frames.pop_back();
+      if (f.n_novel > 0) {
+        s.pending.pop_back();
+        s.n_pending -= f.n_novel;
+      }
+      throw;
+    }
+  }
   s.frames.back().n_components = s.model.gmm.size();
   return s.frames.back();
 }
@@ -180,8 +193,15 @@ FrameStats Map::insert_backprojected(const PointsView& points, const Camera& cam
               " to " + checked::exact(s_->options.depth.depth_max) + " m)");
   check_frame(points);
   // Set before the insert: a flush it runs records the camera in the model.
-  if (!s_->camera) s_->camera = camera;
-  return insert_frame(*s_, *this, points, camera_to_world, true, progress);
+  // A failed insert is undone, the camera included.
+  const bool first_camera = !s_->camera;
+  if (first_camera) s_->camera = camera;
+  try {
+    return insert_frame(*s_, *this, points, camera_to_world, true, progress);
+  } catch (...) {
+    if (first_camera) s_->camera.reset();
+    throw;
+  }
 }
 
 std::size_t Map::flush(const ProgressSink& progress) {

@@ -27,6 +27,8 @@ const char* stage_name(Stage stage) {
     case Stage::Em: return "EM";
     case Stage::Run: return "run";
     case Stage::Sampling: return "sampling";
+    case Stage::Scoring: return "scoring";
+    case Stage::Regression: return "gray regression";
   }
   return "an unknown stage";
 }

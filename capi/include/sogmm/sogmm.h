@@ -225,6 +225,9 @@ SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm
 #define SOGMM_STAGE_RUN 4        /* SOGMM_OPT_N_INIT > 1 only: run `step` (from 1) of `total` starts;
                                   * log_likelihood: the best final value of the runs before (0 at first) */
 #define SOGMM_STAGE_SAMPLING 5   /* sogmm_model_sample_f32; step/total: points drawn / requested */
+#define SOGMM_STAGE_SCORING 6    /* sogmm_*_score_samples_f32*; step/total: points scored / requested
+                                  * (the last report has step = total) */
+#define SOGMM_STAGE_REGRESSION 7 /* sogmm_*_regress_gray_f32*; step/total as SCORING */
 
 /* Progress callback. Return 0 to continue; any non-zero value cancels: the
  * call stops within one report interval, frees everything it allocated,
@@ -247,9 +250,13 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
 /* Sets the progress callback of `options` (fn = NULL removes it); user_data
  * is passed through and not owned. sogmm_options_clone copies the pair.
  * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
- * sogmm_fit_rgbd (from the mode count on) and sogmm_model_sample_f32
- * (which then draws into a temporary buffer: n * dims floats more memory);
- * other functions ignore it. Bindings set it on a private clone for one call. */
+ * sogmm_fit_points_warm_f32, sogmm_fit_rgbd (from the mode count on),
+ * sogmm_model_sample_f32, sogmm_model_regress_gray_f32_v2,
+ * sogmm_model_score_samples_f32_v2 and the map queries sogmm_map_score_samples_f32,
+ * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
+ * a temporary buffer: as much memory again as their output); the map's
+ * inserts and flushes use the callback of sogmm_map_set_progress. Other
+ * functions ignore it. Bindings set it on a private clone for one call. */
 SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_progress_fn fn, void* user_data);
 
 /* ---- fitting ---------------------------------------------------------- */
@@ -456,6 +463,20 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, co
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out);
 
+/* sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32 with
+ * options (NULL = defaults), for their progress callback
+ * (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION, SOGMM_STAGE_SCORING):
+ * the same bits; a cancel returns SOGMM_E_CANCELLED with the outputs
+ * untouched (they are then written through a temporary buffer: as much
+ * memory again as the output). Arguments and errors otherwise as the
+ * functions without _v2. */
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
+                                                       const sogmm_options* options, float* mean_out,
+                                                       float* variance_out);
+SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
+                                                        size_t n, int32_t dims, const sogmm_options* options,
+                                                        double* out);
+
 /* New model with the components of a and b, weights re-weighted by support
  * size; support size a + b. Both must be in the same frame (key
  * "coordinate_frame": absent or "camera", or "world"), else
@@ -529,7 +550,8 @@ SOGMM_API void sogmm_map_free(sogmm_map* map);
  * frame with its camera-to-world `pose`. Errors (the map is unchanged):
  * n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA; pose not finite or not rigid ->
  * SOGMM_E_INVALID_ARG; n > 2^26 -> SOGMM_E_LIMIT; a fit this insert triggers
- * fails -> its status (the frame's novel points then stay pending). */
+ * fails or is cancelled (sogmm_map_set_progress) -> its status, and the
+ * insert is undone: the map is as before the call. */
 SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
                                                    const double* pose);
 /* Inserts an RGB-D frame (arguments as sogmm_fit_rgbd; decimation and depth
@@ -541,9 +563,17 @@ SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* 
 SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
                                              int32_t color_format, uint32_t width, uint32_t height, double fx,
                                              double fy, double cx, double cy, const double* pose);
-/* Fits the pending points now (no-op when none are pending). A failed fit
- * leaves the map and the pending points unchanged. */
+/* Fits the pending points now (no-op when none are pending). A failed or
+ * cancelled fit leaves the map and the pending points unchanged. */
 SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map);
+/* Sets the progress callback of the fits that later inserts and flushes of
+ * `map` run (fn = NULL removes it; rules of sogmm_progress_fn; user_data is
+ * passed through and not owned). A non-zero return cancels the fit: the call
+ * returns SOGMM_E_CANCELLED and the map is as before it. sogmm_map_create and
+ * sogmm_map_load start with the callback of their options (none by
+ * default). An insert that runs no fit calls no callback. Needs exclusive
+ * use of the map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data);
 
 /* Totals of a map. */
 typedef struct sogmm_map_stats {
@@ -578,6 +608,37 @@ SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t 
  * SOGMM_E_INVALID_DATA; a box with min > max or NaN/Inf ->
  * SOGMM_E_INVALID_ARG. Pending points are not in it. */
 SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map, const float* box);
+
+/* World-frame queries on the map, without exporting it. Each writes exactly
+ * (bitwise) what the same sogmm_model_* query writes on sogmm_map_export(map,
+ * NULL): they run on the map's model itself (core/include/sogmm/map_queries.hpp
+ * says why not on the component index). Pending points are not in the map.
+ * `options` (NULL = defaults) gives the progress callback
+ * (sogmm_options_set_progress; SOGMM_STAGE_SCORING, _REGRESSION, _SAMPLING)
+ * and, for sampling, SOGMM_OPT_SAMPLE_TRUNCATION; a cancel returns
+ * SOGMM_E_CANCELLED with the outputs untouched. Errors, checked in this
+ * order: map NULL -> SOGMM_E_NULL_ARG; dims not 3 or 4 ->
+ * SOGMM_E_INVALID_ARG; a map without components (nothing flushed yet) ->
+ * SOGMM_E_INVALID_DATA; then n == 0 writes nothing and succeeds (arrays may
+ * be NULL); an input or output array NULL -> SOGMM_E_NULL_ARG; n * dims
+ * overflowing size_t -> SOGMM_E_LIMIT; NaN/Inf input -> SOGMM_E_INVALID_DATA.
+ * Const on the map: any number of threads may query one map at once. */
+
+/* Log-density of n world points (dims = 4: rows of x, y, z, gray, joint;
+ * dims = 3: rows of x, y, z, marginal over gray) into `out` (n doubles), as
+ * sogmm_model_score_samples_f32. */
+SOGMM_API sogmm_status sogmm_map_score_samples_f32(const sogmm_map* map, const float* points, size_t n,
+                                                   int32_t dims, const sogmm_options* options, double* out);
+/* Expected gray at n world points (`xyz`: n * 3 floats) into `mean_out` (n
+ * floats) and, if `variance_out` is not NULL, its variance (n floats), as
+ * sogmm_model_regress_gray_f32. */
+SOGMM_API sogmm_status sogmm_map_regress_gray_f32(const sogmm_map* map, const float* xyz, size_t n,
+                                                  const sogmm_options* options, float* mean_out,
+                                                  float* variance_out);
+/* Draws n world points into `out` (n * dims floats, grouped by component),
+ * as sogmm_model_sample_f32: same seed, same samples. */
+SOGMM_API sogmm_status sogmm_map_sample_f32(const sogmm_map* map, size_t n, uint64_t seed, int32_t dims,
+                                            const sogmm_options* options, float* out);
 
 /* Writes the map as a world-frame .sogmm file, atomically as
  * sogmm_model_save (write keys of `options` apply), with the provenance keys

@@ -131,7 +131,8 @@ class Map {
   /// non-finite point -> Error(InvalidData); pose not rigid
   /// (rigid_pose_error) -> Error(InvalidArgument) naming the problem; more
   /// than kMaxPoints points -> Error(Limit). A flush it triggers throws as
-  /// flush(). `progress` reports that fit.
+  /// flush() and the insert is undone: the map is as before the call.
+  /// `progress` reports that fit and may cancel it (Error(Cancelled)).
   FrameStats insert_points(const PointsView& points, const Pose& camera_to_world, const ProgressSink& progress = {});
 
   /// Inserts an RGB-D frame: back-projected with options().depth

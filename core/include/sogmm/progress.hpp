@@ -20,6 +20,8 @@ enum class Stage : std::int32_t {
   Em = 3,         ///< EM; step = iterations done (0 at the start), total = max_iter, log-likelihood of the last
   Run = 4,        ///< n_init > 1 only: run `step` (from 1) starts, total = n_init, best log-likelihood so far
   Sampling = 5,   ///< sampling; step = points drawn, total = points requested
+  Scoring = 6,    ///< log-likelihood of points (map queries); step = points scored, total = points
+  Regression = 7, ///< gray regression (map queries); step = points done, total = points
 };
 
 /// One report. `total` is 0 when unknown; `log_likelihood` is the mean

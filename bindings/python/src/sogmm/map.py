@@ -19,7 +19,8 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError
-from .model import GMM, SOGMM, _pose, _read_options, _rows, _write_options
+from .model import GMM, SOGMM, _pose, _read_options, _rows, _sample_args, _write_options
+from .progress import ProgressArg, call_with_progress
 
 __all__ = ["Map"]
 
@@ -124,28 +125,41 @@ class Map:
         self.close()
 
     # ---- inserting ---------------------------------------------------------
-    def insert_points(self, points, pose) -> dict:
+    def _call(self, progress: ProgressArg, c_call) -> None:
+        """One mutating C call on the map, with ``progress`` (as in SOGMM.fit)
+        reporting the fit it may run (sogmm_map_set_progress). A cancelled
+        call leaves the map as it was."""
+        if progress is None:
+            check(c_call())
+            return
+        h = self._h()
+        call_with_progress(None, progress, c_call, install=lambda cb: lib.sogmm_map_set_progress(h, cb, None))
+
+    def insert_points(self, points, pose, progress: ProgressArg = None) -> dict:
         """Inserts (n, 4) points (x, y, z, gray) in the camera frame with the
         4 x 4 camera-to-world ``pose``; returns that frame's statistics
         (see :meth:`frame_stats`)."""
         x = _rows(points, (4,), "points")
         p = _pose(pose)
-        check(lib.sogmm_map_insert_points_f32(self._h(), x, x.shape[0], p))
+        h = self._h()
+        self._call(progress, lambda: lib.sogmm_map_insert_points_f32(h, x, x.shape[0], p))
         return self.frame_stats(-1)
 
-    def insert_rgbd(self, depth, color, camera: Camera, pose) -> dict:
+    def insert_rgbd(self, depth, color, camera: Camera, pose, progress: ProgressArg = None) -> dict:
         """Inserts an RGB-D frame (depth and color as :meth:`sogmm.SOGMM.fit_rgbd`;
         back-projection options from the constructor) with its 4 x 4
         camera-to-world ``pose``; returns that frame's statistics."""
         f = prepare_frame(depth, color, camera, *self._depth)
         p = _pose(pose)
-        check(lib.sogmm_map_insert_rgbd(self._h(), *f.frame_args(), p))
+        h = self._h()
+        self._call(progress, lambda: lib.sogmm_map_insert_rgbd(h, *f.frame_args(), p))
         return self.frame_stats(-1)
 
-    def flush(self) -> int:
+    def flush(self, progress: ProgressArg = None) -> int:
         """Fits the pending points now; returns the number of components added."""
         before = self.n_components_
-        check(lib.sogmm_map_flush(self._h()))
+        h = self._h()
+        self._call(progress, lambda: lib.sogmm_map_flush(h))
         return self.n_components_ - before
 
     # ---- statistics ----------------------------------------------------------
@@ -197,20 +211,39 @@ class Map:
             check(lib.sogmm_map_export(byref(out), self._h(), b.ctypes.data_as(c_void_p)))
         return GMM._wrap(out)
 
-    def score_samples(self, X) -> np.ndarray:
+    # World-frame queries on the map itself (no export, no copy): each answer
+    # is bitwise what the same GMM method gives on export(). A map without
+    # components (nothing flushed yet) raises InvalidDataError. ``progress``
+    # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING).
+    def score_samples(self, X, progress: ProgressArg = None) -> np.ndarray:
         """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
-        with self.export() as g:
-            return g.score_samples(X)
+        h = self._h()
+        x = _rows(X, (3, 4), "X")
+        out = np.empty(x.shape[0], dtype=np.float64)
+        with _ffi.Options() as o:
+            call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(h, x, x.shape[0], x.shape[1],
+                                                                                     o.ptr, out))
+        return out
 
-    def regress_gray(self, xyz) -> tuple[np.ndarray, np.ndarray]:
+    def regress_gray(self, xyz, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
-        with self.export() as g:
-            return g.regress_gray(xyz)
+        h = self._h()
+        x = _rows(xyz, (3,), "xyz")
+        mean = np.empty(x.shape[0], dtype=np.float32)
+        var = np.empty(x.shape[0], dtype=np.float32)
+        with _ffi.Options() as o:
+            call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(h, x, x.shape[0], o.ptr, mean,
+                                                                                    var))
+        return mean, var
 
-    def sample(self, n_samples: int = 1, seed: int | None = None, **kwargs) -> np.ndarray:
-        """(n, 4) world samples of the map (see GMM.sample)."""
-        with self.export() as g:
-            return g.sample(n_samples, seed, **kwargs)
+    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
+               spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
+        """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""
+        h = self._h()
+        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
+        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
+            call_with_progress(o, progress, lambda: lib.sogmm_map_sample_f32(h, n, seed, dims, o.ptr, out))
+        return out
 
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,

@@ -56,6 +56,18 @@ def _count(n, name: str) -> int:
     return int(n)
 
 
+def _sample_args(n_samples, seed, spatial_only: bool) -> tuple[int, int, int, np.ndarray]:
+    """Checked (n, seed as uint64 bits, dims, output array) of a sample call;
+    seed=None draws a fresh seed."""
+    n = _count(n_samples, "n_samples")
+    if seed is None:
+        seed = secrets.randbits(64)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
+    dims = 3 if spatial_only else 4
+    return n, int(seed) & 0xFFFFFFFFFFFFFFFF, dims, np.empty((n, dims), dtype=np.float32)
+
+
 def _write_options(float64: bool, compress: bool, zstd_level: int) -> _ffi.Options:
     return _ffi.Options(
         i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level}
@@ -344,13 +356,16 @@ class GMM:
         check(lib.sogmm_model_set_value(self._h(), k, v))
 
     # ---- inference -------------------------------------------------------
-    def score_samples(self, X) -> np.ndarray:
+    def score_samples(self, X, progress: ProgressArg = None) -> np.ndarray:
         """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
-        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,)."""
+        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,).
+        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_SCORING, points done)."""
         h = self._h()
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
-        check(lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], out))
+        with _ffi.Options() as o:
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
 
     def score(self, X) -> float:
@@ -364,25 +379,21 @@ class GMM:
         samples; seed=None draws a fresh one. ``truncation`` (in standard
         deviations, may be inf) bounds each draw."""
         h = self._h()
-        n = _count(n_samples, "n_samples")
-        if seed is None:
-            seed = secrets.randbits(64)
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-            raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
-        seed = int(seed) & 0xFFFFFFFFFFFFFFFF
-        dims = 3 if spatial_only else 4
-        out = np.empty((n, dims), dtype=np.float32)
+        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
         with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
             check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
         return out
 
-    def regress_gray(self, xyz) -> tuple[np.ndarray, np.ndarray]:
-        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays."""
+    def regress_gray(self, xyz, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray]:
+        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays.
+        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
         h = self._h()
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
         var = np.empty(x.shape[0], dtype=np.float32)
-        check(lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], mean, var))
+        with _ffi.Options() as o:
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
     def merge(self, other: "GMM") -> "GMM":

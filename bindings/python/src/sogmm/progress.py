@@ -29,12 +29,16 @@ STAGE_SEEDING = 2
 STAGE_EM = 3
 STAGE_RUN = 4
 STAGE_SAMPLING = 5
+STAGE_SCORING = 6
+STAGE_REGRESSION = 7
 STAGE_NAMES = {
     STAGE_MODE_COUNT: "mode count",
     STAGE_SEEDING: "seeding",
     STAGE_EM: "EM",
     STAGE_RUN: "run",
     STAGE_SAMPLING: "sampling",
+    STAGE_SCORING: "scoring",
+    STAGE_REGRESSION: "gray regression",
 }
 
 #: progress= accepts None, True (a tqdm bar) or callable(stage, step, total, log_likelihood) -> truthy cancels.
@@ -81,11 +85,14 @@ def _sink(progress: ProgressArg):
     raise TypeError(f"progress must be None, True or a callable(stage, step, total, log_likelihood), got {progress!r}")
 
 
-def call_with_progress(options: _ffi.Options, progress: ProgressArg, c_call: Callable[[], int]) -> None:
+def call_with_progress(options: Optional[_ffi.Options], progress: ProgressArg, c_call: Callable[[], int], *,
+                       install: Optional[Callable[[object], int]] = None) -> None:
     """Runs ``c_call()`` (one C call using ``options``, returning its status)
     with the progress callback set on ``options``; raises what the call or the
     callback raised, KeyboardInterrupt on Ctrl-C, CancelledError when the
-    callable returned a truthy value."""
+    callable returned a truthy value. ``install(callback)`` replaces setting it
+    on ``options`` (a map's inserts: sogmm_map_set_progress); it is called
+    again with a NULL PROGRESS_FN after the call to remove the callback."""
     sink = _sink(progress)
     state = {"error": None, "sigint": False}
 
@@ -100,7 +107,10 @@ def call_with_progress(options: _ffi.Options, progress: ProgressArg, c_call: Cal
         return 1 if state["error"] is not None or state["sigint"] else 0
 
     c_callback = _ffi.PROGRESS_FN(callback)  # kept alive by this frame during the call
-    check(lib.sogmm_options_set_progress(options.ptr, c_callback, None))
+    if install is None:
+        check(lib.sogmm_options_set_progress(options.ptr, c_callback, None))
+    else:
+        check(install(c_callback))
     previous = None
     if threading.current_thread() is threading.main_thread() and \
             signal.getsignal(signal.SIGINT) is signal.default_int_handler:
@@ -111,6 +121,8 @@ def call_with_progress(options: _ffi.Options, progress: ProgressArg, c_call: Cal
     try:
         status = c_call()
     finally:
+        if install is not None:
+            install(_ffi.PROGRESS_FN())  # NULL: the handle must not keep a callback that dies with this frame
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
         if isinstance(sink, _TqdmSink):

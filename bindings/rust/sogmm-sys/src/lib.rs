@@ -108,6 +108,8 @@ pub const SOGMM_STAGE_SEEDING: i32 = 2;
 pub const SOGMM_STAGE_EM: i32 = 3;
 pub const SOGMM_STAGE_RUN: i32 = 4;
 pub const SOGMM_STAGE_SAMPLING: i32 = 5;
+pub const SOGMM_STAGE_SCORING: i32 = 6;
+pub const SOGMM_STAGE_REGRESSION: i32 = 7;
 
 // ---- color formats --------------------------------------------------------
 pub const SOGMM_COLOR_GRAY8: i32 = 1;
@@ -291,6 +293,22 @@ extern "C" {
         dims: i32,
         out: *mut f64,
     ) -> sogmm_status;
+    pub fn sogmm_model_regress_gray_f32_v2(
+        model: *const sogmm_model,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+        mean_out: *mut f32,
+        variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_model_score_samples_f32_v2(
+        model: *const sogmm_model,
+        points: *const f32,
+        n: usize,
+        dims: i32,
+        options: *const sogmm_options,
+        out: *mut f64,
+    ) -> sogmm_status;
     pub fn sogmm_model_merge(out: *mut *mut sogmm_model, a: *const sogmm_model, b: *const sogmm_model) -> sogmm_status;
     pub fn sogmm_model_transform(
         out: *mut *mut sogmm_model,
@@ -340,6 +358,7 @@ extern "C" {
         pose: *const f64,
     ) -> sogmm_status;
     pub fn sogmm_map_flush(map: *mut sogmm_map) -> sogmm_status;
+    pub fn sogmm_map_set_progress(map: *mut sogmm_map, fn_: sogmm_progress_fn, user_data: *mut c_void) -> sogmm_status;
     pub fn sogmm_map_get_stats(map: *const sogmm_map, out: *mut sogmm_map_stats) -> sogmm_status;
     pub fn sogmm_map_get_frame_stats(
         map: *const sogmm_map,
@@ -347,6 +366,30 @@ extern "C" {
         out: *mut sogmm_map_frame_stats,
     ) -> sogmm_status;
     pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
+    pub fn sogmm_map_score_samples_f32(
+        map: *const sogmm_map,
+        points: *const f32,
+        n: usize,
+        dims: i32,
+        options: *const sogmm_options,
+        out: *mut f64,
+    ) -> sogmm_status;
+    pub fn sogmm_map_regress_gray_f32(
+        map: *const sogmm_map,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+        mean_out: *mut f32,
+        variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_map_sample_f32(
+        map: *const sogmm_map,
+        n: usize,
+        seed: u64,
+        dims: i32,
+        options: *const sogmm_options,
+        out: *mut f32,
+    ) -> sogmm_status;
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(
         out: *mut *mut sogmm_map,

@@ -15,13 +15,14 @@
 //! checks that the loaded library's ABI version is the one these bindings
 //! were written for.
 //!
-//! Threads: `Model` and `Options` are `Send + Sync`. The C API lets any
+//! Threads: `Model`, `Map` and `Options` are `Send + Sync`. The C API lets any
 //! number of threads call functions taking a `const` handle at once; those
 //! are the `&self` methods here. Mutations (`set_pose`, `set_value`, ...)
 //! take `&mut self`, so the borrow checker gives them the exclusive use the C
 //! API requires. The thread-local error message is read on the calling
 //! thread right after each call.
 pub mod error;
+pub mod map;
 pub mod model;
 pub mod options;
 pub mod progress;
@@ -30,8 +31,9 @@ use std::ffi::CStr;
 use std::sync::OnceLock;
 
 pub use error::{Error, Result, Status};
+pub use map::{Map, MapFrameStats, MapStats, Pose};
 pub use model::{Color, Frame, Model};
-pub use options::{ModeCounter, Options, OptionsBuilder};
+pub use options::{FusionMethod, ModeCounter, Options, OptionsBuilder};
 pub use progress::{Progress, Stage};
 pub use sogmm_sys as sys;
 

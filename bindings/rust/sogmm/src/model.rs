@@ -52,7 +52,7 @@ pub struct Frame<'a> {
 impl Frame<'_> {
     /// The color pointer and SOGMM_COLOR_* format, after checking every slice
     /// length against width and height (C cannot see them).
-    fn color_args(&self) -> Result<(*const u8, i32)> {
+    pub(crate) fn color_args(&self) -> Result<(*const u8, i32)> {
         let pixels = len_of(self.width as usize, self.height as usize, "image size")?;
         if self.depth.len() != pixels {
             return Err(invalid(format!(
@@ -109,12 +109,12 @@ impl Frame<'_> {
     }
 }
 
-fn invalid(msg: String) -> Error {
+pub(crate) fn invalid(msg: String) -> Error {
     Error::new(Status::InvalidArg, msg)
 }
 
 /// Number of `cols`-wide rows in `data`, refusing a ragged slice.
-fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
+pub(crate) fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     if data.len() % cols != 0 {
         return Err(invalid(format!(
             "{what} has {} floats, not a multiple of {cols}",
@@ -124,7 +124,37 @@ fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     Ok(data.len() / cols)
 }
 
-fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
+/// Checks a score request (rows of `dims` floats) and runs `call(n, out)`,
+/// the C query writing n doubles to `out`.
+pub(crate) fn score_with(points: &[f32], dims: i32, call: impl FnOnce(usize, *mut f64) -> i32) -> Result<Vec<f64>> {
+    let n = rows(points, dims_ok(dims)?, "points")?;
+    let mut out = vec![0.0f64; n];
+    check(call(n, out.as_mut_ptr()))?;
+    Ok(out)
+}
+
+/// Checks a regression request (rows of 3 floats) and runs
+/// `call(n, mean, variance)`, the C query writing n floats to each.
+pub(crate) fn regress_with(
+    xyz: &[f32],
+    call: impl FnOnce(usize, *mut f32, *mut f32) -> i32,
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    let n = rows(xyz, 3, "xyz")?;
+    let (mut mean, mut var) = (vec![0.0f32; n], vec![0.0f32; n]);
+    check(call(n, mean.as_mut_ptr(), var.as_mut_ptr()))?;
+    Ok((mean, var))
+}
+
+/// `dims` as a row width, refusing anything but 3 or 4.
+pub(crate) fn dims_ok(dims: i32) -> Result<usize> {
+    if dims == 3 || dims == 4 {
+        Ok(dims as usize)
+    } else {
+        Err(invalid(format!("dims must be 3 or 4, got {dims}")))
+    }
+}
+
+pub(crate) fn len_of(n: usize, per: usize, what: &str) -> Result<usize> {
     n.checked_mul(per)
         .ok_or_else(|| Error::new(Status::Limit, format!("{what}: {n} x {per} overflows usize")))
 }
@@ -133,7 +163,7 @@ fn c_string(s: &str, what: &str) -> Result<CString> {
     CString::new(s).map_err(|_| invalid(format!("{what} contains a NUL byte")))
 }
 
-fn c_path(p: &Path) -> Result<CString> {
+pub(crate) fn c_path(p: &Path) -> Result<CString> {
     use std::os::unix::ffi::OsStrExt;
     CString::new(p.as_os_str().as_bytes()).map_err(|_| invalid(format!("path {p:?} contains a NUL byte")))
 }
@@ -147,7 +177,7 @@ fn owned(p: *const sys::c_char) -> String {
 
 impl Model {
     /// Runs a C constructor taking an out-pointer first.
-    fn make(f: impl FnOnce(*mut *mut sys::sogmm_model) -> i32) -> Result<Model> {
+    pub(crate) fn make(f: impl FnOnce(*mut *mut sys::sogmm_model) -> i32) -> Result<Model> {
         crate::ensure_abi()?;
         let mut out = ptr::null_mut();
         check(f(&mut out))?;
@@ -156,7 +186,7 @@ impl Model {
         })
     }
 
-    fn raw(&self) -> *const sys::sogmm_model {
+    pub(crate) fn raw(&self) -> *const sys::sogmm_model {
         self.ptr.as_ptr()
     }
 
@@ -194,6 +224,36 @@ impl Model {
     ) -> Result<Model> {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| Model::fit_rgbd_raw(frame, o))
+    }
+
+    /// Warm start: fits n points starting from `initial`, a model of an
+    /// earlier, overlapping cloud already moved into these points' frame
+    /// (e.g. the previous frame's model moved with `transform`). Self-
+    /// organizing: components `initial` no longer explains are dropped and
+    /// new ones are added for the novel points; with SOGMM_OPT_N_COMPONENTS
+    /// = K, EM runs from `initial` as given (K must be its size). Needs
+    /// n_init 1. `initial` is not changed.
+    pub fn fit_warm(points: &[f32], initial: &Model, options: Option<&Options>) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
+        Model::make(|out| unsafe {
+            sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
+        })
+    }
+
+    /// As `fit_warm`, with progress and cancel as `fit_with_progress`.
+    pub fn fit_warm_with_progress(
+        points: &[f32],
+        initial: &Model,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Model> {
+        let n = rows(points, 4, "points")?;
+        crate::ensure_abi()?;
+        with_progress(options, on_progress, |o| {
+            // SAFETY: as fit_warm; `o` is a valid options handle for the call.
+            Model::make(|out| unsafe { sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), o) })
+        })
     }
 
     /// Fits exactly `k` components (1 <= k <= n).
@@ -391,10 +451,7 @@ impl Model {
 
     /// As `sample`, with SOGMM_OPT_SAMPLE_TRUNCATION from `options`.
     pub fn sample_with(&self, n: usize, seed: u64, dims: i32, options: Option<&Options>) -> Result<Vec<f32>> {
-        if dims != 3 && dims != 4 {
-            return Err(invalid(format!("dims must be 3 or 4, got {dims}")));
-        }
-        let mut out = vec![0.0f32; len_of(n, dims as usize, "samples")?];
+        let mut out = vec![0.0f32; len_of(n, dims_ok(dims)?, "samples")?];
         // SAFETY: `out` holds n * dims floats.
         check(unsafe { sys::sogmm_model_sample_f32(self.raw(), n, seed, dims, opt_ptr(options), out.as_mut_ptr()) })?;
         Ok(out)
@@ -402,25 +459,47 @@ impl Model {
 
     /// Expected gray and its conditional variance at n points (`xyz`: n rows of 3).
     pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
-        let n = rows(xyz, 3, "xyz")?;
-        let (mut mean, mut var) = (vec![0.0f32; n], vec![0.0f32; n]);
-        // SAFETY: n rows in, n floats of room in each output.
-        check(unsafe {
-            sys::sogmm_model_regress_gray_f32(self.raw(), xyz.as_ptr(), n, mean.as_mut_ptr(), var.as_mut_ptr())
-        })?;
-        Ok((mean, var))
+        self.regress_raw(xyz, ptr::null())
+    }
+
+    /// As `regress_gray`, reporting `Stage::Regression` (points done) and
+    /// cancellable as `fit_with_progress`; the same values.
+    pub fn regress_gray_with_progress(
+        &self,
+        xyz: &[f32],
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<(Vec<f32>, Vec<f32>)> {
+        with_progress(None, on_progress, |o| self.regress_raw(xyz, o))
+    }
+
+    fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
+        // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
+        regress_with(xyz, |n, mean, var| unsafe {
+            sys::sogmm_model_regress_gray_f32_v2(self.raw(), xyz.as_ptr(), n, o, mean, var)
+        })
     }
 
     /// Log-density of rows of `dims` floats (4: joint; 3: marginal over gray).
     pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
-        if dims != 3 && dims != 4 {
-            return Err(invalid(format!("dims must be 3 or 4, got {dims}")));
-        }
-        let n = rows(points, dims as usize, "points")?;
-        let mut out = vec![0.0f64; n];
-        // SAFETY: n rows in, n doubles of room out.
-        check(unsafe { sys::sogmm_model_score_samples_f32(self.raw(), points.as_ptr(), n, dims, out.as_mut_ptr()) })?;
-        Ok(out)
+        self.score_raw(points, dims, ptr::null())
+    }
+
+    /// As `score_samples`, reporting `Stage::Scoring` (points scored) and
+    /// cancellable as `fit_with_progress`; the same values.
+    pub fn score_samples_with_progress(
+        &self,
+        points: &[f32],
+        dims: i32,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Vec<f64>> {
+        with_progress(None, on_progress, |o| self.score_raw(points, dims, o))
+    }
+
+    fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
+        // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
+        score_with(points, dims, |n, out| unsafe {
+            sys::sogmm_model_score_samples_f32_v2(self.raw(), points.as_ptr(), n, dims, o, out)
+        })
     }
 
     /// A new model with the components of both, weighted by support size.

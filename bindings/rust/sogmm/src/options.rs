@@ -28,6 +28,15 @@ pub enum ModeCounter {
     GaussianBlurring,
 }
 
+/// How a map's fusion measures two components (SOGMM_OPT_MAP_FUSION_METHOD).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FusionMethod {
+    /// Hellinger distance, in [0, 1] (default).
+    Hellinger,
+    /// Symmetric Kullback-Leibler divergence, in nats.
+    Kl,
+}
+
 impl Options {
     /// Every default.
     pub fn new() -> Result<Options> {
@@ -193,6 +202,23 @@ impl OptionsBuilder {
         verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 i64::from;
         /// Sampling truncation in standard deviations (default 2.5; may be inf).
         sample_truncation(f64) => SOGMM_OPT_SAMPLE_TRUNCATION as f64 |v| v;
+        /// Map: test each point's novelty (default true; false = append everything).
+        map_novelty(bool) => SOGMM_OPT_MAP_NOVELTY as i64 i64::from;
+        /// Map: points with a 3-D log-likelihood below this (nats) are novel (default 3.0).
+        map_novelty_threshold(f64) => SOGMM_OPT_MAP_NOVELTY_THRESHOLD as f64 |v| v;
+        /// Map: pending novel points that trigger a fit (default 12288).
+        map_batch_size(i64) => SOGMM_OPT_MAP_BATCH_SIZE as i64 |v| v;
+        /// Map: fuse new components into close ones (default false).
+        map_fusion(bool) => SOGMM_OPT_MAP_FUSION as i64 i64::from;
+        /// Map: the fusion distance.
+        map_fusion_method(FusionMethod) => SOGMM_OPT_MAP_FUSION_METHOD as i64 |m| match m {
+            FusionMethod::Hellinger => sys::SOGMM_FUSION_HELLINGER,
+            FusionMethod::Kl => sys::SOGMM_FUSION_KL,
+        };
+        /// Map: fuse below this distance (Hellinger in [0, 1] or KL in nats; default 0.3).
+        map_fusion_threshold(f64) => SOGMM_OPT_MAP_FUSION_THRESHOLD as f64 |v| v;
+        /// Map: warm-start each batch's fit from the previous one (default false; needs n_init 1).
+        map_warm_start(bool) => SOGMM_OPT_MAP_WARM_START as i64 i64::from;
     }
 
     pub fn build(&self) -> Result<Options> {

@@ -31,6 +31,10 @@ pub enum Stage {
     Run,
     /// Sampling; step/total: points drawn / requested.
     Sampling,
+    /// Scoring points on a map; step/total: points scored / requested.
+    Scoring,
+    /// Gray regression on a map; step/total: points done / requested.
+    Regression,
     Unknown(i32),
 }
 
@@ -42,6 +46,8 @@ impl Stage {
             sys::SOGMM_STAGE_EM => Stage::Em,
             sys::SOGMM_STAGE_RUN => Stage::Run,
             sys::SOGMM_STAGE_SAMPLING => Stage::Sampling,
+            sys::SOGMM_STAGE_SCORING => Stage::Scoring,
+            sys::SOGMM_STAGE_REGRESSION => Stage::Regression,
             other => Stage::Unknown(other),
         }
     }
@@ -113,6 +119,29 @@ pub(crate) fn with_progress<T>(
     if let Some(payload) = cx.panic.take() {
         resume_unwind(payload);
     }
+    result
+}
+
+/// Runs `call` with the trampoline for `f` installed on `map`
+/// (sogmm_map_set_progress, for its inserts and flushes) and removed again
+/// on every path; resumes a panic of `f` afterwards. The caller holds the map
+/// exclusively (`&mut`), so no other call sees the callback.
+pub(crate) fn with_map_progress<T>(
+    map: *mut sys::sogmm_map,
+    mut f: impl FnMut(Progress) -> ControlFlow<()>,
+    call: impl FnOnce() -> Result<T>,
+) -> Result<T> {
+    let mut cx = Ctx { f: &mut f, panic: None };
+    // SAFETY: `map` is a valid handle used only by this thread for the call;
+    // `cx` outlives it, and the callback is removed before `cx` goes away.
+    check(unsafe { sys::sogmm_map_set_progress(map, Some(trampoline), &mut cx as *mut Ctx<'_> as *mut c_void) })?;
+    let result = call();
+    // SAFETY: as above; removing a callback cannot fail for a valid handle.
+    let removed = check(unsafe { sys::sogmm_map_set_progress(map, None, ptr::null_mut()) });
+    if let Some(payload) = cx.panic.take() {
+        resume_unwind(payload);
+    }
+    removed?;
     result
 }
 

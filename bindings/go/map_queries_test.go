@@ -1,0 +1,240 @@
+package sogmm
+
+import (
+	"context"
+	"errors"
+	"slices"
+	"testing"
+)
+
+// newTestMap is NewMap with bandwidth 0.3, two threads and the given keys.
+func newTestMap(t *testing.T, opts ...Option) *Map {
+	t.Helper()
+	o, err := NewOptions(append([]Option{Bandwidth(0.3), Seed(2), Threads(2)}, opts...)...)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	m, err := NewMap(o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	return m
+}
+
+// A map of two posed copies of twoBlobs, flushed.
+func twoFrameMap(t *testing.T) *Map {
+	t.Helper()
+	m := newTestMap(t, I64(OptMapBatchSize, 100000))
+	pts := twoBlobs(600)
+	for _, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(0, 3, 0, 0)} {
+		if err := m.InsertPoints(pts, pose); err != nil {
+			t.Fatal(err)
+		}
+	}
+	if err := m.Flush(); err != nil {
+		t.Fatal(err)
+	}
+	return m
+}
+
+// The map's queries are bitwise the exported model's, with and without a
+// progress func; a cancelled query returns ErrCancelled with its cause.
+func TestMapQueriesEqualTheExportedModel(t *testing.T) {
+	m := twoFrameMap(t)
+	defer m.Close()
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer model.Close()
+	q4 := twoBlobs(5000)
+	for i := 0; i < len(q4); i += 20 {
+		q4[i] += 4 // every fifth point far off
+	}
+	q3 := make([]float32, 0, len(q4)/4*3)
+	for i := 0; i < len(q4); i += 4 {
+		q3 = append(q3, q4[i:i+3]...)
+	}
+	for _, c := range []struct {
+		q    []float32
+		dims int
+	}{{q3, 3}, {q4, 4}} {
+		want, err := model.ScoreSamples(c.q, c.dims)
+		if err != nil {
+			t.Fatal(err)
+		}
+		got, err := m.ScoreSamples(c.q, c.dims)
+		if err != nil || !slices.Equal(got, want) {
+			t.Fatalf("dims %d: map score differs from the model's (err %v)", c.dims, err)
+		}
+		var last Progress
+		got, err = m.ScoreSamplesContext(context.Background(), c.q, c.dims, func(p Progress) error { last = p; return nil })
+		if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
+			t.Fatalf("dims %d: with progress: err %v, last %+v", c.dims, err, last)
+		}
+	}
+	wm, wv, err := model.RegressGray(q3)
+	if err != nil {
+		t.Fatal(err)
+	}
+	gm, gv, err := m.RegressGray(q3)
+	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
+		t.Fatalf("regress differs (err %v)", err)
+	}
+	gm, gv, err = m.RegressGrayContext(context.Background(), q3, nil)
+	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
+		t.Fatalf("regress with context differs (err %v)", err)
+	}
+	ws, _ := model.Sample(3000, 4, 4, nil)
+	gs, err := m.Sample(3000, 4, 4, nil)
+	if err != nil || !slices.Equal(gs, ws) {
+		t.Fatalf("sample differs (err %v)", err)
+	}
+	gs, err = m.SampleContext(context.Background(), 3000, 4, 4, nil, nil)
+	if err != nil || !slices.Equal(gs, ws) {
+		t.Fatalf("sample with context differs (err %v)", err)
+	}
+
+	ctx, cancel := context.WithCancel(context.Background())
+	cancel()
+	_, _, err = m.RegressGrayContext(ctx, q3, nil)
+	if !errors.Is(err, ErrCancelled) || !errors.Is(err, context.Canceled) {
+		t.Fatalf("cancelled regress: %v", err)
+	}
+	if _, err := m.ScoreSamples(q3, 5); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("dims 5: %v", err)
+	}
+	empty, err := NewMap(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer empty.Close()
+	if _, err := empty.Sample(10, 1, 4, nil); !errors.Is(err, ErrInvalidData) {
+		t.Fatalf("empty map: %v", err)
+	}
+}
+
+// A cancelled insert or flush leaves the map as it was.
+func TestMapInsertCancelLeavesTheMapUnchanged(t *testing.T) {
+	m := newTestMap(t, I64(OptMapNovelty, 0))
+	defer m.Close()
+	pts := twoBlobs(400)
+	var stages []Stage
+	if err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 0, 0, 0), func(p Progress) error {
+		stages = append(stages, p.Stage)
+		return nil
+	}); err != nil {
+		t.Fatal(err)
+	}
+	if len(stages) == 0 || stages[len(stages)-1] != StageEM {
+		t.Fatalf("stages %v", stages)
+	}
+	before, _ := m.Stats()
+	stop := errors.New("stop")
+	err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 3, 0, 0), func(Progress) error { return stop })
+	if !errors.Is(err, ErrCancelled) || !errors.Is(err, stop) {
+		t.Fatalf("cancelled insert: %v", err)
+	}
+	if after, _ := m.Stats(); after != before {
+		t.Fatalf("a cancelled insert changed the map: %+v -> %+v", before, after)
+	}
+	if err := m.InsertPoints(pts, yawPose(0, 3, 0, 0)); err != nil { // the callback is gone
+		t.Fatal(err)
+	}
+
+	p := newTestMap(t, I64(OptMapBatchSize, 100000))
+	defer p.Close()
+	if err := p.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
+		t.Fatal(err)
+	}
+	ctx, cancel := context.WithCancel(context.Background())
+	cancel()
+	if err := p.FlushContext(ctx, nil); !errors.Is(err, context.Canceled) {
+		t.Fatalf("cancelled flush: %v", err)
+	}
+	if s, _ := p.Stats(); s.Pending != 400 || s.Components != 0 {
+		t.Fatalf("a cancelled flush changed the map: %+v", s)
+	}
+	if err := p.FlushContext(context.Background(), nil); err != nil {
+		t.Fatal(err)
+	}
+}
+
+// A warm start from a fixed-K fit of the same points keeps K and does not
+// lower the likelihood (EM is monotone); it refuses a K mismatch.
+func TestFitWarm(t *testing.T) {
+	pts := twoBlobs(2000)
+	o, _ := NewOptions(NComponents(2), Seed(1), Threads(2))
+	defer o.Close()
+	cold, err := Fit(pts, o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer cold.Close()
+	warm, err := FitWarmContext(context.Background(), pts, cold, o, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer warm.Close()
+	mean := func(m *Model) float64 {
+		s, _ := m.ScoreSamples(pts, 4)
+		var sum float64
+		for _, v := range s {
+			sum += v
+		}
+		return sum / float64(len(s))
+	}
+	if k, _ := warm.NComponents(); k != 2 || mean(warm) < mean(cold)-1e-6 {
+		t.Fatalf("warm: K %d, mean log-likelihood %v < cold %v", k, mean(warm), mean(cold))
+	}
+	plain, err := FitWarm(pts, cold, o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer plain.Close()
+	a, _ := plain.Means()
+	b, _ := warm.Means()
+	if !slices.Equal(a, b) {
+		t.Fatal("progress changed the warm fit")
+	}
+	k3, _ := NewOptions(NComponents(3))
+	defer k3.Close()
+	if _, err := FitWarm(pts, cold, k3); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("K mismatch: %v", err)
+	}
+	if _, err := FitWarm(pts, nil, nil); !errors.Is(err, ErrClosed) {
+		t.Fatalf("nil initial: %v", err)
+	}
+}
+
+// The model's context queries give the same values and report points.
+func TestModelQueryContexts(t *testing.T) {
+	m := twoFrameMap(t)
+	defer m.Close()
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer model.Close()
+	q := twoBlobs(5000)
+	want, _ := model.ScoreSamples(q, 4)
+	var last Progress
+	got, err := model.ScoreSamplesContext(context.Background(), q, 4, func(p Progress) error { last = p; return nil })
+	if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
+		t.Fatalf("score with context: err %v, last %+v", err, last)
+	}
+	xyz := make([]float32, 0, 3*5000)
+	for i := 0; i < len(q); i += 4 {
+		xyz = append(xyz, q[i:i+3]...)
+	}
+	wm, _, _ := model.RegressGray(xyz)
+	gm, _, err := model.RegressGrayContext(context.Background(), xyz, func(p Progress) error { last = p; return nil })
+	if err != nil || !slices.Equal(gm, wm) || last.Stage != StageRegression {
+		t.Fatalf("regress with context: err %v, last %+v", err, last)
+	}
+	stop := errors.New("stop")
+	if _, err := model.ScoreSamplesContext(context.Background(), q, 4, func(Progress) error { return stop }); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
+		t.Fatalf("cancelled score: %v", err)
+	}
+}

@@ -1,0 +1,299 @@
+//! `Map`: an owned sogmm_map handle, the incremental world map of posed
+//! frames (core/include/sogmm/map.hpp): only the points the map does not yet
+//! explain are fitted and merged in the world frame.
+use std::ops::ControlFlow;
+use std::path::Path;
+use std::ptr::{self, NonNull};
+
+use sogmm_sys as sys;
+
+use crate::error::{check, Result};
+use crate::model::{c_path, dims_ok, len_of, regress_with, rows, score_with, Frame, Model};
+use crate::options::{opt_ptr, Options};
+use crate::progress::{with_map_progress, with_progress, Progress};
+
+/// A row-major 4 x 4 rigid camera-to-world transform [R t; 0 0 0 1].
+pub type Pose = [f64; 16];
+
+/// Totals of a map.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapStats {
+    /// Components in the map.
+    pub n_components: u64,
+    /// Novel points waiting for a fit (not in the map yet).
+    pub n_pending: u64,
+    /// Frames inserted (a loaded map counts the frames of its file).
+    pub n_frames: u64,
+    /// Fits run by this handle.
+    pub n_flushes: u64,
+    /// New components fused into existing ones instead of appended.
+    pub n_fused: u64,
+}
+
+/// What one insert did (frames of a loaded map have zero times).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MapFrameStats {
+    pub n_points: u64,
+    pub n_novel: u64,
+    /// Map components after the insert.
+    pub n_components: u64,
+    /// The insert ran a fit.
+    pub flushed: bool,
+    pub ms_novelty: f64,
+    pub ms_fit: f64,
+    pub ms_merge: f64,
+    /// The camera-to-world pose given with the frame.
+    pub pose: Pose,
+}
+
+/// An incremental world map. Inserting needs `&mut self`; the queries
+/// (`stats`, `export`, `score_samples`, `regress_gray`, `sample`, `save`)
+/// take `&self` and may run on many threads at once.
+pub struct Map {
+    ptr: NonNull<sys::sogmm_map>,
+}
+
+// SAFETY: sogmm.h: functions taking a const map may run concurrently on one
+// handle (the `&self` methods); inserts, flushes and sogmm_map_set_progress
+// need exclusive use, which `&mut self` and `Drop` give. The map has no
+// thread affinity, so moving it between threads is fine.
+unsafe impl Send for Map {}
+unsafe impl Sync for Map {}
+
+impl Map {
+    fn make(f: impl FnOnce(*mut *mut sys::sogmm_map) -> i32) -> Result<Map> {
+        crate::ensure_abi()?;
+        let mut out = ptr::null_mut();
+        check(f(&mut out))?;
+        Ok(Map {
+            ptr: NonNull::new(out).expect("libsogmm returned OK and a NULL map"),
+        })
+    }
+
+    fn raw(&self) -> *const sys::sogmm_map {
+        self.ptr.as_ptr()
+    }
+
+    /// An empty map with the map, fit and RGB-D keys of `options` (None =
+    /// defaults: novelty 3.0 nats, batches of 12,288 points, no fusion).
+    pub fn new(options: Option<&Options>) -> Result<Map> {
+        // SAFETY: valid out-pointer; options a valid handle or NULL.
+        Map::make(|out| unsafe { sys::sogmm_map_create(out, opt_ptr(options)) })
+    }
+
+    /// Reads a map file written by `save` (or any world-frame model, without
+    /// frame provenance); the keys of `options` govern later inserts.
+    pub fn load(path: impl AsRef<Path>, options: Option<&Options>) -> Result<Map> {
+        let p = c_path(path.as_ref())?;
+        // SAFETY: NUL-terminated path.
+        Map::make(|out| unsafe { sys::sogmm_map_load(out, p.as_ptr(), opt_ptr(options)) })
+    }
+
+    /// Inserts n points (rows of x, y, z, gray) in the camera frame with the
+    /// frame's camera-to-world pose. A failed insert leaves the map as it was.
+    pub fn insert_points(&mut self, points: &[f32], pose: &Pose) -> Result<()> {
+        let n = rows(points, 4, "points")?;
+        // SAFETY: exclusive through &mut self; n * 4 floats and 16 doubles.
+        check(unsafe { sys::sogmm_map_insert_points_f32(self.ptr.as_ptr(), points.as_ptr(), n, pose.as_ptr()) })
+    }
+
+    /// Inserts an RGB-D frame (decimation and depth range from the map's
+    /// options) with its camera-to-world pose. The first frame fixes the camera.
+    pub fn insert_frame(&mut self, frame: &Frame<'_>, pose: &Pose) -> Result<()> {
+        let (color, format) = frame.color_args()?;
+        // SAFETY: exclusive through &mut self; color_args checked the slices.
+        check(unsafe {
+            sys::sogmm_map_insert_rgbd(
+                self.ptr.as_ptr(),
+                frame.depth.as_ptr(),
+                color,
+                format,
+                frame.width,
+                frame.height,
+                frame.fx,
+                frame.fy,
+                frame.cx,
+                frame.cy,
+                pose.as_ptr(),
+            )
+        })
+    }
+
+    /// Fits the pending points now (nothing when none are pending).
+    pub fn flush(&mut self) -> Result<()> {
+        // SAFETY: exclusive through &mut self.
+        check(unsafe { sys::sogmm_map_flush(self.ptr.as_ptr()) })
+    }
+
+    /// As `insert_points`, reporting the fit it may run to `on_progress`
+    /// (see `Model::fit_with_progress`). `ControlFlow::Break(())` or a panic
+    /// cancels: `Err` with `Status::Cancelled` (the panic resumes) and the
+    /// map as before the call.
+    pub fn insert_points_with_progress(
+        &mut self,
+        points: &[f32],
+        pose: &Pose,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<()> {
+        let map = self.ptr.as_ptr();
+        with_map_progress(map, on_progress, || self.insert_points(points, pose))
+    }
+
+    /// As `insert_frame`, with progress and cancel as `insert_points_with_progress`.
+    pub fn insert_frame_with_progress(
+        &mut self,
+        frame: &Frame<'_>,
+        pose: &Pose,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<()> {
+        let map = self.ptr.as_ptr();
+        with_map_progress(map, on_progress, || self.insert_frame(frame, pose))
+    }
+
+    /// As `flush`, with progress and cancel; a cancelled flush keeps the
+    /// pending points.
+    pub fn flush_with_progress(&mut self, on_progress: impl FnMut(Progress) -> ControlFlow<()>) -> Result<()> {
+        let map = self.ptr.as_ptr();
+        with_map_progress(map, on_progress, || self.flush())
+    }
+
+    /// The map's totals.
+    pub fn stats(&self) -> Result<MapStats> {
+        let mut s = sys::sogmm_map_stats::default();
+        // SAFETY: valid handle and out-pointer.
+        check(unsafe { sys::sogmm_map_get_stats(self.raw(), &mut s) })?;
+        Ok(MapStats {
+            n_components: s.n_components,
+            n_pending: s.n_pending,
+            n_frames: s.n_frames,
+            n_flushes: s.n_flushes,
+            n_fused: s.n_fused,
+        })
+    }
+
+    /// What the insert of frame `frame` (insertion order, from 0) did.
+    pub fn frame_stats(&self, frame: u64) -> Result<MapFrameStats> {
+        let mut s = sys::sogmm_map_frame_stats::default();
+        // SAFETY: valid handle and out-pointer.
+        check(unsafe { sys::sogmm_map_get_frame_stats(self.raw(), frame, &mut s) })?;
+        Ok(MapFrameStats {
+            n_points: s.n_points,
+            n_novel: s.n_novel,
+            n_components: s.n_components,
+            flushed: s.flushed != 0,
+            ms_novelty: s.ms_novelty,
+            ms_fit: s.ms_fit,
+            ms_merge: s.ms_merge,
+            pose: s.pose,
+        })
+    }
+
+    /// The whole map as a world-frame model.
+    pub fn export(&self) -> Result<Model> {
+        // SAFETY: valid handles; NULL box = everything.
+        Model::make(|out| unsafe { sys::sogmm_map_export(out, self.raw(), ptr::null()) })
+    }
+
+    /// The components whose 3-sigma box meets `bounds` (x_min, y_min, z_min,
+    /// x_max, y_max, z_max), weights renormalised over them.
+    pub fn export_box(&self, bounds: &[f32; 6]) -> Result<Model> {
+        // SAFETY: valid handles; 6 floats.
+        Model::make(|out| unsafe { sys::sogmm_map_export(out, self.raw(), bounds.as_ptr()) })
+    }
+
+    /// Log-density of world points (rows of `dims` floats; 4: joint, 3:
+    /// marginal over gray), bitwise what `export()?.score_samples` gives,
+    /// without the copy.
+    pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
+        self.score_raw(points, dims, opt_ptr(None))
+    }
+
+    /// As `score_samples`, reporting `Stage::Scoring` and cancellable.
+    pub fn score_samples_with_progress(
+        &self,
+        points: &[f32],
+        dims: i32,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Vec<f64>> {
+        with_progress(None, on_progress, |o| self.score_raw(points, dims, o))
+    }
+
+    fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
+        // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
+        score_with(points, dims, |n, out| unsafe {
+            sys::sogmm_map_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
+        })
+    }
+
+    /// Expected gray and its variance at world points (`xyz`: rows of 3).
+    pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
+        self.regress_raw(xyz, opt_ptr(None))
+    }
+
+    /// As `regress_gray`, reporting `Stage::Regression` and cancellable.
+    pub fn regress_gray_with_progress(
+        &self,
+        xyz: &[f32],
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<(Vec<f32>, Vec<f32>)> {
+        with_progress(None, on_progress, |o| self.regress_raw(xyz, o))
+    }
+
+    fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
+        // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
+        regress_with(xyz, |n, mean, var| unsafe {
+            sys::sogmm_map_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
+        })
+    }
+
+    /// Draws n world points (rows of `dims` floats, grouped by component);
+    /// `options` gives SOGMM_OPT_SAMPLE_TRUNCATION (None = 2.5).
+    pub fn sample(&self, n: usize, seed: u64, dims: i32, options: Option<&Options>) -> Result<Vec<f32>> {
+        self.sample_raw(n, seed, dims, opt_ptr(options))
+    }
+
+    /// As `sample`, reporting `Stage::Sampling` and cancellable.
+    pub fn sample_with_progress(
+        &self,
+        n: usize,
+        seed: u64,
+        dims: i32,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Vec<f32>> {
+        with_progress(options, on_progress, |o| self.sample_raw(n, seed, dims, o))
+    }
+
+    fn sample_raw(&self, n: usize, seed: u64, dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f32>> {
+        let mut out = vec![0.0f32; len_of(n, dims_ok(dims)?, "samples")?];
+        // SAFETY: `out` holds n * dims floats.
+        check(unsafe { sys::sogmm_map_sample_f32(self.raw(), n, seed, dims, o, out.as_mut_ptr()) })?;
+        Ok(out)
+    }
+
+    /// Writes the map as a world-frame .sogmm file with its frame provenance,
+    /// atomically (write keys of `options` apply). Flush pending points first.
+    pub fn save(&self, path: impl AsRef<Path>, options: Option<&Options>) -> Result<()> {
+        let p = c_path(path.as_ref())?;
+        // SAFETY: NUL-terminated path; const use of the map.
+        check(unsafe { sys::sogmm_map_save(self.raw(), p.as_ptr(), opt_ptr(options)) })
+    }
+}
+
+impl Drop for Map {
+    fn drop(&mut self) {
+        // SAFETY: we own the handle; nothing else uses it once dropped.
+        unsafe { sys::sogmm_map_free(self.ptr.as_ptr()) }
+    }
+}
+
+impl std::fmt::Debug for Map {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = self.stats().unwrap_or_default();
+        f.debug_struct("Map")
+            .field("n_frames", &s.n_frames)
+            .field("n_components", &s.n_components)
+            .field("n_pending", &s.n_pending)
+            .finish_non_exhaustive()
+    }
+}

@@ -1,0 +1,220 @@
+//! The safe `Map`: inserts, statistics, export, files, world-frame queries
+//! (bitwise the exported model's), progress and cancel; the warm start.
+use std::ops::ControlFlow;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use sogmm::{Map, Model, Options, Pose, Stage, Status};
+
+const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
+
+fn shifted(tx: f64) -> Pose {
+    let mut p = IDENTITY;
+    p[3] = tx;
+    p
+}
+
+/// Deterministic cloud: three tight blobs (x, y, z, gray) from a fixed LCG.
+fn blobs(n: usize, seed: u64) -> Vec<f32> {
+    let centres = [[0.0, 0.0, 1.0, 0.2], [0.5, 0.0, 1.5, 0.5], [0.0, 0.5, 2.0, 0.8]];
+    let mut s = seed;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 40) as f32 / (1u64 << 24) as f32) - 0.5
+    };
+    (0..n).flat_map(|i| centres[i % 3].map(|c| c + 0.05 * next())).collect()
+}
+
+fn map_options(novelty: bool) -> Options {
+    Options::builder()
+        .map_novelty(novelty)
+        .map_batch_size(100_000)
+        .threads(2)
+        .build()
+        .unwrap()
+}
+
+/// Two posed copies of the blobs, flushed.
+fn two_frame_map() -> Map {
+    let pts = blobs(3000, 7);
+    let mut map = Map::new(Some(&map_options(true))).unwrap();
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    map.insert_points(&pts, &shifted(2.0)).unwrap();
+    map.flush().unwrap();
+    map
+}
+
+#[test]
+fn inserts_stats_export_and_files() {
+    let pts = blobs(3000, 7);
+    let mut map = Map::new(Some(&map_options(true))).unwrap();
+    assert_eq!(map.export().unwrap_err().status(), Status::InvalidData);
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    let s = map.stats().unwrap();
+    assert_eq!((s.n_frames, s.n_pending, s.n_components), (1, 3000, 0));
+    map.flush().unwrap();
+    // The same points again are (almost) all explained; 2 m away, all novel.
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    assert!(map.frame_stats(1).unwrap().n_novel < 150);
+    map.insert_points(&pts, &shifted(2.0)).unwrap();
+    let f = map.frame_stats(2).unwrap();
+    assert_eq!((f.n_points, f.n_novel, f.pose[3]), (3000, 3000, 2.0));
+    assert_eq!(map.frame_stats(3).unwrap_err().status(), Status::InvalidArg);
+    let path = std::env::temp_dir().join(format!("sogmm-rust-map-{}.sogmm", std::process::id()));
+    assert_eq!(map.save(&path, None).unwrap_err().status(), Status::InvalidArg); // pending
+    map.flush().unwrap();
+    let all = map.export().unwrap();
+    assert_eq!(all.n_components() as u64, map.stats().unwrap().n_components);
+    assert_eq!(all.value("coordinate_frame").unwrap().as_deref(), Some("world"));
+    let part = map.export_box(&[-0.3, -0.3, 0.7, 0.3, 0.3, 1.3]).unwrap();
+    assert!(part.n_components() >= 1 && part.n_components() < all.n_components());
+    map.save(&path, None).unwrap();
+    let loaded = Map::load(&path, Some(&map_options(true))).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(loaded.stats().unwrap().n_frames, 3);
+    assert_eq!(loaded.frame_stats(2).unwrap().pose[3], 2.0);
+    assert_eq!(loaded.export().unwrap().means().unwrap(), all.means().unwrap());
+    // Bad input: ragged rows, an empty frame, a pose that is not rigid.
+    assert_eq!(
+        map.insert_points(&pts[..7], &IDENTITY).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    assert_eq!(
+        map.insert_points(&[], &IDENTITY).unwrap_err().status(),
+        Status::InvalidData
+    );
+    let mut scaled = IDENTITY;
+    scaled[0] = 2.0;
+    let e = map.insert_points(&pts, &scaled).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+    assert!(e.message().contains("pose"), "{e}");
+}
+
+#[test]
+fn queries_equal_the_exported_model_bitwise() {
+    let map = two_frame_map();
+    let model = map.export().unwrap();
+    // The blobs, every fifth point moved 3.5 m off (far regime).
+    let q4: Vec<f32> = blobs(5000, 11)
+        .chunks(4)
+        .enumerate()
+        .flat_map(|(i, r)| [r[0] + if i % 5 == 0 { 3.5 } else { 0.0 }, r[1], r[2], r[3]])
+        .collect();
+    let q3: Vec<f32> = q4.chunks(4).flat_map(|r| [r[0], r[1], r[2]]).collect();
+    for (q, dims) in [(&q3, 3), (&q4, 4)] {
+        let want = model.score_samples(q, dims).unwrap();
+        assert_eq!(map.score_samples(q, dims).unwrap(), want);
+        let mut last = 0;
+        let got = map
+            .score_samples_with_progress(q, dims, |p| {
+                assert_eq!(p.stage, Stage::Scoring);
+                last = p.step;
+                ControlFlow::Continue(())
+            })
+            .unwrap();
+        assert_eq!(got, want);
+        assert_eq!(last, 5000);
+    }
+    assert_eq!(map.regress_gray(&q3).unwrap(), model.regress_gray(&q3).unwrap());
+    assert_eq!(
+        map.regress_gray_with_progress(&q3, |_| ControlFlow::Continue(()))
+            .unwrap(),
+        model.regress_gray(&q3).unwrap()
+    );
+    assert_eq!(map.sample(4000, 3, 4, None).unwrap(), model.sample(4000, 3, 4).unwrap());
+    let trunc = Options::builder().sample_truncation(1.0).build().unwrap();
+    assert_eq!(
+        map.sample(4000, 3, 3, Some(&trunc)).unwrap(),
+        model.sample_with(4000, 3, 3, Some(&trunc)).unwrap()
+    );
+    // Cancel and bad input.
+    let e = map
+        .regress_gray_with_progress(&q3, |_| ControlFlow::Break(()))
+        .unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+    assert_eq!(map.score_samples(&q3, 5).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(map.score_samples(&q3[..4], 3).unwrap_err().status(), Status::InvalidArg);
+    let mut nan = q3.clone();
+    nan[4] = f32::NAN;
+    assert_eq!(map.score_samples(&nan, 3).unwrap_err().status(), Status::InvalidData);
+    let empty = Map::new(None).unwrap();
+    assert_eq!(empty.sample(10, 1, 4, None).unwrap_err().status(), Status::InvalidData);
+    // Shared across threads: the same answers.
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2).map(|_| s.spawn(|| map.score_samples(&q4, 4).unwrap())).collect();
+        for h in handles {
+            assert_eq!(h.join().unwrap(), model.score_samples(&q4, 4).unwrap());
+        }
+    });
+}
+
+#[test]
+fn a_cancelled_insert_or_flush_leaves_the_map_as_it_was() {
+    let pts = blobs(3000, 5);
+    let mut map = Map::new(Some(&map_options(false))).unwrap();
+    let mut stages = Vec::new();
+    map.insert_points_with_progress(&pts, &IDENTITY, |p| {
+        stages.push(p.stage);
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert_eq!(stages.last(), Some(&Stage::Em));
+    let before = (map.stats().unwrap(), map.export().unwrap().means().unwrap());
+    let e = map
+        .insert_points_with_progress(&pts, &shifted(3.0), |_| ControlFlow::Break(()))
+        .unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+    assert_eq!((map.stats().unwrap(), map.export().unwrap().means().unwrap()), before);
+    // A panic cancels too, resumes here, and leaves the map as it was.
+    let r = catch_unwind(AssertUnwindSafe(|| {
+        let _ = map.insert_points_with_progress(&pts, &shifted(3.0), |_| panic!("stop"));
+    }));
+    assert!(r.is_err());
+    assert_eq!(map.stats().unwrap(), before.0);
+    // The callback is gone after the call: a plain insert works.
+    map.insert_points(&pts, &shifted(3.0)).unwrap();
+    assert_eq!(map.stats().unwrap().n_frames, 2);
+
+    let mut pending = Map::new(Some(&map_options(true))).unwrap();
+    pending.insert_points(&pts, &IDENTITY).unwrap();
+    let e = pending.flush_with_progress(|_| ControlFlow::Break(())).unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+    assert_eq!(pending.stats().unwrap().n_pending, 3000);
+    pending.flush_with_progress(|_| ControlFlow::Continue(())).unwrap();
+    assert_eq!(pending.stats().unwrap().n_pending, 0);
+}
+
+#[test]
+fn warm_start_from_a_fit_of_the_same_points() {
+    let pts = blobs(3000, 9);
+    let fixed = Options::builder().n_components(3).seed(2).threads(2).build().unwrap();
+    let cold = Model::fit(&pts, Some(&fixed)).unwrap();
+    // EM from a converged model of the same points: at least as likely (EM
+    // never lowers the likelihood) and the same size.
+    let mut reports = 0;
+    let warm = Model::fit_warm_with_progress(&pts, &cold, Some(&fixed), |_| {
+        reports += 1;
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert!(reports > 0);
+    assert_eq!(warm.n_components(), 3);
+    let ll = |m: &Model| m.score_samples(&pts, 4).unwrap().iter().sum::<f64>() / 3000.0;
+    assert!(ll(&warm) >= ll(&cold) - 1e-6, "{} < {}", ll(&warm), ll(&cold));
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&fixed)).unwrap().means().unwrap(),
+        warm.means().unwrap()
+    );
+    // K must be the initial model's size; a warm start is one run.
+    let k4 = Options::builder().n_components(4).build().unwrap();
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&k4)).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    let two_runs = Options::builder().n_init(2).build().unwrap();
+    assert_eq!(
+        Model::fit_warm(&pts, &cold, Some(&two_runs)).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    let e = Model::fit_warm_with_progress(&pts, &cold, None, |_| ControlFlow::Break(())).unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+}

@@ -1,0 +1,36 @@
+// sogmm_model_regress_gray_f32_v2 and sogmm_model_score_samples_f32_v2: the
+// model queries with options for progress and cancel
+// (sogmm/query_progress.hpp), with the checks of the functions without _v2.
+#include "internal.hpp"
+#include "queries.hpp"
+#include "sogmm/query_progress.hpp"
+
+extern "C" {
+
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
+                                                       const sogmm_options* options, float* mean_out,
+                                                       float* variance_out) {
+  SOGMM_TRY {
+    sogmm_capi::require_nonnull(model, "model");
+    sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
+                                  [&](float* mean, float* variance, const sogmm::ProgressSink& sink) {
+                                    sogmm::regress_gray(model->model.gmm, xyz, n, mean, variance, sink);
+                                  });
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
+                                                        size_t n, int32_t dims, const sogmm_options* options,
+                                                        double* out) {
+  SOGMM_TRY {
+    sogmm_capi::require_nonnull(model, "model");
+    sogmm_capi::require_dims(dims);
+    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::ProgressSink& sink) {
+      sogmm::score_samples(model->model.gmm, points, n, dims, dst, sink);
+    });
+  }
+  SOGMM_CATCH
+}
+
+}  // extern "C"
