@@ -19,6 +19,15 @@ void require_dims(int32_t dims) {
     fail(SOGMM_E_INVALID_ARG, "dims = " + std::to_string(dims) + " (must be 3 or 4)");
 }
 
+// The query keys of `options` (NULL = defaults).
+sogmm::QueryOptions query_options(const sogmm_options* options) {
+  const sogmm_options& o = sogmm_capi::opts_or_default(options);
+  sogmm::QueryOptions q;
+  q.threads = static_cast<int>(o.threads);
+  q.truncation_nats = o.query_truncation_nats;
+  return q;
+}
+
 }  // namespace
 
 extern "C" {
@@ -47,19 +56,31 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
 
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
                                                     float* mean_out, float* variance_out) {
+  return sogmm_model_regress_gray_opt_f32(model, xyz, n, nullptr, mean_out, variance_out);
+}
+
+SOGMM_API sogmm_status sogmm_model_regress_gray_opt_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                        const sogmm_options* options, float* mean_out,
+                                                        float* variance_out) {
   SOGMM_TRY {
     require_nonnull(model, "model");
     if (n == 0) return SOGMM_OK;
     require_nonnull(xyz, "xyz");
     require_nonnull(mean_out, "mean_out");
     sogmm_capi::require_finite(xyz, sogmm::checked::mul<std::size_t>(n, 3, "xyz"), "xyz");
-    sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out);
+    sogmm::regress_gray(model->model.gmm, xyz, n, mean_out, variance_out, query_options(options));
   }
   SOGMM_CATCH
 }
 
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out) {
+  return sogmm_model_score_samples_opt_f32(model, points, n, dims, nullptr, out);
+}
+
+SOGMM_API sogmm_status sogmm_model_score_samples_opt_f32(const sogmm_model* model, const float* points,
+                                                         size_t n, int32_t dims, const sogmm_options* options,
+                                                         double* out) {
   SOGMM_TRY {
     require_nonnull(model, "model");
     require_dims(dims);
@@ -68,7 +89,7 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
     require_nonnull(out, "out");
     sogmm_capi::require_finite(points, sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "points"),
                                "points");
-    sogmm::score_samples(model->model.gmm, points, n, dims, out);
+    sogmm::score_samples(model->model.gmm, points, n, dims, out, query_options(options));
   }
   SOGMM_CATCH
 }

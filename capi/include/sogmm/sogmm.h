@@ -181,8 +181,14 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
 
-/* Sampling (sogmm_model_sample_f32). */
+/* Sampling (sogmm_model_sample_f32) and queries (the *_opt_f32 score and
+ * regression, which also use SOGMM_OPT_THREADS). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
+#define SOGMM_OPT_QUERY_TRUNCATION_NATS 501 /* f64, >= 0, finite; default 0 = exact queries. > 0: culled score
+                                             * and regression that skip a component at a point only when its
+                                             * term is provably more than this many nats below the point's
+                                             * largest (as SOGMM_OPT_TRUNCATION_NATS for the E-step): a score is
+                                             * then at most log(1 + M exp(-nats)) below the exact one */
 
 /* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
  * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
@@ -436,6 +442,13 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
  * -> SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
                                                     float* mean_out, float* variance_out);
+/* sogmm_model_regress_gray_f32 with the query keys of `options` (NULL =
+ * defaults, the same as sogmm_model_regress_gray_f32): SOGMM_OPT_THREADS
+ * (results are bitwise the same for any count) and
+ * SOGMM_OPT_QUERY_TRUNCATION_NATS (culled regression). */
+SOGMM_API sogmm_status sogmm_model_regress_gray_opt_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                        const sogmm_options* options, float* mean_out,
+                                                        float* variance_out);
 
 /* Log-density of n points under the model into `out` (n doubles). dims = 4:
  * rows of (x, y, z, gray), joint density; dims = 3: rows of (x, y, z), the
@@ -443,6 +456,13 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, co
  * SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
                                                      size_t n, int32_t dims, double* out);
+/* sogmm_model_score_samples_f32 with the query keys of `options` (NULL =
+ * defaults, the same as sogmm_model_score_samples_f32): SOGMM_OPT_THREADS
+ * (results are bitwise the same for any count) and
+ * SOGMM_OPT_QUERY_TRUNCATION_NATS (culled score). */
+SOGMM_API sogmm_status sogmm_model_score_samples_opt_f32(const sogmm_model* model, const float* points,
+                                                         size_t n, int32_t dims, const sogmm_options* options,
+                                                         double* out);
 
 /* New model with the components of a and b, weights re-weighted by support
  * size; support size a + b. Both must be in the same frame (key
