@@ -55,6 +55,7 @@ OPT_COMPRESS = 302
 OPT_MAX_DECODED_BYTES = 400
 OPT_VERIFY_CHECKSUMS = 401
 OPT_SAMPLE_TRUNCATION = 500
+OPT_QUERY_TRUNCATION_NATS = 501
 OPT_MAP_NOVELTY = 600
 OPT_MAP_NOVELTY_THRESHOLD = 601
 OPT_MAP_BATCH_SIZE = 602
@@ -182,6 +183,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_sample_f32": (STATUS, [HANDLE, c_size_t, c_uint64, c_int32, HANDLE, F32_OUT]),
     "sogmm_model_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F32_OUT, F32_OUT]),
     "sogmm_model_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, F64_OUT]),
+    "sogmm_model_regress_gray_opt_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
+    "sogmm_model_score_samples_opt_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_model_merge": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
     "sogmm_model_transform": (STATUS, [HANDLE_OUT, HANDLE, F64_IN]),
     "sogmm_model_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
@@ -358,6 +361,7 @@ OPTION_NAMES = {
     OPT_MAX_DECODED_BYTES: "max_decoded_bytes",
     OPT_VERIFY_CHECKSUMS: "verify_checksums",
     OPT_SAMPLE_TRUNCATION: "truncation",
+    OPT_QUERY_TRUNCATION_NATS: "truncation_nats",
     OPT_MAP_NOVELTY: "novelty",
     OPT_MAP_NOVELTY_THRESHOLD: "novelty_threshold",
     OPT_MAP_BATCH_SIZE: "batch_size",
