@@ -9,16 +9,20 @@
 //   marginal) from every point of B, and the joint (4-D) distance is at least
 //   the marginal one, so its term is below c_k - R^2 / 2, with c_k its log
 //   weight minus log det L minus D/2 log 2 pi;
-// - the block first evaluates the components whose box meets B (and the
-//   regression's background); with `worst` the lowest per-point maximum found,
-//   and cut = worst - nats, every other component whose term can reach the
-//   cut is evaluated too: those with c_k - R^2 / 2 >= cut (a prefix of the
-//   components sorted by c_k, so this costs nothing when there are none)
-//   whose bound over B is >= cut as well. That bound is the truncated
+// - every component has an upper bound on its term over B, the truncated
 //   E-step's (em.cpp): interval arithmetic of the whitened coordinates
 //   y = L^-1 (x - mu) over B (in D dimensions, gray included for scores)
-//   bounds |y|^2 below by the squared distance of each y_j's interval from 0.
-//   All other terms are below cut = worst - nats <= best - nats.
+//   bounds |y|^2 below by the squared distance of each y_j's interval from 0;
+// - the block first evaluates, among the components whose box meets B, the
+//   few that best explain a few probe points of the block (and the
+//   regression's background); with `worst` the
+//   lowest per-point maximum found, and cut = worst - nats, every other
+//   component whose term can reach the cut is evaluated too: first the
+//   remaining candidates with bound >= cut, then (with the cut raised by
+//   what they found) the components outside the index's answer with
+//   c_k - R^2 / 2 >= cut (a prefix of the components sorted by c_k, so this
+//   costs nothing when there are none) and bound >= cut. All other terms are
+//   below cut = worst - nats <= best - nats.
 // R only trades index work against that fallback, never the guarantee: it is
 // chosen so that the fallback is rare (R^2 / 2 = nats + the spread of c_k
 // between its median and 90th percentile + 8 nats of a point's own distance).
@@ -28,6 +32,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "query_kernel.hpp"
@@ -38,8 +43,12 @@ namespace sogmm::detail {
 
 /// Per-thread lists of one block's components.
 struct CullScratch {
-  std::vector<std::uint32_t> list;
-  std::vector<std::uint32_t> extra;
+  std::vector<std::uint32_t> candidates;  ///< the index's answer, ascending
+  std::vector<double> upper;              ///< their bounds
+  std::vector<std::uint32_t> first;       ///< evaluated first
+  std::vector<std::uint32_t> extra;       ///< evaluated once the cut is known
+  std::vector<std::pair<double, std::uint32_t>> ranked;
+  double lo[4], hi[4];                    ///< the block's box
 };
 
 class QueryCuller {
@@ -58,19 +67,32 @@ class QueryCuller {
   /// after the first call).
   template <class Eval>
   void evaluate(const QueryBlock& block, CullScratch& s, const Eval& eval, const double* max) const {
-    candidates(block, s.list);
-    eval(s.list.data(), s.list.size());
-    double worst = max[0];
-    for (int p = 1; p < block.count; ++p) worst = worst < max[p] ? worst : max[p];
-    fallback(block, worst - nats_, s.list, s.extra);
+    choose_first(block, s);
+    eval(s.first.data(), s.first.size());
+    // Each step can only raise the worst maximum, so a later cut is higher.
+    choose_candidates(cut(block, max), s);
+    if (!s.extra.empty()) eval(s.extra.data(), s.extra.size());
+    choose_others(cut(block, max), s);
     if (!s.extra.empty()) eval(s.extra.data(), s.extra.size());
   }
 
  private:
-  void candidates(const QueryBlock& block, std::vector<std::uint32_t>& out) const;
-  void fallback(const QueryBlock& block, double cut, const std::vector<std::uint32_t>& taken,
-                std::vector<std::uint32_t>& out) const;
+  /// Points of a block probed, and components kept per probe, for the
+  /// first evaluation.
+  static constexpr int kProbes = 4;
+  static constexpr std::size_t kPerProbe = 8;
+  void choose_first(const QueryBlock& block, CullScratch& s) const;
+  void choose_candidates(double cut, CullScratch& s) const;
+  void choose_others(double cut, CullScratch& s) const;
+  /// The lowest per-point maximum of the block minus nats.
+  double cut(const QueryBlock& block, const double* max) const {
+    double worst = max[0];
+    for (int p = 1; p < block.count; ++p) worst = worst < max[p] ? worst : max[p];
+    return worst - nats_;
+  }
   double upper_bound(std::uint32_t k, const double* lo, const double* hi) const;
+  /// Component k's term at point p of the block.
+  double term_at(std::uint32_t k, const QueryBlock& block, int p) const;
 
   const std::vector<double>& params_;
   int dims_;
