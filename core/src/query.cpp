@@ -154,13 +154,13 @@ void run_blocks(const float* points, std::size_t n, int width, const std::vector
   std::vector<detail::CullScratch> cull(culler ? static_cast<std::size_t>(team) : 0);
   detail::parallel_for(n_blocks, team, 1, [&](std::size_t b, int thread) {
     alignas(64) double coord[4][kQueryBlock];
-    std::uint32_t index[kQueryBlock];
+    std::size_t index[kQueryBlock];
     const std::size_t first = b * kQueryBlock;
     const int count = static_cast<int>(std::min<std::size_t>(kQueryBlock, n - first));
     for (int p = 0; p < kQueryBlock; ++p) {
       // Entries past the last point repeat it (finite, ignored).
       const std::size_t i = first + static_cast<std::size_t>(std::min(p, count - 1));
-      index[p] = static_cast<std::uint32_t>(culler ? culler->order()[i] : i);
+      index[p] = culler ? culler->order()[i] : i;
       for (int j = 0; j < width; ++j) coord[j][p] = points[static_cast<std::size_t>(width) * index[p] + j];
     }
     const detail::QueryBlock block{{coord[0], coord[1], coord[2], coord[3]}, count};

@@ -19,7 +19,7 @@ std::uint64_t z_key(const std::uint32_t c[3]) {
 }
 
 // The points' permutation along a Z-order curve over their bounding box.
-std::vector<std::uint32_t> z_order(const float* points, std::size_t n, int width) {
+std::vector<std::size_t> z_order(const float* points, std::size_t n, int width) {
   double lo[3], hi[3];
   for (int j = 0; j < 3; ++j) lo[j] = hi[j] = points[j];
   for (std::size_t i = 1; i < n; ++i)
@@ -30,15 +30,15 @@ std::vector<std::uint32_t> z_order(const float* points, std::size_t n, int width
   double extent = 0.0;
   for (int j = 0; j < 3; ++j) extent = std::max(extent, hi[j] - lo[j]);
   const double scale = extent > 0 ? 65535.0 / extent : 0.0;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t c[3];
     for (int j = 0; j < 3; ++j)
       c[j] = static_cast<std::uint32_t>(std::clamp((points[width * i + j] - lo[j]) * scale, 0.0, 65535.0));
-    keyed[i] = {z_key(c), static_cast<std::uint32_t>(i)};
+    keyed[i] = {z_key(c), i};
   }
   std::sort(keyed.begin(), keyed.end());
-  std::vector<std::uint32_t> order(n);
+  std::vector<std::size_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
   return order;
 }

@@ -60,7 +60,7 @@ class QueryCuller {
               const float* points, std::size_t n, int width);
 
   /// The order in which points are visited (a permutation of [0, n)).
-  const std::vector<std::uint32_t>& order() const { return order_; }
+  const std::vector<std::size_t>& order() const { return order_; }
 
   /// Calls eval(list, count) with the components `block` must evaluate, in
   /// one or two lists; `max` is the block's running per-point maximum (read
@@ -103,7 +103,7 @@ class QueryCuller {
   ComponentIndex index_;
   std::vector<std::uint32_t> by_const_;  ///< components by c_k, descending
   std::vector<double> const_;            ///< c_k in that order
-  std::vector<std::uint32_t> order_;
+  std::vector<std::size_t> order_;
 };
 
 }  // namespace sogmm::detail
