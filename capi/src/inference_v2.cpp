@@ -13,8 +13,8 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model,
   SOGMM_TRY {
     sogmm_capi::require_nonnull(model, "model");
     sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
-                                  [&](float* mean, float* variance, const sogmm::ProgressSink& sink) {
-                                    sogmm::regress_gray(model->model.gmm, xyz, n, mean, variance, sink);
+                                  [&](float* mean, float* variance, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
+                                    sogmm::regress_gray(model->model.gmm, xyz, n, mean, variance, query, sink);
                                   });
   }
   SOGMM_CATCH
@@ -26,8 +26,8 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model
   SOGMM_TRY {
     sogmm_capi::require_nonnull(model, "model");
     sogmm_capi::require_dims(dims);
-    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::ProgressSink& sink) {
-      sogmm::score_samples(model->model.gmm, points, n, dims, dst, sink);
+    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
+      sogmm::score_samples(model->model.gmm, points, n, dims, dst, query, sink);
     });
   }
   SOGMM_CATCH

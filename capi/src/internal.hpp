@@ -48,6 +48,7 @@ struct sogmm_options {
   std::int64_t verify_checksums = 1;
   // sample
   double sample_truncation = 2.5;
+  double query_truncation_nats = 0.0;  // SOGMM_OPT_QUERY_TRUNCATION_NATS: 0 = exact queries
   // progress (sogmm_options_set_progress): not a key, never stored in files
   sogmm_progress_fn progress = nullptr;
   void* progress_user_data = nullptr;

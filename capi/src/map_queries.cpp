@@ -30,8 +30,8 @@ SOGMM_API sogmm_status sogmm_map_score_samples_f32(const sogmm_map* map, const f
     require_nonnull(map, "map");
     require_dims(dims);
     require_map_with_components(map);
-    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::ProgressSink& sink) {
-      sogmm::score_samples(map->map, points, n, dims, dst, sink);
+    sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
+      sogmm::score_samples(map->map, points, n, dims, dst, query, sink);
     });
   }
   SOGMM_CATCH
@@ -43,8 +43,8 @@ SOGMM_API sogmm_status sogmm_map_regress_gray_f32(const sogmm_map* map, const fl
   SOGMM_TRY {
     require_map_with_components(map);
     sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
-                                  [&](float* mean, float* variance, const sogmm::ProgressSink& sink) {
-                                    sogmm::regress_gray(map->map, xyz, n, mean, variance, sink);
+                                  [&](float* mean, float* variance, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
+                                    sogmm::regress_gray(map->map, xyz, n, mean, variance, query, sink);
                                   });
   }
   SOGMM_CATCH

@@ -10,6 +10,7 @@
 
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
+#include "sogmm/inference.hpp"
 
 namespace sogmm_capi {
 
@@ -25,6 +26,14 @@ inline void require_query_input(const float* in, std::size_t n, std::size_t widt
   require_nonnull(in, in_name);
   require_nonnull(out, out_name);
   require_finite(in, sogmm::checked::mul<std::size_t>(n, width, in_name), in_name);
+}
+
+/// The query keys of `o`: SOGMM_OPT_THREADS, SOGMM_OPT_QUERY_TRUNCATION_NATS.
+inline sogmm::QueryOptions query_options(const sogmm_options& o) {
+  sogmm::QueryOptions q;
+  q.threads = static_cast<int>(o.threads);
+  q.truncation_nats = o.query_truncation_nats;
+  return q;
 }
 
 /// Runs write(dst) for an output of `count` values: straight into `out`, or,
@@ -43,7 +52,7 @@ void write_on_success(bool progress, T* out, std::size_t count, const Write& wri
 
 /// The body of a score query (model or map) after the handle and dims
 /// checks: n == 0 writes nothing; then require_query_input; then
-/// score(dst, sink) with the options' progress sink, through
+/// score(dst, query options, sink) with the options' query keys and progress sink, through
 /// write_on_success.
 template <class Score>
 void run_score_query(const float* points, std::size_t n, int32_t dims, const sogmm_options* options, double* out,
@@ -51,10 +60,10 @@ void run_score_query(const float* points, std::size_t n, int32_t dims, const sog
   if (n == 0) return;
   require_query_input(points, n, static_cast<std::size_t>(dims), "points", out, "out");
   const sogmm_options& o = opts_or_default(options);
-  write_on_success(o.progress != nullptr, out, n, [&](double* dst) { score(dst, progress_sink(o)); });
+  write_on_success(o.progress != nullptr, out, n, [&](double* dst) { score(dst, query_options(o), progress_sink(o)); });
 }
 
-/// The same for a gray regression: regress(mean, variance, sink), the
+/// The same for a gray regression: regress(mean, variance, query options, sink), the
 /// variance optional (NULL stays NULL).
 template <class Regress>
 void run_regress_query(const float* xyz, std::size_t n, const sogmm_options* options, float* mean_out,
@@ -64,7 +73,7 @@ void run_regress_query(const float* xyz, std::size_t n, const sogmm_options* opt
   const sogmm_options& o = opts_or_default(options);
   write_on_success(o.progress != nullptr, mean_out, n, [&](float* mean) {
     write_on_success(o.progress != nullptr, variance_out, n,
-                     [&](float* variance) { regress(mean, variance, progress_sink(o)); });
+                     [&](float* variance) { regress(mean, variance, query_options(o), progress_sink(o)); });
   });
 }
 

@@ -11,13 +11,13 @@ namespace sogmm {
 // any other check.
 
 void score_samples(const Map& map, const float* points, std::size_t n, int dims, double* out,
-                   const ProgressSink& progress) {
-  score_samples(map.model().gmm, points, n, dims, out, progress);
+                   const QueryOptions& options, const ProgressSink& progress) {
+  score_samples(map.model().gmm, points, n, dims, out, options, progress);
 }
 
 void regress_gray(const Map& map, const float* xyz, std::size_t n, float* mean, float* variance,
-                  const ProgressSink& progress) {
-  regress_gray(map.model().gmm, xyz, n, mean, variance, progress);
+                  const QueryOptions& options, const ProgressSink& progress) {
+  regress_gray(map.model().gmm, xyz, n, mean, variance, options, progress);
 }
 
 void sample(const Map& map, std::size_t n, std::uint64_t seed, int dims, float* out, double truncation,

@@ -51,27 +51,27 @@ void run_query(Stage stage, std::size_t n, const ProgressSink& progress, const Q
 }  // namespace
 
 void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out,
-                   const ProgressSink& progress) {
+                   const QueryOptions& options, const ProgressSink& progress) {
   if (!progress || n == 0 || dims < 3 || dims > 4 || points == nullptr || out == nullptr) {
-    score_samples(gmm, points, n, dims, out);  // its checks and errors
+    score_samples(gmm, points, n, dims, out, options);  // its checks and errors
     return;
   }
   const std::size_t width = static_cast<std::size_t>(dims);
   require_finite_rows(points, n, width, "points to score");
   run_query(Stage::Scoring, n, progress, [&](std::size_t first, std::size_t count) {
-    score_samples(gmm, points + width * first, count, dims, out + first);
+    score_samples(gmm, points + width * first, count, dims, out + first, options);
   });
 }
 
 void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance,
-                  const ProgressSink& progress) {
+                  const QueryOptions& options, const ProgressSink& progress) {
   if (!progress || n == 0 || xyz == nullptr || mean == nullptr) {
-    regress_gray(gmm, xyz, n, mean, variance);
+    regress_gray(gmm, xyz, n, mean, variance, options);
     return;
   }
   require_finite_rows(xyz, n, 3, "points to regress");
   run_query(Stage::Regression, n, progress, [&](std::size_t first, std::size_t count) {
-    regress_gray(gmm, xyz + 3 * first, count, mean + first, variance ? variance + first : nullptr);
+    regress_gray(gmm, xyz + 3 * first, count, mean + first, variance ? variance + first : nullptr, options);
   });
 }
 

@@ -86,7 +86,7 @@ TEST(MapQueries, EqualTheModelQueriesBitwiseWithAndWithoutASink) {
     sogmm::score_samples(gmm, q.data(), n, dims, want.data());
     sogmm::score_samples(map, q.data(), n, dims, plain.data());
     reports = 0;
-    sogmm::score_samples(map, q.data(), n, dims, chunked.data(), sink);
+    sogmm::score_samples(map, q.data(), n, dims, chunked.data(), {}, sink);
     EXPECT_TRUE(same_bits(want, plain));
     EXPECT_TRUE(same_bits(want, chunked));
     EXPECT_GE(reports, 2u);  // the start and the end at least
@@ -97,7 +97,7 @@ TEST(MapQueries, EqualTheModelQueriesBitwiseWithAndWithoutASink) {
   std::vector<float> mean(n), var(n), mean_m(n), var_m(n), mean_s(n);
   sogmm::regress_gray(gmm, q.data(), n, mean.data(), var.data());
   sogmm::regress_gray(map, q.data(), n, mean_m.data(), var_m.data());
-  sogmm::regress_gray(map, q.data(), n, mean_s.data(), nullptr, sink);
+  sogmm::regress_gray(map, q.data(), n, mean_s.data(), nullptr, {}, sink);
   EXPECT_TRUE(same_bits(mean, mean_m) && same_bits(var, var_m) && same_bits(mean, mean_s));
 
   std::vector<float> s(4 * n), s_m(4 * n);
@@ -124,9 +124,9 @@ TEST(MapQueries, RefuseAnEmptyMapAndBadPoints) {
   for (bool with_sink : {false, true}) {
     const sogmm::ProgressSink sink = with_sink ? sogmm::ProgressSink([](const sogmm::Progress&) { return false; })
                                                : sogmm::ProgressSink();
-    expect_error([&] { sogmm::score_samples(map, q.data(), 4, 3, out.data(), sink); }, ErrorCode::InvalidData,
+    expect_error([&] { sogmm::score_samples(map, q.data(), 4, 3, out.data(), {}, sink); }, ErrorCode::InvalidData,
                  {"row 2"}, "NaN score");
-    expect_error([&] { sogmm::regress_gray(map, q.data(), 4, g.data(), nullptr, sink); }, ErrorCode::InvalidData,
+    expect_error([&] { sogmm::regress_gray(map, q.data(), 4, g.data(), nullptr, {}, sink); }, ErrorCode::InvalidData,
                  {"row 2"}, "NaN regress");
   }
 }
@@ -135,7 +135,7 @@ TEST(MapQueries, ACancelledQueryThrowsCancelled) {
   const Map map = two_frame_map();
   const std::vector<float> q = queries(100, 4);
   std::vector<double> out(100);
-  expect_error([&] { sogmm::score_samples(map, q.data(), 100, 4, out.data(), [](const sogmm::Progress&) { return true; }); },
+  expect_error([&] { sogmm::score_samples(map, q.data(), 100, 4, out.data(), {}, [](const sogmm::Progress&) { return true; }); },
                ErrorCode::Cancelled, {"scoring"}, "cancel score");
 }
 

@@ -121,6 +121,7 @@ def main():
                         lambda b, t: warm6[t]["s_warm"] if b == "new" else None, None))
     if "d1s02" in cases:
         rows.append(("d=1 regress all points (exact fit)", 0.2, "s", lambda b, t: get(b, "d1s02", "s_regress", t), None))
+        rows.append(("same, culled at 20 nats", 0.2, "s", lambda b, t: get(b, "d1s02", "s_regress_culled", t), None))
     if "d1s02t20" in cases:
         rows.append(("d=1 regress all points (truncated fit)", 0.2, "s",
                      lambda b, t: get(b, "d1s02t20", "s_regress", t), None))
@@ -129,6 +130,8 @@ def main():
         rows.append((f"regress gray {n} points, {m} components", 0.02, "ms",
                      lambda b, t: get(b, "d5s02", "s_regress", t), None))
         rows.append(("score_samples, same", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_score", t), None))
+        rows.append(("regress gray, culled at 20 nats", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_regress_culled", t), None))
+        rows.append(("score_samples, culled at 20 nats", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_score_culled", t), None))
         rows.append(("seeding share of a fit (bw 0.02)", 0.10, "%", lambda b, t: share(b, "d5s02", t), None))
     if "d5s01" in cases:
         rows.append(("seeding share of a fit (bw 0.01)", 0.10, "%", lambda b, t: share(b, "d5s01", t), None))

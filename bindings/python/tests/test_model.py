@@ -137,6 +137,30 @@ def test_regress_gray_matches_numpy(fitted, points):
     assert np.abs(mean - points[::11, 3]).mean() < 0.05
 
 
+def test_culled_queries_within_bound_and_thread_independent(fitted, points):
+    """truncation_nats culls components provably below each point's best term
+    (issue 17): the score never rises and falls by at most log(1 + M e^-nats);
+    0 is the exact default, and the thread count changes no bit."""
+    m = fitted
+    M = m.n_components_
+    exact = m.score_samples(points)
+    np.testing.assert_array_equal(exact, m.score_samples(points, truncation_nats=0.0, n_threads=1))
+    np.testing.assert_array_equal(exact, m.score_samples(points, n_threads=2))
+    for nats in (2.0, 20.0):
+        culled = m.score_samples(points, truncation_nats=nats)
+        np.testing.assert_array_equal(culled, m.score_samples(points, truncation_nats=nats, n_threads=1))
+        slack = 1e-12 * (1 + np.abs(exact))
+        assert np.all(culled <= exact + slack)
+        assert np.all(exact - culled <= np.log1p(M * np.exp(-nats)) + slack)
+    mean, var = m.regress_gray(points[:, :3])
+    cm, cv = m.regress_gray(points[:, :3], truncation_nats=20.0, n_threads=1)
+    np.testing.assert_allclose(cm, mean, atol=1e-5)
+    with pytest.raises(sogmm.InvalidArgumentError, match="truncation"):
+        m.score_samples(points, truncation_nats=-1.0)
+    with pytest.raises(sogmm.InvalidArgumentError, match="truncation"):
+        m.regress_gray(points[:, :3], truncation_nats=float("nan"))
+
+
 def test_sample(fitted):
     m = fitted
     a = m.sample(20000, seed=5)

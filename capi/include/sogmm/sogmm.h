@@ -181,8 +181,14 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
 
-/* Sampling (sogmm_model_sample_f32). */
+/* Sampling (sogmm_model_sample_f32) and queries (the _v2 score and
+ * regression and the map queries, which also use SOGMM_OPT_THREADS). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
+#define SOGMM_OPT_QUERY_TRUNCATION_NATS 501 /* f64, >= 0, finite; default 0 = exact queries. > 0: culled score
+                                             * and regression that skip a component at a point only when its
+                                             * term is provably more than this many nats below the point's
+                                             * largest (as SOGMM_OPT_TRUNCATION_NATS for the E-step): a score is
+                                             * then at most log(1 + M exp(-nats)) below the exact one */
 
 /* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
  * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
@@ -464,12 +470,17 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
                                                      size_t n, int32_t dims, double* out);
 
 /* sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32 with
- * options (NULL = defaults), for their progress callback
- * (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION, SOGMM_STAGE_SCORING):
- * the same bits; a cancel returns SOGMM_E_CANCELLED with the outputs
- * untouched (they are then written through a temporary buffer: as much
- * memory again as the output). Arguments and errors otherwise as the
- * functions without _v2. */
+ * options (NULL = defaults, the same bits as the functions without _v2):
+ * - SOGMM_OPT_THREADS: worker threads; the answers are bitwise the same for
+ *   any count;
+ * - SOGMM_OPT_QUERY_TRUNCATION_NATS: 0 = exact (default); > 0 culls (a
+ *   component is skipped at a point only when its term is provably more than
+ *   that many nats below the point's largest);
+ * - the progress callback (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION,
+ *   SOGMM_STAGE_SCORING): the same bits; a cancel returns SOGMM_E_CANCELLED
+ *   with the outputs untouched (they are then written through a temporary
+ *   buffer: as much memory again as the output).
+ * Arguments and errors otherwise as the functions without _v2. */
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
                                                        const sogmm_options* options, float* mean_out,
                                                        float* variance_out);

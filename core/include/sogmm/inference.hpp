@@ -11,12 +11,32 @@
 
 namespace sogmm {
 
+/// How score_samples and regress_gray run. The defaults are the exact
+/// queries on OpenMP's default team.
+struct QueryOptions {
+  /// Worker threads; 0 = OpenMP's default (omp_get_max_threads()); at most
+  /// 4 x omp_get_num_procs(). Results are bitwise the same for any count.
+  int threads = 0;
+  /// 0 (default): exact, every point against every component. > 0: culled
+  /// (opt-in), with the truncated E-step's guarantee (EmOptions::
+  /// truncation_nats): a component is skipped at a point only when its term
+  /// is provably more than `truncation_nats` below the point's largest one
+  /// (a spatial index over 3-D boxes of the components and a bound on the
+  /// rest). So a score is at most log(1 + M exp(-truncation_nats)) below the
+  /// exact one (M components), and the regression is that of the mixture
+  /// without components whose share of the weight at the point is below
+  /// exp(-truncation_nats) each. Must be finite and >= 0.
+  double truncation_nats = 0.0;
+};
+
 /// Log-density of each of `n` points under the model. `dims` = 4: rows of 4
 /// floats (x, y, z, gray), joint density; `dims` = 3: rows of 3 floats (x, y,
 /// z), the marginal over gray. Writes n doubles to `out`. Computed in double
-/// with log-sum-exp. Throws Error(InvalidArgument) for dims not 3 or 4,
+/// with log-sum-exp (terms below exp(-708) of a point's largest are dropped).
+/// Throws Error(InvalidArgument) for dims not 3 or 4 or bad options,
 /// Error(InvalidData) for non-finite input, Error(Numeric) for an invalid model.
-void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out);
+void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out,
+                   const QueryOptions& options = {});
 
 /// Mean of score_samples (the average log-likelihood, scikit-learn's score).
 double mean_log_likelihood(const Gmm& gmm, const float* points, std::size_t n, int dims);
@@ -48,7 +68,9 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
 /// `variance`, if not null, receives the variance of this mixture
 /// conditional, sum_m w_m (nu_m^2 + (lambda_m - mean)^2) (computed about the
 /// mean, so it does not cancel far out). `xyz` holds n rows of 3 floats.
-void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance);
+/// Computed in double; `options` as for score_samples.
+void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance,
+                  const QueryOptions& options = {});
 
 /// Merges two models into one: components are concatenated and weights
 /// re-weighted by support size (w = w_a S_a / (S_a + S_b) for a's

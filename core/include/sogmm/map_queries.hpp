@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
 #include "sogmm/progress.hpp"
 
@@ -25,13 +26,13 @@ namespace sogmm {
 /// then as score_samples. `progress` (optional) receives Stage::Scoring
 /// reports and may cancel, as in sogmm/query_progress.hpp.
 void score_samples(const Map& map, const float* points, std::size_t n, int dims, double* out,
-                   const ProgressSink& progress = {});
+                   const QueryOptions& options = {}, const ProgressSink& progress = {});
 
 /// regress_gray (sogmm/inference.hpp) at n world points (rows of 3 floats):
 /// expected gray into `mean`, its variance into `variance` (may be null).
 /// Errors and progress as score_samples above, with Stage::Regression.
 void regress_gray(const Map& map, const float* xyz, std::size_t n, float* mean, float* variance,
-                  const ProgressSink& progress = {});
+                  const QueryOptions& options = {}, const ProgressSink& progress = {});
 
 /// sample (sogmm/inference.hpp) of n world points from the map, rows of
 /// `dims` floats grouped by component; the same seed gives the same points.

@@ -6,11 +6,12 @@
 #include <cstddef>
 
 #include "sogmm/gmm.hpp"
+#include "sogmm/inference.hpp"
 #include "sogmm/progress.hpp"
 
 namespace sogmm {
 
-/// score_samples(gmm, points, n, dims, out) (sogmm/inference.hpp), the same
+/// score_samples(gmm, points, n, dims, out, options) (sogmm/inference.hpp), the same
 /// bits, reporting Stage::Scoring to `progress` (step = points scored: the
 /// first report at 0, the last at n; total = n). Without a sink it is that
 /// one call. With one, the points go in chunks of at least 4,096 (at most 64
@@ -20,11 +21,11 @@ namespace sogmm {
 /// named by its row); a cancel throws Error(Cancelled) with `out` partly
 /// written.
 void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims, double* out,
-                   const ProgressSink& progress);
+                   const QueryOptions& options, const ProgressSink& progress);
 
-/// regress_gray(gmm, xyz, n, mean, variance) (sogmm/inference.hpp) with
+/// regress_gray(gmm, xyz, n, mean, variance, options) (sogmm/inference.hpp) with
 /// Stage::Regression reports, as score_samples above.
 void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean, float* variance,
-                  const ProgressSink& progress);
+                  const QueryOptions& options, const ProgressSink& progress);
 
 }  // namespace sogmm

@@ -19,7 +19,7 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError
-from .model import GMM, SOGMM, _pose, _read_options, _rows, _sample_args, _write_options
+from .model import GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args, _write_options
 from .progress import ProgressArg, call_with_progress
 
 __all__ = ["Map"]
@@ -214,24 +214,27 @@ class Map:
     # World-frame queries on the map itself (no export, no copy): each answer
     # is bitwise what the same GMM method gives on export(). A map without
     # components (nothing flushed yet) raises InvalidDataError. ``progress``
-    # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING).
-    def score_samples(self, X, progress: ProgressArg = None) -> np.ndarray:
+    # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING);
+    # ``truncation_nats`` and ``n_threads`` as in GMM.score_samples.
+    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
+                      n_threads: int = 0) -> np.ndarray:
         """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
         h = self._h()
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
-        with _ffi.Options() as o:
+        with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(h, x, x.shape[0], x.shape[1],
                                                                                      o.ptr, out))
         return out
 
-    def regress_gray(self, xyz, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray]:
+    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
+                     n_threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
         h = self._h()
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
         var = np.empty(x.shape[0], dtype=np.float32)
-        with _ffi.Options() as o:
+        with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(h, x, x.shape[0], o.ptr, mean,
                                                                                     var))
         return mean, var

@@ -74,6 +74,10 @@ def _write_options(float64: bool, compress: bool, zstd_level: int) -> _ffi.Optio
     )
 
 
+def _query_options(truncation_nats: float, n_threads: int) -> _ffi.Options:
+    return _ffi.Options(f64={_ffi.OPT_QUERY_TRUNCATION_NATS: truncation_nats}, i64={_ffi.OPT_THREADS: n_threads})
+
+
 def _read_options(verify_checksums: bool, max_decoded_bytes: int) -> _ffi.Options:
     return _ffi.Options(
         i64={_ffi.OPT_VERIFY_CHECKSUMS: int(bool(verify_checksums)), _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
@@ -356,14 +360,21 @@ class GMM:
         check(lib.sogmm_model_set_value(self._h(), k, v))
 
     # ---- inference -------------------------------------------------------
-    def score_samples(self, X, progress: ProgressArg = None) -> np.ndarray:
+    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
+                      n_threads: int = 0) -> np.ndarray:
         """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
         (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,).
-        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_SCORING, points done)."""
+
+        ``truncation_nats`` > 0 culls: a component is skipped at a point only
+        when its term is provably more than that many nats below the point's
+        largest, so each score is at most log(1 + M exp(-truncation_nats))
+        below the exact one (0, the default, is exact). ``n_threads``: 0 = all
+        cores; the answers are the same for any count. ``progress`` as in
+        :meth:`SOGMM.fit` (stage STAGE_SCORING, points done)."""
         h = self._h()
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
-        with _ffi.Options() as o:
+        with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
                                lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
@@ -384,14 +395,16 @@ class GMM:
             check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
         return out
 
-    def regress_gray(self, xyz, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray]:
+    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
+                     n_threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays.
-        ``progress`` as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
+        ``truncation_nats`` and ``n_threads`` as for score_samples; ``progress``
+        as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
         h = self._h()
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
         var = np.empty(x.shape[0], dtype=np.float32)
-        with _ffi.Options() as o:
+        with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
                                lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var

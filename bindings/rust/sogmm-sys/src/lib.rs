@@ -92,6 +92,7 @@ pub const SOGMM_OPT_COMPRESS: sogmm_key = 302;
 pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
 pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
 pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
+pub const SOGMM_OPT_QUERY_TRUNCATION_NATS: sogmm_key = 501;
 pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
 pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
 pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
@@ -283,6 +284,14 @@ extern "C" {
         model: *const sogmm_model,
         xyz: *const f32,
         n: usize,
+        mean_out: *mut f32,
+        variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_model_regress_gray_opt_f32(
+        model: *const sogmm_model,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
         mean_out: *mut f32,
         variance_out: *mut f32,
     ) -> sogmm_status;

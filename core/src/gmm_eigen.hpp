@@ -1,0 +1,40 @@
+// A Gmm's components as Eigen matrices in double, and a checked Cholesky
+// factorisation (private to the core: inference.cpp and query.cpp).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "sogmm/error.hpp"
+#include "sogmm/gmm.hpp"
+
+namespace sogmm::detail {
+
+/// Component k's covariance, in double.
+inline Eigen::Matrix4d covariance_of(const Gmm& gmm, std::size_t k) {
+  return Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
+}
+/// Component k's mean, in double.
+inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
+  return Eigen::Map<const Eigen::Vector4f>(gmm.mean(k)).cast<double>();
+}
+
+/// The Cholesky factorisation of a covariance (or a block of one), checked:
+/// validate() accepts the float32 model, yet a sub-block or a derived matrix
+/// could still fail in double, and an unchecked failure would turn into NaN
+/// answers silently. Throws Error(Numeric) naming `what` and component `k`
+/// (none when k is -1).
+template <class M>
+Eigen::LLT<M> checked_llt(const M& c, const char* what, std::size_t k = static_cast<std::size_t>(-1)) {
+  Eigen::LLT<M> llt(c);
+  if (llt.info() != Eigen::Success)
+    throw Error(ErrorCode::Numeric, std::string(what) +
+                                        (k == static_cast<std::size_t>(-1) ? "" : " of component " + std::to_string(k)) +
+                                        " is not positive definite");
+  return llt;
+}
+
+}  // namespace sogmm::detail
