@@ -254,11 +254,9 @@ SOGMM_API sogmm_status sogmm_model_get_value(const sogmm_model* model, const cha
     require_nonnull(model, "model");
     require_nonnull(key, "key");
     require_nonnull(value_out, "value_out");
-    for (const auto& kv : model->model.key_values) {
-      if (kv.first == key) {
-        *value_out = kv.second.c_str();
-        return SOGMM_OK;
-      }
+    if (const std::string* v = sogmm::find_value(model->model, key)) {
+      *value_out = v->c_str();
+      return SOGMM_OK;
     }
     fail(SOGMM_E_NOT_FOUND, std::string("no metadata key \"") + key + "\"");
   }
@@ -277,13 +275,7 @@ SOGMM_API sogmm_status sogmm_model_set_value(sogmm_model* model, const char* key
       if (!problem.empty())
         fail(SOGMM_E_INVALID_ARG, std::string("metadata ") + (s == key ? "key" : "value") + ": " + problem);
     }
-    for (auto& kv : model->model.key_values) {
-      if (kv.first == key) {
-        kv.second = value;
-        return SOGMM_OK;
-      }
-    }
-    model->model.key_values.emplace_back(key, value);
+    sogmm::set_value(model->model, key, value);
   }
   SOGMM_CATCH
 }

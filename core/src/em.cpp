@@ -213,7 +213,8 @@ void log_density_upper_bounds(const BoundParams& bp, const float* box, double* u
 // `list` (warm first, then the additions in ascending order) and its
 // log-density rows in `rows`.
 void truncated_log_density(const detail::EmKernels& kernels, const detail::Block& block, const float* box,
-                           const std::vector<float>& params, const BoundParams& bounds, double nats,
+                           const std::vector<float>& params, const std::vector<double>& exact,
+                           const BoundParams& bounds, double nats,
                            const std::vector<std::uint32_t>& warm,
                            std::vector<double>& upper, std::vector<char>& taken, std::vector<std::uint32_t>& list,
                            float* rows, float* row_lp_max, float* max_lp) {
@@ -231,7 +232,7 @@ void truncated_log_density(const detail::EmKernels& kernels, const detail::Block
     list.assign(idx.begin(), idx.begin() + first);
     std::sort(list.begin(), list.end());
   }
-  kernels.log_density(block, params.data(), list.data(), list.size(), rows, row_lp_max, max_lp);
+  kernels.log_density(block, params.data(), exact.data(), list.data(), list.size(), rows, row_lp_max, max_lp);
   float worst = max_lp[0];
   for (int p = 1; p < block.count; ++p) worst = std::min(worst, max_lp[p]);
   const double cut = static_cast<double>(worst) - nats;
@@ -240,7 +241,7 @@ void truncated_log_density(const detail::EmKernels& kernels, const detail::Block
   const std::size_t first = list.size();
   for (std::size_t k = 0; k < m; ++k)
     if (!taken[k] && upper[k] >= cut) list.push_back(static_cast<std::uint32_t>(k));
-  kernels.log_density(block, params.data(), list.data() + first, list.size() - first, rows + first * kBlock,
+  kernels.log_density(block, params.data(), exact.data(), list.data() + first, list.size() - first, rows + first * kBlock,
                       row_lp_max + first, max_lp);
 }
 
@@ -256,22 +257,47 @@ struct Working {
   std::size_t size() const { return log_weight.size(); }
 };
 
-// Writes component k's packed kernel parameters. The precision Cholesky
-// factor U = L^-T (covariance = L L^T) is computed in double by a triangular
-// solve. Returns false when the covariance is not positive definite.
-bool pack_component(const Working& w, std::size_t k, float* out) {
+// Whether float32 arithmetic would lose component k's thin directions. The
+// kernels compute y_j = sum_i U_ij d_i with d about the size of the
+// component's standard deviations, so each y_j carries an absolute float32
+// error of about eps_f sum_i |U_ij| sqrt(Sigma_ii) (~1 for y ~ 1 means every
+// digit is lost), and the second moments sum r d d^T carry errors of eps_f
+// Sigma_ii where the thin variance may be 1e8 times smaller. Above
+// kDoubleAmplification (relative error of y ~ 1.5e-5, of the thinnest
+// variance ~ 4e-3) the kernels evaluate the component in double. A room-sized
+// scene's components (10 cm x 1 mm: ~50) stay in float32 and bit for bit as
+// before; a 1 km plane with 1 cm noise (~3e4) does not.
+constexpr double kDoubleAmplification = 256.0;
+
+bool needs_double(const Eigen::Matrix4d& cov, const Eigen::Matrix4d& u) {
+  double worst = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    double a = 0.0;
+    for (int i = 0; i <= j; ++i) a += std::fabs(u(i, j)) * std::sqrt(cov(i, i));
+    worst = std::max(worst, a);
+  }
+  return worst > kDoubleAmplification;
+}
+
+// Writes component k's packed kernel parameters, in float32 to `out` and in
+// double to `exact` (the same layout; used by the kernels for components
+// flagged by needs_double). The precision Cholesky factor U = L^-T
+// (covariance = L L^T) is computed in double by a triangular solve. Returns
+// false when the covariance is not positive definite.
+bool pack_component(const Working& w, std::size_t k, float* out, double* exact) {
   const Eigen::Matrix4d cov = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&w.covariance[16 * k]);
   Eigen::LLT<Eigen::Matrix4d> llt(cov);
   if (llt.info() != Eigen::Success) return false;
   const Eigen::Matrix4d l = llt.matrixL();
   if (!(l.diagonal().minCoeff() > 0.0)) return false;
   const Eigen::Matrix4d u = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d::Identity()).transpose();
-  for (int i = 0; i < 4; ++i) out[i] = static_cast<float>(w.mean[4 * k + i]);
+  for (int i = 0; i < 4; ++i) exact[i] = w.mean[4 * k + i];
   int t = 4;
   for (int i = 0; i < 4; ++i)
-    for (int j = i; j < 4; ++j) out[t++] = static_cast<float>(u(i, j));
-  out[14] = static_cast<float>(w.log_weight[k] + u.diagonal().array().log().sum() - 2.0 * kLog2Pi);
-  out[15] = 0.f;
+    for (int j = i; j < 4; ++j) exact[t++] = u(i, j);
+  exact[14] = w.log_weight[k] + u.diagonal().array().log().sum() - 2.0 * kLog2Pi;
+  exact[15] = needs_double(cov, u) ? 1.0 : 0.0;
+  for (int i = 0; i < kParamStride; ++i) out[i] = static_cast<float>(exact[i]);
   return std::isfinite(out[14]);
 }
 
@@ -280,13 +306,14 @@ bool pack_component(const Working& w, std::size_t k, float* out) {
 // degenerate component): first reg_covar or 1e-12 of the component's largest
 // variance (of the data's extent squared when it has none), then x10 up to
 // 12 times, so the loading follows the component's own scale.
-void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed) {
+void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
+                            double* exact) {
   double* c = &w.covariance[16 * k];
   double own = 0.0;
   for (int i = 0; i < 4; ++i) own = std::max(own, c[5 * i]);
   double extra = std::max(reg_covar, 1e-12 * (own > 0.0 ? own : data_scale2));
   int attempts = 0;
-  while (!pack_component(w, k, packed)) {
+  while (!pack_component(w, k, packed, exact)) {
     require(++attempts <= 12, ErrorCode::Numeric,
             "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
     for (int i = 0; i < 4; ++i) c[5 * i] += extra;
@@ -294,14 +321,17 @@ void make_positive_definite(Working& w, std::size_t k, double reg_covar, double 
   }
 }
 
-void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params) {
+void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params, std::vector<double>& exact) {
   params.assign(w.size() * kParamStride, 0.f);
-  for (std::size_t k = 0; k < w.size(); ++k) make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride]);
+  exact.assign(w.size() * kParamStride, 0.0);
+  for (std::size_t k = 0; k < w.size(); ++k)
+    make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
 }
 
 // M-step for one component from its statistics, which are centred at the
-// packed (float32) mean `centre`; returns sum r + guard.
-double m_step_component(const double* st, double reg_covar, const float* centre, double* mean, double* cov) {
+// mean the kernels used, `centre` (the packed float32 one, or the double one
+// for a flagged component); returns sum r + guard.
+double m_step_component(const double* st, double reg_covar, const double* centre, double* mean, double* cov) {
   const double nk = st[0] + kEmptyGuard;
   if (st[0] <= 0.0) {
     // No point is responsible: keep the mean, reset the shape to the regulariser.
@@ -320,7 +350,7 @@ double m_step_component(const double* st, double reg_covar, const float* centre,
       cov[4 * i + j] = cov[4 * j + i] = c;
     }
   }
-  for (int i = 0; i < 4; ++i) mean[i] = static_cast<double>(centre[i]) + delta[i];
+  for (int i = 0; i < 4; ++i) mean[i] = centre[i] + delta[i];
   return nk;
 }
 
@@ -331,12 +361,13 @@ Gmm to_model(Working& w, const Frame& frame, double reg_covar, std::size_t n) {
   Gmm gmm;
   gmm.resize(m);
   std::vector<float> packed(kParamStride);
+  std::vector<double> exact(kParamStride);
   double max_lw = -std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < m; ++k) max_lw = std::max(max_lw, w.log_weight[k]);
   double sum = 0.0;
   for (std::size_t k = 0; k < m; ++k) sum += std::exp(w.log_weight[k] - max_lw);
   for (std::size_t k = 0; k < m; ++k) {
-    make_positive_definite(w, k, reg_covar, frame.extent * frame.extent, packed.data());
+    make_positive_definite(w, k, reg_covar, frame.extent * frame.extent, packed.data(), exact.data());
     detail::store_covariance(&w.covariance[16 * k], &gmm.covariances[16 * k]);
     for (int i = 0; i < 4; ++i) gmm.means[4 * k + i] = static_cast<float>(frame.origin[i] + w.mean[4 * k + i]);
     gmm.weights[k] = static_cast<float>(std::exp(w.log_weight[k] - max_lw) / sum);
@@ -361,6 +392,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   const detail::EmKernels& kernels = detail::em_kernels();
 
   std::vector<float> params;
+  std::vector<double> exact;
   BoundParams bounds;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
@@ -381,79 +413,108 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   EmReport rep;
   double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
+  // The first model's kernel parameters; each iteration packs the next.
+  pack_all(w, options.reg_covar, data_scale2, params, exact);
+  std::vector<float> next_params;
+  std::vector<double> next_exact;
   for (int iter = 1; iter <= options.max_iter; ++iter) {
-    pack_all(w, options.reg_covar, data_scale2, params);
     if (truncated) bounds.load(params);
-    std::fill(stats.begin(), stats.end(), 0.0);
-    double total_ll = 0.0;
-    for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
-      const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
-      detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
-        double* st = &slot_stats[s * m * kStatStride];
-        std::fill(st, st + m * kStatStride, 0.0);
-        float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
-        float* row_max = scratch + m * kBlock;
-        std::vector<std::uint32_t> list;
-        std::vector<double> upper;
-        std::vector<char> taken;
-        alignas(64) float max_lp[kBlock];
-        double ll = 0.0, pairs = 0.0;
-        const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
-        const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
-        for (std::size_t b = b0; b < b1; ++b) {
-          const std::size_t first = b * kBlock;
-          const detail::Block block{{&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]},
-                                    static_cast<int>(std::min<std::size_t>(kBlock, n - first))};
-          std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
-          const std::vector<std::uint32_t>* evaluated = &all;
-          if (truncated) {
-            truncated_log_density(kernels, block, &soa.box[8 * b], params, bounds, options.truncation_nats, warm[b],
-                                  upper, taken, list, scratch, row_max, max_lp);
-            evaluated = &list;
-          } else {
-            kernels.log_density(block, params.data(), all.data(), m, scratch, row_max, max_lp);
+    double mean_ll = 0.0, iteration_pairs = 0.0;
+    bool promoted = false;
+    do {
+      std::fill(stats.begin(), stats.end(), 0.0);
+      double total_ll = 0.0;
+      iteration_pairs = 0.0;
+      for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
+        const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
+        detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
+          double* st = &slot_stats[s * m * kStatStride];
+          std::fill(st, st + m * kStatStride, 0.0);
+          float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
+          float* row_max = scratch + m * kBlock;
+          std::vector<std::uint32_t> list;
+          std::vector<double> upper;
+          std::vector<char> taken;
+          alignas(64) float max_lp[kBlock];
+          double ll = 0.0, pairs = 0.0;
+          const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
+          const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
+          for (std::size_t b = b0; b < b1; ++b) {
+            const std::size_t first = b * kBlock;
+            const detail::Block block{{&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]},
+                                      static_cast<int>(std::min<std::size_t>(kBlock, n - first))};
+            std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
+            const std::vector<std::uint32_t>* evaluated = &all;
+            if (truncated) {
+              truncated_log_density(kernels, block, &soa.box[8 * b], params, exact, bounds, options.truncation_nats, warm[b],
+                                    upper, taken, list, scratch, row_max, max_lp);
+              evaluated = &list;
+            } else {
+              kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
+            }
+            const std::size_t ne = evaluated->size();
+            ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
+            pairs += static_cast<double>(block.count) * ne;
+            if (truncated) {
+              // Next iteration starts from the components some point of this
+              // block still gives at least exp(-nats) of its best weight.
+              const float keep = std::exp(static_cast<float>(-options.truncation_nats));
+              warm[b].clear();
+              for (std::size_t i = 0; i < ne; ++i)
+                if (row_max[i] >= keep) warm[b].push_back(list[i]);
+              std::sort(warm[b].begin(), warm[b].end());
+            }
           }
-          const std::size_t ne = evaluated->size();
-          ll += kernels.finish(block, params.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
-          pairs += static_cast<double>(block.count) * ne;
-          if (truncated) {
-            // Next iteration starts from the components some point of this
-            // block still gives at least exp(-nats) of its best weight.
-            const float keep = std::exp(static_cast<float>(-options.truncation_nats));
-            warm[b].clear();
-            for (std::size_t i = 0; i < ne; ++i)
-              if (row_max[i] >= keep) warm[b].push_back(list[i]);
-            std::sort(warm[b].begin(), warm[b].end());
-          }
+          slot_ll[s] = ll;
+          slot_pairs[s] = pairs;
+        });
+        // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
+        for (std::size_t s = 0; s < wave_chunks; ++s) {
+          const double* st = &slot_stats[s * m * kStatStride];
+          for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
+          total_ll += slot_ll[s];
+          iteration_pairs += slot_pairs[s];
         }
-        slot_ll[s] = ll;
-        slot_pairs[s] = pairs;
-      });
-      // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
-      for (std::size_t s = 0; s < wave_chunks; ++s) {
-        const double* st = &slot_stats[s * m * kStatStride];
-        for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
-        total_ll += slot_ll[s];
-        pairs_evaluated += slot_pairs[s];
       }
-    }
-    const double mean_ll = total_ll / static_cast<double>(n);
-    require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
-                                                            std::to_string(iter));
+      mean_ll = total_ll / static_cast<double>(n);
+      require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
+                                                              std::to_string(iter));
 
-    // M-step.
-    double weight_sum = 0.0;
-    for (std::size_t k = 0; k < m; ++k) {
-      nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, &params[k * kParamStride], &w.mean[4 * k],
-                               &w.covariance[16 * k]);
-      if (!options.quantisation.empty()) {
-        double mean[4];
-        for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
-        options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+      // M-step.
+      double weight_sum = 0.0;
+      for (std::size_t k = 0; k < m; ++k) {
+        const float* packed = &params[k * kParamStride];
+        double centre[4];
+        for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
+        nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
+        if (!options.quantisation.empty()) {
+          double mean[4];
+          for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
+          options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+        }
+        weight_sum += nk[k];
       }
-      weight_sum += nk[k];
-    }
-    for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
+      for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
+
+      // The next model's parameters. A component evaluated in float32 whose
+      // new covariance is too elongated for float32 (needs_double) got
+      // statistics that cannot hold its thin direction: the float32 second
+      // moments of a 1 km plane carry errors above its thickness, and they
+      // differ between kernels. This E+M step is repeated with such
+      // components evaluated in double (e.g. the first step of a large
+      // scene, from point-sized seeds; never on the shared room-sized
+      // frames, whose components stay below a third of the threshold).
+      pack_all(w, options.reg_covar, data_scale2, next_params, next_exact);
+      promoted = false;
+      for (std::size_t k = 0; k < m; ++k)
+        if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {
+          params[k * kParamStride + 15] = 1.0f;
+          promoted = true;
+        }
+    } while (promoted);
+    pairs_evaluated += iteration_pairs;
+    params.swap(next_params);
+    exact.swap(next_exact);
 
     rep.iterations = iter;
     rep.log_likelihood = mean_ll;

@@ -8,9 +8,10 @@ namespace sogmm::detail {
 
 #define SOGMM_DECLARE_KERNELS(isa)                                                                            \
   namespace isa {                                                                                              \
-  void em_log_density(const Block&, const float*, const std::uint32_t*, std::size_t, float*, float*, float*); \
-  double em_finish(const Block&, const float*, const std::uint32_t*, std::size_t, float*, const float*, float*, \
-                   double*);                                                                                   \
+  void em_log_density(const Block&, const float*, const double*, const std::uint32_t*, std::size_t, float*,    \
+                      float*, float*);                                                                         \
+  double em_finish(const Block&, const float*, const double*, const std::uint32_t*, std::size_t, float*,       \
+                   const float*, float*, double*);                                                             \
   }
 SOGMM_DECLARE_KERNELS(sse2)
 SOGMM_DECLARE_KERNELS(avx2)

@@ -13,46 +13,109 @@
 #endif
 
 namespace sogmm::detail::SOGMM_ISA {
+namespace {
 
-void em_log_density(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
-                    float* rows, float* row_lp_max, float* max_lp) {
+// One component's log-densities log w + log det U - 2 log 2 pi - |d^T U|^2 / 2
+// with d = x - mu, U upper triangular, from its parameters `q` in the packed
+// layout, computed in T: float, or double for a flagged component (the
+// whitened coordinate U^T (x - mu) of a component that is thin and large
+// cancels too many digits in float32; the points' float32 coordinates are
+// exact in double). Raises `mx` to the running maximum per point and returns
+// the row's maximum.
+template <typename T>
+float log_density_row(const Block& block, const T* q, float* __restrict lp, float* __restrict mx) {
   const float* __restrict px = block.xyzg[0];
   const float* __restrict py = block.xyzg[1];
   const float* __restrict pz = block.xyzg[2];
   const float* __restrict pg = block.xyzg[3];
-  float* __restrict mx = max_lp;
+  const T m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
+  const T u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
+          u23 = q[12], u33 = q[13], c = q[14];
   const int count = block.count;
-  // log w + log det U - 2 log 2 pi - |d^T U|^2 / 2 with d = x - mu, U upper triangular.
-  for (std::size_t i = 0; i < n; ++i) {
-    const float* q = params + components[i] * kParamStride;
-    const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
-    const float u00 = q[4], u01 = q[5], u02 = q[6], u03 = q[7], u11 = q[8], u12 = q[9], u13 = q[10], u22 = q[11],
-                u23 = q[12], u33 = q[13], c = q[14];
-    float* __restrict lp = rows + i * kBlock;
-    float lmax = -std::numeric_limits<float>::infinity();
+  float lmax = -std::numeric_limits<float>::infinity();
 #pragma omp simd reduction(max : lmax)
-    for (int p = 0; p < count; ++p) {
-      const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
-      const float y0 = d0 * u00;
-      const float y1 = d0 * u01 + d1 * u11;
-      const float y2 = d0 * u02 + d1 * u12 + d2 * u22;
-      const float y3 = d0 * u03 + d1 * u13 + d2 * u23 + d3 * u33;
-      const float l = c - 0.5f * (y0 * y0 + y1 * y1 + y2 * y2 + y3 * y3);
-      lp[p] = l;
-      mx[p] = l > mx[p] ? l : mx[p];  // (a ternary vectorizes where fmax on a stored array did not)
-      lmax = l > lmax ? l : lmax;
-    }
-    row_lp_max[i] = lmax;
+  for (int p = 0; p < count; ++p) {
+    const T d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
+    const T y0 = d0 * u00;
+    const T y1 = d0 * u01 + d1 * u11;
+    const T y2 = d0 * u02 + d1 * u12 + d2 * u22;
+    const T y3 = d0 * u03 + d1 * u13 + d2 * u23 + d3 * u33;
+    const float l = static_cast<float>(c - T(0.5) * (y0 * y0 + y1 * y1 + y2 * y2 + y3 * y3));
+    lp[p] = l;
+    mx[p] = l > mx[p] ? l : mx[p];  // (a ternary vectorizes where fmax on a stored array did not)
+    lmax = l > lmax ? l : lmax;
+  }
+  return lmax;
+}
+
+// One component's sufficient statistics over the block, centred at its mean
+// `q` (packed layout), from its exp(lp - max) row `e`, accumulated in T
+// within the block and then added to `st` in double. T is double for a
+// flagged component: in float32 the second moments of a 1 km plane (entries
+// ~1e4 m^2) would carry errors far above its 1e-4 m^2 thickness.
+template <typename T>
+void add_statistics(const Block& block, const T* q, const float* __restrict e, const float* __restrict inv_sum,
+                    double* st) {
+  const float* __restrict px = block.xyzg[0];
+  const float* __restrict py = block.xyzg[1];
+  const float* __restrict pz = block.xyzg[2];
+  const float* __restrict pg = block.xyzg[3];
+  const T m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
+  const int count = block.count;
+  T s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0;
+  T c00 = 0, c01 = 0, c02 = 0, c03 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
+#pragma omp simd reduction(+ : s0, s1, s2, s3, s4, c00, c01, c02, c03, c11, c12, c13, c22, c23, c33)
+  for (int p = 0; p < count; ++p) {
+    const T r = e[p] * inv_sum[p];
+    const T d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
+    const T r0 = r * d0, r1 = r * d1, r2 = r * d2, r3 = r * d3;
+    s0 += r;
+    s1 += r0;
+    s2 += r1;
+    s3 += r2;
+    s4 += r3;
+    c00 += r0 * d0;
+    c01 += r0 * d1;
+    c02 += r0 * d2;
+    c03 += r0 * d3;
+    c11 += r1 * d1;
+    c12 += r1 * d2;
+    c13 += r1 * d3;
+    c22 += r2 * d2;
+    c23 += r2 * d3;
+    c33 += r3 * d3;
+  }
+  st[0] += s0;
+  st[1] += s1;
+  st[2] += s2;
+  st[3] += s3;
+  st[4] += s4;
+  st[5] += c00;
+  st[6] += c01;
+  st[7] += c02;
+  st[8] += c03;
+  st[9] += c11;
+  st[10] += c12;
+  st[11] += c13;
+  st[12] += c22;
+  st[13] += c23;
+  st[14] += c33;
+}
+
+}  // namespace
+
+void em_log_density(const Block& block, const float* params, const double* exact, const std::uint32_t* components,
+                    std::size_t n, float* rows, float* row_lp_max, float* max_lp) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t at = components[i] * static_cast<std::size_t>(kParamStride);
+    row_lp_max[i] = params[at + 15] != 0.0f ? log_density_row(block, exact + at, rows + i * kBlock, max_lp)
+                                            : log_density_row(block, params + at, rows + i * kBlock, max_lp);
   }
 }
 
-double em_finish(const Block& block, const float* params, const std::uint32_t* components, std::size_t n,
-                 float* rows, const float* max_lp, float* row_max, double* stats) {
+double em_finish(const Block& block, const float* params, const double* exact, const std::uint32_t* components,
+                 std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats) {
   // row_max holds each row's largest log-density on entry (see em_kernel.hpp).
-  const float* __restrict px = block.xyzg[0];
-  const float* __restrict py = block.xyzg[1];
-  const float* __restrict pz = block.xyzg[2];
-  const float* __restrict pg = block.xyzg[3];
   const float* __restrict mx = max_lp;
   const int count = block.count;
   alignas(64) float sum[kBlock];
@@ -90,48 +153,12 @@ double em_finish(const Block& block, const float* params, const std::uint32_t* c
   // responsibilities are all exactly 0 in this block adds nothing: skip it.
   for (std::size_t i = 0; i < n; ++i) {
     if (row_max[i] == 0.0f) continue;
-    const float* q = params + components[i] * kParamStride;
-    const float m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
-    const float* __restrict e = rows + i * kBlock;
-    float s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0;
-    float c00 = 0, c01 = 0, c02 = 0, c03 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
-#pragma omp simd reduction(+ : s0, s1, s2, s3, s4, c00, c01, c02, c03, c11, c12, c13, c22, c23, c33)
-    for (int p = 0; p < count; ++p) {
-      const float r = e[p] * inv_sum[p];
-      const float d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
-      const float r0 = r * d0, r1 = r * d1, r2 = r * d2, r3 = r * d3;
-      s0 += r;
-      s1 += r0;
-      s2 += r1;
-      s3 += r2;
-      s4 += r3;
-      c00 += r0 * d0;
-      c01 += r0 * d1;
-      c02 += r0 * d2;
-      c03 += r0 * d3;
-      c11 += r1 * d1;
-      c12 += r1 * d2;
-      c13 += r1 * d3;
-      c22 += r2 * d2;
-      c23 += r2 * d3;
-      c33 += r3 * d3;
-    }
+    const std::size_t at = components[i] * static_cast<std::size_t>(kParamStride);
     double* st = stats + components[i] * kStatStride;
-    st[0] += s0;
-    st[1] += s1;
-    st[2] += s2;
-    st[3] += s3;
-    st[4] += s4;
-    st[5] += c00;
-    st[6] += c01;
-    st[7] += c02;
-    st[8] += c03;
-    st[9] += c11;
-    st[10] += c12;
-    st[11] += c13;
-    st[12] += c22;
-    st[13] += c23;
-    st[14] += c33;
+    if (params[at + 15] != 0.0f)
+      add_statistics(block, exact + at, rows + i * kBlock, inv_sum, st);
+    else
+      add_statistics(block, params + at, rows + i * kBlock, inv_sum, st);
   }
   return log_likelihood;
 }

@@ -17,7 +17,11 @@ namespace sogmm::detail {
 inline constexpr int kBlock = 256;
 /// Floats per component in the packed parameter array: mean (4), upper
 /// triangle of the precision Cholesky factor U (10, row-major: U00 U01 U02 U03
-/// U11 U12 U13 U22 U23 U33), log(weight) + log det U - 2 log(2 pi) (1), pad (1).
+/// U11 U12 U13 U22 U23 U33), log(weight) + log det U - 2 log(2 pi) (1), and a
+/// flag (1): 0 = evaluate in float32; 1 = the component is too elongated for
+/// float32 (see em.cpp, needs_double), so the kernels evaluate it and
+/// accumulate its statistics in double from the same layout in double
+/// (`exact`, kParamStride doubles per component).
 inline constexpr int kParamStride = 16;
 /// Doubles per component in the sufficient statistics, all centred at the
 /// component's current mean: sum r (1), sum r d (4), upper triangle of
@@ -35,19 +39,24 @@ struct Block {
 /// receives component components[i] and `row_lp_max[i]` its largest value;
 /// `max_lp` (kBlock floats) is raised to the running maximum per point. Rows
 /// for more components can be appended by further calls before em_finish.
-using EmLogDensityFn = void (*)(const Block& block, const float* params, const std::uint32_t* components,
-                                std::size_t n, float* rows, float* row_lp_max, float* max_lp);
+/// `exact` holds the double parameters of the flagged components (may be null
+/// when none is flagged).
+using EmLogDensityFn = void (*)(const Block& block, const float* params, const double* exact,
+                                const std::uint32_t* components, std::size_t n, float* rows, float* row_lp_max,
+                                float* max_lp);
 
 /// Turns the `n` rows of log-densities into responsibilities (log-sum-exp per
 /// point over the rows) and adds the block's sufficient statistics
-/// (accumulated in float within the block, then in double) into `stats`
-/// (M x kStatStride, indexed by component). A row whose largest log-density
+/// (accumulated in float within the block, then in double; in double
+/// throughout for flagged components, centred at their double mean) into
+/// `stats` (M x kStatStride, indexed by component). A row whose largest log-density
 /// is more than 87 below every point's maximum has responsibilities exactly 0
 /// in float and is skipped without changing the result. On return
 /// `row_lp_max[i]` holds the largest exp(lp - max) of row i (0 for skipped
 /// rows). Returns the sum of the points' log-likelihoods.
-using EmFinishFn = double (*)(const Block& block, const float* params, const std::uint32_t* components,
-                              std::size_t n, float* rows, const float* max_lp, float* row_lp_max, double* stats);
+using EmFinishFn = double (*)(const Block& block, const float* params, const double* exact,
+                              const std::uint32_t* components, std::size_t n, float* rows, const float* max_lp,
+                              float* row_lp_max, double* stats);
 
 /// The kernels for this CPU (resolved once).
 struct EmKernels {

@@ -75,8 +75,8 @@ Model Map::to_model() const {
   require(s_->n_pending == 0, ErrorCode::InvalidArgument,
           "map: " + std::to_string(s_->n_pending) + " points are pending; flush first (a map file holds components only)");
   Model m = model();
-  for (auto it = m.key_values.begin(); it != m.key_values.end();)
-    it = it->first == kMapFramesKey || it->first == kMapOptionsKey ? m.key_values.erase(it) : it + 1;
+  erase_value(m, kMapFramesKey);
+  erase_value(m, kMapOptionsKey);
   m.key_values.emplace_back(kMapFramesKey, frames_text(s_->frames));
   m.key_values.emplace_back(kMapOptionsKey, options_text(s_->options));
   return m;
@@ -89,14 +89,10 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   Map map(options);
   State& s = *map.s_;
   s.model = model;
-  for (const auto& kv : model.key_values)
-    if (kv.first == kMapFramesKey) {
-      s.frames = parse_frames(kv.second);
-      break;
-    }
+  if (const std::string* frames = find_value(model, kMapFramesKey)) s.frames = parse_frames(*frames);
   // The provenance lives in s.frames now; to_model() writes it afresh.
-  for (auto it = s.model.key_values.begin(); it != s.model.key_values.end();)
-    it = it->first == kMapFramesKey || it->first == kMapOptionsKey ? s.model.key_values.erase(it) : it + 1;
+  erase_value(s.model, kMapFramesKey);
+  erase_value(s.model, kMapOptionsKey);
   if (model.camera.known) s.camera = model.camera.camera;
   s.marginals.reserve(model.gmm.size());
   for (std::size_t k = 0; k < model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(model.gmm, k));

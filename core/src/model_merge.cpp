@@ -12,16 +12,10 @@
 namespace sogmm {
 namespace {
 
-const std::string* first_value(const Model& m, const std::string& key) {
-  for (const auto& kv : m.key_values)
-    if (kv.first == key) return &kv.second;
-  return nullptr;
-}
-
 // How many fits a model holds: its merged_fits, or 1. A value that is not a
 // count >= 2 (written by something else) counts as one fit.
 std::uint64_t fit_count(const Model& m) {
-  const std::string* v = first_value(m, kMergedFitsKey);
+  const std::string* v = find_value(m, kMergedFitsKey);
   if (v == nullptr || v->empty() || v->size() > 19 || !std::all_of(v->begin(), v->end(), [](char c) { return c >= '0' && c <= '9'; })) return 1;
   return std::max<std::uint64_t>(1, std::stoull(*v));
 }
@@ -41,7 +35,7 @@ bool same_camera(const CameraInfo& a, const CameraInfo& b) {
 }  // namespace
 
 std::string coordinate_frame(const Model& m) {
-  const std::string* v = first_value(m, kCoordinateFrameKey);
+  const std::string* v = find_value(m, kCoordinateFrameKey);
   return v == nullptr ? std::string("camera") : *v;
 }
 

@@ -80,7 +80,7 @@ PointScores score_points(const PointsView& points, const Gmm& gmm, int threads, 
           coord[j][p] = static_cast<float>(static_cast<double>(points[first + p][j]) - origin[j]);
       const Block block{{coord[0], coord[1], coord[2], coord[3]}, count};
       std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
-      kernels.log_density(block, params.data(), all.data(), m, rows, row_max, max_lp);
+      kernels.log_density(block, params.data(), nullptr, all.data(), m, rows, row_max, max_lp);
       float lowest = max_lp[0];
       for (int p = 1; p < count; ++p) lowest = std::min(lowest, max_lp[p]);
       std::fill(inv_sum, inv_sum + kBlock, 0.0f);

@@ -501,6 +501,26 @@ static void test_inference(void) {
     EXPECT_NEAR(l3[0], log(0.25) - 1.5 * log(2 * 3.141592653589793 * 0.01), 0.05);
     EXPECT_OK(sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL));
   }
+  /* PSNR: honest figure at the given data range, paper figure always range 2 over all pixels */
+  {
+    const float truth[4] = {0.5f, 0.2f, -1.0f, 0.8f};
+    const float est[4] = {0.6f, 0.2f, -1.0f, 0.8f};
+    const double d = (double)0.6f - (double)0.5f;
+    const double paper = 10.0 * log10(4.0 / (d * d / 4.0));
+    double p = 0, pp = 0;
+    EXPECT_OK(sogmm_psnr_images_f32(truth, est, 4, 1.0, &p, &pp));
+    EXPECT_NEAR(p, 10.0 * log10(1.0 / (d * d / 3.0)), 1e-9);
+    EXPECT_NEAR(pp, paper, 1e-9);
+    EXPECT_OK(sogmm_psnr_images_f32(truth, est, 4, 2.0, &p, NULL));
+    EXPECT_NEAR(p, 10.0 * log10(4.0 / (d * d / 3.0)), 1e-9); /* +6.02 dB */
+    EXPECT_OK(sogmm_psnr_images_f32(truth, est, 4, 0.0, &p, &pp)); /* 0: measured range 0.8 - 0.2 */
+    EXPECT_NEAR(p, 10.0 * log10(((double)0.8f - (double)0.2f) * ((double)0.8f - (double)0.2f) / (d * d / 3.0)), 1e-9);
+    EXPECT_NEAR(pp, paper, 1e-9);
+    EXPECT_STATUS(sogmm_psnr_images_f32(truth, est, 4, -1.0, &p, NULL), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_psnr_images_f32(truth, est, 4, NAN, &p, NULL), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_psnr_images_f32(NULL, est, 4, 1.0, &p, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_psnr_images_f32(truth, est, 4, 1.0, NULL, NULL), SOGMM_E_NULL_ARG);
+  }
   /* merge: components concatenated, weights by support size */
   {
     size_t M = 0;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sogmm/inference.hpp"
+#include "sogmm/model.hpp"
 #include "test_util.hpp"
 
 using sogmm_test::cov_of;
@@ -228,4 +229,24 @@ TEST(Validate, AcceptsValidRejectsBroken) {
   sogmm::Gmm sizes = good;
   sizes.means.pop_back();
   EXPECT_FALSE(sogmm::validation_error(sizes).empty());
+}
+
+// Model::key_values by key (sogmm/model.hpp): first match wins, set replaces
+// the first entry in place or appends, erase removes every entry.
+TEST(ModelValues, FindSetErase) {
+  sogmm::Model m;
+  m.key_values = {{"a", "1"}, {"b", "2"}, {"a", "3"}};
+  ASSERT_NE(sogmm::find_value(m, "a"), nullptr);
+  EXPECT_EQ(*sogmm::find_value(m, "a"), "1");
+  EXPECT_EQ(sogmm::find_value(m, "c"), nullptr);
+  sogmm::set_value(m, "b", "20");
+  sogmm::set_value(m, "c", "4");
+  const std::vector<std::pair<std::string, std::string>> set = {{"a", "1"}, {"b", "20"}, {"a", "3"}, {"c", "4"}};
+  EXPECT_EQ(m.key_values, set);
+  sogmm::erase_value(m, "a");
+  const std::vector<std::pair<std::string, std::string>> erased = {{"b", "20"}, {"c", "4"}};
+  EXPECT_EQ(m.key_values, erased);
+  EXPECT_EQ(sogmm::coordinate_frame(m), "camera");
+  sogmm::set_value(m, sogmm::kCoordinateFrameKey, "world");
+  EXPECT_EQ(sogmm::coordinate_frame(m), "world");
 }

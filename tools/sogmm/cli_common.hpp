@@ -57,7 +57,13 @@ struct Evaluation {
   std::size_t model_bytes = 0;
 };
 /// Evaluates a model against the cloud it came from (camera = decimated camera).
-Evaluation evaluate(FitResult fit, const PointsView& truth, const Camera& decimated_camera, std::uint64_t seed);
+Evaluation evaluate(FitResult fit, const PointsView& truth, const Camera& decimated_camera, std::uint64_t seed,
+                    double data_range = 1.0);
+
+/// Adds --data-range (into `data_range`): the peak of the honest PSNR (1 for
+/// gray in [0, 1], 0 = the frame's actual gray range); the paper-compatible
+/// PSNR keeps the authors' range 2 whatever it is (sogmm::psnr_images).
+void add_data_range_flag(CLI::App& app, double& data_range);
 
 /// Runs `body`, turning sogmm::Error and other exceptions into a one-line
 /// message on stderr ("sogmm: error: ...") and the documented exit code.
@@ -67,7 +73,8 @@ int run_guarded(const std::function<int()>& body);
 
 namespace sogmm::tools {
 /// Prints an evaluation as a human table, or with `json` as one JSON object
-/// with keys n_points, n_components, psnr, psnr_paper, mre, precision, recall,
+/// with keys n_points, n_components, psnr, psnr_paper, psnr_data_range (the
+/// honest PSNR's peak; the paper figure always uses 2), mre, precision, recall,
 /// fscore, model_bytes, em_iterations, converged, log_likelihood, n_init,
 /// run, run_log_likelihoods, seconds_mode_count, seconds_seeding, seconds_em,
 /// seconds_total.

@@ -29,6 +29,7 @@ struct RenderState {
   bool compare = false, uncertainty = false;
   int scale = 0;
   double error_max = 0.25, std_max = 0.0, max_mahalanobis = 3.0;
+  double data_range = 1.0;  // honest PSNR's peak (--data-range, with --compare)
 };
 
 std::vector<float> upscale_values(const std::vector<float>& v, int w, int h, int scale) {
@@ -91,7 +92,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     for (std::size_t i = 0; i < cloud.size(); ++i) gray_truth[i] = cloud.xyzg[4 * i + 3];
     const std::vector<float> truth = project_to_image(cloud.view(), gray_truth.data(), dc, -1.f);
     const RenderedView est = render_at_points(gmm, cloud.xyzg, dc);
-    const PsnrResult p = psnr_images(truth.data(), est.gray.data(), truth.size());
+    const PsnrResult p = psnr_images(truth.data(), est.gray.data(), truth.size(), s.data_range);
     const int scale = s.scale > 0 ? s.scale : std::max(1, (320 + dc.width - 1) / dc.width);
     char headline[256];
     std::snprintf(headline, sizeof headline, "PSNR %.2f dB  |  %s: %zu components  |  %s, %dx%d", p.psnr,
@@ -161,6 +162,7 @@ Command add_render_command(CLI::App& root) {
   app->add_option("--depth", s->depth, "16-bit depth PNG: regress at its points (needed by --compare)");
   app->add_option("--color", s->color, "color image of the frame (needed by --compare)");
   app->add_flag("--compare", s->compare, "side-by-side original | regressed | error picture (needs --depth, --color)");
+  add_data_range_flag(*app, s->data_range);
   app->add_flag("--uncertainty", s->uncertainty, "write the conditional standard deviation of gray instead");
   app->add_option("--trajectory", s->trajectory, "Redwood .log poses: render a world-frame model from --frame");
   app->add_option("--frame", s->frame, "pose index in --trajectory");

@@ -59,9 +59,8 @@ Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const C
 }
 
 std::string key_value(const Model& model, const std::string& key) {
-  for (const auto& kv : model.key_values)
-    if (kv.first == key) return kv.second;
-  return "";
+  const std::string* v = find_value(model, key);
+  return v ? *v : std::string();
 }
 
 DepthOptions depth_options_for(const CLI::App& app, const DepthOptions& flags, const Model& model) {

@@ -488,6 +488,22 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model
                                                         size_t n, int32_t dims, const sogmm_options* options,
                                                         double* out);
 
+/* PSNR of a gray image `estimate` against `truth` (`pixels` floats each;
+ * -1 marks an empty pixel, e.g. a rendering of the model against the
+ * frame's gray, as `sogmm eval` draws them). *psnr_out receives the honest
+ * figure: 10 log10(data_range^2 / MSE) over the pixels valid in `truth`
+ * (>= 0), with data_range 1 for gray in [0, 1], any other peak for other
+ * data, or 0 for the actual range of the valid truth pixels (max - min).
+ * *psnr_paper_out (may be NULL) receives the paper-compatible figure, which
+ * keeps the authors' evaluation whatever data_range is: range 2 and every
+ * pixel counted, the empty ones as perfect. Identical images give +infinity.
+ * Errors: NULL truth/estimate/psnr_out -> SOGMM_E_NULL_ARG; data_range
+ * negative or not finite -> SOGMM_E_INVALID_ARG; NaN/Inf pixels, no valid
+ * truth pixel, or data_range 0 on a constant truth that is not matched
+ * exactly -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_psnr_images_f32(const float* truth, const float* estimate, size_t pixels,
+                                             double data_range, double* psnr_out, double* psnr_paper_out);
+
 /* New model with the components of a and b, weights re-weighted by support
  * size; support size a + b. Both must be in the same frame (key
  * "coordinate_frame": absent or "camera", or "world"), else

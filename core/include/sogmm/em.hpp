@@ -72,7 +72,11 @@ using EmIterationCallback = std::function<void(int iteration, double log_likelih
 /// Precision: the fit works relative to the midpoint of the data's bounding
 /// box, so a cloud far from the origin is fitted as well as the same cloud at
 /// the origin; means and covariances are held in double between iterations
-/// (the block kernels run in float32, sums accumulate in double). Every
+/// (the block kernels run in float32, sums accumulate in double; a component
+/// too elongated for float32 arithmetic, such as a 1 km plane with 1 cm
+/// noise, is evaluated and accumulated in double, and an iteration whose
+/// M-step first makes a component that elongated is repeated with it in
+/// double, so the log-likelihood never falls by more than rounding). Every
 /// covariance that leaves the fit is checked in double and rounded to float32
 /// so that it stays positive definite (an eigenvalue floor relative to the
 /// component's own largest eigenvalue only if no rounding is), so the model

@@ -80,6 +80,16 @@ inline constexpr const char* kCoordinateFrameKey = "coordinate_frame";
 /// >= 2; spec/format.md section 2.2).
 inline constexpr const char* kMergedFitsKey = "merged_fits";
 
+/// Model::key_values by key: the one mechanism every reader and writer of the
+/// metadata uses (the C API's get/set, the CLI, merge, the map's provenance).
+/// The value of the first entry with `key`, or nullptr when there is none.
+const std::string* find_value(const Model& model, const std::string& key);
+/// Sets `key` to `value`: the first entry with `key` is replaced, else one is
+/// appended (order of the other entries kept).
+void set_value(Model& model, const std::string& key, std::string value);
+/// Removes every entry with `key`.
+void erase_value(Model& model, const std::string& key);
+
 /// The frame of a model: the value of its first coordinate_frame key, or "camera".
 std::string coordinate_frame(const Model& model);
 

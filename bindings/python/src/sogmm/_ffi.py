@@ -187,6 +187,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, F64_OUT]),
     "sogmm_model_regress_gray_f32_v2": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
     "sogmm_model_score_samples_f32_v2": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
+    "sogmm_psnr_images_f32": (STATUS, [F32_IN, F32_IN, c_size_t, c_double, F64_OUT, F64_OUT]),
     "sogmm_model_merge": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
     "sogmm_model_transform": (STATUS, [HANDLE_OUT, HANDLE, F64_IN]),
     "sogmm_model_save": (STATUS, [HANDLE, c_char_p, HANDLE]),

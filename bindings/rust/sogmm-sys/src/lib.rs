@@ -318,6 +318,14 @@ extern "C" {
         options: *const sogmm_options,
         out: *mut f64,
     ) -> sogmm_status;
+    pub fn sogmm_psnr_images_f32(
+        truth: *const f32,
+        estimate: *const f32,
+        pixels: usize,
+        data_range: f64,
+        psnr_out: *mut f64,
+        psnr_paper_out: *mut f64,
+    ) -> sogmm_status;
     pub fn sogmm_model_merge(out: *mut *mut sogmm_model, a: *const sogmm_model, b: *const sogmm_model) -> sogmm_status;
     pub fn sogmm_model_transform(
         out: *mut *mut sogmm_model,
