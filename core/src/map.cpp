@@ -9,6 +9,7 @@
 #include <string>
 
 #include "map_state.hpp"
+#include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/warm_start.hpp"
@@ -121,14 +122,33 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   detail::PendingFrame novel;
   novel.pose = pose;
   novel.from_rgbd = from_rgbd;
-  if (!s.options.novelty || s.model.gmm.size() == 0) {
+  std::vector<std::uint64_t> novel_voxels;
+  if (!s.options.novelty) {
     novel.xyzg.assign(points.data, points.data + 4 * points.size);
   } else {
+    // Novel: the map does not explain the point (below the threshold) and no
+    // earlier frame's pending point lies near it (that surface is already
+    // waiting for the next fit).
     const std::vector<double> world = to_world(points, pose);
-    std::vector<double> ll(points.size);
-    map.local_log_likelihood(world.data(), points.size, ll.data());
-    for (std::size_t i = 0; i < points.size; ++i)
-      if (ll[i] < s.options.novelty_threshold) novel.xyzg.insert(novel.xyzg.end(), points[i], points[i] + 4);
+    std::vector<double> ll(points.size, -std::numeric_limits<double>::infinity());
+    if (s.model.gmm.size() > 0) map.local_log_likelihood(world.data(), points.size, ll.data());
+    // Per point: 0 explained, 1 novel, 2 novel without a voxel (far out).
+    std::vector<std::uint8_t> state(points.size, 0);
+    std::vector<std::int64_t> voxels(3 * points.size, 0);
+    detail::parallel_for(points.size, detail::team_size(s.options.fit.em.threads), 1024, [&](std::size_t i, int) {
+      if (ll[i] >= s.options.novelty_threshold) return;
+      std::int64_t* v = voxels.data() + 3 * i;
+      if (!detail::pending_voxel(world.data() + 3 * i, v)) {
+        state[i] = 2;
+      } else if (!detail::near_pending(s.pending_voxels, v)) {
+        state[i] = 1;
+      }
+    });
+    for (std::size_t i = 0; i < points.size; ++i) {
+      if (state[i] == 0) continue;
+      if (state[i] == 1) novel_voxels.push_back(detail::pending_voxel_key(voxels.data() + 3 * i));
+      novel.xyzg.insert(novel.xyzg.end(), points[i], points[i] + 4);
+    }
   }
   f.ms_novelty = ms_since(t0);
   f.n_novel = novel.xyzg.size() / 4;
@@ -137,6 +157,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   if (f.n_novel > 0) {
     s.pending.push_back(std::move(novel));
     s.n_pending += f.n_novel;
+    s.pending_voxels.insert(novel_voxels.begin(), novel_voxels.end());
   }
   s.frames.push_back(f);
   // Novelty off: each frame is its own batch (append everything).
@@ -289,6 +310,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   s.index.add(s.model.gmm, first);
   s.pending.clear();
   s.n_pending = 0;
+  s.pending_voxels.clear();
   if (s.options.warm_start) {
     s.previous_fit = std::move(r.gmm);
     s.previous_pose = last;

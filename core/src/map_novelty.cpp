@@ -1,5 +1,6 @@
 // The novelty test of the map: each point's 3-D marginal log-likelihood under
 // the local submap (sogmm/map.hpp).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -52,56 +53,72 @@ Marginal3 marginal3(const Gmm& gmm, std::size_t m) {
   return r;
 }
 
+namespace {
+constexpr std::int64_t kVoxelHalfRange = std::int64_t{1} << 20;
+}
+
+bool pending_voxel(const double xyz[3], std::int64_t voxel[3]) {
+  for (int i = 0; i < 3; ++i) {
+    const double v = std::floor(xyz[i] / kPendingVoxel);
+    // One voxel of margin on each side keeps the neighbours' keys in range.
+    if (!(v > -static_cast<double>(kVoxelHalfRange) && v < static_cast<double>(kVoxelHalfRange - 1))) return false;
+    voxel[i] = static_cast<std::int64_t>(v);
+  }
+  return true;
+}
+
+std::uint64_t pending_voxel_key(const std::int64_t voxel[3]) {
+  std::uint64_t k = 0;
+  for (int i = 0; i < 3; ++i) k = (k << 21) | static_cast<std::uint64_t>(voxel[i] + kVoxelHalfRange);
+  return k;
+}
+
+bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::int64_t voxel[3]) {
+  if (voxels.empty()) return false;
+  for (std::int64_t dx = -1; dx <= 1; ++dx)
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dz = -1; dz <= 1; ++dz) {
+        const std::int64_t v[3] = {voxel[0] + dx, voxel[1] + dy, voxel[2] + dz};
+        if (voxels.count(pending_voxel_key(v)) > 0) return true;
+      }
+  return false;
+}
+
 void local_log_likelihood(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
                           const double* xyz, std::size_t n, double* out) {
   const double neg_inf = -std::numeric_limits<double>::infinity();
-  const std::size_t m = marginals.size();
-  if (m == 0) {
-    for (std::size_t i = 0; i < n; ++i) out[i] = neg_inf;
-    return;
-  }
   const int team = team_size(threads);
-  // Per thread: the candidates of one point and which components any point
-  // touched (the submap, over which the weights are renormalised).
   std::vector<std::vector<std::uint32_t>> scratch(team);
-  std::vector<std::vector<std::uint8_t>> touched(team, std::vector<std::uint8_t>(m, 0));
   std::vector<std::vector<double>> terms(team);
   std::vector<ComponentIndex::Cursor> cursors(team);
+  // Each point on its own: the weights are renormalised over the components
+  // whose box holds it (its neighbourhood), so nothing outside that
+  // neighbourhood changes its score, and the sums run in id order (the same
+  // value whatever the team size).
   parallel_for(n, team, 256, [&](std::size_t i, int t) {
     std::vector<std::uint32_t>& ids = scratch[t];
     index.query_point(xyz + 3 * i, ids, cursors[t]);
     std::vector<double>& v = terms[t];
     v.clear();
-    double best = neg_inf;
+    double best = neg_inf, best_count = neg_inf;
     for (std::uint32_t id : ids) {
-      touched[t][id] = 1;
-      const double lp = marginals[id].log_count + log_density(marginals[id], xyz + 3 * i);
+      const Marginal3& c = marginals[id];
+      const double lp = c.log_count + log_density(c, xyz + 3 * i);
       v.push_back(lp);
-      if (lp > best) best = lp;
+      best = std::max(best, lp);
+      best_count = std::max(best_count, c.log_count);
     }
     if (!(best > neg_inf)) {
       out[i] = neg_inf;
       return;
     }
-    double sum = 0.0;
-    for (double lp : v) sum += std::exp(lp - best);
-    out[i] = best + std::log(sum);
+    double sum = 0.0, count = 0.0;
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      sum += std::exp(v[k] - best);
+      count += std::exp(marginals[ids[k]].log_count - best_count);
+    }
+    out[i] = best + std::log(sum) - best_count - std::log(count);
   });
-  // log of the submap's total count, log-sum-exp over the touched components
-  // in id order (the same sum whatever the team size).
-  double best = neg_inf;
-  for (std::size_t k = 0; k < m; ++k) {
-    bool hit = false;
-    for (int t = 0; t < team; ++t) hit = hit || touched[t][k];
-    touched[0][k] = hit;
-    if (hit && marginals[k].log_count > best) best = marginals[k].log_count;
-  }
-  if (!(best > neg_inf)) return;  // no point met any component: every out is -inf already
-  double sum = 0.0;
-  for (std::size_t k = 0; k < m; ++k)
-    if (touched[0][k]) sum += std::exp(marginals[k].log_count - best);
-  const double log_total = best + std::log(sum);
-  for (std::size_t i = 0; i < n; ++i) out[i] -= log_total;
 }
 
 }  // namespace sogmm::detail

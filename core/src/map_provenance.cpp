@@ -1,5 +1,6 @@
 // What a map file stores beyond its components: the provenance keys
 // kMapFramesKey and kMapOptionsKey (sogmm/map.hpp, spec/format.md 2.3).
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -9,13 +10,14 @@
 #include "map_state.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/inference.hpp"
 
 namespace sogmm {
 namespace {
 
 // One line per frame: index, points, novel points, then the 12 entries of the
 // pose's first three rows (the last row of a rigid pose is 0 0 0 1), each at
-// round-trip precision.
+// round-trip precision, then the map's components after the frame.
 std::string frames_text(const std::vector<FrameStats>& frames) {
   std::string text;
   char buf[64];
@@ -23,7 +25,7 @@ std::string frames_text(const std::vector<FrameStats>& frames) {
     std::snprintf(buf, sizeof buf, "%" PRIu64 " %zu %zu", f.index, f.n_points, f.n_novel);
     text += buf;
     for (int i = 0; i < 12; ++i) text += " " + checked::exact(f.pose[i]);
-    text += "\n";
+    text += " " + std::to_string(f.n_components) + "\n";
   }
   return text;
 }
@@ -33,7 +35,7 @@ std::string options_text(const MapOptions& o) {
          " batch_size=" + std::to_string(o.batch_size) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
          " fusion_method=" + (o.fusion_method == FusionMethod::Hellinger ? "hellinger" : "kl") +
          " fusion_threshold=" + checked::exact(o.fusion_threshold) + " index_sigmas=" + checked::exact(o.index_sigmas) +
-         " bandwidth=" + checked::exact(o.fit.bandwidth);
+         " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0);
 }
 
 std::vector<FrameStats> parse_frames(const std::string& text) {
@@ -59,14 +61,54 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
     f.n_novel = n_novel;
     for (int i = 0; i < 12; ++i)
       if (!(row >> f.pose[i])) throw bad("expected 12 pose entries");
+    // The component count after the frame (absent in files of before it was
+    // recorded: 0, which no warm start trusts).
     std::string rest;
-    if (row >> rest) throw bad("unexpected '" + rest + "' after the pose");
+    if (row >> rest) {
+      std::istringstream count(rest);
+      if (!(count >> f.n_components) || !count.eof()) throw bad("expected a component count after the pose, got '" + rest + "'");
+      if (row >> rest) throw bad("unexpected '" + rest + "' after the component count");
+    }
     f.pose[15] = 1.0;
     const std::string problem = rigid_pose_error(f.pose);
     if (!problem.empty()) throw bad("pose is not rigid: " + problem);
     frames.push_back(f);
   }
   return frames;
+}
+
+// With options.warm_start, the loaded map's first flush warm-starts like any
+// later one: from the last flush's fit in its camera. That fit is the block of
+// components the last flush appended, found from the per-frame component
+// counts (the last frame whose count grew), fitted in the camera of the
+// latest frame up to it that gave points; moved back there with its weights
+// renormalised. Not bitwise the fit before the save (two float moves, and
+// merge() rescaled the weights), and with fusion the fused ones are missing
+// from the block. Files without counts, or whose last count is not the
+// model's size, leave it cold.
+void restore_warm_start(Map::State& s) {
+  const std::vector<FrameStats>& f = s.frames;
+  const std::size_t m = s.model.gmm.size();
+  if (!s.options.warm_start || f.empty() || f.back().n_components != m) return;
+  std::size_t last = f.size() - 1;
+  while (last > 0 && f[last - 1].n_components == m) --last;
+  const std::size_t before = last > 0 ? f[last - 1].n_components : 0;
+  if (before >= m) return;
+  std::size_t camera = last;
+  while (camera > 0 && f[camera].n_novel == 0) --camera;
+  Gmm block;
+  block.resize(m - before);
+  double total = 0.0;
+  for (std::size_t k = before; k < m; ++k) total += s.model.gmm.weights[k];
+  if (!(total > 0)) return;
+  for (std::size_t k = before; k < m; ++k) {
+    block.weights[k - before] = static_cast<float>(s.model.gmm.weights[k] / total);
+    std::copy_n(s.model.gmm.mean(k), 4, block.means.data() + 4 * (k - before));
+    std::copy_n(s.model.gmm.covariance(k), 16, block.covariances.data() + 16 * (k - before));
+  }
+  block.support_size = std::max<std::uint64_t>(1, f[camera].n_novel);
+  s.previous_pose = f[camera].pose;
+  s.previous_fit = transform(block, inverse_rigid(s.previous_pose));
 }
 
 }  // namespace
@@ -94,6 +136,7 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   erase_value(s.model, kMapFramesKey);
   erase_value(s.model, kMapOptionsKey);
   if (model.camera.known) s.camera = model.camera.camera;
+  restore_warm_start(s);
   s.marginals.reserve(model.gmm.size());
   for (std::size_t k = 0; k < model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(model.gmm, k));
   s.index.build(model.gmm);

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include "sogmm/map.hpp"
@@ -50,6 +51,23 @@ void local_log_likelihood(const ComponentIndex& index, const std::vector<Margina
 std::vector<std::size_t> fuse_new_components(Gmm& gmm, std::size_t first, const ComponentIndex& index,
                                              const MapOptions& options);
 
+/// Edge (m) of the world voxels that remember where pending points lie. A
+/// point is taken as pending when a pending point lies in its voxel or one of
+/// the 26 around it, i.e. within 1 to 3.5 cm: more than the spacing of a
+/// frame decimated by 5 at 2 m (1.9 cm: 525 / 5 pixels per radian), so a new
+/// view of a pending surface finds it, and less than the size of the
+/// components the fit will give that surface.
+inline constexpr double kPendingVoxel = 0.01;
+
+/// The voxel of world point `xyz`; false when the point lies beyond +-2^20
+/// voxels (+-10 km) on an axis, where keys would alias (such a point is then
+/// never taken as pending).
+bool pending_voxel(const double xyz[3], std::int64_t voxel[3]);
+/// The key of a voxel (each coordinate in [-2^20, 2^20)).
+std::uint64_t pending_voxel_key(const std::int64_t voxel[3]);
+/// Whether a pending point lies in the voxel or one of its 26 neighbours.
+bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::int64_t voxel[3]);
+
 /// Novel points of one frame waiting for a fit, in that frame's camera frame.
 struct PendingFrame {
   Pose pose{};
@@ -68,6 +86,9 @@ struct Map::State {
   std::vector<detail::Marginal3> marginals;  ///< one per component of model.gmm
   std::vector<detail::PendingFrame> pending;
   std::size_t n_pending = 0;
+  /// pending_voxel_key of every pending point: a later point in one of these
+  /// voxels is already waiting for the fit and is not novel again.
+  std::unordered_set<std::uint64_t> pending_voxels;
   std::vector<FrameStats> frames;
   std::uint64_t n_flushes = 0;
   std::uint64_t n_fused = 0;

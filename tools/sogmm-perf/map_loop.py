@@ -6,8 +6,9 @@ For each sequence (the synthetic room loop of `sogmm demo --write-frame
   1. append everything: `sogmm fit --sequence` (components M_append);
   2. the map: `sogmm map` with the given options (components M_map, per-frame
      CSV); ratio M_map / M_append (target <= 0.30);
-  3. accuracy: `sogmm eval MAP --sequence` per frame vs `sogmm eval` of that
-     frame's own fit (every --accuracy-step-th frame): worst PSNR loss (target
+  3. accuracy: `sogmm eval MAP --sequence` per frame vs the same evaluation of
+     that frame's own fit (`sogmm fit --sequence` of the frame alone; every
+     --accuracy-step-th frame): worst PSNR loss (target
      <= 0.5 dB) and worst MRE increase (target <= 1 mm); also vs the
      append-everything map evaluated the same way (eval --sequence);
   4. insert time: median of novelty + fit + merge ms over frames 290-299 vs
@@ -57,14 +58,20 @@ def measure(name, sogmm, seq, frames, a, map_flags, work):
     worst_dpsnr, worst_dmre, worst_app_dpsnr, worst_app_dmre, per = -1e9, -1e9, -1e9, -1e9, []
     for k in check:
         ev = run_json(sogmm, ["eval", out, "--sequence", seq, "--trajectory", traj, "--frames", k])
-        # The same evaluation (world model moved into the frame, frustum
-        # samples) of the append-everything map: separates what the map loses
+        # The same evaluation (world model moved into the frame, samples the
+        # camera could see: in the frustum, not behind the frame's depth) of
+        # the append-everything map: separates what the map loses
         # from what any world-frame model scores against a single frame.
         app = run_json(sogmm, ["eval", os.path.join(work, name + "_append.sogmm"), "--sequence", seq,
                                "--trajectory", traj, "--frames", k])["frames"][0]
-        own = run_json(sogmm, ["eval", "--depth", os.path.join(seq, "depth", "%05d.png" % k), "--color",
-                               own_color(seq, k), "--intrinsics", os.path.join(seq, "intrinsics.json"), "--decimate",
-                               a.decimate, "--bandwidth", a.bandwidth])
+        # The frame's own fit, scored by the same evaluation: fitted alone
+        # (sogmm fit --sequence of that one frame, a world-frame model) and
+        # evaluated with eval --sequence, so that both sides see the same
+        # sample selection (frustum and first-surface rule).
+        own_path = os.path.join(work, "%s_own_%05d.sogmm" % (name, k))
+        run_json(sogmm, ["fit", "--sequence", seq, "-o", own_path, "--trajectory", traj, "--frames", k, "--decimate",
+                         a.decimate, "--bandwidth", a.bandwidth])
+        own = run_json(sogmm, ["eval", own_path, "--sequence", seq, "--trajectory", traj, "--frames", k])["frames"][0]
         r = ev["frames"][0]
         dpsnr = own["psnr"] - r["psnr"]  # dB lost by the map
         dmre = (r["mre"] - own["mre"]) * 1000.0  # mm added by the map
@@ -90,14 +97,6 @@ def measure(name, sogmm, seq, frames, a, map_flags, work):
         "insert_time_ratio": late / early if early > 0 else float("nan"),
         "per_frame": per,
     }
-
-
-def own_color(seq, k):
-    for ext in ("png", "jpg", "jpeg"):
-        p = os.path.join(seq, "color", "%05d.%s" % (k, ext))
-        if os.path.isfile(p):
-            return p
-    return os.path.join(seq, "color", "%05d.png" % k)
 
 
 def main():

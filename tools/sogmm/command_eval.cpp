@@ -1,7 +1,9 @@
 // `sogmm eval`: score a model against RGB-D frames. Without MODEL it fits the
 // frame first (the original behaviour); with MODEL it evaluates the saved
 // model, on one frame or on every frame of a posed sequence.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -28,9 +30,39 @@ struct EvalState {
   bool json = false;
 };
 
-/// Samples of the model that fall inside the frame's view frustum.
-std::vector<float> frustum_samples(const Gmm& gmm, std::size_t n, std::uint64_t seed, const Camera& cam,
-                                   const DepthOptions& d) {
+/// How far (m) behind the observed depth of its pixel a model sample may lie
+/// and still count as seen (the first-surface rule of frustum_samples). It
+/// must exceed the spread of a visible surface's own samples across the
+/// surface (a few standard deviations of its components' thickness, and of
+/// the depth noise the fit absorbed), so that the rule never drops a sample
+/// of what the frame sees, only samples of surfaces hidden behind it.
+constexpr double kOcclusionTolerance = 0.05;
+
+/// Samples of the model that this camera could see: inside its view frustum
+/// and, where the frame has a depth at the sample's pixel, not more than
+/// kOcclusionTolerance behind it. A depth camera sees only the first surface
+/// along each ray; a world-frame model also holds the surfaces behind it
+/// (seen from other poses), and its samples there lie far from every point
+/// of this frame, so MRE would count occlusion as error. A single frame's own
+/// fit has no such samples. Samples in front of the observed depth (model
+/// error in free space) and at pixels without depth are kept.
+std::vector<float> visible_samples(const Gmm& gmm, std::size_t n, std::uint64_t seed, const Camera& cam,
+                                   const DepthOptions& d, const PointsView& frame) {
+  // Observed depth per pixel of the (decimated) camera: the nearest point.
+  const std::size_t w = static_cast<std::size_t>(cam.width), h = static_cast<std::size_t>(cam.height);
+  std::vector<float> observed(w * h, std::numeric_limits<float>::infinity());
+  auto pixel = [&](const float* p, std::size_t* at) {
+    const double z = p[2];
+    if (!(z > 0)) return false;
+    const long u = std::lround(cam.fx * p[0] / z + cam.cx), v = std::lround(cam.fy * p[1] / z + cam.cy);
+    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) return false;
+    *at = static_cast<std::size_t>(v) * w + static_cast<std::size_t>(u);
+    return true;
+  };
+  for (std::size_t i = 0; i < frame.size; ++i) {
+    std::size_t at = 0;
+    if (pixel(frame[i], &at)) observed[at] = std::min(observed[at], frame[i][2]);
+  }
   std::vector<float> all(4 * n);
   sample(gmm, n, seed, 4, all.data());
   std::vector<float> kept;
@@ -38,9 +70,9 @@ std::vector<float> frustum_samples(const Gmm& gmm, std::size_t n, std::uint64_t 
   for (std::size_t i = 0; i < n; ++i) {
     const float* p = all.data() + 4 * i;
     const double z = p[2];
-    if (!(z > d.depth_min && z <= d.depth_max)) continue;
-    const long u = std::lround(cam.fx * p[0] / z + cam.cx), v = std::lround(cam.fy * p[1] / z + cam.cy);
-    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) continue;
+    std::size_t at = 0;
+    if (!(z > d.depth_min && z <= d.depth_max) || !pixel(p, &at)) continue;
+    if (z > observed[at] + kOcclusionTolerance) continue;  // hidden behind the observed surface
     kept.insert(kept.end(), p, p + 4);
   }
   return kept;
@@ -170,7 +202,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     // As many samples as the model was fitted on, kept where this camera sees.
     const std::size_t n = static_cast<std::size_t>(
         std::min<std::uint64_t>(std::max<std::uint64_t>(model.gmm.support_size, cloud.size()), 4000000));
-    const std::vector<float> kept = frustum_samples(local, n, s.fit.seed + i, dc, d);
+    const std::vector<float> kept = visible_samples(local, n, s.fit.seed + i, dc, d, cloud.view());
     sc.n_samples = kept.size() / 4;
     if (sc.n_samples > 0) {
       sc.rec = compare_clouds(kept.data(), sc.n_samples, 4, cloud.view(), 0.01);
@@ -203,7 +235,8 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     return 0;
   }
   std::printf("frames of %s, decimated by %d; model moved into each camera with the inverse pose;\n"
-              "MRE/F-score use samples inside each camera's view (n_samples)\n",
+              "MRE/F-score use the samples each camera could see (n_samples: in view, not hidden behind the "
+              "frame's depth)\n",
               s.src.sequence.c_str(), d.decimate);
   std::printf("%-6s %-12s %8s %9s %9s %8s %7s %9s\n", "frame", "file", "points", "PSNR dB", "paper dB", "MRE m",
               "F@1cm", "samples");
@@ -226,7 +259,9 @@ Command add_eval_command(CLI::App& root) {
       "Without MODEL the frame is fitted first (fit flags apply) and timings are reported. With MODEL the\n"
       "saved model is scored; its camera, decimation and depth range are taken from the file unless given.\n"
       "With --sequence DIR --trajectory FILE a world-frame model (sogmm fit --sequence) is moved into each\n"
-      "frame's camera with the inverse pose and scored per frame.\n\n"
+      "frame's camera with the inverse pose and scored per frame; MRE and F-score use the model's samples\n"
+      "that the camera could see: in its frustum and not more than 5 cm behind the frame's depth at\n"
+      "their pixel (a depth camera sees the first surface only).\n\n"
       "Examples:\n"
       "  sogmm eval --depth ../shared/data/rgbd/livingroom/depth/00000.png \\\n"
       "    --color ../shared/data/rgbd/livingroom/color/00000.jpg \\\n"
