@@ -172,6 +172,9 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       if (f.n_novel > 0) {
         s.pending.pop_back();
         s.n_pending -= f.n_novel;
+        // Each of these voxels was new to the set (its points were not near
+        // a pending one), so erasing them restores the set exactly.
+        for (const std::uint64_t key : novel_voxels) s.pending_voxels.erase(key);
       }
       throw;
     }

@@ -234,9 +234,13 @@ def test_map_reduce_in_any_tile_order_gives_the_canonical_model(sequence, map_re
     assert map_reference.metadata["frames"] == ",".join(map(str, expected))
     lines = map_reference.metadata["map_frames"].splitlines()
     assert [int(line.split()[0]) for line in lines] == list(range(len(expected)))
-    poses = [np.array([float(v) for v in line.split()[3:]]).reshape(3, 4) for line in lines]
+    poses = [np.array([float(v) for v in line.split()[3:15]]).reshape(3, 4) for line in lines]
     by_id = {f.index: np.array(f.pose).reshape(4, 4)[:3] for f in frames}
     assert all(np.array_equal(p, by_id[i]) for p, i in zip(poses, expected))
+    # The components after each frame count the earlier tiles' too: they rise
+    # and end at the united map's size (spec/format.md 2.3).
+    counts = [int(line.split()[15]) for line in lines]
+    assert counts == sorted(counts) and counts[-1] == map_reference.n_components_
     # Novelty did its work: points the tile's map already explained were not fitted again.
     assert map_reference.support_size_ < reference.support_size_
 

@@ -287,14 +287,6 @@ extern "C" {
         mean_out: *mut f32,
         variance_out: *mut f32,
     ) -> sogmm_status;
-    pub fn sogmm_model_regress_gray_opt_f32(
-        model: *const sogmm_model,
-        xyz: *const f32,
-        n: usize,
-        options: *const sogmm_options,
-        mean_out: *mut f32,
-        variance_out: *mut f32,
-    ) -> sogmm_status;
     pub fn sogmm_model_score_samples_f32(
         model: *const sogmm_model,
         points: *const f32,

@@ -127,13 +127,25 @@ def finalize(part: dict, metadata: dict[str, str] | None = None) -> GMM:
         values["merged_fits"] = str(int(t["fits"].sum()))
     texts = [part["map_frames"][i] for i in order]
     if any(texts):  # maps: one provenance line per frame, renumbered in the canonical insertion order
-        lines = [line.split(" ", 1)[1] for text in texts for line in text.splitlines()]
+        lines = [_united_line(line, offset) for text, offset in zip(texts, np.cumsum(t["n"]) - t["n"])
+                 for line in text.splitlines()]
         values["map_frames"] = "".join(f"{k} {rest}\n" for k, rest in enumerate(lines))
         values["map_options"] = part["map_options"]
     values.update(metadata or {})
     for k, v in values.items():
         out.set_metadata(k, v)
     return out
+
+
+def _united_line(line: str, offset: int) -> str:
+    """A tile map's ``map_frames`` line without its index, in the united map:
+    the optional last field, the map's components after the frame
+    (spec/format.md 2.3), counts the components of the tiles before it too,
+    since the united model holds the tiles' components tile by tile."""
+    fields = line.split(" ")[1:]
+    if len(fields) == 15:  # n_points n_novel, 12 pose numbers, n_components
+        fields[-1] = str(int(fields[-1]) + int(offset))
+    return " ".join(fields)
 
 
 #: The info names a .sogmm file stores (GMM.set_info accepts them).
