@@ -31,13 +31,28 @@ inline double dist2(const float* a, const float* b) {
 // is a point coordinate, and rounding is monotone, so the box distance as
 // computed (each coordinate's gap to the box, no larger than to any member)
 // never exceeds a member's distance as computed. The work per candidate is the points near it, not K clusters.
+// The points and their `closest` are also kept in tree order, so that a leaf
+// is read in place rather than gathered from all over the cloud.
 class SeedTree {
  public:
-  SeedTree(const PointsView& points, std::vector<double>& closest) : points_(points), closest_(closest) {
-    order_.resize(points.size);
-    for (std::size_t i = 0; i < points.size; ++i) order_[i] = static_cast<std::uint32_t>(i);
+  SeedTree(const PointsView& points, std::vector<double>& closest) : closest_(closest) {
+    // The tree is built on copies of the points that carry their index (the
+    // same comparisons and moves as on an index array, read in place).
+    std::vector<Entry> entries(points.size);
+    for (std::size_t i = 0; i < points.size; ++i) {
+      std::copy(points[i], points[i] + 4, entries[i].p);
+      entries[i].index = static_cast<std::uint32_t>(i);
+    }
     nodes_.reserve(2 * (points.size / kLeafSize + 1));
-    build(0, points.size);
+    build(entries, 0, points.size);
+    order_.resize(points.size);
+    sorted_.resize(4 * points.size);
+    sorted_closest_.resize(points.size);
+    for (std::size_t k = 0; k < points.size; ++k) {
+      order_[k] = entries[k].index;
+      std::copy(entries[k].p, entries[k].p + 4, &sorted_[4 * k]);
+      sorted_closest_[k] = closest_[order_[k]];
+    }
     refresh(0);
   }
 
@@ -60,30 +75,35 @@ class SeedTree {
     double max_closest = 0.0;
   };
 
-  std::int32_t build(std::size_t begin, std::size_t end) {
+  struct Entry {
+    float p[4];
+    std::uint32_t index;
+  };
+
+  std::int32_t build(std::vector<Entry>& entries, std::size_t begin, std::size_t end) {
     const auto id = static_cast<std::int32_t>(nodes_.size());
     nodes_.emplace_back();
     Node node;
     node.begin = static_cast<std::uint32_t>(begin);
     node.end = static_cast<std::uint32_t>(end);
-    for (int d = 0; d < 4; ++d) node.lo[d] = node.hi[d] = points_[order_[begin]][d];
+    for (int d = 0; d < 4; ++d) node.lo[d] = node.hi[d] = entries[begin].p[d];
     for (std::size_t k = begin; k < end; ++k)
       for (int d = 0; d < 4; ++d) {
-        node.lo[d] = std::min(node.lo[d], points_[order_[k]][d]);
-        node.hi[d] = std::max(node.hi[d], points_[order_[k]][d]);
+        node.lo[d] = std::min(node.lo[d], entries[k].p[d]);
+        node.hi[d] = std::max(node.hi[d], entries[k].p[d]);
       }
     if (end - begin > kLeafSize) {
       int axis = 0;  // the widest side; the median splits it (deterministic: nth_element on fixed input)
       for (int d = 1; d < 4; ++d)
         if (static_cast<double>(node.hi[d]) - node.lo[d] > static_cast<double>(node.hi[axis]) - node.lo[axis]) axis = d;
       const std::size_t mid = begin + (end - begin) / 2;
-      std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                       [&](std::uint32_t a, std::uint32_t b) {
-                         const float pa = points_[a][axis], pb = points_[b][axis];
-                         return pa < pb || (pa == pb && a < b);
+      std::nth_element(entries.begin() + begin, entries.begin() + mid, entries.begin() + end,
+                       [&](const Entry& a, const Entry& b) {
+                         const float pa = a.p[axis], pb = b.p[axis];
+                         return pa < pb || (pa == pb && a.index < b.index);
                        });
-      node.left = build(begin, mid);
-      node.right = build(mid, end);
+      node.left = build(entries, begin, mid);
+      node.right = build(entries, mid, end);
     }
     nodes_[id] = node;
     return id;
@@ -94,7 +114,7 @@ class SeedTree {
     Node& node = nodes_[id];
     if (node.left < 0) {
       node.max_closest = 0.0;
-      for (std::uint32_t k = node.begin; k < node.end; ++k) node.max_closest = std::max(node.max_closest, closest_[order_[k]]);
+      for (std::uint32_t k = node.begin; k < node.end; ++k) node.max_closest = std::max(node.max_closest, sorted_closest_[k]);
     } else {
       node.max_closest = std::max(refresh(node.left), refresh(node.right));
     }
@@ -117,11 +137,13 @@ class SeedTree {
     const Node& node = nodes_[id];
     if (out_of_reach(node, q)) return 0.0;
     if (node.left >= 0) return gain(node.left, q) + gain(node.right, q);
+    // Adding 0.0 for a point that does not move leaves g unchanged (g starts
+    // at +0.0 and only grows), so this branch-free sum is the sum over the
+    // moved points.
     double g = 0.0;
     for (std::uint32_t k = node.begin; k < node.end; ++k) {
-      const std::uint32_t i = order_[k];
-      const double d2 = dist2(points_[i], q);
-      if (d2 < closest_[i]) g += closest_[i] - d2;
+      const double d2 = dist2(&sorted_[4 * k], q), c = sorted_closest_[k];
+      g += d2 < c ? c - d2 : 0.0;
     }
     return g;
   }
@@ -138,53 +160,65 @@ class SeedTree {
     }
     double m = 0.0;
     for (std::uint32_t k = node.begin; k < node.end; ++k) {
-      const std::uint32_t i = order_[k];
-      const double d2 = dist2(points_[i], q);
-      if (d2 < closest_[i]) {
-        closest_[i] = d2;
-        moved(i);
+      const double d2 = dist2(&sorted_[4 * k], q);
+      if (d2 < sorted_closest_[k]) {
+        sorted_closest_[k] = d2;
+        closest_[order_[k]] = d2;
+        moved(order_[k]);
       }
-      m = std::max(m, closest_[i]);
+      m = std::max(m, sorted_closest_[k]);
     }
     node.max_closest = m;
   }
 
-  PointsView points_;
   std::vector<double>& closest_;
   std::vector<std::uint32_t> order_;
+  std::vector<float> sorted_;           // point order_[k] at 4 k
+  std::vector<double> sorted_closest_;  // closest_[order_[k]] at k
   std::vector<Node> nodes_;
 };
 
 // Draws with probability proportional to closest[] as a search of u *
 // potential in the running sum in index order (scikit-learn's rule), without
 // rebuilding that sum each step: sums of blocks of kBlock consecutive points
-// are kept and only blocks with a moved point are re-summed.
+// are kept and only blocks with a moved point are re-summed. The running sums
+// of the block sums (prefix_) are those a walk from block 0 would form, so a
+// draw is a binary search over them, and they are re-formed once per step from
+// the first changed block on, not walked once per draw.
 class PotentialSampler {
  public:
   explicit PotentialSampler(const std::vector<double>& closest)
-      : closest_(closest), block_sum_((closest.size() + kBlock - 1) / kBlock) {
+      : closest_(closest),
+        block_sum_((closest.size() + kBlock - 1) / kBlock),
+        prefix_(block_sum_.size() + 1, 0.0),
+        is_dirty_(block_sum_.size(), 0) {
     for (std::size_t b = 0; b < block_sum_.size(); ++b) resum(b);
+    accumulate_from(0);
   }
-  void mark(std::size_t i) { dirty_.push_back(i / kBlock); }
+  void mark(std::size_t i) {
+    const std::size_t b = i / kBlock;
+    if (!is_dirty_[b]) is_dirty_[b] = 1, dirty_.push_back(b);
+  }
   void flush() {
-    std::sort(dirty_.begin(), dirty_.end());
-    dirty_.erase(std::unique(dirty_.begin(), dirty_.end()), dirty_.end());
-    for (std::size_t b : dirty_) resum(b);
+    if (dirty_.empty()) return;
+    for (std::size_t b : dirty_) resum(b), is_dirty_[b] = 0;
+    accumulate_from(*std::min_element(dirty_.begin(), dirty_.end()));
     dirty_.clear();
   }
-  double potential() const {
-    double s = 0.0;
-    for (double v : block_sum_) s += v;
-    return s;
-  }
+  /// The sum of closest[] (block sums added in order from 0.0).
+  double potential() const { return prefix_.back(); }
   /// First index whose running sum exceeds target (the last index if none).
   std::size_t find(double target) const {
     const std::size_t n = closest_.size();
-    double before = 0.0;
-    std::size_t b = 0;
-    while (b + 1 < block_sum_.size() && !(before + block_sum_[b] > target)) before += block_sum_[b++];
+    // The walk "before += block_sum_[b] while before + block_sum_[b] <= target"
+    // stops at the first b whose prefix_[b + 1] exceeds target (prefix_ never
+    // decreases: the block sums are >= 0 and rounding is monotone), or at the
+    // last block.
+    const std::size_t last = block_sum_.size() - 1;
+    const std::size_t b = static_cast<std::size_t>(
+        std::upper_bound(prefix_.begin() + 1, prefix_.begin() + 1 + last, target) - (prefix_.begin() + 1));
     // Walk from the block found; rounding may carry the crossing into a later block.
-    double running = before;
+    double running = prefix_[b];
     for (std::size_t i = b * kBlock; i < n; ++i)
       if ((running += closest_[i]) > target) return i;
     return n - 1;
@@ -197,9 +231,14 @@ class PotentialSampler {
     for (std::size_t i = b * kBlock; i < std::min(closest_.size(), (b + 1) * kBlock); ++i) s += closest_[i];
     block_sum_[b] = s;
   }
+  void accumulate_from(std::size_t first) {
+    for (std::size_t b = first; b < block_sum_.size(); ++b) prefix_[b + 1] = prefix_[b] + block_sum_[b];
+  }
   const std::vector<double>& closest_;
   std::vector<double> block_sum_;
-  std::vector<std::size_t> dirty_;
+  std::vector<double> prefix_;  // prefix_[b] = block sums 0 .. b - 1, added in order
+  std::vector<std::size_t> dirty_;  // blocks with a moved point, each once
+  std::vector<char> is_dirty_;
 };
 
 }  // namespace

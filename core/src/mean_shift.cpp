@@ -152,11 +152,7 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
     for (int it = 0;; ++it) {
       double sx = 0.0, sy = 0.0;
       std::size_t count = 0;
-      checks[s] += grid.for_each_within(mx, my, bandwidth, [&](std::uint32_t i) {
-        sx += xy[2 * i];
-        sy += xy[2 * i + 1];
-        ++count;
-      });
+      checks[s] += grid.sum_within(mx, my, bandwidth, sx, sy, count);
       within = count;
       if (count == 0) break;
       const double nx = sx / count, ny = sy / count;

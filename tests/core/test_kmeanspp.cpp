@@ -2,6 +2,7 @@
 // out here: the plain greedy algorithm, O(N K trials), as the header
 // documents it. Same seed, same centres.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -97,4 +98,25 @@ TEST(KmeansPlusPlus, SameCentresAsBruteForceOnCoincidentAndCollinearPoints) {
   for (int i = 0; i < 500; ++i) cloud.insert(cloud.end(), {static_cast<float>(i % 17), 0.0f, 0.0f, 0.5f});
   for (std::size_t k : {3u, 17u, 40u})
     for (std::uint64_t seed : {5u, 6u}) expect_same_as_brute_force(cloud, k, seed);
+}
+
+TEST(KmeansPlusPlus, LargeCloudSameCentresForOneTwoThreeThreads) {
+  // Above 65536 points the candidates' gains are computed in parallel: the
+  // seeds must not depend on the team size, and still match the reference.
+  sogmm_test::TestRng rng(17);
+  std::vector<float> cloud;
+  for (int i = 0; i < 70000; ++i) {
+    const double blob = static_cast<double>(rng.next() % 7);
+    cloud.insert(cloud.end(), {static_cast<float>(0.3 * blob + 0.05 * rng.normal()), static_cast<float>(0.05 * rng.normal()),
+                               static_cast<float>(1.0 + 0.1 * blob + 0.02 * rng.normal()),
+                               static_cast<float>(rng.uniform())});
+  }
+  const sogmm::PointsView view{cloud.data(), cloud.size() / 4};
+  const std::vector<std::size_t> want = brute_force_kmeanspp(cloud, 40, 11);
+  const int saved = omp_get_max_threads();
+  for (int t : {1, 2, 3}) {
+    omp_set_num_threads(t);
+    EXPECT_EQ(sogmm::kmeanspp_seeds(view, 40, 11), want) << t << " threads";
+  }
+  omp_set_num_threads(saved);
 }

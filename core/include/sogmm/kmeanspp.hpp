@@ -17,7 +17,8 @@ namespace sogmm {
 /// points whose nodes hold their largest squared distance to the nearest
 /// seed, so a candidate visits only the points it could move (exact pruning,
 /// no O(K) loop over the seeds), and the running sum of the draw is kept in
-/// blocks of 64 points that are re-summed only when a point in them moved.
+/// blocks of 64 points that are re-summed only when a point in them moved
+/// (a draw is a binary search over the running sums of those blocks).
 /// The seeds are those of the plain O(N K trials) algorithm up to the rounding
 /// of the potentials (identical in tests/core/test_kmeanspp.cpp against a
 /// brute-force reference). Deterministic for a given seed, independent of

@@ -26,9 +26,10 @@ struct MeanShiftOptions {
 struct MeanShiftResult {
   std::vector<double> centers;        ///< K x 2 row-major
   std::vector<std::size_t> strengths; ///< points within bandwidth of each centre
-  /// Cost of the run: points whose distance to a query was evaluated (all
-  /// neighbour queries, including duplicate suppression). Deterministic and
-  /// independent of the thread count, so tests can bound cost without a clock.
+  /// Cost of the run: the points each neighbour query examined (including
+  /// duplicate suppression's), i.e. those of the grid cells whose bounding box
+  /// the query's disc reaches. Deterministic and independent of the thread
+  /// count, so tests can bound cost without a clock.
   std::uint64_t neighbour_checks = 0;
   std::size_t size() const { return strengths.size(); }
 };
