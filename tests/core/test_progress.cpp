@@ -56,8 +56,11 @@ TEST(Progress, SinkChangesNoResultForAnyThreadCount) {
     ASSERT_FALSE(seen.empty());
     EXPECT_EQ(seen.front().stage, sogmm::Stage::ModeCount);
     // Within a stage (until the stage changes) steps never decrease.
-    for (std::size_t i = 1; i < seen.size(); ++i)
-      if (seen[i].stage == seen[i - 1].stage) EXPECT_GE(seen[i].step, seen[i - 1].step) << i;
+    for (std::size_t i = 1; i < seen.size(); ++i) {
+      if (seen[i].stage == seen[i - 1].stage) {
+        EXPECT_GE(seen[i].step, seen[i - 1].step) << i;
+      }
+    }
     EXPECT_EQ(seen.back().stage, sogmm::Stage::Em);
     EXPECT_EQ(seen.back().step, static_cast<std::uint64_t>(r.em.iterations));
     EXPECT_EQ(seen.back().total, 12u);
