@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "finite_rows.hpp"
 #include "gmm_eigen.hpp"
 #include "parallel.hpp"
 #include "query_cull.hpp"
@@ -125,15 +126,6 @@ std::vector<double> pack_model(const Gmm& gmm, int dims, bool background, int th
   return params;
 }
 
-// Rows of `width` floats; the message (built only on failure) names the row.
-void require_finite(const float* v, std::size_t rows, int width, const char* what) {
-  const std::size_t count = checked::mul<std::size_t>(rows, static_cast<std::size_t>(width), "input size");
-  for (std::size_t i = 0; i < count; ++i)
-    if (!std::isfinite(v[i]))
-      throw Error(ErrorCode::InvalidData, std::string(what) + " has a non-finite value (NaN or Inf) at row " +
-                                              std::to_string(i / static_cast<std::size_t>(width)));
-}
-
 void check_options(const QueryOptions& o) {
   require(std::isfinite(o.truncation_nats) && o.truncation_nats >= 0, ErrorCode::InvalidArgument,
           "query truncation_nats must be finite and >= 0 (0 = exact), got " + checked::exact(o.truncation_nats));
@@ -206,7 +198,7 @@ void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims,
   check_options(options);
   if (n == 0) return;
   require(points != nullptr && out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
-  require_finite(points, n, dims, "points to score");
+  detail::require_finite_rows(points, n, static_cast<std::size_t>(dims), "points to score");
   const detail::QueryKernels& k = detail::query_kernels();
   score_with(gmm, points, n, dims, out, options, dims == 4 ? k.score4 : k.score3);
 }
@@ -225,7 +217,7 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
   check_options(options);
   if (n == 0) return;
   require(xyz != nullptr && mean_out != nullptr, ErrorCode::InvalidArgument, "points and output must not be null");
-  require_finite(xyz, n, 3, "points to regress");
+  detail::require_finite_rows(xyz, n, 3, "points to regress");
   const std::vector<double> params = pack_model(gmm, 3, true, options.threads);
   const std::size_t m = gmm.size();
   std::unique_ptr<detail::QueryCuller> culler;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "finite_rows.hpp"
 #include "progress.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
@@ -20,16 +21,10 @@ namespace {
 constexpr std::size_t kMinChunk = 4096;
 constexpr std::size_t kMaxChunks = 64;
 
-// The model queries' own check, on the whole input before the first chunk,
-// so that the message names the row in the caller's array and nothing is
-// written for bad input.
-void require_finite_rows(const float* v, std::size_t rows, std::size_t width, const char* what) {
-  const std::size_t count = checked::mul<std::size_t>(rows, width, "input size");
-  for (std::size_t i = 0; i < count; ++i)
-    if (!std::isfinite(v[i]))
-      throw Error(ErrorCode::InvalidData,
-                  std::string(what) + " has a non-finite value (NaN or Inf) at row " + std::to_string(i / width));
-}
+// The model queries' own check (finite_rows.hpp), on the whole input before
+// the first chunk, so that the message names the row in the caller's array
+// and nothing is written for bad input.
+using detail::require_finite_rows;
 
 // Runs query(first, count) over [0, n) in chunks, reporting to `progress`
 // the start, the chunks done (when a report is due, sogmm/progress.hpp) and
