@@ -198,7 +198,8 @@ impl OptionsBuilder {
         float64(bool) => SOGMM_OPT_FLOAT64 as i64 i64::from;
         /// Compress arrays (default true).
         compress(bool) => SOGMM_OPT_COMPRESS as i64 i64::from;
-        /// Cap on decoded bytes when loading; 0 = the format's default.
+        /// Cap on the arrays' decoded bytes when loading, and when saving (a model
+        /// above it is refused: raise it on both sides); 0 = the format's 1 GiB.
         max_decoded_bytes(i64) => SOGMM_OPT_MAX_DECODED_BYTES as i64 |v| v;
         /// Verify checksums when loading (default true).
         verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 i64::from;
