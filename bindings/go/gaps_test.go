@@ -303,3 +303,30 @@ func TestInvalidCullingOrThreadsAreRefused(t *testing.T) {
 		t.Fatalf("threads -1: %v", err)
 	}
 }
+
+// ---- the writer keeps to the reader's decoded-size cap --------------------
+
+func TestSaveAboveTheDecodedSizeCapIsRefused(t *testing.T) {
+	m := twoComponents(t) // 2 x 15 float32 values: 120 decoded bytes
+	capped := func(c int64) *Options {
+		o, err := NewOptions(I64(OptMaxDecodedBytes, c))
+		if err != nil {
+			t.Fatal(err)
+		}
+		t.Cleanup(o.Close)
+		return o
+	}
+	_, err := m.Bytes(capped(119))
+	if !errors.Is(err, ErrLimit) || !strings.Contains(err.Error(), "over the cap of 119 bytes") {
+		t.Fatalf("cap 119: %v", err)
+	}
+	data, err := m.Bytes(capped(120))
+	if err != nil {
+		t.Fatal(err)
+	}
+	back, err := FromBytes(data, capped(120))
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer back.Close()
+}

@@ -206,3 +206,20 @@ fn invalid_culling_or_threads_are_refused() {
     let e = Options::builder().threads(-1).build().unwrap_err();
     assert_eq!(e.status(), Status::InvalidArg);
 }
+
+// ---- the writer keeps to the reader's decoded-size cap --------------------
+
+#[test]
+fn save_above_the_decoded_size_cap_is_refused() {
+    let m = two_components(); // 2 x 15 f32 values: 120 decoded bytes
+    let cap = |c| Options::builder().max_decoded_bytes(c).build().unwrap();
+    let e = m.to_bytes(Some(&cap(119))).unwrap_err();
+    assert_eq!(e.status(), Status::Limit);
+    assert!(e.message().contains("over the cap of 119 bytes"), "{e}");
+    assert!(e.message().contains("SOGMM_OPT_MAX_DECODED_BYTES"), "{e}");
+    let bytes = m.to_bytes(Some(&cap(120))).unwrap();
+    assert_eq!(
+        Model::from_bytes(&bytes, Some(&cap(120))).unwrap().means().unwrap(),
+        m.means().unwrap()
+    );
+}
