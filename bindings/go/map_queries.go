@@ -23,6 +23,12 @@ func (m *Map) ScoreSamplesContext(ctx context.Context, points []float32, dims in
 	return withProgress(ctx, nil, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
 }
 
+// ScoreSamplesWith is ScoreSamples with the Threads and QueryTruncationNats
+// of o, as Model.ScoreSamplesWith.
+func (m *Map) ScoreSamplesWith(points []float32, dims int, o *Options) ([]float64, error) {
+	return m.scoreSamples(points, dims, o)
+}
+
 func (m *Map) scoreSamples(points []float32, dims int, o *Options) ([]float64, error) {
 	n, out, err := scoreBuffer(points, dims)
 	if err != nil {
@@ -51,6 +57,12 @@ func (m *Map) RegressGrayContext(ctx context.Context, xyz []float32, fn Progress
 		return [2][]float32{mean, variance}, err
 	})
 	return both[0], both[1], err
+}
+
+// RegressGrayWith is RegressGray with the Threads and QueryTruncationNats of
+// o, as Model.RegressGrayWith.
+func (m *Map) RegressGrayWith(xyz []float32, o *Options) (mean, variance []float32, err error) {
+	return m.regressGray(xyz, o)
 }
 
 func (m *Map) regressGray(xyz []float32, o *Options) (mean, variance []float32, err error) {

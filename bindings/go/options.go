@@ -31,6 +31,8 @@ const (
 	OptMaxDecodedBytes  Key = C.SOGMM_OPT_MAX_DECODED_BYTES
 	OptVerifyChecksums  Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
 	OptSampleTruncation Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
+	// OptQueryTruncationNats culls the queries given these options (see QueryTruncationNats).
+	OptQueryTruncationNats Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
 )
 
 // Options is an owned sogmm_options handle: parameters for fit, save, load
@@ -168,7 +170,8 @@ func MaxIter(n int64) Option { return I64(OptMaxIter, n) }
 // Seed of k-means++ (default 0); stored as the uint64's bits.
 func Seed(s uint64) Option { return I64(OptSeed, int64(s)) }
 
-// Threads of a fit; 0 = all cores (default).
+// Threads of a fit, and of the queries given these options (ScoreSamplesWith,
+// RegressGrayWith: the same bits for any count); 0 = all cores (default).
 func Threads(n int64) Option { return I64(OptThreads, n) }
 
 // NInit runs of k-means++ + EM (default 1).
@@ -199,3 +202,10 @@ func VerifyChecksums(b bool) Option { return I64(OptVerifyChecksums, boolI64(b))
 
 // SampleTruncation in standard deviations (default 2.5; may be +Inf).
 func SampleTruncation(v float64) Option { return F64(OptSampleTruncation, v) }
+
+// QueryTruncationNats culls the queries given these options (ScoreSamplesWith,
+// RegressGrayWith): 0 = exact (default); > 0 skips a component at a point
+// only when its term is provably more than v nats below the point's largest,
+// so a score is at most ln(1 + M e^-v) below the exact one. Negative or not
+// finite: ErrInvalidArg.
+func QueryTruncationNats(v float64) Option { return F64(OptQueryTruncationNats, v) }

@@ -206,6 +206,12 @@ func (m *Model) RegressGray(xyz []float32) (mean, variance []float32, err error)
 	return m.regressGray(xyz, nil)
 }
 
+// RegressGrayWith is RegressGray with the Threads and QueryTruncationNats of
+// o (nil o = exact, all cores).
+func (m *Model) RegressGrayWith(xyz []float32, o *Options) (mean, variance []float32, err error) {
+	return m.regressGray(xyz, o)
+}
+
 func (m *Model) regressGray(xyz []float32, o *Options) (mean, variance []float32, err error) {
 	n, err := rowsOf(xyz, 3, "xyz")
 	if err != nil {
@@ -225,6 +231,13 @@ func (m *Model) regressGray(xyz []float32, o *Options) (mean, variance []float32
 // marginal over gray).
 func (m *Model) ScoreSamples(points []float32, dims int) ([]float64, error) {
 	return m.scoreSamples(points, dims, nil)
+}
+
+// ScoreSamplesWith is ScoreSamples with the Threads and QueryTruncationNats
+// of o (nil o = exact, all cores): each culled score is at most
+// ln(1 + M e^-nats) below the exact one.
+func (m *Model) ScoreSamplesWith(points []float32, dims int, o *Options) ([]float64, error) {
+	return m.scoreSamples(points, dims, o)
 }
 
 func (m *Model) scoreSamples(points []float32, dims int, o *Options) ([]float64, error) {

@@ -18,6 +18,7 @@ sogmm::format::WriteOptions write_options(const sogmm_options& o) {
   w.zstd_level = static_cast<int>(o.zstd_level);
   w.float64 = o.float64 != 0;
   w.compress = o.compress != 0;
+  if (o.max_decoded_bytes > 0) w.max_decoded_bytes = static_cast<std::uint64_t>(o.max_decoded_bytes);
   return w;
 }
 

@@ -58,4 +58,10 @@ inline std::uint64_t columns(int which, bool packed) {
   return which == kWeights ? 1 : which == kMeans ? 4 : (packed ? 10 : 16);
 }
 
+/// The writer's size cap: throws FormatError(Limit, "limit") when the three
+/// arrays of an M-component model (covariances packed or full, float32 or
+/// float64 elements) decode to more than `cap` bytes, the message naming
+/// both sizes and how to raise the cap. Reads no array: M is enough.
+void check_decoded_size(std::uint64_t m, bool packed, bool float64, std::uint64_t cap);
+
 }  // namespace sogmm::format::detail

@@ -186,6 +186,8 @@ class EncodedFile {
     const Gmm& g = model.gmm;
     const std::size_t m = g.weights.size();
     const bool packed = !t.force_full_layout && g.covariances.size() == 16 * m && bit_symmetric(g.covariances, m);
+    // Before any array is encoded: a file a reader would refuse is not written.
+    if (t.validate) check_decoded_size(m, packed, options.float64, options.max_decoded_bytes);
     arrays_[kWeights] = encode_one(g.weights, 1, options);
     arrays_[kMeans] = encode_one(g.means, 4, options);
     arrays_[kCovariances] = encode_one(packed ? pack_upper(g.covariances, m) : g.covariances, packed ? 10 : 16, options);
@@ -264,6 +266,29 @@ class EncodedFile {
 };
 
 }  // namespace
+
+void check_decoded_size(std::uint64_t m, bool packed, bool float64, std::uint64_t cap) {
+  // The reader's step 14 arithmetic (schema.cpp), in one dtype.
+  std::uint64_t total = 0;
+  bool overflow = false;
+  for (int i = 0; i < 3 && !overflow; ++i) {
+    std::uint64_t values = 0, bytes = 0;
+    overflow = !checked::try_mul<std::uint64_t>(m, columns(i, packed), &values) ||
+               !checked::try_mul<std::uint64_t>(values, float64 ? 8 : 4, &bytes) ||
+               !checked::try_add(total, bytes, &total);
+  }
+  if (overflow || total > cap) {
+    const std::string over = cap == kDefaultMaxDecodedBytes
+                                  ? "the 1 GiB (" + std::to_string(cap) + " bytes) cap that readers apply by default"
+                                  : "the cap of " + std::to_string(cap) + " bytes given for writing";
+    fail(ErrorCode::Limit, "limit",
+         "the arrays of " + std::to_string(m) + " components would decode to " +
+             (overflow ? std::string("more than 2^64") : std::to_string(total)) + " bytes, over " + over +
+             ": a reader with that cap refuses the file. To write it anyway raise the cap on both sides "
+             "(WriteOptions::max_decoded_bytes and ReadOptions::max_decoded_bytes; C API and bindings: "
+             "SOGMM_OPT_MAX_DECODED_BYTES for save and load)");
+  }
+}
 
 std::vector<std::uint8_t> encode(const Model& model, const WriteOptions& options, const Tweaks& t) {
   return EncodedFile(model, options, t).to_vector();

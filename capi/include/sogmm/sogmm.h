@@ -177,8 +177,10 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_FLOAT64 301    /* i64, 0 or 1; default 0: store arrays as float64 */
 #define SOGMM_OPT_COMPRESS 302   /* i64, 0 or 1; default 1: zstd-compress the arrays */
 
-/* Reading .sogmm (load, load_from_memory). */
-#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap */
+/* Reading .sogmm (load, load_from_memory); MAX_DECODED_BYTES also for writing (save, save_to_memory). */
+#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap (1 GiB)
+                                         * on the arrays' decoded bytes: load refuses a file above it and
+                                         * save a model above it (what a default reader would refuse) */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
 
 /* Sampling (sogmm_model_sample_f32) and queries (the _v2 score and
@@ -535,7 +537,9 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
  * replaced and the link kept. The file gets the permission bits of the file
  * it replaces (never set-user-ID, set-group-ID or sticky bits), or 0666 minus
  * the umask. Write keys of `options` apply. Errors: metadata too large for a
- * .sogmm file (2^31 - 1 bytes; 100 000 tables: 99 994 to 99 996 key/value pairs)
+ * .sogmm file (2^31 - 1 bytes; 100 000 tables: 99 994 to 99 996 key/value pairs),
+ * or arrays decoding to more bytes than SOGMM_OPT_MAX_DECODED_BYTES (default
+ * 1 GiB: the cap of a default reader; about 17.9 million float32 components)
  * -> SOGMM_E_LIMIT, checked before anything is written; cannot write, or the
  * path names something other than a regular file -> SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* path,

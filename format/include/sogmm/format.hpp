@@ -37,6 +37,11 @@ struct WriteOptions {
   int zstd_level = 19;   ///< zstd compression level, 1..22 (clamped)
   bool float64 = false;  ///< store arrays as float64 (exact widening of the float32 values)
   bool compress = true;  ///< false: arrays stored raw (no filter, no codec), component-major
+  /// Refuse (Error(Limit), nothing written) a model whose arrays would decode
+  /// to more bytes than this. The default is the reader's default cap, so a
+  /// file a default reader would refuse is never written silently; raise it
+  /// together with the readers' ReadOptions::max_decoded_bytes.
+  std::uint64_t max_decoded_bytes = kDefaultMaxDecodedBytes;
 };
 
 /// How a file is read.

@@ -30,6 +30,7 @@ from .errors import (
     SogmmMemoryError,
 )
 from .map import Map
+from .metrics import PSNR, psnr_images
 from .model import GMM, SOGMM, from_bytes, load
 from .ply import read_ply, write_ply
 
@@ -65,6 +66,7 @@ __all__ = [
     "NotFoundError",
     "NullArgumentError",
     "NumericError",
+    "PSNR",
     "SOGMM",
     "SogmmError",
     "SogmmIOError",
@@ -73,6 +75,7 @@ __all__ = [
     "library_path",
     "library_version",
     "load",
+    "psnr_images",
     "read_ply",
     "rgbd_to_points",
     "write_ply",

@@ -68,9 +68,10 @@ def _sample_args(n_samples, seed, spatial_only: bool) -> tuple[int, int, int, np
     return n, int(seed) & 0xFFFFFFFFFFFFFFFF, dims, np.empty((n, dims), dtype=np.float32)
 
 
-def _write_options(float64: bool, compress: bool, zstd_level: int) -> _ffi.Options:
+def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = 0) -> _ffi.Options:
     return _ffi.Options(
-        i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level}
+        i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level,
+             _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
     )
 
 
@@ -434,18 +435,23 @@ class GMM:
 
     # ---- files and bytes ---------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,
-             zstd_level: int = 19) -> None:
-        """Writes a .sogmm file atomically (temporary file + rename)."""
+             zstd_level: int = 19, max_decoded_bytes: int = 0) -> None:
+        """Writes a .sogmm file atomically (temporary file + rename).
+
+        Arrays decoding to more than ``max_decoded_bytes`` (0 = the 1 GiB that
+        :func:`sogmm.load` accepts by default) raise LimitError, nothing
+        written: raise it here and in ``load`` together."""
         h = self._h()
         p = os.fsencode(os.fspath(path))
-        with _write_options(float64, compress, zstd_level) as o:
+        with _write_options(float64, compress, zstd_level, max_decoded_bytes) as o:
             check(lib.sogmm_model_save(h, p, o.ptr))
 
-    def to_bytes(self, *, float64: bool = False, compress: bool = True, zstd_level: int = 19) -> bytes:
-        """The bytes of a .sogmm file."""
+    def to_bytes(self, *, float64: bool = False, compress: bool = True, zstd_level: int = 19,
+                 max_decoded_bytes: int = 0) -> bytes:
+        """The bytes of a .sogmm file (``max_decoded_bytes`` as in :meth:`save`)."""
         h = self._h()
         buf = c_void_p()
-        with _write_options(float64, compress, zstd_level) as o:
+        with _write_options(float64, compress, zstd_level, max_decoded_bytes) as o:
             check(lib.sogmm_model_save_to_memory(byref(buf), h, o.ptr))
         try:
             return _ffi.buffer_to_bytes(buf)

@@ -147,7 +147,6 @@ pub const SOGMM_INFO_CAMERA_DEPTH_SCALE: sogmm_key = 10207;
 pub const SOGMM_INFO_CAMERA_DEPTH_MIN: sogmm_key = 10208;
 pub const SOGMM_INFO_CAMERA_DEPTH_MAX: sogmm_key = 10209;
 
-
 /// Totals of a map (sogmm_map_get_stats).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
@@ -400,11 +399,8 @@ extern "C" {
         out: *mut f32,
     ) -> sogmm_status;
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
-    pub fn sogmm_map_load(
-        out: *mut *mut sogmm_map,
-        path: *const c_char,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
+    pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
+        -> sogmm_status;
     pub fn sogmm_buffer_data(buffer: *const sogmm_buffer) -> *const u8;
     pub fn sogmm_buffer_size(buffer: *const sogmm_buffer) -> usize;
     pub fn sogmm_buffer_free(buffer: *mut sogmm_buffer);

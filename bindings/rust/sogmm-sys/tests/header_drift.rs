@@ -194,7 +194,9 @@ fn header_callbacks(header: &str) -> Protos {
     let mut out = Protos::new();
     for stmt in c_declarations(header).split(';') {
         let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
-        let Some(rest) = decl.strip_prefix("typedef ") else { continue };
+        let Some(rest) = decl.strip_prefix("typedef ") else {
+            continue;
+        };
         let Some(star) = rest.find("(*") else { continue };
         let ret = rest[..star].trim();
         let name_end = rest[star..].find(')').unwrap() + star;
@@ -215,14 +217,21 @@ fn rust_callbacks(lib: &str) -> Protos {
         let decl = stmt.split_whitespace().collect::<Vec<_>>().join(" ");
         let Some(at) = decl.find("pub type ") else { continue };
         let decl = &decl[at + "pub type ".len()..];
-        let Some((name, ty)) = decl.split_once(" = Option<unsafe extern \"C\" fn(") else { continue };
+        let Some((name, ty)) = decl.split_once(" = Option<unsafe extern \"C\" fn(") else {
+            continue;
+        };
         let close = ty.rfind(')').unwrap();
         let args = ty[..close]
             .split(',')
             .filter(|a| !a.trim().is_empty())
             .map(|a| a.split_once(':').expect("argument without a name").1.trim().to_string())
             .collect();
-        let ret = ty[close + 1..].trim().trim_end_matches('>').trim().strip_prefix("->").map(|r| r.trim().to_string());
+        let ret = ty[close + 1..]
+            .trim()
+            .trim_end_matches('>')
+            .trim()
+            .strip_prefix("->")
+            .map(|r| r.trim().to_string());
         out.insert(name.trim().to_string(), (args, ret));
     }
     out

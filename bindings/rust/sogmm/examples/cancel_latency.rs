@@ -12,14 +12,22 @@ use sogmm::{Model, Options, Status};
 
 fn main() -> Result<(), sogmm::Error> {
     let args: Vec<String> = std::env::args().collect();
-    let path = args.get(1).expect("usage: cancel_latency POINTS.f32 [runs] [delay-seconds]");
+    let path = args
+        .get(1)
+        .expect("usage: cancel_latency POINTS.f32 [runs] [delay-seconds]");
     let raw = std::fs::read(path).expect("cannot read the points file");
     assert!(raw.len() % 16 == 0, "not n x 4 float32 values");
-    let pts: Vec<f32> = raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let pts: Vec<f32> = raw
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
     let runs: usize = args.get(2).map_or(5, |s| s.parse().unwrap());
     let delay: f64 = args.get(3).map_or(1.0, |s| s.parse().unwrap());
     let opts = Options::builder().bandwidth(0.02).seed(0).build()?;
-    println!("rust: d = 1 fit of {} points, cancel requested after {delay} s", pts.len() / 4);
+    println!(
+        "rust: d = 1 fit of {} points, cancel requested after {delay} s",
+        pts.len() / 4
+    );
     let mut lat = Vec::new();
     for r in 0..runs {
         let stop = Arc::new(AtomicBool::new(false));

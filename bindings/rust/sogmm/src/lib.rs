@@ -23,6 +23,7 @@
 //! thread right after each call.
 pub mod error;
 pub mod map;
+pub mod metrics;
 pub mod model;
 pub mod options;
 pub mod progress;
@@ -32,6 +33,7 @@ use std::sync::OnceLock;
 
 pub use error::{Error, Result, Status};
 pub use map::{Map, MapFrameStats, MapStats, Pose};
+pub use metrics::{psnr_images, Psnr};
 pub use model::{Color, Frame, Model};
 pub use options::{FusionMethod, ModeCounter, Options, OptionsBuilder};
 pub use progress::{Progress, Stage};

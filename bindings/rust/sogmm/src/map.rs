@@ -208,6 +208,12 @@ impl Map {
         self.score_raw(points, dims, opt_ptr(None))
     }
 
+    /// As `score_samples`, with the threads and culling of `options` (as
+    /// `Model::score_samples_with`).
+    pub fn score_samples_with(&self, points: &[f32], dims: i32, options: Option<&Options>) -> Result<Vec<f64>> {
+        self.score_raw(points, dims, opt_ptr(options))
+    }
+
     /// As `score_samples`, reporting `Stage::Scoring` and cancellable.
     pub fn score_samples_with_progress(
         &self,
@@ -228,6 +234,12 @@ impl Map {
     /// Expected gray and its variance at world points (`xyz`: rows of 3).
     pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
         self.regress_raw(xyz, opt_ptr(None))
+    }
+
+    /// As `regress_gray`, with the threads and culling of `options` (as
+    /// `Model::regress_gray_with`).
+    pub fn regress_gray_with(&self, xyz: &[f32], options: Option<&Options>) -> Result<(Vec<f32>, Vec<f32>)> {
+        self.regress_raw(xyz, opt_ptr(options))
     }
 
     /// As `regress_gray`, reporting `Stage::Regression` and cancellable.

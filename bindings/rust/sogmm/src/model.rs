@@ -390,6 +390,24 @@ impl Model {
         )
     }
 
+    /// Sets an f64 SOGMM_INFO_* key that .sogmm files store (the fit record,
+    /// SOGMM_INFO_FIT_*, or the camera, SOGMM_INFO_CAMERA_*), e.g. to give a
+    /// model rebuilt with `from_arrays` the provenance of its fit; a model
+    /// without that record gets one with the format's defaults first. A key
+    /// files do not store, or a value the format cannot hold (non-finite),
+    /// is `Status::InvalidArg` naming the key, the model unchanged.
+    pub fn set_info_f64(&mut self, key: i32, value: f64) -> Result<()> {
+        // SAFETY: exclusive through &mut self.
+        check(unsafe { sys::sogmm_model_set_info_f64(self.ptr.as_ptr(), key, value) })
+    }
+
+    /// As `set_info_f64` for i64 keys (FIT_CONVERGED 0 or 1, int32 fields in
+    /// range, CAMERA_DECIMATION >= 1, ...; FIT_SEED takes the u64's bits).
+    pub fn set_info_i64(&mut self, key: i32, value: i64) -> Result<()> {
+        // SAFETY: exclusive through &mut self.
+        check(unsafe { sys::sogmm_model_set_info_i64(self.ptr.as_ptr(), key, value) })
+    }
+
     /// The 4 x 4 row-major pose of the model's frame, if set.
     pub fn pose(&self) -> Result<Option<[f64; 16]>> {
         let mut p = [0.0; 16];
@@ -462,6 +480,13 @@ impl Model {
         self.regress_raw(xyz, ptr::null())
     }
 
+    /// As `regress_gray`, with SOGMM_OPT_THREADS and
+    /// SOGMM_OPT_QUERY_TRUNCATION_NATS from `options` (`OptionsBuilder::threads`,
+    /// `query_truncation_nats`; None = exact, all cores).
+    pub fn regress_gray_with(&self, xyz: &[f32], options: Option<&Options>) -> Result<(Vec<f32>, Vec<f32>)> {
+        self.regress_raw(xyz, opt_ptr(options))
+    }
+
     /// As `regress_gray`, reporting `Stage::Regression` (points done) and
     /// cancellable as `fit_with_progress`; the same values.
     pub fn regress_gray_with_progress(
@@ -482,6 +507,13 @@ impl Model {
     /// Log-density of rows of `dims` floats (4: joint; 3: marginal over gray).
     pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
         self.score_raw(points, dims, ptr::null())
+    }
+
+    /// As `score_samples`, with the threads and culling of `options` as
+    /// `regress_gray_with`: each culled score is at most
+    /// ln(1 + M e^-nats) below the exact one.
+    pub fn score_samples_with(&self, points: &[f32], dims: i32, options: Option<&Options>) -> Result<Vec<f64>> {
+        self.score_raw(points, dims, opt_ptr(options))
     }
 
     /// As `score_samples`, reporting `Stage::Scoring` (points scored) and

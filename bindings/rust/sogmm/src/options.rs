@@ -171,7 +171,9 @@ impl OptionsBuilder {
         max_iter(i64) => SOGMM_OPT_MAX_ITER as i64 |v| v;
         /// k-means++ seed (default 0); the u64's bits, as the header says.
         seed(u64) => SOGMM_OPT_SEED as i64 |v: u64| v as i64;
-        /// OpenMP threads of a fit; 0 = all cores (default).
+        /// Worker threads of a fit, and of the queries given these options
+        /// (`score_samples_with`, `regress_gray_with`: the same bits for any
+        /// count); 0 = all cores (default).
         threads(i64) => SOGMM_OPT_THREADS as i64 |v| v;
         /// Mode-count variant.
         mode_counter(ModeCounter) => SOGMM_OPT_MODE_COUNTER as i64 |m| match m {
@@ -196,12 +198,19 @@ impl OptionsBuilder {
         float64(bool) => SOGMM_OPT_FLOAT64 as i64 i64::from;
         /// Compress arrays (default true).
         compress(bool) => SOGMM_OPT_COMPRESS as i64 i64::from;
-        /// Cap on decoded bytes when loading; 0 = the format's default.
+        /// Cap on the arrays' decoded bytes when loading, and when saving (a model
+        /// above it is refused: raise it on both sides); 0 = the format's 1 GiB.
         max_decoded_bytes(i64) => SOGMM_OPT_MAX_DECODED_BYTES as i64 |v| v;
         /// Verify checksums when loading (default true).
         verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 i64::from;
         /// Sampling truncation in standard deviations (default 2.5; may be inf).
         sample_truncation(f64) => SOGMM_OPT_SAMPLE_TRUNCATION as f64 |v| v;
+        /// Culled queries (`score_samples_with`, `regress_gray_with`): 0 = exact
+        /// (default); > 0 skips a component at a point only when its term is
+        /// provably more than this many nats below the point's largest, so a
+        /// score is at most ln(1 + M e^-nats) below the exact one. Negative or
+        /// not finite: `build` fails with `Status::InvalidArg`.
+        query_truncation_nats(f64) => SOGMM_OPT_QUERY_TRUNCATION_NATS as f64 |v| v;
         /// Map: test each point's novelty (default true; false = append everything).
         map_novelty(bool) => SOGMM_OPT_MAP_NOVELTY as i64 i64::from;
         /// Map: points with a 3-D log-likelihood below this (nats) are novel (default 3.0).

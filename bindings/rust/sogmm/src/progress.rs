@@ -113,7 +113,9 @@ pub(crate) fn with_progress<T>(
     let mut cx = Ctx { f: &mut f, panic: None };
     // SAFETY: `private` is ours; `cx` outlives the call below, the only one
     // that uses these options.
-    check(unsafe { sys::sogmm_options_set_progress(private.0, Some(trampoline), &mut cx as *mut Ctx<'_> as *mut c_void) })?;
+    check(unsafe {
+        sys::sogmm_options_set_progress(private.0, Some(trampoline), &mut cx as *mut Ctx<'_> as *mut c_void)
+    })?;
     let result = call(private.0);
     drop(private);
     if let Some(payload) = cx.panic.take() {

@@ -17,7 +17,14 @@ fn cube(n: usize) -> Vec<f32> {
 }
 
 fn opts() -> Options {
-    Options::builder().n_components(8).tol(1e-12).max_iter(25).seed(5).threads(2).build().unwrap()
+    Options::builder()
+        .n_components(8)
+        .tol(1e-12)
+        .max_iter(25)
+        .seed(5)
+        .threads(2)
+        .build()
+        .unwrap()
 }
 
 #[test]
@@ -37,13 +44,23 @@ fn reports_em_iterations_in_order_and_change_nothing() {
     assert_eq!(seen.first().unwrap().stage, Stage::Seeding);
     assert_eq!(seen.last().unwrap().stage, Stage::Em);
     let em: Vec<&Progress> = seen.iter().filter(|p| p.stage == Stage::Em).collect();
-    assert!(em.windows(2).all(|w| w[0].step <= w[1].step), "EM steps decrease: {em:?}");
+    assert!(
+        em.windows(2).all(|w| w[0].step <= w[1].step),
+        "EM steps decrease: {em:?}"
+    );
     assert!(em.iter().all(|p| p.total == 25));
     let mut steps: Vec<u64> = em.iter().map(|p| p.step).collect();
     steps.dedup();
-    assert_eq!(steps, (0..=iterations).collect::<Vec<_>>(), "every iteration reported once");
+    assert_eq!(
+        steps,
+        (0..=iterations).collect::<Vec<_>>(),
+        "every iteration reported once"
+    );
     let last = em.last().unwrap().log_likelihood;
-    assert_eq!(last, m.info_f64(sogmm::sys::SOGMM_INFO_FIT_LOG_LIKELIHOOD).unwrap().unwrap());
+    assert_eq!(
+        last,
+        m.info_f64(sogmm::sys::SOGMM_INFO_FIT_LOG_LIKELIHOOD).unwrap().unwrap()
+    );
 }
 
 #[test]
@@ -106,6 +123,8 @@ fn scoring_and_regression_report_points_and_change_nothing() {
     });
     assert_eq!(got.unwrap(), m.regress_gray(&q).unwrap());
     assert_eq!(last, (Some(Stage::Regression), 10_000));
-    let e = m.score_samples_with_progress(&q, 3, |_| ControlFlow::Break(())).unwrap_err();
+    let e = m
+        .score_samples_with_progress(&q, 3, |_| ControlFlow::Break(()))
+        .unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
 }

@@ -71,6 +71,8 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--max-iter", type=int, default=d.max_iter)
     g.add_argument("--reg-covar", type=float, default=d.reg_covar)
     g.add_argument("--truncate", type=float, default=d.truncate)
+    g.add_argument("--dequantise-depth", action="store_true",
+                   help="floor variances along viewing rays at the depth quantisation (structured-light depth)")
     g.add_argument("--decimate", type=int, default=None, help="default 1, 5 with --reduce map (as sogmm map)")
     g.add_argument("--depth-scale", type=float, default=d.depth_scale)
     g.add_argument("--depth-min", type=float, default=d.depth_min)
@@ -105,8 +107,8 @@ def main(argv=None) -> int:
         frames_per_task = _frames_per_task(a.frames_per_task)
         settings = FitSettings(bandwidth=a.bandwidth, n_components=a.components, seed=a.seed, n_init=a.n_init,
                                threads=a.threads, tol=a.tol, max_iter=a.max_iter, reg_covar=a.reg_covar,
-                               truncate=a.truncate, decimate=a.decimate, depth_scale=a.depth_scale,
-                               depth_min=a.depth_min, depth_max=a.depth_max)
+                               truncate=a.truncate, dequantise_depth=a.dequantise_depth, decimate=a.decimate,
+                               depth_scale=a.depth_scale, depth_min=a.depth_min, depth_max=a.depth_max)
         intrinsics = a.intrinsics or str(Path(a.sequence) / "intrinsics.json")
         if not os.path.isfile(intrinsics):
             raise SogmmError(f"no camera: give --intrinsics FILE (or put intrinsics.json in {a.sequence})")

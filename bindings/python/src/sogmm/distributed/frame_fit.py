@@ -33,6 +33,9 @@ class FitSettings:
     max_iter: int = 100
     reg_covar: float = 1e-6
     truncate: float = 0.0
+    #: ``--dequantise-depth``: floor variances along viewing rays at the depth
+    #: quantisation (SOGMM(dequantise_depth=True)); False = the paper's plain EM.
+    dequantise_depth: bool = False
     decimate: int = 1
     depth_scale: float = 1000.0
     depth_min: float = 0.1
@@ -84,7 +87,8 @@ def fit_frame(frame: Frame, settings: FitSettings, camera: dict) -> tuple[dict, 
         depth, color = read_images(frame)
         model = SOGMM(bandwidth=settings.bandwidth, seed=settings.seed, tol=settings.tol, reg_covar=settings.reg_covar,
                       max_iter=settings.max_iter, n_components=settings.n_components, n_threads=settings.threads,
-                      truncation_nats=settings.truncate, n_init=settings.n_init)
+                      truncation_nats=settings.truncate, n_init=settings.n_init,
+                      dequantise_depth=settings.dequantise_depth)
         model.fit_rgbd(depth, color, Camera(**camera), depth_scale=settings.depth_scale, depth_min=settings.depth_min,
                        depth_trunc=settings.depth_max, decimate=settings.decimate)
         part = leaf(frame.index, model.transform(np.asarray(frame.pose).reshape(4, 4)))

@@ -60,7 +60,7 @@ class MapSettings:
                    depth_min=fit.depth_min, depth_trunc=fit.depth_max, decimate=fit.decimate,
                    bandwidth=fit.bandwidth, n_components=fit.n_components, seed=fit.seed, n_init=fit.n_init,
                    n_threads=fit.threads, tol=fit.tol, max_iter=fit.max_iter, reg_covar=fit.reg_covar,
-                   truncation_nats=fit.truncate)
+                   truncation_nats=fit.truncate, dequantise_depth=fit.dequantise_depth)
 
 
 def _map_partial(saved: GMM, frames: list[int]) -> dict:
