@@ -31,8 +31,6 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 // count), so the order in which partial sums are added never changes.
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
-// Components per task in the per-component loops (reduction, M-step, packing).
-constexpr std::size_t kComponentChunk = 32;
 
 void check_options(const EmOptions& o) {
   require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
@@ -300,45 +298,26 @@ bool pack_component(const Working& w, std::size_t k, float* out, double* exact) 
 // degenerate component): first reg_covar or 1e-12 of the component's largest
 // variance (of the data's extent squared when it has none), then x10 up to
 // 12 times, so the loading follows the component's own scale.
-// Returns false when 12 loadings do not suffice (no throw: it runs in
-// parallel loops, whose error is then reported for the lowest k).
-bool try_make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
-                                double* exact) {
+void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
+                            double* exact) {
   double* c = &w.covariance[16 * k];
   double own = 0.0;
   for (int i = 0; i < 4; ++i) own = std::max(own, c[5 * i]);
   double extra = std::max(reg_covar, 1e-12 * (own > 0.0 ? own : data_scale2));
   int attempts = 0;
   while (!pack_component(w, k, packed, exact)) {
-    if (++attempts > 12) return false;
+    require(++attempts <= 12, ErrorCode::Numeric,
+            "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
     for (int i = 0; i < 4; ++i) c[5 * i] += extra;
     extra *= 10.0;
   }
-  return true;
 }
 
-void require_positive_definite(bool ok, std::size_t k) {
-  require(ok, ErrorCode::Numeric,
-          "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
-}
-
-void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
-                            double* exact) {
-  require_positive_definite(try_make_positive_definite(w, k, reg_covar, data_scale2, packed, exact), k);
-}
-
-// Components in parallel: each is packed on its own, so the bits do not
-// depend on the team; serial, this was 2-4% of a d = 5 fit's work, a limit
-// on the two-thread speed-up (Amdahl).
-void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params, std::vector<double>& exact,
-              int threads) {
+void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params, std::vector<double>& exact) {
   params.assign(w.size() * kParamStride, 0.f);
   exact.assign(w.size() * kParamStride, 0.0);
-  std::vector<char> ok(w.size());
-  detail::parallel_for(w.size(), threads, kComponentChunk, [&](std::size_t k, int) {
-    ok[k] = try_make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
-  });
-  for (std::size_t k = 0; k < w.size(); ++k) require_positive_definite(ok[k], k);
+  for (std::size_t k = 0; k < w.size(); ++k)
+    make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
 }
 
 // M-step for one component from its statistics, which are centred at the
@@ -427,7 +406,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
   // The first model's kernel parameters; each iteration packs the next.
-  pack_all(w, options.reg_covar, data_scale2, params, exact, threads);
+  pack_all(w, options.reg_covar, data_scale2, params, exact);
   std::vector<float> next_params;
   std::vector<double> next_exact;
   for (int iter = 1; iter <= options.max_iter; ++iter) {
@@ -481,40 +460,32 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
           slot_ll[s] = ll;
           slot_pairs[s] = pairs;
         });
-        // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them;
-        // each statistic is summed in that order, so the components can be
-        // reduced in parallel. After the last wave the same loop runs the
-        // M-step of each component (one parallel region instead of two).
+        // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
         for (std::size_t s = 0; s < wave_chunks; ++s) {
+          const double* st = &slot_stats[s * m * kStatStride];
+          for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
           total_ll += slot_ll[s];
           iteration_pairs += slot_pairs[s];
         }
-        const bool last_wave = wave_start + kWave >= n_chunks;
-        detail::parallel_for(m, threads, kComponentChunk, [&](std::size_t k, int) {
-          double* sum = &stats[k * kStatStride];
-          for (std::size_t s = 0; s < wave_chunks; ++s) {
-            const double* st = &slot_stats[(s * m + k) * kStatStride];
-            for (int i = 0; i < kStatStride; ++i) sum[i] += st[i];
-          }
-          if (!last_wave) return;
-          // M-step.
-          const float* packed = &params[k * kParamStride];
-          double centre[4];
-          for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
-          nk[k] = m_step_component(sum, options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
-          if (!options.quantisation.empty()) {
-            double mean[4];
-            for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
-            options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
-          }
-        });
       }
       mean_ll = total_ll / static_cast<double>(n);
       require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
                                                               std::to_string(iter));
 
+      // M-step.
       double weight_sum = 0.0;
-      for (std::size_t k = 0; k < m; ++k) weight_sum += nk[k];
+      for (std::size_t k = 0; k < m; ++k) {
+        const float* packed = &params[k * kParamStride];
+        double centre[4];
+        for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
+        nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
+        if (!options.quantisation.empty()) {
+          double mean[4];
+          for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
+          options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+        }
+        weight_sum += nk[k];
+      }
       for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
 
       // The next model's parameters. A component evaluated in float32 whose
@@ -525,7 +496,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
       // components evaluated in double (e.g. the first step of a large
       // scene, from point-sized seeds; never on the shared room-sized
       // frames, whose components stay below a third of the threshold).
-      pack_all(w, options.reg_covar, data_scale2, next_params, next_exact, threads);
+      pack_all(w, options.reg_covar, data_scale2, next_params, next_exact);
       promoted = false;
       for (std::size_t k = 0; k < m; ++k)
         if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "parallel.hpp"
+#include "parallel_stages.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
@@ -264,29 +264,35 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
 
   std::vector<std::size_t> candidates(trials);
   std::vector<double> gain(trials);
-  for (std::size_t c = 1; c < k; ++c) {
+  // Candidates drawn with probability proportional to the squared distance
+  // to the nearest seed (as scikit-learn: uniform * potential, searched in
+  // the running sum).
+  const auto draw = [&](std::size_t c) {
     detail::progress_at(c);
-    // Candidates drawn with probability proportional to the squared distance
-    // to the nearest seed (as scikit-learn: uniform * potential, searched in
-    // the running sum).
     const double potential = sampler.potential();
     for (int t = 0; t < trials; ++t) candidates[t] = sampler.find(rng.uniform() * potential);
-    // Potential after adding each candidate = potential - gain, where gain is
-    // what the points that move to the candidate save. Candidates in parallel
-    // for every cloud size: even at d = 5 (10k points) a step's gains take
-    // tens of microseconds against a few for a parallel region, and serial
-    // they were the largest serial share of the fit (issue 17). Each gain is
-    // summed serially in tree order, so the result does not depend on the
-    // thread count.
-    detail::parallel_for(candidates.size(), threads, 1,
-                         [&](std::size_t t, int) { gain[t] = tree.gain(points[candidates[t]]); });
-    int best = 0;
-    for (int t = 1; t < trials; ++t)
-      if (gain[t] > gain[best]) best = t;  // lowest potential; ties keep the first
-    centers.push_back(candidates[best]);
-    tree.add_seed(points[candidates[best]], [&](std::uint32_t i) { sampler.mark(i); });
-    sampler.flush();
-  }
+  };
+  if (k > 1) draw(1);
+  // Step c = s + 1: potential after adding each candidate = potential -
+  // gain, where gain is what the points that move to the candidate save;
+  // the gains in parallel, then the best candidate becomes a seed and the
+  // next step's candidates are drawn, serially. All steps run in one
+  // parallel region (parallel_stages.hpp): a region per step cost a barrier
+  // per step, which a loaded machine makes a scheduler slice. Each gain is
+  // summed serially in tree order, so the result does not depend on the
+  // thread count.
+  detail::parallel_stages(
+      k - 1, threads, [&](std::size_t) { return candidates.size(); },
+      [&](std::size_t, std::size_t t, int) { gain[t] = tree.gain(points[candidates[t]]); },
+      [&](std::size_t s) {
+        int best = 0;
+        for (int t = 1; t < trials; ++t)
+          if (gain[t] > gain[best]) best = t;  // lowest potential; ties keep the first
+        centers.push_back(candidates[best]);
+        tree.add_seed(points[candidates[best]], [&](std::uint32_t i) { sampler.mark(i); });
+        sampler.flush();
+        if (s + 2 < k) draw(s + 2);
+      });
   return centers;
 }
 
