@@ -93,11 +93,16 @@ def print_scaling(rows, cases, get):
         src = getattr(value, "source", None)
         if src:
             case, key = src
-            cpu, serial = get("new", case, f"cpu_{stage_of[key]}", 1), get("new", case, f"serial_cpu_{stage_of[key]}", 1)
+            if isinstance(case, dict):  # a warm row: sogmm-bench-warm's one-thread run
+                one_run = case.get(1, {})
+                cpu, serial, loops = one_run.get("cpu_warm"), one_run.get("serial_cpu_warm"), one_run.get("loops_warm")
+            else:
+                cpu, serial = get("new", case, f"cpu_{stage_of[key]}", 1), get("new", case, f"serial_cpu_{stage_of[key]}", 1)
+                loops = get("new", case, f"loops_{stage_of[key]}", 1)
             if cpu:
                 f = serial / cpu
                 f_txt, bound_txt = f"{100 * f:.1f}%", f"{amdahl(f):.2f}x"
-                loops_txt = f"{get('new', case, f'loops_{stage_of[key]}', 1):.0f}"
+                loops_txt = f"{loops:.0f}"
         ratio = f"{one / two:.2f}x" if one and two else ""
         print(f"| {label} | {fmt(one, unit)} | {fmt(two, unit)} | {ratio} | {f_txt} | {bound_txt} | {loops_txt} |")
     for case in cases:
@@ -112,7 +117,8 @@ def print_scaling(rows, cases, get):
 
 
 def sourced(fn, case, key):
-    """fn with the (case, JSON key) it reads attached, for print_scaling."""
+    """fn with the (case, JSON key) it reads attached, for print_scaling (case:
+    a case name, or a warm row's results by thread count)."""
     fn.source = (case, key)
     return fn
 
@@ -169,9 +175,9 @@ def main():
                          case))
     if warm:
         rows.insert(2, ("d=5, bandwidth 0.02, next frame warm-started (00000 -> 00001)", 0.033, "s",
-                        lambda b, t: warm[t]["s_warm"] if b == "new" else None, None))
+                        sourced(lambda b, t: warm[t]["s_warm"] if b == "new" else None, warm, "warm"), None))
         rows.insert(3, ("same, warm EM capped at 6 iterations (--max-iter 6)", 0.033, "s",
-                        lambda b, t: warm6[t]["s_warm"] if b == "new" else None, None))
+                        sourced(lambda b, t: warm6[t]["s_warm"] if b == "new" else None, warm6, "warm"), None))
     if "d1s02" in cases:
         rows.append(("d=1 regress all points (exact fit)", 0.2, "s",
                      sourced(lambda b, t: get(b, "d1s02", "s_regress", t), "d1s02", "s_regress"), None))
