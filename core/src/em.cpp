@@ -11,7 +11,7 @@
 
 #include "covariance_storage.hpp"
 #include "em_kernel.hpp"
-#include "parallel_stages.hpp"
+#include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "z_order.hpp"
@@ -31,8 +31,6 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 // count), so the order in which partial sums are added never changes.
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
-// Components per item of the per-component stages (reduction, M-step, packing).
-constexpr std::size_t kComponentChunk = 32;
 
 void check_options(const EmOptions& o) {
   require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
@@ -300,31 +298,19 @@ bool pack_component(const Working& w, std::size_t k, float* out, double* exact) 
 // degenerate component): first reg_covar or 1e-12 of the component's largest
 // variance (of the data's extent squared when it has none), then x10 up to
 // 12 times, so the loading follows the component's own scale.
-// Returns false when 12 loadings do not suffice (no throw, so that it can run
-// in parallel and the error name the lowest such k).
-bool try_make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
-                                double* exact) {
+void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
+                            double* exact) {
   double* c = &w.covariance[16 * k];
   double own = 0.0;
   for (int i = 0; i < 4; ++i) own = std::max(own, c[5 * i]);
   double extra = std::max(reg_covar, 1e-12 * (own > 0.0 ? own : data_scale2));
   int attempts = 0;
   while (!pack_component(w, k, packed, exact)) {
-    if (++attempts > 12) return false;
+    require(++attempts <= 12, ErrorCode::Numeric,
+            "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
     for (int i = 0; i < 4; ++i) c[5 * i] += extra;
     extra *= 10.0;
   }
-  return true;
-}
-
-void require_positive_definite(bool ok, std::size_t k) {
-  require(ok, ErrorCode::Numeric,
-          "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
-}
-
-void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
-                            double* exact) {
-  require_positive_definite(try_make_positive_definite(w, k, reg_covar, data_scale2, packed, exact), k);
 }
 
 void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params, std::vector<double>& exact) {
@@ -415,7 +401,6 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   std::vector<std::vector<std::uint32_t>> warm(truncated ? n_blocks : 0);
   std::vector<double> stats(m * kStatStride);
   std::vector<double> nk(m);
-  std::vector<char> packed_ok(m);
 
   EmReport rep;
   double pairs_evaluated = 0.0;
@@ -432,109 +417,78 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
       std::fill(stats.begin(), stats.end(), 0.0);
       double total_ll = 0.0;
       iteration_pairs = 0.0;
-      // E-step of chunk s of the wave starting at chunk wave_start, into slot s.
-      const auto e_step = [&](std::size_t wave_start, std::size_t s, int thread) {
-        double* st = &slot_stats[s * m * kStatStride];
-        std::fill(st, st + m * kStatStride, 0.0);
-        float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
-        float* row_max = scratch + m * kBlock;
-        std::vector<std::uint32_t> list;
-        std::vector<double> upper;
-        std::vector<char> taken;
-        alignas(64) float max_lp[kBlock];
-        double ll = 0.0, pairs = 0.0;
-        const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
-        const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
-        for (std::size_t b = b0; b < b1; ++b) {
-          const std::size_t first = b * kBlock;
-          const detail::Block block{{&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]},
-                                    static_cast<int>(std::min<std::size_t>(kBlock, n - first))};
-          std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
-          const std::vector<std::uint32_t>* evaluated = &all;
-          if (truncated) {
-            truncated_log_density(kernels, block, &soa.box[8 * b], params, exact, bounds, options.truncation_nats, warm[b],
-                                  upper, taken, list, scratch, row_max, max_lp);
-            evaluated = &list;
-          } else {
-            kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
+      for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
+        const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
+        detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
+          double* st = &slot_stats[s * m * kStatStride];
+          std::fill(st, st + m * kStatStride, 0.0);
+          float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
+          float* row_max = scratch + m * kBlock;
+          std::vector<std::uint32_t> list;
+          std::vector<double> upper;
+          std::vector<char> taken;
+          alignas(64) float max_lp[kBlock];
+          double ll = 0.0, pairs = 0.0;
+          const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
+          const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
+          for (std::size_t b = b0; b < b1; ++b) {
+            const std::size_t first = b * kBlock;
+            const detail::Block block{{&soa.x[first], &soa.y[first], &soa.z[first], &soa.g[first]},
+                                      static_cast<int>(std::min<std::size_t>(kBlock, n - first))};
+            std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
+            const std::vector<std::uint32_t>* evaluated = &all;
+            if (truncated) {
+              truncated_log_density(kernels, block, &soa.box[8 * b], params, exact, bounds, options.truncation_nats, warm[b],
+                                    upper, taken, list, scratch, row_max, max_lp);
+              evaluated = &list;
+            } else {
+              kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
+            }
+            const std::size_t ne = evaluated->size();
+            ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
+            pairs += static_cast<double>(block.count) * ne;
+            if (truncated) {
+              // Next iteration starts from the components some point of this
+              // block still gives at least exp(-nats) of its best weight.
+              const float keep = std::exp(static_cast<float>(-options.truncation_nats));
+              warm[b].clear();
+              for (std::size_t i = 0; i < ne; ++i)
+                if (row_max[i] >= keep) warm[b].push_back(list[i]);
+              std::sort(warm[b].begin(), warm[b].end());
+            }
           }
-          const std::size_t ne = evaluated->size();
-          ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
-          pairs += static_cast<double>(block.count) * ne;
-          if (truncated) {
-            // Next iteration starts from the components some point of this
-            // block still gives at least exp(-nats) of its best weight.
-            const float keep = std::exp(static_cast<float>(-options.truncation_nats));
-            warm[b].clear();
-            for (std::size_t i = 0; i < ne; ++i)
-              if (row_max[i] >= keep) warm[b].push_back(list[i]);
-            std::sort(warm[b].begin(), warm[b].end());
-          }
+          slot_ll[s] = ll;
+          slot_pairs[s] = pairs;
+        });
+        // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
+        for (std::size_t s = 0; s < wave_chunks; ++s) {
+          const double* st = &slot_stats[s * m * kStatStride];
+          for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
+          total_ll += slot_ll[s];
+          iteration_pairs += slot_pairs[s];
         }
-        slot_ll[s] = ll;
-        slot_pairs[s] = pairs;
-      };
-      // One parallel region per E+M step (parallel_stages.hpp): per wave,
-      // its E-step chunks, then each component's statistics summed over the
-      // wave's slots in slot order (so the sums do not depend on which
-      // thread ran which chunk), with the M-step after the last wave; then
-      // each component's log weight and kernel parameters. Serial, the
-      // reduction, M-step and packing were 5-7% of a d = 5 fit's work, a
-      // limit on the two-thread speed-up (issue 17).
-      const std::size_t waves = (n_chunks + kWave - 1) / kWave, packing = 2 * waves;
-      const std::size_t component_items = (m + kComponentChunk - 1) / kComponentChunk;
-      const auto wave_chunks = [&](std::size_t wave) { return std::min(kWave, n_chunks - wave * kWave); };
-      double weight_sum = 0.0;
-      next_params.assign(m * kParamStride, 0.f);
-      next_exact.assign(m * kParamStride, 0.0);
-      detail::parallel_stages(
-          packing + 1, threads,
-          [&](std::size_t stage) { return stage < packing && stage % 2 == 0 ? wave_chunks(stage / 2) : component_items; },
-          [&](std::size_t stage, std::size_t item, int thread) {
-            if (stage < packing && stage % 2 == 0) return e_step(stage / 2 * kWave, item, thread);
-            const std::size_t k1 = std::min(m, (item + 1) * kComponentChunk);
-            for (std::size_t k = item * kComponentChunk; k < k1; ++k) {
-              if (stage == packing) {
-                w.log_weight[k] = std::log(nk[k] / weight_sum);
-                packed_ok[k] = try_make_positive_definite(w, k, options.reg_covar, data_scale2, &next_params[k * kParamStride],
-                                                          &next_exact[k * kParamStride]);
-                continue;
-              }
-              double* sum = &stats[k * kStatStride];
-              for (std::size_t s = 0, n_s = wave_chunks(stage / 2); s < n_s; ++s) {
-                const double* st = &slot_stats[(s * m + k) * kStatStride];
-                for (int i = 0; i < kStatStride; ++i) sum[i] += st[i];
-              }
-              if (stage + 1 < packing) continue;
-              // M-step.
-              const float* packed = &params[k * kParamStride];
-              double centre[4];
-              for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
-              nk[k] = m_step_component(sum, options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
-              if (!options.quantisation.empty()) {
-                double mean[4];
-                for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
-                options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
-              }
-            }
-          },
-          [&](std::size_t stage) {
-            if (stage < packing && stage % 2 == 0) {
-              for (std::size_t s = 0; s < wave_chunks(stage / 2); ++s) {
-                total_ll += slot_ll[s];
-                iteration_pairs += slot_pairs[s];
-              }
-              if (stage + 2 < packing) return;
-              mean_ll = total_ll / static_cast<double>(n);
-              require(std::isfinite(mean_ll), ErrorCode::Numeric,
-                      "EM: log-likelihood is not finite at iteration " + std::to_string(iter));
-            } else if (stage + 1 == packing) {
-              for (std::size_t k = 0; k < m; ++k) weight_sum += nk[k];
-            }
-          });
-      for (std::size_t k = 0; k < m; ++k) require_positive_definite(packed_ok[k], k);
+      }
+      mean_ll = total_ll / static_cast<double>(n);
+      require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
+                                                              std::to_string(iter));
 
-      // The next model's parameters (above). A component evaluated in float32 whose
+      // M-step.
+      double weight_sum = 0.0;
+      for (std::size_t k = 0; k < m; ++k) {
+        const float* packed = &params[k * kParamStride];
+        double centre[4];
+        for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
+        nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
+        if (!options.quantisation.empty()) {
+          double mean[4];
+          for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
+          options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+        }
+        weight_sum += nk[k];
+      }
+      for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
+
+      // The next model's parameters. A component evaluated in float32 whose
       // new covariance is too elongated for float32 (needs_double) got
       // statistics that cannot hold its thin direction: the float32 second
       // moments of a 1 km plane carry errors above its thickness, and they
@@ -542,6 +496,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
       // components evaluated in double (e.g. the first step of a large
       // scene, from point-sized seeds; never on the shared room-sized
       // frames, whose components stay below a third of the threshold).
+      pack_all(w, options.reg_covar, data_scale2, next_params, next_exact);
       promoted = false;
       for (std::size_t k = 0; k < m; ++k)
         if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {
