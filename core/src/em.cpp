@@ -14,6 +14,7 @@
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
+#include "z_order.hpp"
 
 namespace sogmm {
 namespace {
@@ -113,15 +114,6 @@ struct SoaPoints {
   }
 
  private:
-  static std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-  }
   static void sort_by_z_order(const PointsView& pts, const Frame& frame, std::vector<std::uint32_t>& order) {
     const double cell = std::ldexp(frame.extent, -20);
     std::vector<std::uint64_t> key(pts.size);
@@ -131,7 +123,7 @@ struct SoaPoints {
         const double from_low = static_cast<double>(pts[i][j]) - frame.origin[j] + 0.5 * frame.extent;
         c[j] = checked::to_int<std::uint64_t>(std::clamp(std::floor(from_low / cell), 0.0, 2097151.0), "EM block cell");
       }
-      key[i] = spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2;
+      key[i] = detail::z_order_key(c[0], c[1], c[2]);
     }
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
   }

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "parallel.hpp"
+#include "parallel_stages.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/random.hpp"
@@ -35,7 +35,7 @@ inline double dist2(const float* a, const float* b) {
 // is read in place rather than gathered from all over the cloud.
 class SeedTree {
  public:
-  SeedTree(const PointsView& points, std::vector<double>& closest) : closest_(closest) {
+  SeedTree(const PointsView& points, std::vector<double>& closest, int threads) : closest_(closest) {
     // The tree is built on copies of the points that carry their index (the
     // same comparisons and moves as on an index array, read in place).
     std::vector<Entry> entries(points.size);
@@ -44,6 +44,7 @@ class SeedTree {
       entries[i].index = static_cast<std::uint32_t>(i);
     }
     nodes_.reserve(2 * (points.size / kLeafSize + 1));
+    partition(entries, threads);
     build(entries, 0, points.size);
     order_.resize(points.size);
     sorted_.resize(4 * points.size);
@@ -80,30 +81,70 @@ class SeedTree {
     std::uint32_t index;
   };
 
-  std::int32_t build(std::vector<Entry>& entries, std::size_t begin, std::size_t end) {
+  // The widest side of the box of entries [begin, end), and that box.
+  static int widest_axis(const std::vector<Entry>& entries, std::size_t begin, std::size_t end, float* lo, float* hi) {
+    for (int d = 0; d < 4; ++d) lo[d] = hi[d] = entries[begin].p[d];
+    for (std::size_t k = begin; k < end; ++k)
+      for (int d = 0; d < 4; ++d) {
+        lo[d] = std::min(lo[d], entries[k].p[d]);
+        hi[d] = std::max(hi[d], entries[k].p[d]);
+      }
+    int axis = 0;
+    for (int d = 1; d < 4; ++d)
+      if (static_cast<double>(hi[d]) - lo[d] > static_cast<double>(hi[axis]) - lo[axis]) axis = d;
+    return axis;
+  }
+
+  // Orders the entries as the tree needs them: every range of more than
+  // kLeafSize entries split at its median along its widest side
+  // (deterministic: nth_element on fixed input). The ranges of one depth are
+  // disjoint, so they are split in parallel, depth by depth; each sees the
+  // same input as in a depth-first recursion, so the order is the same for
+  // any thread count. Serial, this was about a quarter of the seeding at
+  // d = 1 (issue 17).
+  static void partition(std::vector<Entry>& entries, int threads) {
+    std::vector<std::pair<std::size_t, std::size_t>> level{{0, entries.size()}}, next;
+    while (!level.empty()) {
+      next.assign(2 * level.size(), {0, 0});
+      detail::parallel_for(level.size(), threads, 1, [&](std::size_t r, int) {
+        const auto [begin, end] = level[r];
+        if (end - begin <= kLeafSize) return;
+        float lo[4], hi[4];
+        const int axis = widest_axis(entries, begin, end, lo, hi);
+        const std::size_t mid = begin + (end - begin) / 2;
+        std::nth_element(entries.begin() + begin, entries.begin() + mid, entries.begin() + end,
+                         [&](const Entry& a, const Entry& b) {
+                           const float pa = a.p[axis], pb = b.p[axis];
+                           return pa < pb || (pa == pb && a.index < b.index);
+                         });
+        next[2 * r] = {begin, mid};
+        next[2 * r + 1] = {mid, end};
+      });
+      level.clear();
+      for (const auto& range : next)
+        if (range.second - range.first > kLeafSize) level.push_back(range);
+    }
+  }
+
+  // The nodes over the partitioned entries, depth first; a node's box is its
+  // points' (a leaf's from its entries, an inner node's from its children).
+  std::int32_t build(const std::vector<Entry>& entries, std::size_t begin, std::size_t end) {
     const auto id = static_cast<std::int32_t>(nodes_.size());
     nodes_.emplace_back();
     Node node;
     node.begin = static_cast<std::uint32_t>(begin);
     node.end = static_cast<std::uint32_t>(end);
-    for (int d = 0; d < 4; ++d) node.lo[d] = node.hi[d] = entries[begin].p[d];
-    for (std::size_t k = begin; k < end; ++k)
-      for (int d = 0; d < 4; ++d) {
-        node.lo[d] = std::min(node.lo[d], entries[k].p[d]);
-        node.hi[d] = std::max(node.hi[d], entries[k].p[d]);
-      }
     if (end - begin > kLeafSize) {
-      int axis = 0;  // the widest side; the median splits it (deterministic: nth_element on fixed input)
-      for (int d = 1; d < 4; ++d)
-        if (static_cast<double>(node.hi[d]) - node.lo[d] > static_cast<double>(node.hi[axis]) - node.lo[axis]) axis = d;
       const std::size_t mid = begin + (end - begin) / 2;
-      std::nth_element(entries.begin() + begin, entries.begin() + mid, entries.begin() + end,
-                       [&](const Entry& a, const Entry& b) {
-                         const float pa = a.p[axis], pb = b.p[axis];
-                         return pa < pb || (pa == pb && a.index < b.index);
-                       });
       node.left = build(entries, begin, mid);
       node.right = build(entries, mid, end);
+      const Node &l = nodes_[node.left], &r = nodes_[node.right];
+      for (int d = 0; d < 4; ++d) {
+        node.lo[d] = std::min(l.lo[d], r.lo[d]);
+        node.hi[d] = std::max(l.hi[d], r.hi[d]);
+      }
+    } else {
+      widest_axis(entries, begin, end, node.lo, node.hi);
     }
     nodes_[id] = node;
     return id;
@@ -259,33 +300,40 @@ std::vector<std::size_t> kmeanspp_seeds(const PointsView& points, std::size_t k,
   std::vector<double> closest(n);
   for (std::size_t i = 0; i < n; ++i) closest[i] = dist2(points[i], points[centers[0]]);
   detail::progress_poll();
-  SeedTree tree(points, closest);
+  SeedTree tree(points, closest, threads);
   PotentialSampler sampler(closest);
 
   std::vector<std::size_t> candidates(trials);
   std::vector<double> gain(trials);
-  for (std::size_t c = 1; c < k; ++c) {
+  // Candidates drawn with probability proportional to the squared distance
+  // to the nearest seed (as scikit-learn: uniform * potential, searched in
+  // the running sum).
+  const auto draw = [&](std::size_t c) {
     detail::progress_at(c);
-    // Candidates drawn with probability proportional to the squared distance
-    // to the nearest seed (as scikit-learn: uniform * potential, searched in
-    // the running sum).
     const double potential = sampler.potential();
     for (int t = 0; t < trials; ++t) candidates[t] = sampler.find(rng.uniform() * potential);
-    // Potential after adding each candidate = potential - gain, where gain is
-    // what the points that move to the candidate save. Candidates in parallel
-    // only for large clouds: for small ones the work per step is tiny and
-    // thousands of parallel regions cost more than they save. Each gain is
-    // summed serially in tree order, so the result does not depend on the
-    // thread count.
-    detail::parallel_for(candidates.size(), n >= 65536 ? threads : 1, 1,
-                         [&](std::size_t t, int) { gain[t] = tree.gain(points[candidates[t]]); });
-    int best = 0;
-    for (int t = 1; t < trials; ++t)
-      if (gain[t] > gain[best]) best = t;  // lowest potential; ties keep the first
-    centers.push_back(candidates[best]);
-    tree.add_seed(points[candidates[best]], [&](std::uint32_t i) { sampler.mark(i); });
-    sampler.flush();
-  }
+  };
+  if (k > 1) draw(1);
+  // Step c = s + 1: potential after adding each candidate = potential -
+  // gain, where gain is what the points that move to the candidate save;
+  // the gains in parallel, then the best candidate becomes a seed and the
+  // next step's candidates are drawn, serially. All steps run in one
+  // parallel region (parallel_stages.hpp): a region per step cost a barrier
+  // per step, which a loaded machine makes a scheduler slice. Each gain is
+  // summed serially in tree order, so the result does not depend on the
+  // thread count.
+  detail::parallel_stages(
+      k - 1, threads, [&](std::size_t) { return candidates.size(); },
+      [&](std::size_t, std::size_t t, int) { gain[t] = tree.gain(points[candidates[t]]); },
+      [&](std::size_t s) {
+        int best = 0;
+        for (int t = 1; t < trials; ++t)
+          if (gain[t] > gain[best]) best = t;  // lowest potential; ties keep the first
+        centers.push_back(candidates[best]);
+        tree.add_seed(points[candidates[best]], [&](std::uint32_t i) { sampler.mark(i); });
+        sampler.flush();
+        if (s + 2 < k) draw(s + 2);
+      });
   return centers;
 }
 

@@ -10,9 +10,12 @@
 
 #include <omp.h>
 
+#include <time.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <mutex>
 
@@ -35,6 +38,39 @@ inline int team_size(int requested) {
   return std::clamp(wanted, 1, cap);
 }
 
+/// CPU nanoseconds the calling thread has used.
+inline std::uint64_t thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000u + static_cast<std::uint64_t>(ts.tv_nsec);
+}
+
+/// The loop accounting of sogmm/loop_accounting.hpp (process-wide).
+struct LoopTally {
+  std::atomic<bool> on{false};
+  std::atomic<std::uint64_t> loops{0};
+  std::atomic<std::uint64_t> cpu_ns{0};
+};
+inline LoopTally loop_tally;
+
+/// Adds one loop and the calling thread's CPU time from construction to
+/// destruction (however the loop ends) when the accounting is on.
+class LoopTimer {
+ public:
+  LoopTimer() : on_(loop_tally.on.load(std::memory_order_relaxed)), start_(on_ ? thread_cpu_ns() : 0) {}
+  ~LoopTimer() {
+    if (!on_) return;
+    loop_tally.loops.fetch_add(1, std::memory_order_relaxed);
+    loop_tally.cpu_ns.fetch_add(thread_cpu_ns() - start_, std::memory_order_relaxed);
+  }
+  LoopTimer(const LoopTimer&) = delete;
+  LoopTimer& operator=(const LoopTimer&) = delete;
+
+ private:
+  bool on_;
+  std::uint64_t start_;
+};
+
 /// Calls body(i, thread) for every i in [0, n) on a team of `threads`
 /// threads, handing out `chunk` consecutive indices at a time (OpenMP
 /// schedule(dynamic, chunk)); `thread` is the caller's omp_get_thread_num(),
@@ -46,6 +82,7 @@ inline int team_size(int requested) {
 /// chunk.
 template <class Body>
 void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& body) {
+  const LoopTimer timer;
   // One thread: a plain loop (same order as a one-thread team), without the
   // cost of opening a parallel region, e.g. once per k-means++ step.
   if (threads <= 1) {

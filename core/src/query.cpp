@@ -182,7 +182,8 @@ void score_with(const Gmm& gmm, const float* points, std::size_t n, int dims, do
   const std::size_t m = gmm.size();
   std::unique_ptr<detail::QueryCuller> culler;
   if (o.truncation_nats > 0)
-    culler = std::make_unique<detail::QueryCuller>(gmm, params, dims, false, o.truncation_nats, points, n, dims);
+    culler = std::make_unique<detail::QueryCuller>(gmm, params, dims, false, o.truncation_nats, points, n, dims,
+                                                   detail::team_size(o.threads));
   run_blocks<detail::ScoreState>(points, n, dims, params, culler ? std::vector<std::uint32_t>{} : iota(m),
                                  culler.get(), o.threads, kernel,
                                  [&](std::size_t i, const detail::ScoreState& st, int p) {
@@ -222,7 +223,8 @@ void regress_gray(const Gmm& gmm, const float* xyz, std::size_t n, float* mean_o
   const std::size_t m = gmm.size();
   std::unique_ptr<detail::QueryCuller> culler;
   if (options.truncation_nats > 0)
-    culler = std::make_unique<detail::QueryCuller>(gmm, params, 3, true, options.truncation_nats, xyz, n, 3);
+    culler = std::make_unique<detail::QueryCuller>(gmm, params, 3, true, options.truncation_nats, xyz, n, 3,
+                                                   detail::team_size(options.threads));
   // The background (entry m) is in every block's list.
   run_blocks<detail::RegressState>(xyz, n, 3, params, culler ? std::vector<std::uint32_t>{} : iota(m + 1),
                                    culler.get(), options.threads, detail::query_kernels().regress,

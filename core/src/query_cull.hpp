@@ -55,9 +55,10 @@ class QueryCuller {
  public:
   /// `params`: the packed model (query_kernel.hpp) in `dims` (3 or 4)
   /// dimensions, with the background at entry gmm.size() when `background`.
-  /// `points`: the n query points, rows of `width` floats.
+  /// `points`: the n query points, rows of `width` floats. `team`: threads
+  /// for the set-up (the order does not depend on it).
   QueryCuller(const Gmm& gmm, const std::vector<double>& params, int dims, bool background, double nats,
-              const float* points, std::size_t n, int width);
+              const float* points, std::size_t n, int width, int team);
 
   /// The order in which points are visited (a permutation of [0, n)).
   const std::vector<std::size_t>& order() const { return order_; }

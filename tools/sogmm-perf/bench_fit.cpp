@@ -15,9 +15,12 @@
 // pair_fraction / EM seconds: an effective rate, since the pairs of rows that
 // the kernel skips exactly (every responsibility 0 in float) are counted too;
 // pair_fraction < 1 only for the truncated E-step.
+#include <time.h>
+
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -27,7 +30,38 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/kmeanspp.hpp"
+#include "sogmm/loop_accounting.hpp"
 #include "sogmm/metrics.hpp"
+
+namespace {
+// CPU clocks at one instant: the calling thread's, the parallel loops' share
+// of it, and the process's.
+struct CpuMark {
+  double thread = 0.0, in_loops = 0.0, process = 0.0;
+  std::uint64_t loops = 0;
+  static CpuMark now() {
+    CpuMark m;
+    m.thread = sogmm::thread_cpu_seconds();
+    const sogmm::LoopAccounting a = sogmm::loop_accounting();
+    m.in_loops = a.cpu_seconds_in_loops;
+    m.loops = a.loops;
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    m.process = static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+    return m;
+  }
+};
+
+// Per stage: "cpu_S", "serial_cpu_S", "loops_S", "pcpu_S" as JSON members
+// (each with a leading ", ").
+std::string cpu_json(const std::string& stage, const CpuMark& a, const CpuMark& b) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, ", \"cpu_%s\": %.6f, \"serial_cpu_%s\": %.6f, \"loops_%s\": %llu, \"pcpu_%s\": %.6f",
+                stage.c_str(), b.thread - a.thread, stage.c_str(), (b.thread - a.thread) - (b.in_loops - a.in_loops),
+                stage.c_str(), static_cast<unsigned long long>(b.loops - a.loops), stage.c_str(), b.process - a.process);
+  return buf;
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace sogmm;
@@ -52,7 +86,26 @@ int main(int argc, char** argv) {
   const tools::LoadedFrame frame = tools::load_frame(depth, color);
   const Camera camera = read_intrinsics_json(intrinsics);
   const PointCloud cloud = backproject(frame.view(camera), opt);
-  const FitResult r = fit(cloud.view(), fit_options);
+  // The CPU clocks at the start of each stage (the progress reports come on
+  // this thread), then at the end of the fit.
+  set_loop_accounting(true);
+  std::map<Stage, CpuMark> stage_start;
+  const CpuMark fit_start = CpuMark::now();
+  const FitResult r = fit(cloud.view(), fit_options, [&](const Progress& p) {
+    if (!stage_start.count(p.stage)) stage_start[p.stage] = CpuMark::now();
+    return false;
+  });
+  const CpuMark fit_end = CpuMark::now();
+  std::string cpu = cpu_json("fit", fit_start, fit_end);
+  {
+    const Stage order[] = {Stage::ModeCount, Stage::Seeding, Stage::Em};
+    const char* names[] = {"mode_count", "seeding", "em"};
+    for (int i = 0; i < 3; ++i) {
+      if (!stage_start.count(order[i])) continue;
+      const CpuMark end = i < 2 && stage_start.count(order[i + 1]) ? stage_start[order[i + 1]] : fit_end;
+      cpu += cpu_json(names[i], stage_start[order[i]], end);
+    }
+  }
   const std::size_t n = cloud.size(), m = r.gmm.size();
 
   using clock = std::chrono::steady_clock;
@@ -63,11 +116,15 @@ int main(int argc, char** argv) {
   // The queries run on the fit's team, so the 1-thread rows are 1 thread.
   QueryOptions query_options;
   query_options.threads = fit_options.em.threads;
+  CpuMark mark = CpuMark::now();
   regress_gray(r.gmm, xyz.data(), n, mean.data(), var.data(), query_options);
+  cpu += cpu_json("regress", mark, CpuMark::now());
   const double s_regress = std::chrono::duration<double>(clock::now() - t).count();
   t = clock::now();
   std::vector<double> scores(n);
+  mark = CpuMark::now();
   score_samples(r.gmm, cloud.xyzg.data(), n, 4, scores.data(), query_options);
+  cpu += cpu_json("score", mark, CpuMark::now());
   const double s_score = std::chrono::duration<double>(clock::now() - t).count();
   // The same two queries culled (QueryOptions::truncation_nats).
   double s_regress_culled = 0.0, s_score_culled = 0.0;
@@ -75,10 +132,14 @@ int main(int argc, char** argv) {
     QueryOptions culled = query_options;
     culled.truncation_nats = query_nats;
     t = clock::now();
+    mark = CpuMark::now();
     regress_gray(r.gmm, xyz.data(), n, mean.data(), var.data(), culled);
+    cpu += cpu_json("regress_culled", mark, CpuMark::now());
     s_regress_culled = std::chrono::duration<double>(clock::now() - t).count();
     t = clock::now();
+    mark = CpuMark::now();
     score_samples(r.gmm, cloud.xyzg.data(), n, 4, scores.data(), culled);
+    cpu += cpu_json("score_culled", mark, CpuMark::now());
     s_score_culled = std::chrono::duration<double>(clock::now() - t).count();
   }
   // The EM kernel's peak on this machine: exact E+M passes (tol 0) from the
@@ -88,6 +149,7 @@ int main(int argc, char** argv) {
   peak_options.max_iter = 10;
   peak_options.truncation_nats = 0.0;
   t = clock::now();
+  set_loop_accounting(false);
   EmReport peak_report;
   fit_em_from(cloud.view(), r.gmm, peak_options, &peak_report);
   const double peak_pairs_per_s =
@@ -133,9 +195,9 @@ int main(int argc, char** argv) {
       "{\"n\": %zu, \"m\": %zu, \"s_mode_count\": %.6f, \"s_seeding\": %.6f, \"s_em\": %.6f, \"s_total_fit\": %.6f, "
       "\"em_iterations\": %d, \"ms_per_iteration\": %.4f, \"pair_fraction\": %.4f, \"gflops\": %.3f, \"s_regress\": %.6f, \"s_score\": %.6f, \"s_regress_culled\": %.6f, \"s_score_culled\": %.6f, \"peak_pairs_per_s\": %.6g, \"s_sample\": %.6f, "
       "\"s_metrics\": %.6f, \"peak_rss_mib\": %.1f, \"log_likelihood\": %.6f, \"psnr\": %.4f, \"mre\": %.6f, "
-      "\"fscore\": %.4f}\n",
+      "\"fscore\": %.4f%s}\n",
       n, m, r.seconds_mode_count, r.seconds_seeding, r.seconds_em, r.seconds_total, r.em.iterations,
       1000.0 * r.seconds_em / r.em.iterations, r.em.pair_fraction, 80.0 * pairs / r.seconds_em * 1e-9, s_regress, s_score, s_regress_culled, s_score_culled, peak_pairs_per_s, s_sample, s_metrics,
-      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore);
+      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore, cpu.c_str());
   return 0;
 }

@@ -11,6 +11,12 @@ runs of both builds interleaved so that machine load hits both alike. Then one
 roofline line per stage: pairs per second achieved (N x M x iterations x pair
 fraction for EM, N x M for regress and score) against the EM kernel's measured
 peak (ten exact E+M passes from the fitted model, in the same process).
+Then the thread-scaling section: per row the 1- and 2-thread medians, their
+ratio, and the serial share f measured in CPU time on one thread (the calling
+thread's CPU outside the core's parallel loops, which load on the machine
+hardly moves), with Amdahl's bound 1 / (f + (1 - f) / 2) on the two-thread
+speed-up and the number of parallel loops (one OpenMP region each on two
+threads); 1.8x needs f <= 0.111. Per fit also each stage's f.
 
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
@@ -65,6 +71,58 @@ def fmt(v, unit):
                                                       (f"{100 * v:.0f}%" if unit == "%" else f"{v:.0f} MiB"))
 
 
+def amdahl(f):
+    """The best two-thread speed-up with serial fraction f."""
+    return 1.0 / (f + (1.0 - f) / 2.0)
+
+
+def print_scaling(rows, cases, get):
+    """The thread-scaling section (new build): measured ratio against the
+    Amdahl bound of the serial share measured in one-thread CPU time."""
+    stage_of = {"s_total_fit": "fit", "s_regress": "regress", "s_score": "score",
+                "s_regress_culled": "regress_culled", "s_score_culled": "score_culled"}
+    print("\nThread scaling (new build): serial share f = one-thread CPU outside the parallel loops / one-thread CPU "
+          "(medians); Amdahl bound 1 / (f + (1 - f) / 2); 1.8x needs f <= 11.1%")
+    print("| case | 1 thread | 2 threads | 1 -> 2 threads | serial share f | Amdahl bound | parallel loops |")
+    print("|---|---|---|---|---|---|---|")
+    for label, _target, unit, value, _case in rows:
+        if unit in ("%", "MiB"):
+            continue
+        one, two = value("new", 1), value("new", 2)
+        f_txt = bound_txt = loops_txt = ""
+        src = getattr(value, "source", None)
+        if src:
+            case, key = src
+            if isinstance(case, dict):  # a warm row: sogmm-bench-warm's one-thread run
+                one_run = case.get(1, {})
+                cpu, serial, loops = one_run.get("cpu_warm"), one_run.get("serial_cpu_warm"), one_run.get("loops_warm")
+            else:
+                cpu, serial = get("new", case, f"cpu_{stage_of[key]}", 1), get("new", case, f"serial_cpu_{stage_of[key]}", 1)
+                loops = get("new", case, f"loops_{stage_of[key]}", 1)
+            if cpu:
+                f = serial / cpu
+                f_txt, bound_txt = f"{100 * f:.1f}%", f"{amdahl(f):.2f}x"
+                loops_txt = f"{loops:.0f}"
+        ratio = f"{one / two:.2f}x" if one and two else ""
+        print(f"| {label} | {fmt(one, unit)} | {fmt(two, unit)} | {ratio} | {f_txt} | {bound_txt} | {loops_txt} |")
+    for case in cases:
+        parts = []
+        for stage in ("mode_count", "seeding", "em"):
+            cpu, serial = get("new", case, f"cpu_{stage}", 1), get("new", case, f"serial_cpu_{stage}", 1)
+            if cpu:
+                parts.append(f"{stage.replace('_', ' ')} {1000 * cpu:.1f} ms CPU, f {100 * serial / cpu:.1f}% "
+                             f"({1000 * serial:.1f} ms), {get('new', case, f'loops_{stage}', 1):.0f} loops")
+        if parts:
+            print(f"- {case}, one thread: " + "; ".join(parts))
+
+
+def sourced(fn, case, key):
+    """fn with the (case, JSON key) it reads attached, for print_scaling (case:
+    a case name, or a warm row's results by thread count)."""
+    fn.source = (case, key)
+    return fn
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=5)
@@ -113,25 +171,31 @@ def main():
                                 ("d1s02t20", "d=1 full frame, truncated E-step", 1.5),
                                 ("d1s02", "d=1 full frame, exact", 3.5)):
         if case in cases:
-            rows.append((label, target, "s", lambda b, t, c=case: get(b, c, "s_total_fit", t), case))
+            rows.append((label, target, "s", sourced(lambda b, t, c=case: get(b, c, "s_total_fit", t), case, "s_total_fit"),
+                         case))
     if warm:
         rows.insert(2, ("d=5, bandwidth 0.02, next frame warm-started (00000 -> 00001)", 0.033, "s",
-                        lambda b, t: warm[t]["s_warm"] if b == "new" else None, None))
+                        sourced(lambda b, t: warm[t]["s_warm"] if b == "new" else None, warm, "warm"), None))
         rows.insert(3, ("same, warm EM capped at 6 iterations (--max-iter 6)", 0.033, "s",
-                        lambda b, t: warm6[t]["s_warm"] if b == "new" else None, None))
+                        sourced(lambda b, t: warm6[t]["s_warm"] if b == "new" else None, warm6, "warm"), None))
     if "d1s02" in cases:
-        rows.append(("d=1 regress all points (exact fit)", 0.2, "s", lambda b, t: get(b, "d1s02", "s_regress", t), None))
-        rows.append(("same, culled at 20 nats", 0.2, "s", lambda b, t: get(b, "d1s02", "s_regress_culled", t), None))
+        rows.append(("d=1 regress all points (exact fit)", 0.2, "s",
+                     sourced(lambda b, t: get(b, "d1s02", "s_regress", t), "d1s02", "s_regress"), None))
+        rows.append(("same, culled at 20 nats", 0.2, "s",
+                     sourced(lambda b, t: get(b, "d1s02", "s_regress_culled", t), "d1s02", "s_regress_culled"), None))
     if "d1s02t20" in cases:
         rows.append(("d=1 regress all points (truncated fit)", 0.2, "s",
-                     lambda b, t: get(b, "d1s02t20", "s_regress", t), None))
+                     sourced(lambda b, t: get(b, "d1s02t20", "s_regress", t), "d1s02t20", "s_regress"), None))
     if "d5s02" in cases:
         n, m = int(get("new", "d5s02", "n")), int(get("new", "d5s02", "m"))
         rows.append((f"regress gray {n} points, {m} components", 0.02, "ms",
-                     lambda b, t: get(b, "d5s02", "s_regress", t), None))
-        rows.append(("score_samples, same", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_score", t), None))
-        rows.append(("regress gray, culled at 20 nats", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_regress_culled", t), None))
-        rows.append(("score_samples, culled at 20 nats", 0.02, "ms", lambda b, t: get(b, "d5s02", "s_score_culled", t), None))
+                     sourced(lambda b, t: get(b, "d5s02", "s_regress", t), "d5s02", "s_regress"), None))
+        rows.append(("score_samples, same", 0.02, "ms",
+                     sourced(lambda b, t: get(b, "d5s02", "s_score", t), "d5s02", "s_score"), None))
+        rows.append(("regress gray, culled at 20 nats", 0.02, "ms",
+                     sourced(lambda b, t: get(b, "d5s02", "s_regress_culled", t), "d5s02", "s_regress_culled"), None))
+        rows.append(("score_samples, culled at 20 nats", 0.02, "ms",
+                     sourced(lambda b, t: get(b, "d5s02", "s_score_culled", t), "d5s02", "s_score_culled"), None))
         rows.append(("seeding share of a fit (bw 0.02)", 0.10, "%", lambda b, t: share(b, "d5s02", t), None))
     if "d5s01" in cases:
         rows.append(("seeding share of a fit (bw 0.01)", 0.10, "%", lambda b, t: share(b, "d5s01", t), None))
@@ -157,6 +221,8 @@ def main():
                   f"dB; M {w['m_warm']} vs {w['m_cold']} (kept {w['kept']}, removed {w['removed']}, added "
                   f"{w['added']}); EM iterations {w['iter_warm']} vs {w['iter_cold']}; cold fit of 00001 "
                   f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
+
+    print_scaling(rows, cases, get)
 
     print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
     for case in cases:
