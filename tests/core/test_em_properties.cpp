@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,35 @@ TEST(EmProperties, TranslationKeepsTheLikelihood) {
   }
 }
 
+namespace {
+
+// Fits one case of em_large_geometry.json with `reg_covar` (unset: auto) as
+// sklearn's reference did (8 inits, max_iter 1000: compare optima, not
+// iteration limits); the fit must succeed, be positive definite in float32 and
+// score no worse than 0.1 nats/point below `sklearn`.
+sogmm::FitResult expect_close_to_sklearn(const nlohmann::json& c, std::optional<double> reg_covar, double sklearn) {
+  const std::string name = c.at("name").get<std::string>();
+  std::vector<float> pts;
+  for (const auto& row : c.at("points"))
+    for (const auto& v : row) pts.push_back(static_cast<float>(v.get<double>()));
+  sogmm::FitOptions o;
+  o.n_components = c.at("n_components").get<std::size_t>();
+  o.em.reg_covar = reg_covar;
+  o.n_init = 8;
+  o.em.max_iter = 1000;
+  sogmm::FitResult r;
+  EXPECT_NO_THROW(r = sogmm::fit(view(pts), o));
+  if (r.gmm.size() == 0) return r;
+  EXPECT_TRUE(sogmm_test::model_is_valid(r.gmm));
+  const double s = score(r.gmm, pts);
+  EXPECT_GE(s, sklearn - 0.1) << "sogmm " << s << " vs sklearn " << sklearn;
+  std::printf("%s (reg_covar %s): sogmm %.5f, report %.5f, sklearn %.5f\n", name.c_str(),
+              reg_covar ? std::to_string(*reg_covar).c_str() : "auto", s, r.em.log_likelihood, sklearn);
+  return r;
+}
+
+}  // namespace
+
 // Large rotated geometry (fixture from tests/reference/make_em_scale_fixture.py):
 // each fit succeeds, is positive definite in float32, and scores no worse
 // than 0.1 nats/point below scikit-learn's best of 8 inits. (The 1 km plane
@@ -108,21 +138,23 @@ TEST(EmProperties, LargeRotatedGeometryMatchesSklearn) {
   const nlohmann::json ref = sogmm_test::load_fixture("em_large_geometry.json");
   for (const auto& c : ref.at("cases")) {
     SCOPED_TRACE(c.at("name").get<std::string>());
-    std::vector<float> pts;
-    for (const auto& row : c.at("points"))
-      for (const auto& v : row) pts.push_back(static_cast<float>(v.get<double>()));
-    sogmm::FitOptions o;
-    o.n_components = c.at("n_components").get<std::size_t>();
-    o.em.reg_covar = c.at("reg_covar").get<double>();
-    o.n_init = 8;  // as many inits as sklearn's reference
-    o.em.max_iter = 1000;  // sklearn's setting in the fixture: compare optima, not iteration limits
-    sogmm::FitResult r;
-    ASSERT_NO_THROW(r = sogmm::fit(view(pts), o));
-    ASSERT_TRUE(sogmm_test::model_is_valid(r.gmm));
-    const double s = score(r.gmm, pts), sk = c.at("sklearn_score").get<double>();
-    EXPECT_GE(s, sk - 0.1) << "sogmm " << s << " vs sklearn " << sk;
-    std::printf("%s: sogmm %.5f, report %.5f, sklearn %.5f\n", c.at("name").get<std::string>().c_str(), s,
-                r.em.log_likelihood, sk);
+    expect_close_to_sklearn(c, c.at("reg_covar").get<double>(), c.at("sklearn_score").get<double>());
+  }
+}
+
+// The same with the default, automatic reg_covar (issue 14): a 1 km plane
+// gets a spatial floor of 1 m^2 and gray keeps 1e-6, which float32 can hold;
+// the fixture's floors come from an independent implementation of the rule
+// and its reference from sklearn fitted with the same floors.
+TEST(EmProperties, LargeRotatedGeometryWithAutomaticRegCovarMatchesSklearn) {
+  const nlohmann::json ref = sogmm_test::load_fixture("em_large_geometry.json");
+  for (const auto& c : ref.at("cases")) {
+    SCOPED_TRACE(c.at("name").get<std::string>());
+    const nlohmann::json& a = c.at("auto");
+    const sogmm::FitResult r = expect_close_to_sklearn(c, std::nullopt, a.at("sklearn_score").get<double>());
+    EXPECT_TRUE(r.em.reg_covar.automatic);
+    EXPECT_EQ(r.em.reg_covar.spatial, a.at("reg_covar_spatial").get<double>());
+    EXPECT_EQ(r.em.reg_covar.gray, a.at("reg_covar_gray").get<double>());
   }
 }
 
@@ -138,15 +170,19 @@ TEST(EmProperties, LikelihoodNeverDecreasesAtKilometreScale) {
   for (const std::string name : {"plane_30m_1cm", "line_100m_1cm", "plane_1km_1cm", "plane_1km_5cm"}) {
     SCOPED_TRACE(name);
     const std::vector<float> pts = large_geometry_points(name);
-    for (std::uint64_t seed : {0, 1, 2}) {
-      sogmm::EmOptions o;
-      o.max_iter = 40;
-      o.tol = 0.0;
-      std::vector<double> ll;
-      sogmm::fit_em(view(pts), sogmm::kmeanspp_seeds(view(pts), 10, seed), o, nullptr,
-                    [&](int, double v) { ll.push_back(v); });
-      for (std::size_t i = 2; i < ll.size(); ++i)  // from the 2nd: the 1st scores the k-means++ start
-        EXPECT_GE(ll[i], ll[i - 1] - 1e-5) << "seed " << seed << ", iteration " << i + 1;
+    // 1e-6: components thin enough for the double kernels; auto: 1 m^2 at 1 km.
+    for (const std::optional<double> reg : {std::optional<double>(1e-6), std::optional<double>()}) {
+      for (std::uint64_t seed : {0, 1, 2}) {
+        sogmm::EmOptions o;
+        o.reg_covar = reg;
+        o.max_iter = 40;
+        o.tol = 0.0;
+        std::vector<double> ll;
+        sogmm::fit_em(view(pts), sogmm::kmeanspp_seeds(view(pts), 10, seed), o, nullptr,
+                      [&](int, double v) { ll.push_back(v); });
+        for (std::size_t i = 2; i < ll.size(); ++i)  // from the 2nd: the 1st scores the k-means++ start
+          EXPECT_GE(ll[i], ll[i - 1] - 1e-5) << "seed " << seed << ", iteration " << i + 1 << (reg ? "" : ", auto");
+      }
     }
   }
 }
@@ -171,6 +207,7 @@ TEST(EmProperties, BitIdenticalForOneTwoThreeThreads) {
   // The same for components the kernels evaluate in double (a 1 km plane).
   const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
   o.n_components = 10;
+  o.em.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2, float32 kernels)
   std::vector<sogmm::FitResult> p;
   for (int threads : {1, 2, 3}) {
     o.em.threads = threads;
@@ -192,6 +229,7 @@ TEST(EmProperties, FourDimensionalScaleInvariance) {
   sogmm::FitOptions o;
   o.bandwidth = 0.05;
   o.seed = 4;
+  o.em.reg_covar = 1e-6;  // explicit, so that it can scale with s^2
   const sogmm::FitResult a = sogmm::fit(view(pts), o);
   for (double s : {2.0, 10.0, 0.1}) {
     SCOPED_TRACE("s = " + std::to_string(s));
@@ -199,7 +237,7 @@ TEST(EmProperties, FourDimensionalScaleInvariance) {
     for (std::size_t i = 0; i < pts.size(); ++i) scaled[i] = static_cast<float>(s * pts[i]);
     sogmm::FitOptions os = o;
     os.bandwidth = o.bandwidth * s;
-    os.em.reg_covar = o.em.reg_covar * s * s;
+    os.em.reg_covar = *o.em.reg_covar * s * s;
     const sogmm::FitResult b = sogmm::fit(view(scaled), os);
     EXPECT_EQ(a.gmm.size(), b.gmm.size());
     EXPECT_NEAR(b.em.log_likelihood, a.em.log_likelihood - 4.0 * std::log(s), 1e-6);
@@ -281,6 +319,7 @@ TEST(EmProperties, EveryKernelAgrees) {
           sogmm::fit_em(view(pts), sogmm::kmeanspp_seeds(view(pts), 20, 8), o, &rep);
           // and components the kernels evaluate in double (a 1 km plane)
           const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
+          o.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2 and float32 kernels)
           sogmm::fit_em(view(plane), sogmm::kmeanspp_seeds(view(plane), 10, 1), o, &plane_rep);
           std::FILE* f = std::fopen(file.c_str(), "w");
           const bool ok = f != nullptr &&
