@@ -89,7 +89,9 @@ RegCovarFloors auto_reg_covar(const PointsView& points) {
     hi = std::max(hi, points[i][3]);
   }
   const double gray = static_cast<double>(hi) - lo;
-  f.gray = floor_for_decade(gray > 0.0 ? covering_decade(gray) : 0);
+  // A range within float32 rounding above a power of ten counts as that power
+  // (gray in [0, 1] computed in float may end at 1.0000001).
+  f.gray = floor_for_decade(gray > 0.0 ? covering_decade(gray * (1.0 - 1e-6)) : 0);
   return f;
 }
 

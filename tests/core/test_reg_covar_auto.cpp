@@ -82,11 +82,14 @@ TEST(RegCovarAuto, FloorsScaleExactlyBy100PerDecade) {
 // The decade rules at their edges: the spatial size rounds to the nearest
 // decade on a log scale (0.9 m x 3.5 = 3.15 < 10^0.5 stays at 10^0; x 3.6 =
 // 3.24 moves to 10^1); the gray range takes the smallest power of ten not
-// below it (exactly 1 -> 10^0; 1.25 -> 10^1; 0.0625 -> 10^-1; 0.125 -> 10^0).
+// below it (exactly 1 -> 10^0, and 1 + 1e-7 too, float rounding; 1 + 1e-5 and
+// 1.25 -> 10^1; 0.0625 -> 10^-1; 0.125 -> 10^0).
 TEST(RegCovarAuto, DecadeRulesAtTheirEdges) {
   EXPECT_EQ(sogmm::auto_reg_covar(view(scaled_xyz(star(1.0, 0.0, 1.0), 3.5f))).spatial, 1e-6);
   EXPECT_EQ(sogmm::auto_reg_covar(view(scaled_xyz(star(1.0, 0.0, 1.0), 3.6f))).spatial, 1e-4);
   EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.0, 1.25))).gray, 1e-4);
+  EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.0, 1.0000001))).gray, 1e-6);  // float rounding above 1
+  EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.0, 1.00001))).gray, 1e-4);
   EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.5, 0.5625))).gray, 1e-8);  // range 0.0625
   EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.5, 0.625))).gray, 1e-6);   // range 0.125
   EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.5, 0.5))).gray, 1e-6);     // constant gray: 10^0

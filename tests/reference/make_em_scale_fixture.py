@@ -19,7 +19,7 @@ Each case also has "auto": the automatic reg_covar floors, computed here by an
 independent implementation of the rule in core/include/sogmm/reg_covar.hpp
 (spatial 1e-6 x 100^k, 10^k the power of ten nearest the median distance of the
 points from their coordinate-wise lower median; gray 1e-6 x 100^k, 10^k the
-smallest power of ten not below the gray range), and sklearn's best score with
+smallest power of ten not below the gray range, less 1e-6 of it), and sklearn's best score with
 those floors. sklearn adds one scalar reg_covar, so it fits the points with gray
 multiplied by c = sqrt(spatial / gray) and reg_covar = spatial (the same EM in
 other units); the score in the original units is that score + log c.
@@ -64,7 +64,7 @@ def auto_floors(x):
     centre = np.array([lower_median(x[:, j]) for j in range(3)])
     size = lower_median(np.sqrt(((x[:, :3] - centre) ** 2).sum(axis=1)))
     k = int(np.round(np.log10(size)))
-    rng = x[:, 3].max() - x[:, 3].min()
+    rng = (x[:, 3].max() - x[:, 3].min()) * (1 - 1e-6)  # float rounding above a power of ten counts as it
     kg = int(np.ceil(np.log10(rng)))
     while 10.0 ** kg < rng:
         kg += 1

@@ -27,7 +27,8 @@ struct RegCovarFloors {
 ///   A typical size rather than the extent, so that a far outlier does not
 ///   move it.
 /// - gray = 1e-6 x 100^k, where 10^k is the smallest power of ten not below
-///   the gray range (max - min): gray's resolution follows its unit, not its
+///   the gray range (max - min; a range up to 1e-6 above a power of ten,
+///   float rounding, counts as that power): gray's resolution follows its unit, not its
 ///   spread (8-bit gray in [0, 1] keeps 1e-6, about its quantisation
 ///   variance (1/255)^2 / 12, also for a dark or low-contrast frame; in
 ///   [0, 255] it gets 1).
