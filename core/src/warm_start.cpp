@@ -53,13 +53,12 @@ void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
 
 // New components from k-means++ seeds among the novel points: one hard
 // k-means assignment (each point to its nearest seed), then per cluster its
-// mean, its per-coordinate variance + the reg_covar floor of that coordinate
-// on a diagonal covariance and its size as weight. A cold start's needles
-// (the floors on the diagonal, one point each)
+// mean, its per-coordinate variance + reg_covar on a diagonal covariance and
+// its size as weight. A cold start's needles (reg_covar I, one point each)
 // would lose every novel point in the first E-step to the least distant kept
 // component, which then stretches over the new surface; a diagonal covariance
 // is positive definite in float32 whatever the cluster's shape.
-Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, const RegCovarFloors& reg) {
+Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, double reg_covar) {
   const std::size_t k = seeds.size();
   std::vector<double> sum(5 * k, 0.0), sq(4 * k, 0.0);
   float lo[4], hi[4];
@@ -89,7 +88,7 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
   // one-point cluster positive definite.
   double extent = 0.0;
   for (int j = 0; j < 4; ++j) extent = std::max(extent, static_cast<double>(hi[j]) - lo[j]);
-  const double relative = std::max(1e-12 * extent * extent, 1e-30);
+  const double floor = std::max({reg_covar, 1e-12 * extent * extent, 1e-30});
   Gmm g;
   g.resize(k);
   std::fill(g.covariances.begin(), g.covariances.end(), 0.0f);
@@ -99,7 +98,6 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
     for (int j = 0; j < 4; ++j) {
       const double m = sum[5 * c + 1 + j] / n;
       g.means[4 * c + j] = static_cast<float>(nv[seeds[c]][j] + m);
-      const double floor = std::max(j < 3 ? reg.spatial : reg.gray, relative);
       g.covariances[16 * c + 5 * j] = static_cast<float>(std::max(sq[4 * c + j] / n - m * m, 0.0) + floor);
     }
   }
@@ -183,7 +181,7 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
       detail::progress_begin(Stage::Seeding, k_new);
       t = std::chrono::steady_clock::now();
       const std::vector<std::size_t> seeds = kmeanspp_seeds(nv, k_new, options.seed);
-      const Gmm fresh = seed_components(nv, seeds, resolve_reg_covar(points, em.reg_covar));
+      const Gmm fresh = seed_components(nv, seeds, em.reg_covar);
       for (std::size_t c = 0; c < fresh.size(); ++c) append_component(start, fresh, c, fresh.weights[c]);
       rep.added = seeds.size();
       result.seconds_seeding = seconds_since(t);
