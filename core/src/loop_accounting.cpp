@@ -12,6 +12,16 @@ LoopAccounting loop_accounting() {
   LoopAccounting a;
   a.loops = detail::loop_tally.loops.load(std::memory_order_relaxed);
   a.cpu_seconds_in_loops = 1e-9 * static_cast<double>(detail::loop_tally.cpu_ns.load(std::memory_order_relaxed));
+  const detail::LoopTally& t = detail::loop_tally;
+  const auto seconds = [](const std::atomic<std::int64_t>& ns) {
+    return 1e-9 * static_cast<double>(ns.load(std::memory_order_relaxed));
+  };
+  a.team_loops = t.team_loops.load(std::memory_order_relaxed);
+  a.team_wall_seconds = seconds(t.team_wall_ns);
+  a.team_busy_seconds = seconds(t.team_busy_ns);
+  a.team_start_seconds = seconds(t.team_start_ns);
+  a.team_imbalance_seconds = seconds(t.team_imbalance_ns);
+  a.team_join_seconds = seconds(t.team_join_ns);
   return a;
 }
 

@@ -14,10 +14,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <vector>
 
 #include "progress.hpp"
 
@@ -45,11 +47,19 @@ inline std::uint64_t thread_cpu_ns() {
   return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000u + static_cast<std::uint64_t>(ts.tv_nsec);
 }
 
+/// Monotonic nanoseconds (a vDSO call, tens of nanoseconds).
+inline std::uint64_t wall_ns() {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+}
+
 /// The loop accounting of sogmm/loop_accounting.hpp (process-wide).
 struct LoopTally {
   std::atomic<bool> on{false};
   std::atomic<std::uint64_t> loops{0};
   std::atomic<std::uint64_t> cpu_ns{0};
+  std::atomic<std::uint64_t> team_loops{0};
+  std::atomic<std::int64_t> team_wall_ns{0}, team_busy_ns{0}, team_start_ns{0}, team_imbalance_ns{0}, team_join_ns{0};
 };
 inline LoopTally loop_tally;
 
@@ -69,6 +79,71 @@ class LoopTimer {
  private:
   bool on_;
   std::uint64_t start_;
+};
+
+/// One team loop's member timings for the loop accounting (a no-op when it is
+/// off): member k writes only its own slot, and the calling thread adds the
+/// loop to the tally (LoopAccounting::team_*) once every member is done.
+class TeamTimer {
+ public:
+  explicit TeamTimer(int threads) : on_(loop_tally.on.load(std::memory_order_relaxed)) {
+    if (on_) slots_.resize(static_cast<std::size_t>(std::max(threads, 1)));
+    reopen();
+  }
+  bool on() const { return on_; }
+  /// A new loop starts now (a staged region's next stage): slots cleared.
+  void reopen() {
+    if (!on_) return;
+    for (Slot& slot : slots_) slot = Slot{};
+    open_ = wall_ns();
+  }
+  /// parallel_for: member k starts, then finishes, its share.
+  void arrive(int k) {
+    if (on_) slots_[static_cast<std::size_t>(k)].start = wall_ns();
+  }
+  void leave(int k) {
+    if (!on_) return;
+    Slot& slot = slots_[static_cast<std::size_t>(k)];
+    slot.end = wall_ns();
+    slot.busy = slot.end - slot.start;
+  }
+  /// Staged region: member k ran one item from t0 to t1 (wall_ns()).
+  void item(int k, std::uint64_t t0, std::uint64_t t1) {
+    Slot& slot = slots_[static_cast<std::size_t>(k)];
+    slot.busy += t1 - t0;
+    slot.end = t1;
+  }
+  /// Adds the loop (its first `members` slots) to the tally; call after
+  /// every member's last write is visible (after the region, or after the
+  /// stage's completion count was read with acquire).
+  void close(int members) {
+    if (!on_) return;
+    const std::int64_t wall = static_cast<std::int64_t>(wall_ns() - open_);
+    const std::size_t count = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(members, 1)), 1, slots_.size());
+    double busy = 0.0, start = 0.0, end = 0.0, last = 0.0;
+    for (std::size_t k = 0; k < count; ++k) {
+      // e_k from the opening (0 for a member that took no item), s_k = e_k - busy_k.
+      const double e = slots_[k].end > open_ ? static_cast<double>(slots_[k].end - open_) : 0.0;
+      const double b = static_cast<double>(slots_[k].busy);
+      busy += b, start += e - b, end += e, last = std::max(last, e);
+    }
+    const double n = static_cast<double>(count);
+    loop_tally.team_loops.fetch_add(1, std::memory_order_relaxed);
+    loop_tally.team_wall_ns.fetch_add(wall, std::memory_order_relaxed);
+    loop_tally.team_busy_ns.fetch_add(static_cast<std::int64_t>(busy / n), std::memory_order_relaxed);
+    loop_tally.team_start_ns.fetch_add(static_cast<std::int64_t>(start / n), std::memory_order_relaxed);
+    loop_tally.team_imbalance_ns.fetch_add(static_cast<std::int64_t>(last - end / n), std::memory_order_relaxed);
+    loop_tally.team_join_ns.fetch_add(wall - static_cast<std::int64_t>(last), std::memory_order_relaxed);
+  }
+
+ private:
+  // One cache line per member, so that timing does not add false sharing.
+  struct alignas(64) Slot {
+    std::uint64_t start = 0, end = 0, busy = 0;
+  };
+  bool on_;
+  std::uint64_t open_ = 0;
+  std::vector<Slot> slots_;
 };
 
 /// Calls body(i, thread) for every i in [0, n) on a team of `threads`
@@ -96,19 +171,30 @@ void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& bod
   std::exception_ptr first_error;
   std::mutex error_mutex;
   const std::size_t step = std::max<std::size_t>(chunk, 1);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, step)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed.load(std::memory_order_relaxed)) continue;
-    try {
-      const int thread = omp_get_thread_num();
-      if (thread == 0 && i % step == 0) progress_poll();
-      body(i, thread);
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(error_mutex);
-      if (!first_error) first_error = std::current_exception();
-      failed.store(true, std::memory_order_relaxed);
+  TeamTimer team(threads);
+  int members = threads;
+  // The loop's own barrier is dropped (nowait) so that each member's finish
+  // can be timed; the region's barrier takes its place.
+#pragma omp parallel num_threads(threads)
+  {
+    const int thread = omp_get_thread_num();
+    if (thread == 0) members = omp_get_num_threads();
+    team.arrive(thread);
+#pragma omp for schedule(dynamic, step) nowait
+    for (std::size_t i = 0; i < n; ++i) {
+      if (failed.load(std::memory_order_relaxed)) continue;
+      try {
+        if (thread == 0 && i % step == 0) progress_poll();
+        body(i, thread);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!first_error) first_error = std::current_exception();
+        failed.store(true, std::memory_order_relaxed);
+      }
     }
+    team.leave(thread);
   }
+  team.close(members);
   if (first_error) std::rethrow_exception(first_error);
 }
 

@@ -70,18 +70,23 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
   // Thread 0 opens stage s by storing claim, then count, then open (each
   // release); a member reads count before claim, so a count of a later
   // stage comes with that stage's claim tag and claims nothing here.
+  // Team timing of each stage (loop accounting); written before `done`.
+  TeamTimer team(threads);
+  int members = threads;
   const auto run_items = [&](std::uint64_t s, int thread) {
     const std::uint64_t n = count.load(std::memory_order_acquire);
     std::uint64_t c = claim.load(std::memory_order_acquire);
     while (!failed.load(std::memory_order_relaxed)) {
       if ((c >> 32) != s || (c & 0xffffffffu) >= n) return;
       if (!claim.compare_exchange_weak(c, c + 1, std::memory_order_acq_rel, std::memory_order_acquire)) continue;
+      const std::uint64_t t0 = team.on() ? wall_ns() : 0;
       try {
         if (thread == 0) progress_poll();
         item(static_cast<std::size_t>(s), static_cast<std::size_t>(c & 0xffffffffu), thread);
       } catch (...) {
         fail();
       }
+      if (team.on()) team.item(thread, t0, wall_ns());
       done.fetch_add(1, std::memory_order_acq_rel);
       c = claim.load(std::memory_order_acquire);
     }
@@ -89,12 +94,14 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
 #pragma omp parallel num_threads(threads)
   {
     const int thread = omp_get_thread_num();
+    if (thread == 0) members = omp_get_num_threads();
     for (std::uint64_t s = 0; s < stages && !failed.load(std::memory_order_acquire); ++s) {
       if (thread == 0) {
         try {
           const std::uint64_t n = items(static_cast<std::size_t>(s));
           if (n > 0xffffffffu) throw std::length_error("parallel_stages: more than 2^32 - 1 items in a stage");
           done.store(0, std::memory_order_relaxed);
+          team.reopen();
           claim.store(s << 32, std::memory_order_release);
           count.store(n, std::memory_order_release);
           open.store(static_cast<std::int64_t>(s), std::memory_order_release);
@@ -103,6 +110,7 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
             run_items(s, 0);
             wait_until([&] { return done.load(std::memory_order_acquire) == n; });
           }
+          team.close(members);
           if (!failed.load(std::memory_order_acquire)) between(static_cast<std::size_t>(s));
         } catch (...) {
           fail();

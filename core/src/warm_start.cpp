@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -58,12 +59,14 @@ void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
 // would lose every novel point in the first E-step to the least distant kept
 // component, which then stretches over the new surface; a diagonal covariance
 // is positive definite in float32 whatever the cluster's shape.
-Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, double reg_covar) {
+//
+// The nearest seeds (N x K distances, most of this function's work) are found
+// in parallel on `threads`; the sums then run serially in point order, so the
+// result does not depend on the team.
+Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, double reg_covar, int threads) {
   const std::size_t k = seeds.size();
-  std::vector<double> sum(5 * k, 0.0), sq(4 * k, 0.0);
-  float lo[4], hi[4];
-  for (int j = 0; j < 4; ++j) lo[j] = hi[j] = nv[0][j];
-  for (std::size_t i = 0; i < nv.size; ++i) {
+  std::vector<std::uint32_t> nearest(nv.size);
+  detail::parallel_for(nv.size, threads, 256, [&](std::size_t i, int) {
     std::size_t best = 0;
     double best_d = std::numeric_limits<double>::infinity();
     for (std::size_t c = 0; c < k; ++c) {
@@ -74,6 +77,13 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
       }
       if (d < best_d) best_d = d, best = c;
     }
+    nearest[i] = static_cast<std::uint32_t>(best);
+  });
+  std::vector<double> sum(5 * k, 0.0), sq(4 * k, 0.0);
+  float lo[4], hi[4];
+  for (int j = 0; j < 4; ++j) lo[j] = hi[j] = nv[0][j];
+  for (std::size_t i = 0; i < nv.size; ++i) {
+    const std::size_t best = nearest[i];
     sum[5 * best] += 1.0;
     for (int j = 0; j < 4; ++j) {
       lo[j] = std::min(lo[j], nv[i][j]);
@@ -181,7 +191,7 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
       detail::progress_begin(Stage::Seeding, k_new);
       t = std::chrono::steady_clock::now();
       const std::vector<std::size_t> seeds = kmeanspp_seeds(nv, k_new, options.seed);
-      const Gmm fresh = seed_components(nv, seeds, em.reg_covar);
+      const Gmm fresh = seed_components(nv, seeds, em.reg_covar, threads);
       for (std::size_t c = 0; c < fresh.size(); ++c) append_component(start, fresh, c, fresh.weights[c]);
       rep.added = seeds.size();
       result.seconds_seeding = seconds_since(t);

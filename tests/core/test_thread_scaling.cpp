@@ -32,11 +32,17 @@ sogmm::Gmm scattered_model(std::uint64_t seed) {
   return g;
 }
 
+// n points (x, y, z, gray) drawn from g with the given seed.
+std::vector<float> drawn_points(const sogmm::Gmm& g, std::size_t n, std::uint64_t seed) {
+  std::vector<float> pts(4 * n);
+  sogmm::sample(g, n, seed, 4, pts.data());
+  return pts;
+}
+
 TEST(ThreadScaling, CulledQueriesBitwiseIdenticalForAnyTeamOnLargeInputs) {
   const sogmm::Gmm g = scattered_model(17);
   const std::size_t n = 20000;
-  std::vector<float> pts(4 * n);
-  sogmm::sample(g, n, 18, 4, pts.data());
+  const std::vector<float> pts = drawn_points(g, n, 18);
   std::vector<float> xyz(3 * n);
   for (std::size_t i = 0; i < n; ++i)
     for (int j = 0; j < 3; ++j) xyz[3 * i + j] = pts[4 * i + j];
@@ -65,8 +71,7 @@ TEST(ThreadScaling, CulledQueriesBitwiseIdenticalForAnyTeamOnLargeInputs) {
 TEST(ThreadScaling, LoopAccountingCountsOnlyWhenOn) {
   const sogmm::Gmm g = scattered_model(19);
   const std::size_t n = 5000;
-  std::vector<float> pts(4 * n);
-  sogmm::sample(g, n, 20, 4, pts.data());
+  const std::vector<float> pts = drawn_points(g, n, 20);
   std::vector<double> s(n);
   sogmm::QueryOptions o;
   o.threads = 1;
@@ -89,6 +94,63 @@ TEST(ThreadScaling, LoopAccountingCountsOnlyWhenOn) {
   const double in_loops = a2.cpu_seconds_in_loops - a1.cpu_seconds_in_loops;
   EXPECT_GT(in_loops, 0.0);
   EXPECT_LE(in_loops, t1 - t0 + 1e-9);
+}
+
+}  // namespace
+
+namespace {
+
+// The team split of the loop accounting: per loop, wall = busy + start +
+// imbalance + join by construction (each part truncated to whole nanoseconds,
+// so up to 3 ns per loop apart), and each part is non-negative (members start
+// after the loop opens, a member's items fit between the opening and its last
+// finish, and the caller returns after the last member). Checked on team
+// loops of both kinds: parallel_for (the queries) and staged regions (the
+// k-means++ steps of a fit).
+void expect_split_adds_up(const sogmm::LoopAccounting& a, const sogmm::LoopAccounting& b) {
+  const double loops = static_cast<double>(b.team_loops - a.team_loops);
+  ASSERT_GT(loops, 0.0);
+  const double wall = b.team_wall_seconds - a.team_wall_seconds, busy = b.team_busy_seconds - a.team_busy_seconds,
+               start = b.team_start_seconds - a.team_start_seconds,
+               imbalance = b.team_imbalance_seconds - a.team_imbalance_seconds,
+               join = b.team_join_seconds - a.team_join_seconds;
+  EXPECT_GT(busy, 0.0);
+  EXPECT_GE(start, 0.0);
+  EXPECT_GE(imbalance, 0.0);
+  EXPECT_GE(join, 0.0);
+  EXPECT_NEAR(wall, busy + start + imbalance + join, 3e-9 * loops + 1e-12 * wall);
+}
+
+TEST(ThreadScaling, TeamSplitAddsUpToTheWallTime) {
+  const sogmm::Gmm g = scattered_model(23);
+  const std::size_t n = 20000;
+  const std::vector<float> pts = drawn_points(g, n, 24);
+  std::vector<double> s(n);
+  sogmm::QueryOptions o;
+  sogmm::set_loop_accounting(true);
+  // One thread: no team loop.
+  o.threads = 1;
+  const sogmm::LoopAccounting a0 = sogmm::loop_accounting();
+  sogmm::score_samples(g, pts.data(), n, 4, s.data(), o);
+  const sogmm::LoopAccounting a1 = sogmm::loop_accounting();
+  EXPECT_EQ(a1.team_loops, a0.team_loops);
+  EXPECT_EQ(a1.team_wall_seconds, a0.team_wall_seconds);
+  // Two threads: each of the score's two loops is a team loop.
+  o.threads = 2;
+  sogmm::score_samples(g, pts.data(), n, 4, s.data(), o);
+  const sogmm::LoopAccounting a2 = sogmm::loop_accounting();
+  EXPECT_EQ(a2.team_loops - a1.team_loops, 2u);
+  expect_split_adds_up(a1, a2);
+  // A fit on two threads: its k-means++ steps run as stages of one region.
+  sogmm::FitOptions fo;
+  fo.bandwidth = 0.3;
+  fo.em.threads = 2;
+  fo.em.max_iter = 3;
+  sogmm::fit(sogmm::PointsView{pts.data(), n}, fo);
+  const sogmm::LoopAccounting a3 = sogmm::loop_accounting();
+  sogmm::set_loop_accounting(false);
+  EXPECT_GT(a3.team_loops - a2.team_loops, 2u);
+  expect_split_adds_up(a2, a3);
 }
 
 }  // namespace

@@ -37,14 +37,17 @@ namespace {
 // CPU clocks at one instant: the calling thread's, the parallel loops' share
 // of it, and the process's.
 struct CpuMark {
-  double thread = 0.0, in_loops = 0.0, process = 0.0;
+  double thread = 0.0, in_loops = 0.0, process = 0.0, wall = 0.0;
   std::uint64_t loops = 0;
+  sogmm::LoopAccounting acc;
   static CpuMark now() {
     CpuMark m;
     m.thread = sogmm::thread_cpu_seconds();
     const sogmm::LoopAccounting a = sogmm::loop_accounting();
+    m.acc = a;
     m.in_loops = a.cpu_seconds_in_loops;
     m.loops = a.loops;
+    m.wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
     timespec ts{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     m.process = static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
@@ -52,13 +55,24 @@ struct CpuMark {
   }
 };
 
-// Per stage: "cpu_S", "serial_cpu_S", "loops_S", "pcpu_S" as JSON members
-// (each with a leading ", ").
+// Per stage: "cpu_S", "serial_cpu_S", "loops_S", "pcpu_S", and the team
+// split of the wall time (sogmm/loop_accounting.hpp): "wall_S" and
+// "team_{loops,wall,busy,start,imbalance,join}_S", as JSON members (each with
+// a leading ", ").
 std::string cpu_json(const std::string& stage, const CpuMark& a, const CpuMark& b) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, ", \"cpu_%s\": %.6f, \"serial_cpu_%s\": %.6f, \"loops_%s\": %llu, \"pcpu_%s\": %.6f",
-                stage.c_str(), b.thread - a.thread, stage.c_str(), (b.thread - a.thread) - (b.in_loops - a.in_loops),
-                stage.c_str(), static_cast<unsigned long long>(b.loops - a.loops), stage.c_str(), b.process - a.process);
+  const char* st = stage.c_str();
+  char buf[768];
+  std::snprintf(buf, sizeof buf,
+                ", \"cpu_%s\": %.6f, \"serial_cpu_%s\": %.6f, \"loops_%s\": %llu, \"pcpu_%s\": %.6f, \"wall_%s\": %.6f, "
+                "\"team_loops_%s\": %llu, \"team_wall_%s\": %.6f, \"team_busy_%s\": %.6f, \"team_start_%s\": %.6f, "
+                "\"team_imbalance_%s\": %.6f, \"team_join_%s\": %.6f",
+                st, b.thread - a.thread, st, (b.thread - a.thread) - (b.in_loops - a.in_loops), st,
+                static_cast<unsigned long long>(b.loops - a.loops), st, b.process - a.process, st, b.wall - a.wall, st,
+                static_cast<unsigned long long>(b.acc.team_loops - a.acc.team_loops), st,
+                b.acc.team_wall_seconds - a.acc.team_wall_seconds, st, b.acc.team_busy_seconds - a.acc.team_busy_seconds,
+                st, b.acc.team_start_seconds - a.acc.team_start_seconds, st,
+                b.acc.team_imbalance_seconds - a.acc.team_imbalance_seconds, st,
+                b.acc.team_join_seconds - a.acc.team_join_seconds);
   return buf;
 }
 }  // namespace

@@ -80,8 +80,11 @@ int main(int argc, char** argv) {
   // The warm fits' CPU on this thread, and the part outside the core's
   // parallel loops (sogmm/loop_accounting.hpp), summed over the repeats: on
   // one thread, the serial share that bounds the two-thread speed-up.
-  double warm_cpu = 0.0, warm_serial_cpu = 0.0;
+  double warm_cpu = 0.0, warm_serial_cpu = 0.0, warm_wall = 0.0;
   std::uint64_t warm_loops = 0;
+  // On a team: the split of the warm fits' loop wall time (team_* of
+  // LoopAccounting), summed over the repeats.
+  LoopAccounting team;
   set_loop_accounting(true);
   for (int r = 0; r < repeat; ++r) {
     FitOptions wf = fo;
@@ -94,6 +97,13 @@ int main(int argc, char** argv) {
     warm_cpu += cpu;
     warm_serial_cpu += cpu - (acc1.cpu_seconds_in_loops - acc0.cpu_seconds_in_loops);
     warm_loops += acc1.loops - acc0.loops;
+    team.team_loops += acc1.team_loops - acc0.team_loops;
+    team.team_wall_seconds += acc1.team_wall_seconds - acc0.team_wall_seconds;
+    team.team_busy_seconds += acc1.team_busy_seconds - acc0.team_busy_seconds;
+    team.team_start_seconds += acc1.team_start_seconds - acc0.team_start_seconds;
+    team.team_imbalance_seconds += acc1.team_imbalance_seconds - acc0.team_imbalance_seconds;
+    team.team_join_seconds += acc1.team_join_seconds - acc0.team_join_seconds;
+    warm_wall += warm.seconds_total;
     warm_s.push_back(warm.seconds_total);
     cold = fit(b.view(), fo);
     cold_s.push_back(cold.seconds_total);
@@ -106,11 +116,16 @@ int main(int argc, char** argv) {
       "\"added\": %zu, \"novel_points\": %zu, \"s_cold\": %.6f, \"s_warm\": %.6f, \"s_warm_score\": %.6f, "
       "\"s_warm_mode_count\": %.6f, \"s_warm_seeding\": %.6f, \"s_warm_em\": %.6f, \"iter_cold\": %d, "
       "\"iter_warm\": %d, \"ll_cold\": %.6f, \"ll_warm\": %.6f, \"psnr_cold\": %.4f, \"psnr_warm\": %.4f, "
-      "\"cpu_warm\": %.6f, \"serial_cpu_warm\": %.6f, \"loops_warm\": %llu}\n",
+      "\"cpu_warm\": %.6f, \"serial_cpu_warm\": %.6f, \"loops_warm\": %llu, \"wall_warm\": %.6f, "
+      "\"team_loops_warm\": %llu, \"team_wall_warm\": %.6f, \"team_busy_warm\": %.6f, \"team_start_warm\": %.6f, "
+      "\"team_imbalance_warm\": %.6f, \"team_join_warm\": %.6f}\n",
       b.size(), cold.gmm.size(), warm.gmm.size(), moved.size(), rep.kept, rep.removed, rep.added, rep.novel_points,
       median(cold_s), median(warm_s), rep.seconds_score, warm.seconds_mode_count, warm.seconds_seeding,
       warm.seconds_em, cold.em.iterations, warm.em.iterations, cold.em.log_likelihood, warm.em.log_likelihood,
       psnr_cold, psnr_warm, warm_cpu / repeat, warm_serial_cpu / repeat,
-      static_cast<unsigned long long>(warm_loops / static_cast<std::uint64_t>(repeat)));
+      static_cast<unsigned long long>(warm_loops / static_cast<std::uint64_t>(repeat)), warm_wall / repeat,
+      static_cast<unsigned long long>(team.team_loops / static_cast<std::uint64_t>(repeat)),
+      team.team_wall_seconds / repeat, team.team_busy_seconds / repeat, team.team_start_seconds / repeat,
+      team.team_imbalance_seconds / repeat, team.team_join_seconds / repeat);
   return 0;
 }

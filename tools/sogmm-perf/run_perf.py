@@ -11,12 +11,15 @@ runs of both builds interleaved so that machine load hits both alike. Then one
 roofline line per stage: pairs per second achieved (N x M x iterations x pair
 fraction for EM, N x M for regress and score) against the EM kernel's measured
 peak (ten exact E+M passes from the fitted model, in the same process).
-Then the thread-scaling section: per row the 1- and 2-thread medians, their
+Then the thread-scaling sections: per row the 1- and 2-thread medians, their
 ratio, and the serial share f measured in CPU time on one thread (the calling
 thread's CPU outside the core's parallel loops, which load on the machine
 hardly moves), with Amdahl's bound 1 / (f + (1 - f) / 2) on the two-thread
 speed-up and the number of parallel loops (one OpenMP region each on two
-threads); 1.8x needs f <= 0.111. Per fit also each stage's f.
+threads); 1.8x needs f <= 0.111. Per fit also each stage's f. And where the
+two-thread time goes: the Amdahl ideal and the losses on top of it (serial
+growth, work inflation, imbalance, waking and joining the team), from the
+team split of sogmm/loop_accounting.hpp.
 
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
@@ -116,6 +119,44 @@ def print_scaling(rows, cases, get):
             print(f"- {case}, one thread: " + "; ".join(parts))
 
 
+def print_team_split(rows, get):
+    """Where the two-thread time goes (new build), per row: the Amdahl ideal
+    (one-thread serial CPU + half the one-thread loop CPU) and the losses on
+    top of it, from sogmm/loop_accounting.hpp's team split of the two-thread
+    run. They add up to the two-thread wall time (up to taking medians):
+    ideal + serial growth + inflation + imbalance + start + join."""
+    stage_of = {"s_total_fit": "fit", "s_regress": "regress", "s_score": "score",
+                "s_regress_culled": "regress_culled", "s_score_culled": "score_culled"}
+    print("\nWhere the two-thread time goes (new build, medians, ms): ideal = one-thread serial CPU + one-thread loop "
+          "CPU / 2; serial growth = two-thread time outside loops - one-thread serial CPU; inflation = members' mean "
+          "busy time - one-thread loop CPU / 2; imbalance = last member's finish - mean finish; start + join = waking "
+          "the team and the closing barrier; 1.8x budget = one-thread time / 1.8 - ideal, what the four losses may "
+          "add up to for a 1.8x speed-up")
+    print("| case | 2 threads | ideal | serial growth | inflation | imbalance | start + join | 1.8x budget | team loops |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, _target, unit, value, _case in rows:
+        src = getattr(value, "source", None)
+        if not src or unit in ("%", "MiB"):
+            continue
+        case, key = src
+
+        def field(name, threads):
+            if isinstance(case, dict):  # a warm row: sogmm-bench-warm's runs
+                return case.get(threads, {}).get(f"{name}_warm")
+            return get("new", case, f"{name}_{stage_of[key]}", threads)
+
+        cpu1, serial1, wall2 = field("cpu", 1), field("serial_cpu", 1), field("wall", 2)
+        team = {n: field(f"team_{n}", 2) for n in ("loops", "wall", "busy", "start", "imbalance", "join")}
+        if None in (cpu1, serial1, wall2) or None in team.values():
+            continue
+        ideal = serial1 + (cpu1 - serial1) / 2
+        growth = wall2 - team["wall"] - serial1
+        inflation = team["busy"] - (cpu1 - serial1) / 2
+        ms = lambda v: f"{1000 * v:.1f}"
+        print(f"| {label} | {ms(wall2)} | {ms(ideal)} | {ms(growth)} | {ms(inflation)} | {ms(team['imbalance'])} | "
+              f"{ms(team['start'] + team['join'])} | {ms(value('new', 1) / 1.8 - ideal)} | {team['loops']:.0f} |")
+
+
 def sourced(fn, case, key):
     """fn with the (case, JSON key) it reads attached, for print_scaling (case:
     a case name, or a warm row's results by thread count)."""
@@ -141,13 +182,15 @@ def main():
     cases = a.cases.split(",")
     res = {}  # (build, case, threads) -> medians
     for case in cases:
-        for threads in (2, 1):
-            runs = {b: [] for b in builds}
-            for _ in range(a.runs):  # interleaved: both builds see the same load
+        runs = {(b, t): [] for b in builds for t in (2, 1)}
+        # Interleaved: both builds and both thread counts see the same load
+        # and the same drift of the machine's speed.
+        for _ in range(a.runs):
+            for threads in (2, 1):
                 for b, binary in builds.items():
-                    runs[b].append(run_fit(binary, case, threads))
-            for b in builds:
-                res[(b, case, threads)] = medians(runs[b])
+                    runs[(b, threads)].append(run_fit(binary, case, threads))
+        for (b, threads), r in runs.items():
+            res[(b, case, threads)] = medians(r)
         print(f"{case}: done", file=sys.stderr)
     warm, warm6 = {}, {}
     if not a.no_warm:
@@ -223,6 +266,7 @@ def main():
                   f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
 
     print_scaling(rows, cases, get)
+    print_team_split(rows, get)
 
     print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
     for case in cases:
