@@ -11,6 +11,14 @@
 // work: items are claimed from a shared counter, so a descheduled member
 // delays a stage only by the item it holds, and the region's one barrier
 // comes at the end.
+//
+// Which to use: parallel_for (parallel.hpp) for a loop whose work per
+// region is large against a region's cost (about a microsecond idle, a
+// scheduler slice when loaded): the EM's waves, the queries, the mode
+// count. parallel_stages for a sequence of many small loops with serial
+// steps between them, where one region per loop would be paid thousands of
+// times per fit: k-means++. Both count in the loop accounting
+// (sogmm/loop_accounting.hpp) alike, one loop per parallel_for or stage.
 #pragma once
 
 #include <omp.h>

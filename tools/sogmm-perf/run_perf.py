@@ -19,7 +19,8 @@ speed-up and the number of parallel loops (one OpenMP region each on two
 threads); 1.8x needs f <= 0.111. Per fit also each stage's f. And where the
 two-thread time goes: the Amdahl ideal and the losses on top of it (serial
 growth, work inflation, imbalance, waking and joining the team), from the
-team split of sogmm/loop_accounting.hpp.
+team split of sogmm/loop_accounting.hpp, next to what two threads cost on
+this machine whatever the code (sogmm-corun).
 
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
@@ -52,6 +53,13 @@ def run_fit(binary, case, threads):
            "--decimate", str(d), "--bandwidth", str(bw), "--threads", str(threads)]
     if trunc:
         cmd += ["--truncate", str(trunc)]
+    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+
+
+def run_corun():
+    """sogmm-corun: the machine's own two-thread cost (co-run inflation of
+    register, L2 and memory work; an empty region's cost)."""
+    cmd = [os.path.join(ROOT, "build", "tools", "sogmm-perf", "sogmm-corun"), "--repeat", "7"]
     return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
 
 
@@ -119,7 +127,7 @@ def print_scaling(rows, cases, get):
             print(f"- {case}, one thread: " + "; ".join(parts))
 
 
-def print_team_split(rows, get):
+def print_team_split(rows, get, corun):
     """Where the two-thread time goes (new build), per row: the Amdahl ideal
     (one-thread serial CPU + half the one-thread loop CPU) and the losses on
     top of it, from sogmm/loop_accounting.hpp's team split of the two-thread
@@ -155,6 +163,11 @@ def print_team_split(rows, get):
         ms = lambda v: f"{1000 * v:.1f}"
         print(f"| {label} | {ms(wall2)} | {ms(ideal)} | {ms(growth)} | {ms(inflation)} | {ms(team['imbalance'])} | "
               f"{ms(team['start'] + team['join'])} | {ms(value('new', 1) / 1.8 - ideal)} | {team['loops']:.0f} |")
+    if corun:
+        infl = {k: 100 * (corun[f"{k}_2"] / corun[f"{k}_1"] - 1) for k in ("alu", "l2", "dram")}
+        print(f"- The machine itself (sogmm-corun, same run): the same work on both cores at once instead of one "
+              f"takes {infl['alu']:+.1f}% (registers), {infl['l2']:+.1f}% (L2) and {infl['dram']:+.1f}% (memory) "
+              f"per thread; an empty two-thread region costs {corun['region_us']:.2f} us.")
 
 
 def sourced(fn, case, key):
@@ -180,6 +193,7 @@ def main():
         if not os.path.exists(b):
             sys.exit(f"run_perf: {b} not built (cmake --build build --target sogmm_perf)")
     cases = a.cases.split(",")
+    corun = run_corun()
     res = {}  # (build, case, threads) -> medians
     for case in cases:
         runs = {(b, t): [] for b in builds for t in (2, 1)}
@@ -266,7 +280,7 @@ def main():
                   f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
 
     print_scaling(rows, cases, get)
-    print_team_split(rows, get)
+    print_team_split(rows, get, corun)
 
     print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
     for case in cases:
