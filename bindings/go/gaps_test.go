@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"math"
 	"os"
@@ -290,6 +291,33 @@ func TestMapQueriesTakeTheSameOptions(t *testing.T) {
 	em, _, _ := mp.RegressGray(cullQueryXYZ)
 	if !slices.Equal(cm, wm) || slices.Equal(cm, em) {
 		t.Fatalf("map %v, model %v, exact %v", cm, wm, em)
+	}
+	// The context variants take the same options, and report every point.
+	for name, score := range map[string]func(*Options, ProgressFunc) ([]float64, error){
+		"map": func(o *Options, fn ProgressFunc) ([]float64, error) {
+			return mp.ScoreSamplesContext(context.Background(), cullQuery, 4, o, fn)
+		},
+		"model": func(o *Options, fn ProgressFunc) ([]float64, error) {
+			return m.ScoreSamplesContext(context.Background(), cullQuery, 4, o, fn)
+		},
+	} {
+		var last Progress
+		got, err := score(o, func(p Progress) error { last = p; return nil })
+		if err != nil || !slices.Equal(got, c) || last.Stage != StageScoring || last.Step != 3 {
+			t.Fatalf("%s score with context: %v vs %v, err %v, last %+v", name, got, c, err, last)
+		}
+	}
+	for name, regress := range map[string]func(*Options) ([]float32, []float32, error){
+		"map": func(o *Options) ([]float32, []float32, error) {
+			return mp.RegressGrayContext(context.Background(), cullQueryXYZ, o, nil)
+		},
+		"model": func(o *Options) ([]float32, []float32, error) {
+			return m.RegressGrayContext(context.Background(), cullQueryXYZ, o, nil)
+		},
+	} {
+		if got, _, err := regress(o); err != nil || !slices.Equal(got, cm) {
+			t.Fatalf("%s regress with context: %v vs %v, err %v", name, got, cm, err)
+		}
 	}
 }
 

@@ -17,10 +17,11 @@ func (m *Map) ScoreSamples(points []float32, dims int) ([]float64, error) {
 	return m.scoreSamples(points, dims, nil)
 }
 
-// ScoreSamplesContext is ScoreSamples with cancellation and progress
-// (StageScoring) as FitContext.
-func (m *Map) ScoreSamplesContext(ctx context.Context, points []float32, dims int, fn ProgressFunc) ([]float64, error) {
-	return withProgress(ctx, nil, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
+// ScoreSamplesContext is ScoreSamplesWith (the Threads and
+// QueryTruncationNats of o; nil = exact, all cores) with cancellation and
+// progress (StageScoring) as FitContext.
+func (m *Map) ScoreSamplesContext(ctx context.Context, points []float32, dims int, o *Options, fn ProgressFunc) ([]float64, error) {
+	return withProgress(ctx, o, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
 }
 
 // ScoreSamplesWith is ScoreSamples with the Threads and QueryTruncationNats
@@ -49,10 +50,10 @@ func (m *Map) RegressGray(xyz []float32) (mean, variance []float32, err error) {
 	return m.regressGray(xyz, nil)
 }
 
-// RegressGrayContext is RegressGray with cancellation and progress
-// (StageRegression) as FitContext.
-func (m *Map) RegressGrayContext(ctx context.Context, xyz []float32, fn ProgressFunc) (mean, variance []float32, err error) {
-	both, err := withProgress(ctx, nil, fn, func(p *Options) ([2][]float32, error) {
+// RegressGrayContext is RegressGrayWith (options as ScoreSamplesContext)
+// with cancellation and progress (StageRegression) as FitContext.
+func (m *Map) RegressGrayContext(ctx context.Context, xyz []float32, o *Options, fn ProgressFunc) (mean, variance []float32, err error) {
+	both, err := withProgress(ctx, o, fn, func(p *Options) ([2][]float32, error) {
 		mean, variance, err := m.regressGray(xyz, p)
 		return [2][]float32{mean, variance}, err
 	})

@@ -69,7 +69,7 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 			t.Fatalf("dims %d: map score differs from the model's (err %v)", c.dims, err)
 		}
 		var last Progress
-		got, err = m.ScoreSamplesContext(context.Background(), c.q, c.dims, func(p Progress) error { last = p; return nil })
+		got, err = m.ScoreSamplesContext(context.Background(), c.q, c.dims, nil, func(p Progress) error { last = p; return nil })
 		if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
 			t.Fatalf("dims %d: with progress: err %v, last %+v", c.dims, err, last)
 		}
@@ -82,7 +82,7 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
 		t.Fatalf("regress differs (err %v)", err)
 	}
-	gm, gv, err = m.RegressGrayContext(context.Background(), q3, nil)
+	gm, gv, err = m.RegressGrayContext(context.Background(), q3, nil, nil)
 	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
 		t.Fatalf("regress with context differs (err %v)", err)
 	}
@@ -98,7 +98,7 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 
 	ctx, cancel := context.WithCancel(context.Background())
 	cancel()
-	_, _, err = m.RegressGrayContext(ctx, q3, nil)
+	_, _, err = m.RegressGrayContext(ctx, q3, nil, nil)
 	if !errors.Is(err, ErrCancelled) || !errors.Is(err, context.Canceled) {
 		t.Fatalf("cancelled regress: %v", err)
 	}
@@ -220,7 +220,7 @@ func TestModelQueryContexts(t *testing.T) {
 	q := twoBlobs(5000)
 	want, _ := model.ScoreSamples(q, 4)
 	var last Progress
-	got, err := model.ScoreSamplesContext(context.Background(), q, 4, func(p Progress) error { last = p; return nil })
+	got, err := model.ScoreSamplesContext(context.Background(), q, 4, nil, func(p Progress) error { last = p; return nil })
 	if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
 		t.Fatalf("score with context: err %v, last %+v", err, last)
 	}
@@ -229,12 +229,12 @@ func TestModelQueryContexts(t *testing.T) {
 		xyz = append(xyz, q[i:i+3]...)
 	}
 	wm, _, _ := model.RegressGray(xyz)
-	gm, _, err := model.RegressGrayContext(context.Background(), xyz, func(p Progress) error { last = p; return nil })
+	gm, _, err := model.RegressGrayContext(context.Background(), xyz, nil, func(p Progress) error { last = p; return nil })
 	if err != nil || !slices.Equal(gm, wm) || last.Stage != StageRegression {
 		t.Fatalf("regress with context: err %v, last %+v", err, last)
 	}
 	stop := errors.New("stop")
-	if _, err := model.ScoreSamplesContext(context.Background(), q, 4, func(Progress) error { return stop }); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
+	if _, err := model.ScoreSamplesContext(context.Background(), q, 4, nil, func(Progress) error { return stop }); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
 		t.Fatalf("cancelled score: %v", err)
 	}
 }

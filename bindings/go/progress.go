@@ -147,16 +147,18 @@ func FitContext(ctx context.Context, points []float32, o *Options, fn ProgressFu
 	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return Fit(points, p) })
 }
 
-// ScoreSamplesContext is ScoreSamples with cancellation and progress
-// (StageScoring) as FitContext; the same values.
-func (m *Model) ScoreSamplesContext(ctx context.Context, points []float32, dims int, fn ProgressFunc) ([]float64, error) {
-	return withProgress(ctx, nil, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
+// ScoreSamplesContext is ScoreSamplesWith (the Threads and
+// QueryTruncationNats of o; nil = exact, all cores) with cancellation and
+// progress (StageScoring) as FitContext; the same values.
+func (m *Model) ScoreSamplesContext(ctx context.Context, points []float32, dims int, o *Options, fn ProgressFunc) ([]float64, error) {
+	return withProgress(ctx, o, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
 }
 
-// RegressGrayContext is RegressGray with cancellation and progress
-// (StageRegression) as FitContext; the same values.
-func (m *Model) RegressGrayContext(ctx context.Context, xyz []float32, fn ProgressFunc) (mean, variance []float32, err error) {
-	both, err := withProgress(ctx, nil, fn, func(p *Options) ([2][]float32, error) {
+// RegressGrayContext is RegressGrayWith (options as ScoreSamplesContext)
+// with cancellation and progress (StageRegression) as FitContext; the same
+// values.
+func (m *Model) RegressGrayContext(ctx context.Context, xyz []float32, o *Options, fn ProgressFunc) (mean, variance []float32, err error) {
+	both, err := withProgress(ctx, o, fn, func(p *Options) ([2][]float32, error) {
 		mean, variance, err := m.regressGray(xyz, p)
 		return [2][]float32{mean, variance}, err
 	})

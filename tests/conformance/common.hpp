@@ -20,6 +20,9 @@ inline const char* category_of(sogmm::ErrorCode c) {
     case sogmm::ErrorCode::Numeric: return "numeric";
     case sogmm::ErrorCode::Io: return "io";
     case sogmm::ErrorCode::InvalidArgument: return "invalid_argument";
+    // Not a reader's category (a read cannot be cancelled); named so that
+    // every code prints something meaningful and -Wswitch stays quiet.
+    case sogmm::ErrorCode::Cancelled: return "cancelled";
   }
   return "?";
 }

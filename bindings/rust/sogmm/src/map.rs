@@ -214,14 +214,16 @@ impl Map {
         self.score_raw(points, dims, opt_ptr(options))
     }
 
-    /// As `score_samples`, reporting `Stage::Scoring` and cancellable.
+    /// As `score_samples_with` (threads and culling of `options`), reporting
+    /// `Stage::Scoring` and cancellable.
     pub fn score_samples_with_progress(
         &self,
         points: &[f32],
         dims: i32,
+        options: Option<&Options>,
         on_progress: impl FnMut(Progress) -> ControlFlow<()>,
     ) -> Result<Vec<f64>> {
-        with_progress(None, on_progress, |o| self.score_raw(points, dims, o))
+        with_progress(options, on_progress, |o| self.score_raw(points, dims, o))
     }
 
     fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
@@ -242,13 +244,15 @@ impl Map {
         self.regress_raw(xyz, opt_ptr(options))
     }
 
-    /// As `regress_gray`, reporting `Stage::Regression` and cancellable.
+    /// As `regress_gray_with` (threads and culling of `options`), reporting
+    /// `Stage::Regression` and cancellable.
     pub fn regress_gray_with_progress(
         &self,
         xyz: &[f32],
+        options: Option<&Options>,
         on_progress: impl FnMut(Progress) -> ControlFlow<()>,
     ) -> Result<(Vec<f32>, Vec<f32>)> {
-        with_progress(None, on_progress, |o| self.regress_raw(xyz, o))
+        with_progress(options, on_progress, |o| self.regress_raw(xyz, o))
     }
 
     fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {

@@ -1,7 +1,9 @@
 //! PSNR, set_info and culled queries of the safe API, against hand-computed
 //! values, round trips and the documented bound.
+use std::ops::ControlFlow;
+
 use sogmm::sys;
-use sogmm::{psnr_images, Map, Model, Options, Status};
+use sogmm::{psnr_images, Map, Model, Options, Progress, Status};
 
 // ---- psnr_images --------------------------------------------------------
 
@@ -191,6 +193,25 @@ fn map_queries_take_the_same_options() {
     let r = map.regress_gray_with(&QUERY_XYZ, Some(&o)).unwrap();
     assert_eq!(r, m.regress_gray_with(&QUERY_XYZ, Some(&o)).unwrap());
     assert_ne!(r, map.regress_gray(&QUERY_XYZ).unwrap());
+    // The progress variants take the same options, and report every point.
+    let mut last = 0;
+    let mut count = |p: Progress| {
+        last = p.step;
+        ControlFlow::Continue(())
+    };
+    assert_eq!(
+        map.score_samples_with_progress(&QUERY, 4, Some(&o), &mut count)
+            .unwrap(),
+        c
+    );
+    assert_eq!(
+        m.score_samples_with_progress(&QUERY, 4, Some(&o), &mut count).unwrap(),
+        c
+    );
+    assert_eq!(last, 3);
+    let go_on = |_| ControlFlow::Continue(());
+    assert_eq!(map.regress_gray_with_progress(&QUERY_XYZ, Some(&o), go_on).unwrap(), r);
+    assert_eq!(m.regress_gray_with_progress(&QUERY_XYZ, Some(&o), go_on).unwrap(), r);
 }
 
 #[test]

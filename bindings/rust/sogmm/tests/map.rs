@@ -105,7 +105,7 @@ fn queries_equal_the_exported_model_bitwise() {
         assert_eq!(map.score_samples(q, dims).unwrap(), want);
         let mut last = 0;
         let got = map
-            .score_samples_with_progress(q, dims, |p| {
+            .score_samples_with_progress(q, dims, None, |p| {
                 assert_eq!(p.stage, Stage::Scoring);
                 last = p.step;
                 ControlFlow::Continue(())
@@ -116,7 +116,7 @@ fn queries_equal_the_exported_model_bitwise() {
     }
     assert_eq!(map.regress_gray(&q3).unwrap(), model.regress_gray(&q3).unwrap());
     assert_eq!(
-        map.regress_gray_with_progress(&q3, |_| ControlFlow::Continue(()))
+        map.regress_gray_with_progress(&q3, None, |_| ControlFlow::Continue(()))
             .unwrap(),
         model.regress_gray(&q3).unwrap()
     );
@@ -128,7 +128,7 @@ fn queries_equal_the_exported_model_bitwise() {
     );
     // Cancel and bad input.
     let e = map
-        .regress_gray_with_progress(&q3, |_| ControlFlow::Break(()))
+        .regress_gray_with_progress(&q3, None, |_| ControlFlow::Break(()))
         .unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
     assert_eq!(map.score_samples(&q3, 5).unwrap_err().status(), Status::InvalidArg);

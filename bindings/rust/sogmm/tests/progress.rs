@@ -110,21 +110,21 @@ fn scoring_and_regression_report_points_and_change_nothing() {
     let q: Vec<f32> = cube(10_000).chunks(4).flat_map(|r| [r[0], r[1], r[2]]).collect();
     let mut last = (None, 0);
     let got = m
-        .score_samples_with_progress(&q, 3, |p| {
+        .score_samples_with_progress(&q, 3, None, |p| {
             last = (Some(p.stage), p.step);
             ControlFlow::Continue(())
         })
         .unwrap();
     assert_eq!(got, m.score_samples(&q, 3).unwrap());
     assert_eq!(last, (Some(Stage::Scoring), 10_000));
-    let got = m.regress_gray_with_progress(&q, |p| {
+    let got = m.regress_gray_with_progress(&q, None, |p| {
         last = (Some(p.stage), p.step);
         ControlFlow::Continue(())
     });
     assert_eq!(got.unwrap(), m.regress_gray(&q).unwrap());
     assert_eq!(last, (Some(Stage::Regression), 10_000));
     let e = m
-        .score_samples_with_progress(&q, 3, |_| ControlFlow::Break(()))
+        .score_samples_with_progress(&q, 3, None, |_| ControlFlow::Break(()))
         .unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
 }
