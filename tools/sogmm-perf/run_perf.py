@@ -24,10 +24,15 @@ this machine whatever the code (sogmm-corun).
 
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
-        [--cases d5s02,d5s01,d1s02,d1s02t20] [--no-warm]
+        [--cases d5s02,d5s01,d1s02,d1s02t20] [--no-warm] [--update-readme]
 The baseline root is a checkout whose build/tools/sogmm-perf/sogmm-perf exists.
+--update-readme also writes the report into README.md (between its run_perf
+markers), headed by the date, the machine and both commits.
 """
 import argparse
+import contextlib
+import datetime
+import io
 import json
 import os
 import statistics
@@ -170,6 +175,42 @@ def print_team_split(rows, get, corun):
               f"per thread; an empty two-thread region costs {corun['region_us']:.2f} us.")
 
 
+README_BEGIN = "<!-- run_perf: begin (written by tools/sogmm-perf/run_perf.py --update-readme) -->"
+README_END = "<!-- run_perf: end -->"
+
+
+def git_head(root):
+    return subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"], capture_output=True,
+                          text=True).stdout.strip() or "unknown"
+
+
+def update_readme(report, baseline_root, runs):
+    """Replaces the README's measured block (between the run_perf markers)
+    with this run's report, headed by when, where and on which commits it
+    was measured, so the figures are never copied by hand."""
+    path = os.path.join(ROOT, "README.md")
+    text = open(path).read()
+    if README_BEGIN not in text or README_END not in text:
+        sys.exit(f"run_perf: {path} has no run_perf markers")
+    cpu = "unknown CPU"
+    if os.path.exists("/proc/cpuinfo"):
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True).stdout.strip()
+    head = git_head(ROOT) + (" with uncommitted changes" if dirty else "")
+    base = f'"today" is {git_head(baseline_root)}' if baseline_root else "no baseline build"
+    header = (f"Measured {datetime.date.today().isoformat()} on {os.cpu_count()} cores of {cpu}, medians of {runs} "
+              f"runs: {base}, \"new\" is {head}.\n\n")
+    before, rest = text.split(README_BEGIN, 1)
+    after = rest.split(README_END, 1)[1]
+    with open(path + ".tmp", "w") as f:
+        f.write(before + README_BEGIN + "\n" + header + report.strip() + "\n" + README_END + after)
+    os.replace(path + ".tmp", path)
+
+
 def sourced(fn, case, key):
     """fn with the (case, JSON key) it reads attached, for print_scaling (case:
     a case name, or a warm row's results by thread count)."""
@@ -183,6 +224,8 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--baseline-root", default=None, help="checkout with today's build (e.g. main at d0d1d93)")
     ap.add_argument("--no-warm", action="store_true")
+    ap.add_argument("--update-readme", action="store_true",
+                    help="also write the report into README.md between its run_perf markers")
     a = ap.parse_args()
     if not os.path.isdir(DATA):
         sys.exit(f"run_perf: {DATA} not found (the real frames live in ../shared/data)")
@@ -213,88 +256,94 @@ def main():
             warm6[threads] = run_warm(threads, a.runs, 6)
         print("warm: done", file=sys.stderr)
 
-    def get(b, case, key, threads=2):
-        r = res.get((b, case, threads))
-        return None if r is None or key not in r else r[key]
+    # The report goes to stdout and, with --update-readme, into README.md.
+    report = io.StringIO()
+    with contextlib.redirect_stdout(report):
+        def get(b, case, key, threads=2):
+            r = res.get((b, case, threads))
+            return None if r is None or key not in r else r[key]
 
-    def share(b, case, threads=2):
-        s = get(b, case, "s_seeding", threads)
-        return None if s is None else s / get(b, case, "s_total_fit", threads)
+        def share(b, case, threads=2):
+            s = get(b, case, "s_seeding", threads)
+            return None if s is None else s / get(b, case, "s_total_fit", threads)
 
-    # (label, target text, target value, unit, value(build, threads))
-    rows = []
-    for case, label, target in (("d5s02", "d=5, bandwidth 0.02, cold fit", 0.08),
-                                ("d5s01", "d=5, bandwidth 0.01, cold fit", 0.2),
-                                ("d1s02t20", "d=1 full frame, truncated E-step", 1.5),
-                                ("d1s02", "d=1 full frame, exact", 3.5)):
-        if case in cases:
-            rows.append((label, target, "s", sourced(lambda b, t, c=case: get(b, c, "s_total_fit", t), case, "s_total_fit"),
-                         case))
-    if warm:
-        rows.insert(2, ("d=5, bandwidth 0.02, next frame warm-started (00000 -> 00001)", 0.033, "s",
-                        sourced(lambda b, t: warm[t]["s_warm"] if b == "new" else None, warm, "warm"), None))
-        rows.insert(3, ("same, warm EM capped at 6 iterations (--max-iter 6)", 0.033, "s",
-                        sourced(lambda b, t: warm6[t]["s_warm"] if b == "new" else None, warm6, "warm"), None))
-    if "d1s02" in cases:
-        rows.append(("d=1 regress all points (exact fit)", 0.2, "s",
-                     sourced(lambda b, t: get(b, "d1s02", "s_regress", t), "d1s02", "s_regress"), None))
-        rows.append(("same, culled at 20 nats", 0.2, "s",
-                     sourced(lambda b, t: get(b, "d1s02", "s_regress_culled", t), "d1s02", "s_regress_culled"), None))
-    if "d1s02t20" in cases:
-        rows.append(("d=1 regress all points (truncated fit)", 0.2, "s",
-                     sourced(lambda b, t: get(b, "d1s02t20", "s_regress", t), "d1s02t20", "s_regress"), None))
-    if "d5s02" in cases:
-        n, m = int(get("new", "d5s02", "n")), int(get("new", "d5s02", "m"))
-        rows.append((f"regress gray {n} points, {m} components", 0.02, "ms",
-                     sourced(lambda b, t: get(b, "d5s02", "s_regress", t), "d5s02", "s_regress"), None))
-        rows.append(("score_samples, same", 0.02, "ms",
-                     sourced(lambda b, t: get(b, "d5s02", "s_score", t), "d5s02", "s_score"), None))
-        rows.append(("regress gray, culled at 20 nats", 0.02, "ms",
-                     sourced(lambda b, t: get(b, "d5s02", "s_regress_culled", t), "d5s02", "s_regress_culled"), None))
-        rows.append(("score_samples, culled at 20 nats", 0.02, "ms",
-                     sourced(lambda b, t: get(b, "d5s02", "s_score_culled", t), "d5s02", "s_score_culled"), None))
-        rows.append(("seeding share of a fit (bw 0.02)", 0.10, "%", lambda b, t: share(b, "d5s02", t), None))
-    if "d5s01" in cases:
-        rows.append(("seeding share of a fit (bw 0.01)", 0.10, "%", lambda b, t: share(b, "d5s01", t), None))
-    if "d1s02" in cases:
-        rows.append(("peak RSS, d=1", 100, "MiB", lambda b, t: get(b, "d1s02", "peak_rss_mib", t), None))
+        # (label, target text, target value, unit, value(build, threads))
+        rows = []
+        for case, label, target in (("d5s02", "d=5, bandwidth 0.02, cold fit", 0.08),
+                                    ("d5s01", "d=5, bandwidth 0.01, cold fit", 0.2),
+                                    ("d1s02t20", "d=1 full frame, truncated E-step", 1.5),
+                                    ("d1s02", "d=1 full frame, exact", 3.5)):
+            if case in cases:
+                rows.append((label, target, "s", sourced(lambda b, t, c=case: get(b, c, "s_total_fit", t), case, "s_total_fit"),
+                             case))
+        if warm:
+            rows.insert(2, ("d=5, bandwidth 0.02, next frame warm-started (00000 -> 00001)", 0.033, "s",
+                            sourced(lambda b, t: warm[t]["s_warm"] if b == "new" else None, warm, "warm"), None))
+            rows.insert(3, ("same, warm EM capped at 6 iterations (--max-iter 6)", 0.033, "s",
+                            sourced(lambda b, t: warm6[t]["s_warm"] if b == "new" else None, warm6, "warm"), None))
+        if "d1s02" in cases:
+            rows.append(("d=1 regress all points (exact fit)", 0.2, "s",
+                         sourced(lambda b, t: get(b, "d1s02", "s_regress", t), "d1s02", "s_regress"), None))
+            rows.append(("same, culled at 20 nats", 0.2, "s",
+                         sourced(lambda b, t: get(b, "d1s02", "s_regress_culled", t), "d1s02", "s_regress_culled"), None))
+        if "d1s02t20" in cases:
+            rows.append(("d=1 regress all points (truncated fit)", 0.2, "s",
+                         sourced(lambda b, t: get(b, "d1s02t20", "s_regress", t), "d1s02t20", "s_regress"), None))
+        if "d5s02" in cases:
+            n, m = int(get("new", "d5s02", "n")), int(get("new", "d5s02", "m"))
+            rows.append((f"regress gray {n} points, {m} components", 0.02, "ms",
+                         sourced(lambda b, t: get(b, "d5s02", "s_regress", t), "d5s02", "s_regress"), None))
+            rows.append(("score_samples, same", 0.02, "ms",
+                         sourced(lambda b, t: get(b, "d5s02", "s_score", t), "d5s02", "s_score"), None))
+            rows.append(("regress gray, culled at 20 nats", 0.02, "ms",
+                         sourced(lambda b, t: get(b, "d5s02", "s_regress_culled", t), "d5s02", "s_regress_culled"), None))
+            rows.append(("score_samples, culled at 20 nats", 0.02, "ms",
+                         sourced(lambda b, t: get(b, "d5s02", "s_score_culled", t), "d5s02", "s_score_culled"), None))
+            rows.append(("seeding share of a fit (bw 0.02)", 0.10, "%", lambda b, t: share(b, "d5s02", t), None))
+        if "d5s01" in cases:
+            rows.append(("seeding share of a fit (bw 0.01)", 0.10, "%", lambda b, t: share(b, "d5s01", t), None))
+        if "d1s02" in cases:
+            rows.append(("peak RSS, d=1", 100, "MiB", lambda b, t: get(b, "d1s02", "peak_rss_mib", t), None))
 
-    print("| case | today (d0d1d93) | new | target | met | new, 1 thread | 1 -> 2 threads | authors' code |")
-    print("|---|---|---|---|---|---|---|---|")
-    for label, target, unit, value, case in rows:
-        now, new, one = value("today", 2), value("new", 2), value("new", 1)
-        met = "" if new is None else ("yes" if new <= target else "no")
-        scal = "" if unit in ("%", "MiB") or not new or not one else f"{one / new:.2f}x"
-        authors = ""
-        if case in AUTHORS_S and new:
-            authors = f"{AUTHORS_S[case]} s ({AUTHORS_S[case] / new:.0f}x)"
-        one_txt = fmt(one, unit) if unit not in ("MiB",) else ""
-        print(f"| {label} | {fmt(now, unit)} | {fmt(new, unit)} | <= {fmt(target, unit)} | {met} | {one_txt} | "
-              f"{scal} | {authors} |")
-    for name, w in (("", warm.get(2)), (", EM capped at 6", warm6.get(2))):
-        if w:
-            print(f"\nWarm start quality{name} (00001, same run): mean log-likelihood warm {w['ll_warm']:.3f} vs "
-                  f"cold {w['ll_cold']:.3f} nats/point; PSNR warm {w['psnr_warm']:.2f} vs cold {w['psnr_cold']:.2f} "
-                  f"dB; M {w['m_warm']} vs {w['m_cold']} (kept {w['kept']}, removed {w['removed']}, added "
-                  f"{w['added']}); EM iterations {w['iter_warm']} vs {w['iter_cold']}; cold fit of 00001 "
-                  f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
+        print("| case | today (d0d1d93) | new | target | met | new, 1 thread | 1 -> 2 threads | authors' code |")
+        print("|---|---|---|---|---|---|---|---|")
+        for label, target, unit, value, case in rows:
+            now, new, one = value("today", 2), value("new", 2), value("new", 1)
+            met = "" if new is None else ("yes" if new <= target else "no")
+            scal = "" if unit in ("%", "MiB") or not new or not one else f"{one / new:.2f}x"
+            authors = ""
+            if case in AUTHORS_S and new:
+                authors = f"{AUTHORS_S[case]} s ({AUTHORS_S[case] / new:.0f}x)"
+            one_txt = fmt(one, unit) if unit not in ("MiB",) else ""
+            print(f"| {label} | {fmt(now, unit)} | {fmt(new, unit)} | <= {fmt(target, unit)} | {met} | {one_txt} | "
+                  f"{scal} | {authors} |")
+        for name, w in (("", warm.get(2)), (", EM capped at 6", warm6.get(2))):
+            if w:
+                print(f"\nWarm start quality{name} (00001, same run): mean log-likelihood warm {w['ll_warm']:.3f} vs "
+                      f"cold {w['ll_cold']:.3f} nats/point; PSNR warm {w['psnr_warm']:.2f} vs cold {w['psnr_cold']:.2f} "
+                      f"dB; M {w['m_warm']} vs {w['m_cold']} (kept {w['kept']}, removed {w['removed']}, added "
+                      f"{w['added']}); EM iterations {w['iter_warm']} vs {w['iter_cold']}; cold fit of 00001 "
+                      f"{w['s_cold']:.3f} s, warm/cold time {w['s_warm'] / w['s_cold']:.2f}.")
 
-    print_scaling(rows, cases, get)
-    print_team_split(rows, get, corun)
+        print_scaling(rows, cases, get)
+        print_team_split(rows, get, corun)
 
-    print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
-    for case in cases:
-        peak = get("new", case, "peak_pairs_per_s")
-        n, m = get("new", case, "n"), get("new", case, "m")
-        em_pairs = n * m * get("new", case, "em_iterations") * get("new", case, "pair_fraction")
-        parts = [f"EM {em_pairs / get('new', case, 's_em'):.3g} ({100 * em_pairs / get('new', case, 's_em') / peak:.0f}%)",
-                 f"regress {n * m / get('new', case, 's_regress'):.3g} ({100 * n * m / get('new', case, 's_regress') / peak:.0f}%)",
-                 f"score {n * m / get('new', case, 's_score'):.3g} ({100 * n * m / get('new', case, 's_score') / peak:.0f}%)"]
-        total = get("new", case, "s_total_fit")
-        print(f"- {case} (N {int(n)}, M {int(m)}): peak {peak:.3g} pairs/s; " + ", ".join(parts) +
-              f"; mode count {100 * get('new', case, 's_mode_count') / total:.0f}% and seeding "
-              f"{100 * get('new', case, 's_seeding') / total:.0f}% of the fit (not pair work)")
+        print("\nRoofline (new build, 2 threads): pairs/s achieved against the EM kernel's measured peak")
+        for case in cases:
+            peak = get("new", case, "peak_pairs_per_s")
+            n, m = get("new", case, "n"), get("new", case, "m")
+            em_pairs = n * m * get("new", case, "em_iterations") * get("new", case, "pair_fraction")
+            parts = [f"EM {em_pairs / get('new', case, 's_em'):.3g} ({100 * em_pairs / get('new', case, 's_em') / peak:.0f}%)",
+                     f"regress {n * m / get('new', case, 's_regress'):.3g} ({100 * n * m / get('new', case, 's_regress') / peak:.0f}%)",
+                     f"score {n * m / get('new', case, 's_score'):.3g} ({100 * n * m / get('new', case, 's_score') / peak:.0f}%)"]
+            total = get("new", case, "s_total_fit")
+            print(f"- {case} (N {int(n)}, M {int(m)}): peak {peak:.3g} pairs/s; " + ", ".join(parts) +
+                  f"; mode count {100 * get('new', case, 's_mode_count') / total:.0f}% and seeding "
+                  f"{100 * get('new', case, 's_seeding') / total:.0f}% of the fit (not pair work)")
 
+    sys.stdout.write(report.getvalue())
+    if a.update_readme:
+        update_readme(report.getvalue(), a.baseline_root, a.runs)
 
 if __name__ == "__main__":
     main()
