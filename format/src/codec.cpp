@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include <zstd.h>
+#include "zstd_contexts.hpp"
 
 #include "container.hpp"
 
@@ -33,13 +33,11 @@ std::vector<std::uint8_t> split_streams(const std::vector<std::uint8_t>& in, std
   return out;
 }
 
-struct CCtxDeleter {
-  void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
-};
 void append_frame(std::vector<std::uint8_t>& out, ZSTD_CCtx* cctx, const std::uint8_t* src, std::size_t size) {
   const std::size_t pos = out.size();
   out.resize(pos + ZSTD_compressBound(size));
   const std::size_t n = ZSTD_compress2(cctx, out.data() + pos, out.size() - pos, src, size);
+  throw_if_out_of_memory(n);
   if (ZSTD_isError(n)) throw Error(ErrorCode::Format, std::string("zstd compression failed: ") + ZSTD_getErrorName(n));
   out.resize(pos + n);
 }
@@ -53,8 +51,7 @@ std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonica
   if (e.filter == kFilterByteStreamSplit) bytes = split_streams(bytes, shape.width);
   if (e.codec == kCodecNone) return bytes;
 
-  std::unique_ptr<ZSTD_CCtx, CCtxDeleter> cctx(ZSTD_createCCtx());
-  if (!cctx) throw std::bad_alloc();
+  const CCtx cctx = new_cctx();
   if (zstd_level < 1) zstd_level = 1;
   if (zstd_level > ZSTD_maxCLevel()) zstd_level = ZSTD_maxCLevel();
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, zstd_level);

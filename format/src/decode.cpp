@@ -2,9 +2,9 @@
 // join and transpose -> canonical bytes, without intermediate copies.
 #include "decode.hpp"
 
-#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_d_stableOutBuffer: decode into our buffer, no window copy
-#include <zstd.h>
-#include <zstd_errors.h>
+// zstd_contexts.hpp defines ZSTD_STATIC_LINKING_ONLY, which also gives
+// ZSTD_d_stableOutBuffer: decode into our buffer, no window copy.
+#include "zstd_contexts.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -139,10 +139,6 @@ class Scatter {
   std::uint64_t index_ = 0, row_ = 0, col_ = 0, byte_ = 0;  // position of the next stored byte
 };
 
-struct DCtxDeleter {
-  void operator()(ZSTD_DCtx* d) const { ZSTD_freeDCtx(d); }
-};
-
 std::string zstd_error(int frame, std::size_t code) {
   return "frame " + std::to_string(frame) + ": " + ZSTD_getErrorName(code) +
          (ZSTD_getErrorCode(code) == ZSTD_error_dstSize_tooSmall ? " (decodes to more than declared)" : "");
@@ -167,6 +163,7 @@ void decode_frame(ZSTD_DCtx* dctx, StoredBytes& in, ZSTD_outBuffer& ob, int fram
     ZSTD_inBuffer ib{in.data(), in.available(), 0};
     const std::size_t before = ob.pos;
     hint = ZSTD_decompressStream(dctx, &ob, &ib);
+    throw_if_out_of_memory(hint);
     if (ZSTD_isError(hint)) bad(zstd_error(frame, hint));
     in.consume(ib.pos);
     const bool progress = ib.pos > 0 || ob.pos > before;
@@ -269,8 +266,7 @@ class FrameWalker {
 };
 
 void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint64_t expected) {
-  std::unique_ptr<ZSTD_DCtx, DCtxDeleter> dctx(ZSTD_createDCtx());
-  if (!dctx) throw std::bad_alloc();
+  const DCtx dctx = new_dctx();
   // Frames are decoded either into a buffer that holds the whole frame and
   // serves as its window (stable output), or, when the layout needs staging
   // and the frame's window is smaller than its content, streamed through a

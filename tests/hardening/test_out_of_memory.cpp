@@ -15,11 +15,14 @@
 //   SOGMM_OPT_THREADS' range) under an 8 GiB limit, where libgomp used to end
 //   the process ("Thread creation failed"). Skipped under sanitizers, which
 //   reserve terabytes of address space.
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_estimateDCtxSize
 #include <gtest/gtest.h>
 #include <malloc.h>
+#include <zstd.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -242,6 +245,61 @@ TEST_F(OutOfMemory, SaveAndLoadReportNomemForEveryFailedAllocation) {
     return expect_model_or_nothing(
         [&](sogmm_model** out) { return sogmm_model_load_from_memory(out, saved.data(), saved.size(), nullptr); });
   });
+}
+
+// zstd's allocations are the library's too (format/src/zstd_contexts.hpp):
+// loading a zstd-compressed file takes zstd's decompression context through
+// operator new (before, zstd took it from malloc, unseen by the sweeps), and
+// every allocation of a zstd save or load failing is out of memory, not a
+// corrupt file. The model is made compressible (equal covariances, weights
+// and a regular grid of means) so that the writer keeps zstd for its arrays.
+TEST_F(OutOfMemory, ZstdAllocationFailuresAreOutOfMemory) {
+  const std::size_t m = 256;
+  std::vector<float> w(m, 1.0f / m), mu(4 * m), cov(16 * m, 0.0f);
+  for (std::size_t k = 0; k < m; ++k) {
+    for (int i = 0; i < 4; ++i) mu[4 * k + i] = static_cast<float>((k >> (2 * i)) % 4);
+    for (int i = 0; i < 4; ++i) cov[16 * k + 5 * i] = 0.25f;
+  }
+  sogmm_model* model = nullptr;
+  ASSERT_EQ(sogmm_model_from_arrays_f32(&model, m, w.data(), mu.data(), cov.data(), 1000), SOGMM_OK)
+      << sogmm_last_error();
+  std::vector<std::uint8_t> files[2];  // raw, zstd
+  for (int compress : {0, 1}) {
+    sogmm_options* o = options({{SOGMM_OPT_COMPRESS, compress}});
+    sogmm_buffer* out = nullptr;
+    ASSERT_EQ(sogmm_model_save_to_memory(&out, model, o), SOGMM_OK) << sogmm_last_error();
+    files[compress].assign(sogmm_buffer_data(out), sogmm_buffer_data(out) + sogmm_buffer_size(out));
+    sogmm_buffer_free(out);
+    sogmm_options_free(o);
+  }
+  sweep("save with zstd", [&] {
+    sogmm_buffer* out = nullptr;
+    const sogmm_status s = sogmm_model_save_to_memory(&out, model, nullptr);
+    sogmm_buffer_free(out);
+    return s;
+  });
+  sogmm_model_free(model);
+  const std::uint8_t magic[4] = {0x28, 0xB5, 0x2F, 0xFD};  // a zstd frame, little-endian 0xFD2FB528
+  ASSERT_NE(std::search(files[1].begin(), files[1].end(), magic, magic + 4), files[1].end())
+      << "the compressed file holds no zstd frame";
+  ASSERT_LT(files[1].size(), files[0].size());
+  // The zstd load's peak through operator new holds zstd's own estimate of
+  // its decompression context (about 95 KiB; far above this small file and
+  // model, so only zstd's context reaches it).
+  const long long before = heap::live_bytes();
+  heap::reset_peak();
+  sogmm_model* loaded = nullptr;
+  ASSERT_EQ(sogmm_model_load_from_memory(&loaded, files[1].data(), files[1].size(), nullptr), SOGMM_OK);
+  sogmm_model_free(loaded);
+  EXPECT_GE(heap::peak_bytes() - before, static_cast<long long>(ZSTD_estimateDCtxSize()))
+      << "zstd's decompression context was not allocated through operator new";
+  for (int compress : {0, 1}) {
+    const std::vector<std::uint8_t>& f = files[compress];
+    sweep(compress ? "load of a zstd file" : "load of a raw file", [&] {
+      return expect_model_or_nothing(
+          [&](sogmm_model** out) { return sogmm_model_load_from_memory(out, f.data(), f.size(), nullptr); });
+    });
+  }
 }
 
 // A failed save leaves no temporary file: atomic_file.cpp once created it with
