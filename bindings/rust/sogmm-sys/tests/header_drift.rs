@@ -168,7 +168,8 @@ fn header_consts(header: &str) -> BTreeMap<String, String> {
         };
         let value = value.trim_start_matches('(').trim_end_matches(')');
         let digits = value.trim_start_matches('-');
-        let numeric = digits.chars().all(|c| c.is_ascii_digit() || c == '.') && digits.matches('.').count() <= 1
+        let numeric = digits.chars().all(|c| c.is_ascii_digit() || c == '.')
+            && digits.matches('.').count() <= 1
             && digits.chars().any(|c| c.is_ascii_digit());
         if name.starts_with("SOGMM_") && (numeric || value.starts_with('"')) {
             out.insert(name.to_string(), value.to_string());
