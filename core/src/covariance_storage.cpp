@@ -8,11 +8,11 @@
 #include <cstdlib>
 #include <limits>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
 #include "sogmm/checked.hpp"
+#include "sogmm/gmm.hpp"
 #include "sogmm/error.hpp"
 
 namespace sogmm::detail {
@@ -23,12 +23,16 @@ constexpr double kPlainRoundingNats = 1e-9;
 // Corners whose exact divergence is computed (see store_covariance.hpp).
 constexpr int kVerified = 8;
 
-// Cholesky factor of `c` as validate() accepts it, or false.
+// Cholesky factor of `c` by validate()'s own test (stored_cholesky), or
+// false: a candidate accepted by any other factorisation could be one that
+// the writer refuses.
 bool factor(const Mat4& c, Mat4& l) {
-  const Eigen::LLT<Mat4> llt(c);
-  if (llt.info() != Eigen::Success) return false;
-  l = llt.matrixL();
-  return l.diagonal().minCoeff() > 0.0;
+  using RowMajor4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+  const RowMajor4 a = c;
+  RowMajor4 f;
+  if (!stored_cholesky(a.data(), f.data())) return false;
+  l = f;
+  return true;
 }
 
 // KL(N(0, S) || N(0, C)) from the Cholesky factors of S and C.

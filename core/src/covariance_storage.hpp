@@ -6,8 +6,8 @@ namespace sogmm::detail {
 
 /// Writes the float32 covariance (row-major 4 x 4) that represents the
 /// symmetric positive definite double covariance `cov` best, and is positive
-/// definite itself (the test of validate(): a Cholesky factorisation in
-/// double of the stored values succeeds with a positive diagonal).
+/// definite itself by the library's one test, stored_cholesky (sogmm/gmm.hpp),
+/// which validate() and the file writer make too.
 ///
 /// Why: float32 keeps ~7 digits, so a thin component far larger than it is
 /// thick (a 1 km plane with 1 cm noise: eigenvalues 1e4 and 1e-4 m^2) loses

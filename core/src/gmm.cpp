@@ -4,7 +4,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "sogmm/checked.hpp"
@@ -53,17 +52,16 @@ std::string validation_error(const Gmm& gmm, double weight_tolerance) {
     }
     // Positive definite as stored in a file: the symmetric part, each entry
     // (a_ij + a_ji) / 2 rounded to float32, is what a reader returns and what
-    // the writer checks (spec/format.md 5.1), so a model that passes here can
-    // always be saved. Eigen's LLT reads only the lower triangle: a matrix
-    // asymmetric within the tolerance above could pass on its lower triangle
+    // the writer checks (spec/format.md 5.1), with the same test, so a model
+    // that passes here can always be saved. The lower triangle alone is not
+    // enough: a matrix asymmetric within the tolerance above could pass on it
     // while its symmetric part is not positive definite (found by fuzz_api:
     // c22 = 4.7e-41, c23 = 2.6e-9, c32 = 0). For a symmetric matrix, every
     // model the library makes, the symmetric part is the matrix itself.
-    Eigen::Matrix4d sym;
+    double sym[16];
     for (int r = 0; r < 4; ++r)
-      for (int q = 0; q < 4; ++q) sym(r, q) = static_cast<float>((c(r, q) + c(q, r)) / 2.0);
-    Eigen::LLT<Eigen::Matrix4d> llt(sym);
-    if (llt.info() != Eigen::Success || !(llt.matrixL().toDenseMatrix().diagonal().minCoeff() > 0.0)) {
+      for (int q = 0; q < 4; ++q) sym[r * 4 + q] = static_cast<float>((c(r, q) + c(q, r)) / 2.0);
+    if (!stored_cholesky(sym)) {
       msg << "component " << k << " has a covariance that is not positive definite";
       return msg.str();
     }

@@ -1,5 +1,5 @@
 // A Gmm's components as Eigen matrices in double, and a checked Cholesky
-// factorisation (private to the core: inference.cpp and query.cpp).
+// factorisation (private to the core: inference.cpp, query.cpp, point_scores.cpp).
 #pragma once
 
 #include <cstddef>
@@ -20,6 +20,21 @@ inline Eigen::Matrix4d covariance_of(const Gmm& gmm, std::size_t k) {
 /// Component k's mean, in double.
 inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
   return Eigen::Map<const Eigen::Vector4f>(gmm.mean(k)).cast<double>();
+}
+
+/// Component k's Cholesky factor L (covariance = L L^T) by the test validate()
+/// makes (stored_cholesky): every valid model can be scored, sampled and
+/// queried, even one whose nearly singular covariance another factorisation
+/// would round to a zero pivot. Its top-left 3 x 3 block is the factor of the
+/// spatial covariance (the same arithmetic on the same entries). Throws
+/// Error(Numeric) for a model that was never validated and is not positive
+/// definite.
+inline Eigen::Matrix4d cholesky_of(const Gmm& gmm, std::size_t k) {
+  double a[16], l[16];
+  for (int i = 0; i < 16; ++i) a[i] = gmm.covariance(k)[i];
+  if (!stored_cholesky(a, l))
+    throw Error(ErrorCode::Numeric, "covariance of component " + std::to_string(k) + " is not positive definite");
+  return Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(l);
 }
 
 /// The Cholesky factorisation of a covariance (or a block of one), checked:

@@ -7,7 +7,6 @@
 #include <limits>
 #include <string>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/LU>
 
@@ -27,7 +26,6 @@ using Mat3 = Eigen::Matrix3d;
 using detail::covariance_of;
 using detail::mean_of;
 
-using detail::checked_llt;
 
 // Draws between progress reports.
 constexpr std::size_t kPointsPerChunk = 64;
@@ -57,7 +55,7 @@ void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* 
   std::size_t row = 0;
   for (std::size_t k = 0; k < m; ++k) {
     if (counts[k] == 0) continue;
-    const Mat4 l = checked_llt(covariance_of(gmm, k), "covariance", k).matrixL();
+    const Mat4 l = detail::cholesky_of(gmm, k);
     const Eigen::Vector4d mu = mean_of(gmm, k);
     for (std::size_t j = 0; j < counts[k]; ++j, ++row) {
       if (row % kPointsPerChunk == 0) detail::progress_at(row);

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include <Eigen/Cholesky>
+#include "gmm_eigen.hpp"
 #include <Eigen/Core>
 
 #include "em_kernel.hpp"
@@ -22,9 +22,7 @@ constexpr std::size_t kChunks = 16;  // fixed: the reduction order never depends
 
 // Component k in the kernels' packed layout (em_kernel.hpp), mean relative to `origin`.
 void pack(const Gmm& gmm, std::size_t k, const double* origin, float* out) {
-  const Eigen::Matrix4d cov =
-      Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
-  const Eigen::Matrix4d l = Eigen::LLT<Eigen::Matrix4d>(cov).matrixL();
+  const Eigen::Matrix4d l = cholesky_of(gmm, k);
   const Eigen::Matrix4d u = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d::Identity()).transpose();
   for (int i = 0; i < 4; ++i) out[i] = static_cast<float>(static_cast<double>(gmm.mean(k)[i]) - origin[i]);
   int t = 4;

@@ -107,17 +107,18 @@ std::vector<double> pack_model(const Gmm& gmm, int dims, bool background, int th
   detail::parallel_for(m, detail::team_size(threads), 64, [&](std::size_t k, int) {
     double* out = &params[k * kQueryStride];
     const Mat4 c = covariance_of(gmm, k);
+    const Mat4 l = detail::cholesky_of(gmm, k);
     const double lw = log_weight(gmm.weights[k]);
     if (dims == 4) {
-      pack_density<4>(mean_of(gmm, k), checked_llt(c, "covariance", k).matrixL(), lw, out);
+      pack_density<4>(mean_of(gmm, k), l, lw, out);
       return;
     }
-    const Mat3 sxx = c.topLeftCorner<3, 3>();
-    const Eigen::LLT<Mat3> llt = checked_llt(sxx, "spatial covariance", k);
-    out = pack_density<3>(mean_of(gmm, k).head<3>(), llt.matrixL(), lw, out);
+    const Mat3 lxx = l.topLeftCorner<3, 3>();  // the spatial covariance's factor
+    out = pack_density<3>(mean_of(gmm, k).head<3>(), lxx, lw, out);
     // Gain A = Sigma_gx Sigma_xx^-1 and conditional variance Sigma_gg - A Sigma_xg.
     const Eigen::Vector3d sxg = c.topRightCorner<3, 1>();
-    const Eigen::Vector3d gain = llt.solve(sxg);
+    const Eigen::Vector3d gain =
+        lxx.transpose().triangularView<Eigen::Upper>().solve(lxx.triangularView<Eigen::Lower>().solve(sxg));
     for (int i = 0; i < 3; ++i) *out++ = gain[i];
     *out++ = gmm.mean(k)[3];
     *out++ = std::max(0.0, c(3, 3) - gain.dot(sxg));

@@ -7,12 +7,24 @@
 #include <cstdlib>
 #include <cstring>
 
-#define FUZZ_CHECK(cond)                                                          \
-  do {                                                                            \
-    if (!(cond)) {                                                                \
+// Targets built on the C API (its header on their include path) also print the
+// library's last message: a CI log then says why a call failed (which check
+// refused a fitted model, say) without the input at hand. The format-only
+// targets have no such message.
+#if __has_include("sogmm/sogmm.h")
+#include "sogmm/sogmm.h"
+#define FUZZ_PRINT_LAST_ERROR() std::fprintf(stderr, "last sogmm error on this thread: %s\n", sogmm_last_error())
+#else
+#define FUZZ_PRINT_LAST_ERROR() ((void)0)
+#endif
+
+#define FUZZ_CHECK(cond)                                                                  \
+  do {                                                                                    \
+    if (!(cond)) {                                                                        \
       std::fprintf(stderr, "%s:%d: invariant violated: %s\n", __FILE__, __LINE__, #cond); \
-      std::abort();                                                               \
-    }                                                                             \
+      FUZZ_PRINT_LAST_ERROR();                                                            \
+      std::abort();                                                                       \
+    }                                                                                     \
   } while (0)
 
 namespace sogmm_fuzz {

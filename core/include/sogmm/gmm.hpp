@@ -36,11 +36,24 @@ struct Gmm {
   }
 };
 
+/// The library's one positive-definiteness test of a 4 x 4 covariance, step
+/// 19d of spec/format.md exactly: a Cholesky-Banachiewicz factorisation in
+/// binary64 of the lower triangle of `a` (row-major; the upper triangle is not
+/// read), sums in increasing k, no fused multiply-add; true when every pivot is
+/// > 0. validate(), the fit's rounding to float32 and the file reader and
+/// writer all use it: two factorisations that round their sums differently
+/// (Eigen's LLT against this one) disagree about a few nearly singular
+/// matrices, and the fit once handed out a model that the writer then refused
+/// (found by fuzz_fit). When `l` is not null and the test passes, it receives
+/// the factor L (row-major, zero above the diagonal; a = L L^T).
+bool stored_cholesky(const double* a, double* l = nullptr);
+
 /// Checks the invariants of a model: M >= 1, array lengths agree with M, all
 /// values finite, weights >= 0 summing to 1 within `weight_tolerance`, every
-/// covariance symmetric (relative 1e-5) and positive definite (Cholesky in
-/// double succeeds). Throws Error(InvalidData or Numeric) naming the first
-/// violation (component index and what is wrong).
+/// covariance symmetric (relative 1e-5) and positive definite (stored_cholesky
+/// of its symmetric part rounded to float32, which is what a file holds).
+/// Throws Error(InvalidData or Numeric) naming the first violation (component
+/// index and what is wrong).
 void validate(const Gmm& gmm, double weight_tolerance = 1e-4);
 
 /// Same checks, returning an empty string when valid and the message otherwise.
