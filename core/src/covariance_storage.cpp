@@ -22,6 +22,9 @@ using Mat4 = Eigen::Matrix4d;
 constexpr double kPlainRoundingNats = 1e-9;
 // Corners whose exact divergence is computed (see store_covariance.hpp).
 constexpr int kVerified = 8;
+// Row and column of the 10 distinct entries of a symmetric 4 x 4 matrix.
+constexpr int kRow[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 3};
+constexpr int kCol[10] = {0, 1, 2, 3, 1, 2, 3, 2, 3, 3};
 
 // Cholesky factor of `c` by validate()'s own test (stored_cholesky), or
 // false: a candidate accepted by any other factorisation could be one that
@@ -42,25 +45,38 @@ double divergence(const Mat4& ls, const Mat4& lc) {
   return 0.5 * (w.squaredNorm() - 4.0 + log_det_ratio);
 }
 
-// The second-order divergence of rounding errors E (symmetric; the 10
-// distinct entries' errors `delta`) from the target S, with P = S^-1:
-// KL(N(0, S) || N(0, S + E)) = tr(P E P E) / 4 + O(E^3). Costs no
-// factorisation, so all 1024 corners can be ranked by it.
-double proxy(const Mat4& p, const double* delta) {
-  static constexpr int kRow[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 3};
-  static constexpr int kCol[10] = {0, 1, 2, 3, 1, 2, 3, 2, 3, 3};
-  Mat4 e;
-  for (int k = 0; k < 10; ++k) e(kRow[k], kCol[k]) = e(kCol[k], kRow[k]) = delta[k];
-  const Mat4 m = p * e;
-  return 0.25 * (m * m).trace();
-}
-
+// The second-order divergence of rounding errors E (symmetric) from the
+// target S, with P = S^-1: KL(N(0, S) || N(0, S + E)) = tr(P E P E) / 4 +
+// O(E^3). Written in the 10 distinct entries' errors delta (E = sum_a
+// delta_a B_a, B_a the symmetric unit matrix of entry a), it is the quadratic
+// form delta^T G delta / 4 with G_ab = tr(P B_a P B_b). So the 1024 corners
+// can be ranked without a factorisation, at a few operations each along a
+// Gray code (one entry flips per step); evaluating tr(P E P E) with two 4 x 4
+// products per corner made this ranking most of a fit of tiny clouds.
+struct Proxy {
+  double g[10][10];
+  explicit Proxy(const Mat4& p) {
+    for (int a = 0; a < 10; ++a) {
+      for (int b = 0; b < 10; ++b) {
+        // tr(P (e_i e_j^T) P (e_k e_l^T)) = P_jk P_li, summed over the one or
+        // two (row, column) positions of each entry.
+        double sum = 0.0;
+        for (int ta = 0; ta < (kRow[a] == kCol[a] ? 1 : 2); ++ta) {
+          const int i = ta ? kCol[a] : kRow[a], j = ta ? kRow[a] : kCol[a];
+          for (int tb = 0; tb < (kRow[b] == kCol[b] ? 1 : 2); ++tb) {
+            const int k = tb ? kCol[b] : kRow[b], l = tb ? kRow[b] : kCol[b];
+            sum += p(j, k) * p(l, i);
+          }
+        }
+        g[a][b] = sum;
+      }
+    }
+  }
+};
 // Steps 1-2 of store_covariance for one target; returns the divergence of the
 // best positive definite candidate written to `out`, or infinity. At most
 // 1 + kVerified factorisations (`factorisations` counts them).
 double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisations) {
-  static constexpr int kRow[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 3};
-  static constexpr int kCol[10] = {0, 1, 2, 3, 1, 2, 3, 2, 3, 3};
   float nearest[10], down[10], up[10];
   for (int e = 0; e < 10; ++e) {
     const double v = s(kRow[e], kCol[e]);
@@ -89,13 +105,37 @@ double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisati
   // Rank the 1024 corners (each entry rounded down or up) by the proxy, then
   // factor only the kVerified best: the exact divergence decides among them.
   const Mat4 li = ls.triangularView<Eigen::Lower>().solve(Mat4::Identity());
-  const Mat4 p = li.transpose() * li;
+  const Proxy proxy(li.transpose() * li);
+  // Corner 0 (every entry rounded down), then the Gray code: step i flips
+  // entry e, the lowest set bit of i; v = G delta follows each flip by one column of G, and
+  // q = delta . v is recomputed from the exact delta (the proxy of a nearly
+  // singular target is a small difference of large terms: updating q itself
+  // drifted by 6e-5 relative over the 1024 steps, this by 8e-6, about what
+  // separates two exact evaluation orders).
+  double delta[10], v[10], q = 0.0;
+  for (int e = 0; e < 10; ++e) delta[e] = static_cast<double>(down[e]) - s(kRow[e], kCol[e]);
+  for (int a = 0; a < 10; ++a) {
+    v[a] = 0.0;
+    for (int b = 0; b < 10; ++b) v[a] += proxy.g[a][b] * delta[b];
+    q += delta[a] * v[a];
+  }
   std::array<std::pair<double, int>, 1024> ranked;
-  double delta[10];
-  for (int mask = 0; mask < 1024; ++mask) {
-    for (int e = 0; e < 10; ++e)
-      delta[e] = static_cast<double>((mask >> e & 1) ? up[e] : down[e]) - s(kRow[e], kCol[e]);
-    ranked[static_cast<std::size_t>(mask)] = {proxy(p, delta), mask};
+  ranked[0] = {0.25 * q, 0};
+  int mask = 0;
+  for (int i = 1; i < 1024; ++i) {
+    // The lowest set bit of i (a loop, not __builtin_ctz: GCC emits tzcnt
+    // for it, which tools/wheel/check_isa.sh rightly flags outside the kernels).
+    int e = 0;
+    while (!(i >> e & 1)) ++e;
+    mask ^= 1 << e;
+    const double t = (mask >> e & 1) ? static_cast<double>(up[e]) - down[e] : static_cast<double>(down[e]) - up[e];
+    delta[e] = static_cast<double>((mask >> e & 1) ? up[e] : down[e]) - s(kRow[e], kCol[e]);
+    q = 0.0;
+    for (int f = 0; f < 10; ++f) {
+      v[f] += t * proxy.g[f][e];
+      q += delta[f] * v[f];
+    }
+    ranked[static_cast<std::size_t>(i)] = {0.25 * q, mask};
   }
   // Ties go to the lower mask, so the choice is deterministic.
   std::partial_sort(ranked.begin(), ranked.begin() + kVerified, ranked.end());
