@@ -107,7 +107,7 @@ double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisati
   const Mat4 li = ls.triangularView<Eigen::Lower>().solve(Mat4::Identity());
   const Proxy proxy(li.transpose() * li);
   // Corner 0 (every entry rounded down), then the Gray code: step i flips
-  // entry ctz(i); v = G delta follows each flip by one column of G, and
+  // entry e, the lowest set bit of i; v = G delta follows each flip by one column of G, and
   // q = delta . v is recomputed from the exact delta (the proxy of a nearly
   // singular target is a small difference of large terms: updating q itself
   // drifted by 6e-5 relative over the 1024 steps, this by 8e-6, about what
@@ -123,7 +123,10 @@ double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisati
   ranked[0] = {0.25 * q, 0};
   int mask = 0;
   for (int i = 1; i < 1024; ++i) {
-    const int e = __builtin_ctz(static_cast<unsigned>(i));
+    // The lowest set bit of i (a loop, not __builtin_ctz: GCC emits tzcnt
+    // for it, which tools/wheel/check_isa.sh rightly flags outside the kernels).
+    int e = 0;
+    while (!(i >> e & 1)) ++e;
     mask ^= 1 << e;
     const double t = (mask >> e & 1) ? static_cast<double>(up[e]) - down[e] : static_cast<double>(down[e]) - up[e];
     delta[e] = static_cast<double>((mask >> e & 1) ? up[e] : down[e]) - s(kRow[e], kCol[e]);
