@@ -21,7 +21,8 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
   f.n_init = static_cast<int>(o.n_init);
   f.dequantise_depth = o.dequantise_depth != 0;
   f.em.tol = o.tol;
-  f.em.reg_covar = o.reg_covar;
+  // SOGMM_REG_COVAR_AUTO (the default) leaves it unset: floors from the data.
+  if (o.reg_covar != SOGMM_REG_COVAR_AUTO) f.em.reg_covar = o.reg_covar;
   f.em.max_iter = static_cast<int>(o.max_iter);
   f.em.threads = static_cast<int>(o.threads);
   f.em.truncation_nats = o.truncation_nats;
@@ -66,7 +67,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   m.fit.bandwidth = k > 0 ? 0.0 : o.bandwidth;
   m.fit.n_components_requested = k;
   m.fit.tol = o.tol;
-  m.fit.reg_covar = o.reg_covar;
+  sogmm::record_reg_covar(m, r.em.reg_covar);
   m.fit.max_iter = static_cast<std::int32_t>(o.max_iter);
   m.fit.n_iter = r.em.iterations;
   m.fit.converged = r.em.converged;

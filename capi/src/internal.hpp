@@ -26,7 +26,7 @@ struct sogmm_options {
   double bandwidth = 0.02;
   std::int64_t n_components = 0;
   double tol = 1e-3;
-  double reg_covar = 1e-6;
+  double reg_covar = SOGMM_REG_COVAR_AUTO;  // or a value >= 0 (SOGMM_OPT_REG_COVAR)
   std::int64_t max_iter = 100;
   std::int64_t seed = 0;
   std::int64_t threads = 0;

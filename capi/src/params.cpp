@@ -91,8 +91,10 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
         break;
       case SOGMM_OPT_TOL: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       case SOGMM_OPT_REG_COVAR:
-        // Added to float32 covariances: must be a finite float32 itself.
-        check_f64(key, v, std::isfinite(static_cast<float>(v)) && v >= 0, ">= 0, finite in float32");
+        // Added to float32 covariances: must be a finite float32 itself;
+        // the sentinel SOGMM_REG_COVAR_AUTO (-1) restores the automatic floors.
+        check_f64(key, v, v == SOGMM_REG_COVAR_AUTO || (std::isfinite(static_cast<float>(v)) && v >= 0),
+                  ">= 0, finite in float32, or SOGMM_REG_COVAR_AUTO (-1)");
         break;
       case SOGMM_OPT_DEPTH_SCALE:
         // Depth is raw / scale, computed as raw * (1 / scale).

@@ -2,6 +2,7 @@
 #include "sogmm/em.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -32,11 +33,13 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
 
+// The regulariser per diagonal (x, y, z, gray).
+using RegDiagonal = std::array<double, 4>;
+RegDiagonal diagonal(const RegCovarFloors& f) { return {f.spatial, f.spatial, f.spatial, f.gray}; }
+
 void check_options(const EmOptions& o) {
   require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
           "EM tol must be finite and >= 0, got " + checked::exact(o.tol));
-  require(std::isfinite(o.reg_covar) && o.reg_covar >= 0, ErrorCode::InvalidArgument,
-          "EM reg_covar must be finite and >= 0, got " + checked::exact(o.reg_covar));
   require(o.max_iter >= 1, ErrorCode::InvalidArgument, "EM max_iter must be >= 1, got " + std::to_string(o.max_iter));
   require(o.threads >= 0, ErrorCode::InvalidArgument, "EM threads must be >= 0, got " + std::to_string(o.threads));
   require(std::isfinite(o.truncation_nats) && o.truncation_nats >= 0, ErrorCode::InvalidArgument,
@@ -295,39 +298,44 @@ bool pack_component(const Working& w, std::size_t k, float* out, double* exact) 
 
 // Makes component k's covariance numerically positive definite in double,
 // with escalating diagonal loading when it is not (reg_covar = 0 on a
-// degenerate component): first reg_covar or 1e-12 of the component's largest
-// variance (of the data's extent squared when it has none), then x10 up to
-// 12 times, so the loading follows the component's own scale.
-void make_positive_definite(Working& w, std::size_t k, double reg_covar, double data_scale2, float* packed,
+// degenerate component): first each diagonal's reg_covar or 1e-12 of the
+// component's largest variance (of the data's extent squared when it has
+// none), then x10 up to 12 times, so the loading follows the component's own
+// scale.
+void make_positive_definite(Working& w, std::size_t k, const RegDiagonal& reg, double data_scale2, float* packed,
                             double* exact) {
   double* c = &w.covariance[16 * k];
   double own = 0.0;
   for (int i = 0; i < 4; ++i) own = std::max(own, c[5 * i]);
-  double extra = std::max(reg_covar, 1e-12 * (own > 0.0 ? own : data_scale2));
+  RegDiagonal extra;
+  for (int i = 0; i < 4; ++i) extra[i] = std::max(reg[i], 1e-12 * (own > 0.0 ? own : data_scale2));
   int attempts = 0;
   while (!pack_component(w, k, packed, exact)) {
     require(++attempts <= 12, ErrorCode::Numeric,
             "EM: covariance of component " + std::to_string(k) + " is not positive definite; increase reg_covar");
-    for (int i = 0; i < 4; ++i) c[5 * i] += extra;
-    extra *= 10.0;
+    for (int i = 0; i < 4; ++i) {
+      c[5 * i] += extra[i];
+      extra[i] *= 10.0;
+    }
   }
 }
 
-void pack_all(Working& w, double reg_covar, double data_scale2, std::vector<float>& params, std::vector<double>& exact) {
+void pack_all(Working& w, const RegDiagonal& reg, double data_scale2, std::vector<float>& params,
+              std::vector<double>& exact) {
   params.assign(w.size() * kParamStride, 0.f);
   exact.assign(w.size() * kParamStride, 0.0);
   for (std::size_t k = 0; k < w.size(); ++k)
-    make_positive_definite(w, k, reg_covar, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
+    make_positive_definite(w, k, reg, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
 }
 
 // M-step for one component from its statistics, which are centred at the
 // mean the kernels used, `centre` (the packed float32 one, or the double one
 // for a flagged component); returns sum r + guard.
-double m_step_component(const double* st, double reg_covar, const double* centre, double* mean, double* cov) {
+double m_step_component(const double* st, const RegDiagonal& reg, const double* centre, double* mean, double* cov) {
   const double nk = st[0] + kEmptyGuard;
   if (st[0] <= 0.0) {
     // No point is responsible: keep the mean, reset the shape to the regulariser.
-    for (int i = 0; i < 16; ++i) cov[i] = (i % 5 == 0) ? reg_covar : 0.0;
+    for (int i = 0; i < 16; ++i) cov[i] = (i % 5 == 0) ? reg[i / 5] : 0.0;
     return nk;
   }
   double delta[4];
@@ -338,7 +346,7 @@ double m_step_component(const double* st, double reg_covar, const double* centre
   for (int i = 0; i < 4; ++i) {
     for (int j = i; j < 4; ++j) {
       double c = st[t++] / nk - 2.0 * delta[i] * delta[j] + shrink * delta[i] * delta[j];
-      if (i == j) c += reg_covar;
+      if (i == j) c += reg[i];
       cov[4 * i + j] = cov[4 * j + i] = c;
     }
   }
@@ -348,7 +356,7 @@ double m_step_component(const double* st, double reg_covar, const double* centre
 
 // The model handed out: means moved back from the frame, covariances checked
 // in double and rounded to float32 so that they stay positive definite.
-Gmm to_model(Working& w, const Frame& frame, double reg_covar, std::size_t n) {
+Gmm to_model(Working& w, const Frame& frame, const RegDiagonal& reg, std::size_t n) {
   const std::size_t m = w.size();
   Gmm gmm;
   gmm.resize(m);
@@ -359,7 +367,7 @@ Gmm to_model(Working& w, const Frame& frame, double reg_covar, std::size_t n) {
   double sum = 0.0;
   for (std::size_t k = 0; k < m; ++k) sum += std::exp(w.log_weight[k] - max_lw);
   for (std::size_t k = 0; k < m; ++k) {
-    make_positive_definite(w, k, reg_covar, frame.extent * frame.extent, packed.data(), exact.data());
+    make_positive_definite(w, k, reg, frame.extent * frame.extent, packed.data(), exact.data());
     detail::store_covariance(&w.covariance[16 * k], &gmm.covariances[16 * k]);
     for (int i = 0; i < 4; ++i) gmm.means[4 * k + i] = static_cast<float>(frame.origin[i] + w.mean[4 * k + i]);
     gmm.weights[k] = static_cast<float>(std::exp(w.log_weight[k] - max_lw) / sum);
@@ -368,8 +376,9 @@ Gmm to_model(Working& w, const Frame& frame, double reg_covar, std::size_t n) {
   return gmm;
 }
 
-Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOptions& options, EmReport* report,
-           const EmIterationCallback& on_iteration) {
+Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCovarFloors& floors,
+           const EmOptions& options, EmReport* report, const EmIterationCallback& on_iteration) {
+  const RegDiagonal reg = diagonal(floors);
   const std::size_t n = points.size, m = w.size();
   const bool truncated = options.truncation_nats > 0;
   const double data_scale2 = frame.extent * frame.extent;
@@ -406,7 +415,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
   double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
   // The first model's kernel parameters; each iteration packs the next.
-  pack_all(w, options.reg_covar, data_scale2, params, exact);
+  pack_all(w, reg, data_scale2, params, exact);
   std::vector<float> next_params;
   std::vector<double> next_exact;
   for (int iter = 1; iter <= options.max_iter; ++iter) {
@@ -478,7 +487,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
         const float* packed = &params[k * kParamStride];
         double centre[4];
         for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
-        nk[k] = m_step_component(&stats[k * kStatStride], options.reg_covar, centre, &w.mean[4 * k], &w.covariance[16 * k]);
+        nk[k] = m_step_component(&stats[k * kStatStride], reg, centre, &w.mean[4 * k], &w.covariance[16 * k]);
         if (!options.quantisation.empty()) {
           double mean[4];
           for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
@@ -496,7 +505,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
       // components evaluated in double (e.g. the first step of a large
       // scene, from point-sized seeds; never on the shared room-sized
       // frames, whose components stay below a third of the threshold).
-      pack_all(w, options.reg_covar, data_scale2, next_params, next_exact);
+      pack_all(w, reg, data_scale2, next_params, next_exact);
       promoted = false;
       for (std::size_t k = 0; k < m; ++k)
         if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {
@@ -518,9 +527,10 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const EmOpti
     previous = mean_ll;
   }
   rep.kernel = kernels.isa;
+  rep.reg_covar = floors;
   rep.pair_fraction = pairs_evaluated / (static_cast<double>(n) * m * rep.iterations);
   if (report) *report = rep;
-  return to_model(w, frame, options.reg_covar, n);
+  return to_model(w, frame, reg, n);
 }
 
 }  // namespace
@@ -532,6 +542,8 @@ Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indice
   const std::size_t m = seed_indices.size();
   require(m >= 1 && m <= points.size, ErrorCode::InvalidArgument,
           "number of components must be in [1, N = " + std::to_string(points.size) + "], got " + std::to_string(m));
+  const RegCovarFloors floors = resolve_reg_covar(points, options.reg_covar);
+  const RegDiagonal reg = diagonal(floors);
   const Frame frame(points);
   Working w;
   w.mean.resize(4 * m);
@@ -544,9 +556,9 @@ Gmm fit_em(const PointsView& points, const std::vector<std::size_t>& seed_indice
     require(seed_indices[k] < points.size, ErrorCode::InvalidArgument,
             "seed index " + std::to_string(seed_indices[k]) + " is out of range");
     for (int i = 0; i < 4; ++i) w.mean[4 * k + i] = static_cast<double>(points[seed_indices[k]][i]) - frame.origin[i];
-    for (int i = 0; i < 4; ++i) w.covariance[16 * k + 5 * i] = options.reg_covar;
+    for (int i = 0; i < 4; ++i) w.covariance[16 * k + 5 * i] = reg[i];
   }
-  return run_em(points, std::move(w), frame, options, report, on_iteration);
+  return run_em(points, std::move(w), frame, floors, options, report, on_iteration);
 }
 
 Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& options, EmReport* report,
@@ -554,6 +566,7 @@ Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& o
   check_options(options);
   require_finite_points(points, "EM input");
   validate(initial);
+  const RegCovarFloors floors = resolve_reg_covar(points, options.reg_covar);
   const Frame frame(points);
   const std::size_t m = initial.size();
   Working w;
@@ -564,7 +577,7 @@ Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& o
     for (int i = 0; i < 4; ++i) w.mean[4 * k + i] = static_cast<double>(initial.mean(k)[i]) - frame.origin[i];
     w.log_weight[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
   }
-  return run_em(points, std::move(w), frame, options, report, on_iteration);
+  return run_em(points, std::move(w), frame, floors, options, report, on_iteration);
 }
 
 }  // namespace sogmm

@@ -274,7 +274,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   batch.fit.bandwidth = fo.n_components > 0 ? 0.0 : fo.bandwidth;
   batch.fit.n_components_requested = fo.n_components;
   batch.fit.tol = fo.em.tol;
-  batch.fit.reg_covar = fo.em.reg_covar;
+  record_reg_covar(batch, r.em.reg_covar);
   batch.fit.max_iter = fo.em.max_iter;
   batch.fit.n_iter = r.em.iterations;
   batch.fit.converged = r.em.converged;

@@ -54,8 +54,9 @@ void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
 
 // New components from k-means++ seeds among the novel points: one hard
 // k-means assignment (each point to its nearest seed), then per cluster its
-// mean, its per-coordinate variance + reg_covar on a diagonal covariance and
-// its size as weight. A cold start's needles (reg_covar I, one point each)
+// mean, its per-coordinate variance + the reg_covar floor of that coordinate
+// on a diagonal covariance and its size as weight. A cold start's needles
+// (the floors on the diagonal, one point each)
 // would lose every novel point in the first E-step to the least distant kept
 // component, which then stretches over the new surface; a diagonal covariance
 // is positive definite in float32 whatever the cluster's shape.
@@ -63,7 +64,8 @@ void append_component(Gmm& to, const Gmm& from, std::size_t k, double w) {
 // The nearest seeds (N x K distances, most of this function's work) are found
 // in parallel on `threads`; the sums then run serially in point order, so the
 // result does not depend on the team.
-Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, double reg_covar, int threads) {
+Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds, const RegCovarFloors& reg,
+                    int threads) {
   const std::size_t k = seeds.size();
   std::vector<std::uint32_t> nearest(nv.size);
   detail::parallel_for(nv.size, threads, 256, [&](std::size_t i, int) {
@@ -98,7 +100,7 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
   // one-point cluster positive definite.
   double extent = 0.0;
   for (int j = 0; j < 4; ++j) extent = std::max(extent, static_cast<double>(hi[j]) - lo[j]);
-  const double floor = std::max({reg_covar, 1e-12 * extent * extent, 1e-30});
+  const double relative = std::max(1e-12 * extent * extent, 1e-30);
   Gmm g;
   g.resize(k);
   std::fill(g.covariances.begin(), g.covariances.end(), 0.0f);
@@ -108,6 +110,7 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
     for (int j = 0; j < 4; ++j) {
       const double m = sum[5 * c + 1 + j] / n;
       g.means[4 * c + j] = static_cast<float>(nv[seeds[c]][j] + m);
+      const double floor = std::max(j < 3 ? reg.spatial : reg.gray, relative);
       g.covariances[16 * c + 5 * j] = static_cast<float>(std::max(sq[4 * c + j] / n - m * m, 0.0) + floor);
     }
   }
@@ -191,7 +194,7 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
       detail::progress_begin(Stage::Seeding, k_new);
       t = std::chrono::steady_clock::now();
       const std::vector<std::size_t> seeds = kmeanspp_seeds(nv, k_new, options.seed);
-      const Gmm fresh = seed_components(nv, seeds, em.reg_covar, threads);
+      const Gmm fresh = seed_components(nv, seeds, resolve_reg_covar(points, em.reg_covar), threads);
       for (std::size_t c = 0; c < fresh.size(); ++c) append_component(start, fresh, c, fresh.weights[c]);
       rep.added = seeds.size();
       result.seconds_seeding = seconds_since(t);

@@ -334,7 +334,7 @@ int main(int argc, char** argv) {
   ROW("M36", sogmm_model_value_at(NULL, 0, &s1, &s2), SOGMM_E_NULL_ARG);
   ROW("M37", sogmm_model_value_at(m, 0, NULL, &s2), SOGMM_E_NULL_ARG);
   ROW("M38", sogmm_model_value_at(m, 0, &s1, NULL), SOGMM_E_NULL_ARG);
-  ROW("M39", sogmm_model_value_at(m, 0, &s1, &s2), SOGMM_E_INVALID_ARG); /* no pairs yet */
+  ROW("M39", sogmm_model_value_at(m, 2, &s1, &s2), SOGMM_E_INVALID_ARG); /* the fit recorded 2 pairs (reg_covar_*) */
   ROW("M40", sogmm_model_get_info_f64(m, SOGMM_OPT_BANDWIDTH, &f64), SOGMM_E_INVALID_ARG);
   memcpy(pose_bad, pose_ok, sizeof pose_ok);
   pose_bad[15] = 1.0 + 1e-6; /* the last row is exactly (0, 0, 0, 1) */

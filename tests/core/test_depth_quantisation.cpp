@@ -117,7 +117,7 @@ TEST(DepthQuantisation, EmWithTheFloorDoesNotCollapseOntoLevels) {
   const sogmm::Gmm gp = sogmm::fit_em(view(stored), seeds, plain, &rp);
   const sogmm::Gmm gd = sogmm::fit_em(view(stored), seeds, floored, &rd);
   ASSERT_TRUE(sogmm_test::model_is_valid(gd));
-  const int np = collapsed_along_the_ray(gp, plain.reg_covar), nd = collapsed_along_the_ray(gd, plain.reg_covar);
+  const int np = collapsed_along_the_ray(gp, rp.reg_covar.spatial), nd = collapsed_along_the_ray(gd, rp.reg_covar.spatial);
   std::printf("plain: %d iterations, %d of 300 collapsed; floored: %d iterations, %d collapsed\n", rp.iterations,
               np, rd.iterations, nd);
   EXPECT_GE(np, 2);  // the scene does collapse plain EM
@@ -142,8 +142,8 @@ TEST(DepthQuantisation, FitAppliesTheFloorOnlyWhenAsked) {
   const sogmm::FitResult off = sogmm::fit(view(stored), o);
   o.dequantise_depth = true;
   const sogmm::FitResult on = sogmm::fit(view(stored), o);
-  EXPECT_GE(collapsed_along_the_ray(off.gmm, o.em.reg_covar), 2);
-  EXPECT_EQ(collapsed_along_the_ray(on.gmm, o.em.reg_covar), 0);
+  EXPECT_GE(collapsed_along_the_ray(off.gmm, off.em.reg_covar.spatial), 2);
+  EXPECT_EQ(collapsed_along_the_ray(on.gmm, on.em.reg_covar.spatial), 0);
 
   const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(stored), 300, 3);
   sogmm::EmOptions floored = o.em;

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,35 @@ TEST(EmProperties, TranslationKeepsTheLikelihood) {
   }
 }
 
+namespace {
+
+// Fits one case of em_large_geometry.json with `reg_covar` (unset: auto) as
+// sklearn's reference did (8 inits, max_iter 1000: compare optima, not
+// iteration limits); the fit must succeed, be positive definite in float32 and
+// score no worse than 0.1 nats/point below `sklearn`.
+sogmm::FitResult expect_close_to_sklearn(const nlohmann::json& c, std::optional<double> reg_covar, double sklearn) {
+  const std::string name = c.at("name").get<std::string>();
+  std::vector<float> pts;
+  for (const auto& row : c.at("points"))
+    for (const auto& v : row) pts.push_back(static_cast<float>(v.get<double>()));
+  sogmm::FitOptions o;
+  o.n_components = c.at("n_components").get<std::size_t>();
+  o.em.reg_covar = reg_covar;
+  o.n_init = 8;
+  o.em.max_iter = 1000;
+  sogmm::FitResult r;
+  EXPECT_NO_THROW(r = sogmm::fit(view(pts), o));
+  if (r.gmm.size() == 0) return r;
+  EXPECT_TRUE(sogmm_test::model_is_valid(r.gmm));
+  const double s = score(r.gmm, pts);
+  EXPECT_GE(s, sklearn - 0.1) << "sogmm " << s << " vs sklearn " << sklearn;
+  std::printf("%s (reg_covar %s): sogmm %.5f, report %.5f, sklearn %.5f\n", name.c_str(),
+              reg_covar ? std::to_string(*reg_covar).c_str() : "auto", s, r.em.log_likelihood, sklearn);
+  return r;
+}
+
+}  // namespace
+
 // Large rotated geometry (fixture from tests/reference/make_em_scale_fixture.py):
 // each fit succeeds, is positive definite in float32, and scores no worse
 // than 0.1 nats/point below scikit-learn's best of 8 inits. (The 1 km plane
@@ -108,21 +138,23 @@ TEST(EmProperties, LargeRotatedGeometryMatchesSklearn) {
   const nlohmann::json ref = sogmm_test::load_fixture("em_large_geometry.json");
   for (const auto& c : ref.at("cases")) {
     SCOPED_TRACE(c.at("name").get<std::string>());
-    std::vector<float> pts;
-    for (const auto& row : c.at("points"))
-      for (const auto& v : row) pts.push_back(static_cast<float>(v.get<double>()));
-    sogmm::FitOptions o;
-    o.n_components = c.at("n_components").get<std::size_t>();
-    o.em.reg_covar = c.at("reg_covar").get<double>();
-    o.n_init = 8;  // as many inits as sklearn's reference
-    o.em.max_iter = 1000;  // sklearn's setting in the fixture: compare optima, not iteration limits
-    sogmm::FitResult r;
-    ASSERT_NO_THROW(r = sogmm::fit(view(pts), o));
-    ASSERT_TRUE(sogmm_test::model_is_valid(r.gmm));
-    const double s = score(r.gmm, pts), sk = c.at("sklearn_score").get<double>();
-    EXPECT_GE(s, sk - 0.1) << "sogmm " << s << " vs sklearn " << sk;
-    std::printf("%s: sogmm %.5f, report %.5f, sklearn %.5f\n", c.at("name").get<std::string>().c_str(), s,
-                r.em.log_likelihood, sk);
+    expect_close_to_sklearn(c, c.at("reg_covar").get<double>(), c.at("sklearn_score").get<double>());
+  }
+}
+
+// The same with the default, automatic reg_covar (issue 14): a 1 km plane
+// gets a spatial floor of 1 m^2 and gray keeps 1e-6, which float32 can hold;
+// the fixture's floors come from an independent implementation of the rule
+// and its reference from sklearn fitted with the same floors.
+TEST(EmProperties, LargeRotatedGeometryWithAutomaticRegCovarMatchesSklearn) {
+  const nlohmann::json ref = sogmm_test::load_fixture("em_large_geometry.json");
+  for (const auto& c : ref.at("cases")) {
+    SCOPED_TRACE(c.at("name").get<std::string>());
+    const nlohmann::json& a = c.at("auto");
+    const sogmm::FitResult r = expect_close_to_sklearn(c, std::nullopt, a.at("sklearn_score").get<double>());
+    EXPECT_TRUE(r.em.reg_covar.automatic);
+    EXPECT_EQ(r.em.reg_covar.spatial, a.at("reg_covar_spatial").get<double>());
+    EXPECT_EQ(r.em.reg_covar.gray, a.at("reg_covar_gray").get<double>());
   }
 }
 
@@ -140,6 +172,10 @@ TEST(EmProperties, LikelihoodNeverDecreasesAtKilometreScale) {
     const std::vector<float> pts = large_geometry_points(name);
     for (std::uint64_t seed : {0, 1, 2}) {
       sogmm::EmOptions o;
+      // Components thin enough for the double kernels. (With the automatic
+      // floors, 1e-4 m^2 at 30-100 m and 1 m^2 at 1 km, the components stay
+      // in float32, whose rounding moves the value by up to ~1e-4 nats.)
+      o.reg_covar = 1e-6;
       o.max_iter = 40;
       o.tol = 0.0;
       std::vector<double> ll;
@@ -171,6 +207,7 @@ TEST(EmProperties, BitIdenticalForOneTwoThreeThreads) {
   // The same for components the kernels evaluate in double (a 1 km plane).
   const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
   o.n_components = 10;
+  o.em.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2, float32 kernels)
   std::vector<sogmm::FitResult> p;
   for (int threads : {1, 2, 3}) {
     o.em.threads = threads;
@@ -183,27 +220,53 @@ TEST(EmProperties, BitIdenticalForOneTwoThreeThreads) {
 }
 
 // 4-D scaling: x, y, z, gray by s, bandwidth by s, reg_covar by s^2 gives the
-// same M and the log-likelihood shifted by -4 ln s, within 1e-6: the
-// kernels round each component's constant log w + log det U to float32
-// (~2e-7 relative at |c| ~ 4-8), and that rounding differs between scales
-// (the code before issue 14 gave up to 8.2e-7 on this scene).
+// same M and iterations and the log-likelihood shifted by -4 ln s, within
+// 1e-6 (the issue asks for 2e-7; measured worst 6.2e-7 here). The test keeps
+// float32 rounding of the inputs out: the frame is put on a grid of
+// 10 x 2^-16 (0.15 mm, 0.00015 in gray), on which s = k / 10 for integer k
+// gives exactly representable float32 points n k 2^-16. (Rounding the scaled
+// inputs to float32 instead moves the likelihood of one and the same model by
+// up to 4.7e-7 at s = 7 and 2.7e-7 at s = 0.1 on this scene: the data
+// changing, not the fit.) What remains is the float32 E-step: each
+// component's constant log w + log det U - 2 log 2 pi (shifted by -4 ln s) and
+// each thin component's mean and the centred points (3 mm thick, ~1.5 m from
+// the frame's origin: 2e-5 of a standard deviation) round differently at
+// each scale. Carrying the constants relative to the largest one makes
+// s = 2 exact (2e-15) but leaves the other scales at ~6e-7 (issue 14 notes).
 TEST(EmProperties, FourDimensionalScaleInvariance) {
   const std::vector<float> pts = frame_points();
+  std::vector<double> grid(pts.size());  // integer multiples n of 10 x 2^-16
+  for (std::size_t i = 0; i < pts.size(); ++i) grid[i] = std::nearbyint(pts[i] / (10 * 0x1p-16));
+  auto scaled_by_tenths = [&](int k) {  // the grid cloud scaled by s = k / 10, exactly
+    std::vector<float> out(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double v = grid[i] * k * 0x1p-16;
+      out[i] = static_cast<float>(v);
+      EXPECT_EQ(static_cast<double>(out[i]), v) << "not exact at k = " << k;
+    }
+    return out;
+  };
   sogmm::FitOptions o;
   o.bandwidth = 0.05;
   o.seed = 4;
-  const sogmm::FitResult a = sogmm::fit(view(pts), o);
-  for (double s : {2.0, 10.0, 0.1}) {
+  o.em.reg_covar = 1e-6;  // explicit, so that it can scale with s^2
+  const sogmm::FitResult a = sogmm::fit(view(scaled_by_tenths(10)), o);
+  double worst = 0.0;
+  for (int k : {20, 100, 1, 30, 70, 3}) {
+    const double s = k / 10.0;
     SCOPED_TRACE("s = " + std::to_string(s));
-    std::vector<float> scaled(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) scaled[i] = static_cast<float>(s * pts[i]);
     sogmm::FitOptions os = o;
     os.bandwidth = o.bandwidth * s;
-    os.em.reg_covar = o.em.reg_covar * s * s;
-    const sogmm::FitResult b = sogmm::fit(view(scaled), os);
+    os.em.reg_covar = *o.em.reg_covar * s * s;
+    const sogmm::FitResult b = sogmm::fit(view(scaled_by_tenths(k)), os);
     EXPECT_EQ(a.gmm.size(), b.gmm.size());
-    EXPECT_NEAR(b.em.log_likelihood, a.em.log_likelihood - 4.0 * std::log(s), 1e-6);
+    EXPECT_EQ(a.em.iterations, b.em.iterations);
+    const double deviation = b.em.log_likelihood - (a.em.log_likelihood - 4.0 * std::log(s));
+    EXPECT_NEAR(deviation, 0.0, 1e-6);
+    worst = std::max(worst, std::fabs(deviation));
+    std::printf("s = %g: M %zu, log-likelihood deviation %.2e\n", s, b.gmm.size(), deviation);
   }
+  std::printf("largest deviation %.2e (bound 1e-6; the issue asks for 2e-7)\n", worst);
 }
 
 // The truncated E-step (truncation_nats = 25) stays within its documented
@@ -281,6 +344,7 @@ TEST(EmProperties, EveryKernelAgrees) {
           sogmm::fit_em(view(pts), sogmm::kmeanspp_seeds(view(pts), 20, 8), o, &rep);
           // and components the kernels evaluate in double (a 1 km plane)
           const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
+          o.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2 and float32 kernels)
           sogmm::fit_em(view(plane), sogmm::kmeanspp_seeds(view(plane), 10, 1), o, &plane_rep);
           std::FILE* f = std::fopen(file.c_str(), "w");
           const bool ok = f != nullptr &&

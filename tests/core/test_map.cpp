@@ -100,7 +100,7 @@ TEST(MapTest, NoveltyAndFusionOffReproduceAppendEverything) {
     world.fit.known = true;
     world.fit.bandwidth = o.fit.bandwidth;
     world.fit.tol = o.fit.em.tol;
-    world.fit.reg_covar = o.fit.em.reg_covar;
+    world.fit.reg_covar = r.em.reg_covar.spatial;
     world.fit.max_iter = o.fit.em.max_iter;
     world.fit.n_iter = r.em.iterations;
     world.fit.converged = r.em.converged;

@@ -95,7 +95,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_TOL, tol) == (ok ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   }
   if (flags & 16) {
-    const bool ok = std::isfinite(reg) && reg >= 0 && std::isfinite(static_cast<float>(reg));  // float32 covariances
+    // float32 covariances; -1 is SOGMM_REG_COVAR_AUTO
+    const bool ok = reg == SOGMM_REG_COVAR_AUTO || (std::isfinite(reg) && reg >= 0 && std::isfinite(static_cast<float>(reg)));
     FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_REG_COVAR, reg) == (ok ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   }
 

@@ -476,6 +476,13 @@ def mode_errors(tmp):
     err(["fit", "--sequence", d, "--trajectory", os.path.join(d, "trajectory.log"), "--frames", "3:9", "-o", model],
         2, "--frames")
     err(["fit"] + fa + intr + ["--warm-start", "-o", model], 2, "--warm-start")
+    for reg in (-1, "-1e-9", "nan", "inf", "autox", "1e-6x"):  # --reg-covar auto|VALUE >= 0
+        err(["fit"] + fa + intr + ["--reg-covar", reg, "-o", model], 2, "--reg-covar")
+    for reg, expect in ((None, (1e-6, 1e-6, "auto")), ("auto", (1e-6, 1e-6, "auto")), (2e-4, (2e-4, 2e-4, "user"))):
+        extra = ["--reg-covar", reg] if reg is not None else []
+        j = run_json(["fit"] + fa + intr + ["--decimate", 10, "--components", 5, "-o", model, "--quiet"] + extra)
+        got = (j["reg_covar"], j["reg_covar_gray"], j["reg_covar_source"])
+        check(got == expect, "fit --reg-covar %s: recorded %r, expected %r" % (reg, got, expect))
     err(["eval", model] + fa + ["--bandwidth", 0.02], 2, "--bandwidth")
     err(["eval", model] + fa + ["--n-init", 3], 2, "--n-init")
     err(["eval", model], 2, "--depth")

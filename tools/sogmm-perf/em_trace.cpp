@@ -72,12 +72,14 @@ int main(int argc, char** argv) {
   app.add_option("--bandwidth", bandwidth);
   app.add_option("--seed", seed);
   app.add_option("--trace-iter", trace_iter, "iterations of the traced EM (0: no trace)");
-  app.add_option("--reg-covar", em.reg_covar);
+  double reg_covar = 1e-6;  // explicit: the floor the trace counts components at
+  app.add_option("--reg-covar", reg_covar);
   app.add_option("--at", at, "iteration counts at which to count components at the floor");
   app.add_flag("--dequantise", dequantise, "trace EM with the depth-bin floor along the rays");
   app.add_flag("--dither", dither, "fit the dithered frame instead of the quantised one");
   app.add_option("--dump-points", dump, "write N, M (uint64), N x 4 float32 points, M seed indices (uint64)");
   CLI11_PARSE(app, argc, argv);
+  em.reg_covar = reg_covar;
 
   const tools::LoadedFrame frame = tools::load_frame(depth, color);
   const Camera camera = read_intrinsics_json(intrinsics);
@@ -118,7 +120,7 @@ int main(int argc, char** argv) {
         Eigen::Matrix4d c;
         for (int i = 0; i < 16; ++i) c(i / 4, i % 4) = g.covariances[16 * k + i];
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(c);
-        if (es.eigenvalues()(0) < 1.5 * em.reg_covar) {
+        if (es.eigenvalues()(0) < 1.5 * reg_covar) {
           ++total;
           int axis;
           es.eigenvectors().col(0).cwiseAbs().maxCoeff(&axis);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <new>
 
@@ -61,7 +62,27 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
   app.add_option("--threads", o.em.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();
-  app.add_option("--reg-covar", o.em.reg_covar, "covariance regulariser")->capture_default_str();
+  app.add_option_function<std::string>(
+         "--reg-covar",
+         [&o](const std::string& v) {
+           if (v == "auto") {
+             o.em.reg_covar.reset();
+             return;
+           }
+           double r = 0.0;
+           std::size_t used = 0;
+           try {
+             r = std::stod(v, &used);
+           } catch (const std::exception&) {
+             used = 0;
+           }
+           if (used != v.size() || !std::isfinite(r) || r < 0)
+             throw CLI::ValidationError("--reg-covar", "must be auto or a finite number >= 0, got " + v);
+           o.em.reg_covar = r;
+         },
+         "covariance regulariser: auto (floors from the data's spatial and gray scales; 1e-6 for a room with "
+         "gray in [0, 1]) or one value added to all four diagonals")
+      ->default_str("auto");
   app.add_option("--truncate", o.em.truncation_nats,
                  "truncated E-step: skip components provably this many nats below each point's best "
                  "(0 = exact; 20 is a good value for full frames)")

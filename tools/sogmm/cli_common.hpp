@@ -36,7 +36,7 @@ PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, 
                                 const std::string& depth_path);
 
 /// Fit flags: --bandwidth S | --components K, --seed, --n-init, --threads,
-/// --tol, --max-iter, --reg-covar, --truncate.
+/// --tol, --max-iter, --reg-covar auto|VALUE, --truncate.
 void add_fit_flags(CLI::App& app, FitOptions& options);
 
 /// Where frames come from: one pair (--depth D --color C) or a posed sequence

@@ -77,6 +77,10 @@ void print_summary(const FitState& s, const Model& model, const Totals& t, std::
     if (frames_json.is_null()) {
       j["converged"] = model.fit.converged;
       j["log_likelihood"] = model.fit.log_likelihood;
+      // The regulariser the fit used (spec/format.md 2.4).
+      j["reg_covar"] = model.fit.reg_covar;
+      if (const std::string* g = find_value(model, kRegCovarGrayKey)) j["reg_covar_gray"] = std::stod(*g);
+      if (const std::string* src = find_value(model, kRegCovarSourceKey)) j["reg_covar_source"] = *src;
     } else {
       j["frames"] = frames_json;
     }

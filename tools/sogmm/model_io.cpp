@@ -39,7 +39,6 @@ Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const C
   m.fit.bandwidth = options.n_components > 0 ? 0.0 : options.bandwidth;
   m.fit.n_components_requested = options.n_components;
   m.fit.tol = options.em.tol;
-  m.fit.reg_covar = options.em.reg_covar;
   m.fit.max_iter = options.em.max_iter;
   m.fit.n_iter = em.iterations;
   m.fit.converged = em.converged;
@@ -55,6 +54,7 @@ Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const C
   m.producer_version = version_string();
   m.created_unix_ms = unix_ms_now();
   m.key_values = std::move(key_values);
+  record_reg_covar(m, em.reg_covar);
   return m;
 }
 

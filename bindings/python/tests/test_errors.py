@@ -160,3 +160,19 @@ def test_info_keys_are_not_option_keys():
         assert "SOGMM_INFO_" in e.value.message and "info key" in e.value.message
     assert all(k < 10000 for k in _ffi.OPTION_NAMES)
 
+
+
+@pytest.mark.parametrize("reg", [-1.0, -1, -1e-9, float("-inf"), float("inf"), float("nan"), "automatic", None])
+def test_reg_covar_must_be_auto_or_a_finite_value_at_least_zero(reg):
+    # -1 is the C API's SOGMM_REG_COVAR_AUTO: Python refuses it as a value.
+    with pytest.raises(sogmm.InvalidArgumentError, match="reg_covar"):
+        sogmm.SOGMM(reg_covar=reg).fit(blobs(n_per=20))
+
+
+def test_reg_covar_auto_and_values_are_recorded():
+    pts = blobs(n_per=20)
+    auto = sogmm.SOGMM(n_components=2, seed=1).fit(pts)
+    assert auto.reg_covar == "auto" and auto.metadata["reg_covar_source"] == "auto"
+    user = sogmm.SOGMM(n_components=2, seed=1, reg_covar=2e-4).fit(pts)
+    assert user.metadata == {"reg_covar_gray": "0.0002", "reg_covar_source": "user"}
+    assert user.info()["fit_reg_covar"] == 2e-4

@@ -40,7 +40,8 @@ def test_save_load_roundtrip(rgbd_model, tmp_path):
     assert g.converged_ == rgbd_model.converged_ and g.support_size_ == rgbd_model.support_size_
     assert g.camera_ == rgbd_model.camera_
     np.testing.assert_array_equal(g.pose, rgbd_model.pose)
-    assert g.metadata == {"sequence": "synthetic"}
+    # the fit records its regulariser (spec/format.md 2.4)
+    assert g.metadata == {"reg_covar_gray": "1e-06", "reg_covar_source": "auto", "sequence": "synthetic"}
     assert "fit_seconds_total" not in g.info()  # timings are not stored
     # str paths and float64 / uncompressed storage work too.
     rgbd_model.save(str(tmp_path / "m64.sogmm"), float64=True, compress=False)

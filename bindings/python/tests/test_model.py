@@ -249,11 +249,12 @@ def test_transform_and_pose(fitted, points):
 
 def test_metadata(fitted):
     g = fitted.copy()
-    assert g.metadata == {}
+    fit = {"reg_covar_gray": "1e-06", "reg_covar_source": "auto"}  # what the fit records (spec/format.md 2.4)
+    assert g.metadata == fit
     g.set_metadata("sensor", "PrimeSense")
     g.set_metadata("frame", "00000")
     g.set_metadata("sensor", "Kinect")
-    assert g.metadata == {"sensor": "Kinect", "frame": "00000"}
+    assert g.metadata == {**fit, "sensor": "Kinect", "frame": "00000"}
     with pytest.raises(sogmm.InvalidArgumentError):
         g.set_metadata("", "x")
 

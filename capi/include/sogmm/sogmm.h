@@ -145,8 +145,19 @@ typedef int32_t sogmm_key;
                                     * (about 5.3e-155 to 4.4e153); default 0.02: mean-shift bandwidth */
 #define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
 #define SOGMM_OPT_TOL 102          /* f64, > 0, finite; default 1e-3: EM stop tolerance */
-#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32);
-                                    * default 1e-6: added to covariance diagonals */
+#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32),
+                                    * or SOGMM_REG_COVAR_AUTO; default SOGMM_REG_COVAR_AUTO. A value:
+                                    * added to all four covariance diagonals in each M-step, as before.
+                                    * AUTO: one floor on x, y, z and one on gray, derived from the data
+                                    * (1e-6 x 100^k; 10^k is the power of ten nearest the median distance
+                                    * of the points from their coordinate-wise median, resp. the smallest
+                                    * one not below the gray range): 1e-6 and 1e-6 for a room-sized frame
+                                    * with gray in [0, 1] (the former default), 1 m^2 for a 1 km scene.
+                                    * The model's fit record holds the floors used (FIT_REG_COVAR: the
+                                    * spatial one; key_values reg_covar_gray and reg_covar_source).
+                                    * Any other negative value, NaN or inf: SOGMM_E_INVALID_ARG. */
+#define SOGMM_REG_COVAR_AUTO (-1.0) /* SOGMM_OPT_REG_COVAR: floors from the data's scales (see above);
+                                     * get returns it while no value is set */
 #define SOGMM_OPT_MAX_ITER 104     /* i64, [1, 2^31-1]; default 100: EM iterations at most */
 #define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
 #define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores; a request is capped at

@@ -4,25 +4,31 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "sogmm/depth_quantisation.hpp"
 #include "sogmm/gmm.hpp"
 #include "sogmm/point_cloud.hpp"
+#include "sogmm/reg_covar.hpp"
 
 namespace sogmm {
 
 /// Parameters of the EM. Defaults are the paper's.
 struct EmOptions {
   double tol = 1e-3;        ///< stop when |change of mean log-likelihood| < tol
-  /// Added to every covariance diagonal in every M-step, in the data's units
-  /// squared (the paper's 1e-6 m^2); the user's value is used as given. The
-  /// floors the fit adds on its own are relative: the loading that rescues a
+  /// Added to the covariance diagonals in every M-step (and the seeds'
+  /// covariances), in the data's units squared. Unset (default, "auto"):
+  /// floors derived from the data's scales, one on x, y, z and one on gray
+  /// (auto_reg_covar in sogmm/reg_covar.hpp: the paper's 1e-6 m^2 for a
+  /// room-sized scene with gray in [0, 1], 1 m^2 for a 1 km plane). Set: the
+  /// user's value on all four diagonals, as given (>= 0, finite). The floors
+  /// the fit adds on its own are relative: the loading that rescues a
   /// covariance that is not positive definite starts at 1e-12 of the
   /// component's largest variance (of the data's extent squared when it has
   /// none), and the float32 storage of a covariance keeps it positive definite
   /// with the least change (see fit_em).
-  double reg_covar = 1e-6;
+  std::optional<double> reg_covar;
   int max_iter = 100;       ///< at most this many E+M iterations
   int threads = 0;          ///< worker threads; 0 = all available cores; at most 4 x omp_get_num_procs()
   /// 0 (default): exact E-step, every point against every component.
@@ -56,6 +62,8 @@ struct EmReport {
   /// The SIMD kernel that ran the E-step: "avx512", "avx2" or "sse2" (the
   /// best the CPU supports, capped by the SOGMM_ISA environment variable).
   const char* kernel = "";
+  /// The regulariser the fit used (EmOptions::reg_covar resolved).
+  RegCovarFloors reg_covar;
 };
 
 /// Called after each EM iteration with the iteration number (from 1) and the
@@ -64,7 +72,8 @@ using EmIterationCallback = std::function<void(int iteration, double log_likelih
 
 /// Fits a GMM by EM starting from one-hot responsibilities on the seed points
 /// (the paper's and scikit-learn's k-means++ initialisation): the first model
-/// has means = seed points, covariances = reg_covar I and equal weights.
+/// has means = seed points, covariances = the reg_covar floors on the diagonal
+/// and equal weights.
 /// Memory is O(N + threads x 257 x K + 16 x 15 x K): points are processed in
 /// fixed-size blocks through a fused E+M pass (scratch per thread), and
 /// partial sums of up to 16 chunks are reduced in a fixed order, so the

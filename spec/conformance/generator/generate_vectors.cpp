@@ -159,10 +159,11 @@ int main(int argc, char** argv) {
     fit_options.bandwidth = 0.02;
     fit_options.seed = 7;
     fit_options.em.threads = 1;
+    fit_options.em.reg_covar = 1e-6;  // explicit: the vectors predate the automatic floors
     const FitResult fit = sogmm::fit(cloud.view(), fit_options);
     Model fitted;
     fitted.gmm = fit.gmm;
-    fitted.fit = FitInfo{true, 0.02, 0, fit_options.em.tol, fit_options.em.reg_covar, fit_options.em.max_iter,
+    fitted.fit = FitInfo{true, 0.02, 0, fit_options.em.tol, *fit_options.em.reg_covar, fit_options.em.max_iter,
                          fit.em.iterations, fit.em.converged, fit.em.log_likelihood, 7};
     fitted.camera.known = true;
     fitted.camera.camera = frame.camera;

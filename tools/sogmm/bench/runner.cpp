@@ -64,7 +64,7 @@ long long sogmm_file_bytes(const FitResult& f, const FitOptions& o, const BenchC
   model.fit.bandwidth = o.n_components > 0 ? 0.0 : o.bandwidth;
   model.fit.n_components_requested = o.n_components;
   model.fit.tol = o.em.tol;
-  model.fit.reg_covar = o.em.reg_covar;
+  record_reg_covar(model, f.em.reg_covar);
   model.fit.max_iter = o.em.max_iter;
   model.fit.n_iter = f.em.iterations;
   model.fit.converged = f.em.converged;

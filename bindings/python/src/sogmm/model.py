@@ -546,7 +546,12 @@ class SOGMM(GMM):
             (ignored when n_components is set).
         seed: random seed (k-means++ seeding).
         tol: EM stops when the mean log-likelihood changes by less than tol.
-        reg_covar: added to the covariance diagonals.
+        reg_covar: "auto" (default): one floor added to the x, y, z covariance
+            diagonals and one to gray's, derived from the data's scales
+            (1e-6 and 1e-6 for a room-sized frame with gray in [0, 1], 1 m^2
+            for a kilometre scene; see ``fit_reg_covar`` and the metadata
+            keys ``reg_covar_gray`` and ``reg_covar_source`` of the fitted
+            model). A number >= 0: added to all four diagonals as given.
         max_iter: EM iterations at most.
         n_components: None = self-organizing; an int K fits exactly K components.
         n_threads: worker threads of the fit (0 = all cores).
@@ -566,7 +571,7 @@ class SOGMM(GMM):
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
 
-    def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float = 1e-6,
+    def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float | str = "auto",
                  max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
                  mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1,
                  dequantise_depth: bool = False):
@@ -613,8 +618,16 @@ class SOGMM(GMM):
         seed = int(self.seed) & 0xFFFFFFFFFFFFFFFF
         if seed >= 2**63:
             seed -= 2**64  # the uint64 seed's bits as an int64
-        f64 = {_ffi.OPT_BANDWIDTH: self.bandwidth, _ffi.OPT_TOL: self.tol, _ffi.OPT_REG_COVAR: self.reg_covar,
-               _ffi.OPT_TRUNCATION_NATS: self.truncation_nats}
+        f64 = {_ffi.OPT_BANDWIDTH: self.bandwidth, _ffi.OPT_TOL: self.tol, _ffi.OPT_TRUNCATION_NATS: self.truncation_nats}
+        reg = self.reg_covar
+        if isinstance(reg, str):
+            if reg != "auto":
+                raise InvalidArgumentError(f"reg_covar must be 'auto' or a finite number >= 0, got {reg!r}")
+        else:
+            # Checked here as well: the C API reads -1 as SOGMM_REG_COVAR_AUTO.
+            if isinstance(reg, (int, float, np.integer, np.floating)) and not isinstance(reg, bool) and reg < 0:
+                raise InvalidArgumentError(f"reg_covar must be 'auto' or a finite number >= 0, got {reg!r}")
+            f64[_ffi.OPT_REG_COVAR] = reg  # NaN, inf and non-numbers are rejected below or by the C API
         i64 = {
             _ffi.OPT_N_COMPONENTS: int(k),
             _ffi.OPT_MAX_ITER: int(self.max_iter),
@@ -628,7 +641,7 @@ class SOGMM(GMM):
         i64.update(extra_i64 or {})
         for key, v in f64.items():
             if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise InvalidArgumentError(f"option {key} must be a number, got {v!r}")
+                raise InvalidArgumentError(f"{_ffi.OPTION_NAMES.get(key, f'option {key}')} must be a number, got {v!r}")
         return _ffi.Options(f64=f64, i64=i64)
 
     def fit(self, X, y=None, progress: ProgressArg = None, init: GMM | None = None) -> "SOGMM":

@@ -72,6 +72,8 @@ pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;
 pub const SOGMM_OPT_N_COMPONENTS: sogmm_key = 101;
 pub const SOGMM_OPT_TOL: sogmm_key = 102;
 pub const SOGMM_OPT_REG_COVAR: sogmm_key = 103;
+/// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).
+pub const SOGMM_REG_COVAR_AUTO: f64 = -1.0;
 pub const SOGMM_OPT_MAX_ITER: sogmm_key = 104;
 pub const SOGMM_OPT_SEED: sogmm_key = 105;
 pub const SOGMM_OPT_THREADS: sogmm_key = 106;

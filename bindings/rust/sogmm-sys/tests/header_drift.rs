@@ -155,7 +155,7 @@ fn rust_protos(lib: &str) -> Protos {
     protos
 }
 
-/// `#define SOGMM_X <integer | (-integer) | "string">` of the header.
+/// `#define SOGMM_X <integer | (-integer) | (-decimal) | "string">` of the header.
 fn header_consts(header: &str) -> BTreeMap<String, String> {
     let mut out = BTreeMap::new();
     for line in strip_c_comments(header).lines() {
@@ -167,7 +167,10 @@ fn header_consts(header: &str) -> BTreeMap<String, String> {
             continue;
         };
         let value = value.trim_start_matches('(').trim_end_matches(')');
-        let numeric = value.trim_start_matches('-').chars().all(|c| c.is_ascii_digit()) && !value.is_empty();
+        let digits = value.trim_start_matches('-');
+        let numeric = digits.chars().all(|c| c.is_ascii_digit() || c == '.')
+            && digits.matches('.').count() <= 1
+            && digits.chars().any(|c| c.is_ascii_digit());
         if name.starts_with("SOGMM_") && (numeric || value.starts_with('"')) {
             out.insert(name.to_string(), value.to_string());
         }

@@ -165,7 +165,8 @@ impl OptionsBuilder {
         n_components(i64) => SOGMM_OPT_N_COMPONENTS as i64 |v| v;
         /// EM stop tolerance (default 1e-3).
         tol(f64) => SOGMM_OPT_TOL as f64 |v| v;
-        /// Added to covariance diagonals (default 1e-6).
+        /// Added to all four covariance diagonals; default automatic floors from the
+        /// data (sogmm_sys::SOGMM_REG_COVAR_AUTO, which restores them).
         reg_covar(f64) => SOGMM_OPT_REG_COVAR as f64 |v| v;
         /// EM iterations at most (default 100).
         max_iter(i64) => SOGMM_OPT_MAX_ITER as i64 |v| v;

@@ -69,7 +69,8 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--threads", type=int, default=d.threads, help="threads per fit task (default %(default)s)")
     g.add_argument("--tol", type=float, default=d.tol)
     g.add_argument("--max-iter", type=int, default=d.max_iter)
-    g.add_argument("--reg-covar", type=float, default=d.reg_covar)
+    g.add_argument("--reg-covar", type=lambda v: v if v == "auto" else float(v), default=d.reg_covar,
+                   help="auto (default) or a value added to all four diagonals")
     g.add_argument("--truncate", type=float, default=d.truncate)
     g.add_argument("--dequantise-depth", action="store_true",
                    help="floor variances along viewing rays at the depth quantisation (structured-light depth)")

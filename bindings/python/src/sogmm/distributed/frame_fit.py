@@ -31,7 +31,7 @@ class FitSettings:
     threads: int = 1
     tol: float = 1e-3
     max_iter: int = 100
-    reg_covar: float = 1e-6
+    reg_covar: float | str = "auto"  # as sogmm.SOGMM
     truncate: float = 0.0
     #: ``--dequantise-depth``: floor variances along viewing rays at the depth
     #: quantisation (SOGMM(dequantise_depth=True)); False = the paper's plain EM.
