@@ -161,8 +161,16 @@ func NComponents(k int64) Option { return I64(OptNComponents, k) }
 // Tol is the EM stop tolerance (default 1e-3).
 func Tol(v float64) Option { return F64(OptTol, v) }
 
-// RegCovar is added to covariance diagonals (default 1e-6).
+// RegCovar sets one floor, added to all four covariance diagonals in each
+// M-step (>= 0, finite in float32), or RegCovarAuto (the default).
 func RegCovar(v float64) Option { return F64(OptRegCovar, v) }
+
+// RegCovarAuto, as RegCovar's value (the default), derives the floors from the
+// data: 1e-6 x 100^k on x, y and z, 10^k the power of ten nearest the points'
+// median distance from their coordinate-wise median, and on gray, 10^k the
+// smallest power of ten not below the gray range (1e-6 and 1e-6 for a room with
+// gray in [0, 1]). A fitted model records the spatial floor (InfoFitRegCovar).
+const RegCovarAuto = float64(C.SOGMM_REG_COVAR_AUTO)
 
 // MaxIter bounds EM iterations (default 100).
 func MaxIter(n int64) Option { return I64(OptMaxIter, n) }

@@ -110,6 +110,55 @@ func TestFixedKFit(t *testing.T) {
 	}
 }
 
+func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
+	o, err := NewOptions(Seed(1), Threads(1))
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	if v, _ := o.GetF64(OptRegCovar); v != RegCovarAuto {
+		t.Fatalf("default reg_covar %v, want RegCovarAuto", v)
+	}
+	floor := func(scale float32) float64 {
+		pts := twoBlobs(400)
+		for i := 0; i < len(pts); i += 4 {
+			pts[i], pts[i+1], pts[i+2] = scale*pts[i], scale*pts[i+1], scale*pts[i+2]
+		}
+		m, err := FitFixedK(pts, 2, o)
+		if err != nil {
+			t.Fatal(err)
+		}
+		defer m.Close()
+		f, err := m.InfoF64(InfoFitRegCovar)
+		if err != nil {
+			t.Fatal(err)
+		}
+		return f
+	}
+	// twoBlobs' median distance from the median is about 0.11 (10^-1: 1e-8);
+	// a thousand times larger, 10^2: 1e-2, 100^3 times the first.
+	small, large := floor(1), floor(1000)
+	if small != 1e-8 || large != 1e-2 {
+		t.Fatalf("automatic spatial floors %v and %v, want 1e-8 and 1e-2", small, large)
+	}
+	// A value replaces the automatic floors; RegCovarAuto restores them.
+	if err := o.Set(RegCovar(1e-3)); err != nil {
+		t.Fatal(err)
+	}
+	if f := floor(1000); f != 1e-3 {
+		t.Fatalf("user floor recorded as %v", f)
+	}
+	if err := o.Set(RegCovar(RegCovarAuto)); err != nil {
+		t.Fatal(err)
+	}
+	if f := floor(1000); f != 1e-2 {
+		t.Fatalf("restored automatic floor %v", f)
+	}
+	if err := o.Set(RegCovar(-2)); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("reg_covar -2: %v", err)
+	}
+}
+
 func TestSeedsAreReproducible(t *testing.T) {
 	o, _ := NewOptions(Bandwidth(0.5), Seed(3), Threads(1))
 	defer o.Close()
