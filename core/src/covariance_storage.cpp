@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
@@ -169,16 +170,25 @@ double store_covariance(const double* cov, float* out, int* factorisations_out) 
   } report{factorisations, factorisations_out};
   Mat4 s = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(cov);
   s = 0.5 * (s + s.transpose());
-  Mat4 ls;
-  require(s.allFinite() && factor(s, ls), ErrorCode::Numeric,
-          "EM: a covariance to store is not positive definite");
+  require(s.allFinite(), ErrorCode::Numeric, "EM: a covariance to store is not finite");
   // float32 storage: an entry beyond its range has no float32 value (and the
   // conversion would be undefined), so such a component cannot be stored.
   require(s.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max()), ErrorCode::Numeric,
           "EM: a covariance entry is beyond the float32 range (" + checked::exact(s.cwiseAbs().maxCoeff()) +
               "); scale the data down");
-  const double d = best_rounding(s, ls, out, factorisations);
-  if (d < std::numeric_limits<double>::infinity()) return d;
+  Mat4 ls;
+  if (factor(s, ls)) {
+    const double d = best_rounding(s, ls, out, factorisations);
+    if (d < std::numeric_limits<double>::infinity()) return d;
+  } else {
+    // The EM makes its covariances positive definite by Eigen's LLT; one so
+    // nearly singular that stored_cholesky refuses it goes straight to the
+    // eigenvalue floor (its factor from LLT serves only the divergence).
+    const Eigen::LLT<Mat4> llt(s);
+    require(llt.info() == Eigen::Success && Mat4(llt.matrixL()).diagonal().minCoeff() > 0.0, ErrorCode::Numeric,
+            "EM: a covariance to store is not positive definite");
+    ls = llt.matrixL();
+  }
   // Step 3: an eigenvalue floor relative to the component's largest one.
   const Eigen::SelfAdjointEigenSolver<Mat4> eig(s);
   const Eigen::Vector4d lambda = eig.eigenvalues();

@@ -31,7 +31,9 @@ namespace sogmm::detail {
 /// the corners once took 1024-3584 per near-singular component, which made
 /// fits of tiny clouds with tiny floors slow; issue 14). `factorisations`
 /// (optional) receives how many were made.
-/// `cov` must be finite, symmetric and positive definite. Returns the
+/// `cov` must be finite, symmetric and positive definite (by Eigen's LLT at
+/// least, the EM's own test: a target stored_cholesky refuses starts at step
+/// 3; the map's fused components are stored here too). Returns the
 /// divergence of the stored matrix from `cov` (nats).
 double store_covariance(const double* cov, float* out, int* factorisations = nullptr);
 

@@ -13,9 +13,17 @@
 
 namespace sogmm::detail {
 
-/// Component k's covariance, in double.
+/// Component k's covariance, in double: its symmetric part, each entry
+/// (a_ij + a_ji) / 2 rounded to float32, which is what validate() tests and a
+/// file holds (the matrix itself for every model the library makes; a model
+/// given as arrays may be asymmetric within validate's tolerance).
 inline Eigen::Matrix4d covariance_of(const Gmm& gmm, std::size_t k) {
-  return Eigen::Map<const Eigen::Matrix<float, 4, 4, Eigen::RowMajor>>(gmm.covariance(k)).cast<double>();
+  const float* c = gmm.covariance(k);
+  Eigen::Matrix4d s;
+  for (int r = 0; r < 4; ++r)
+    for (int q = 0; q < 4; ++q)
+      s(r, q) = static_cast<float>((static_cast<double>(c[4 * r + q]) + c[4 * q + r]) / 2.0);
+  return s;
 }
 /// Component k's mean, in double.
 inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
@@ -30,9 +38,9 @@ inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
 /// Error(Numeric) for a model that was never validated and is not positive
 /// definite.
 inline Eigen::Matrix4d cholesky_of(const Gmm& gmm, std::size_t k) {
-  double a[16], l[16];
-  for (int i = 0; i < 16; ++i) a[i] = gmm.covariance(k)[i];
-  if (!stored_cholesky(a, l))
+  const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> a = covariance_of(gmm, k);
+  double l[16];
+  if (!stored_cholesky(a.data(), l))
     throw Error(ErrorCode::Numeric, "covariance of component " + std::to_string(k) + " is not positive definite");
   return Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(l);
 }

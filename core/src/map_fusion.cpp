@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "covariance_storage.hpp"
 #include "map_state.hpp"
 
 namespace sogmm::detail {
@@ -96,7 +97,10 @@ std::vector<std::size_t> fuse_new_components(Gmm& gmm, std::size_t first, const 
     float* mt = gmm.means.data() + 4 * target;
     float* ct = gmm.covariances.data() + 16 * target;
     for (int r = 0; r < 4; ++r) mt[r] = static_cast<float>(mu[r]);
-    for (int r = 0; r < 16; ++r) ct[r] = static_cast<float>(cov(r / 4, r % 4));
+    // Rounded to float32 as the fit rounds its covariances, so that the
+    // fused model stays positive definite by the writer's test.
+    const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> row = cov;
+    store_covariance(row.data(), ct);
     removed[j] = 1;
     changed.push_back(target);
   }

@@ -2,7 +2,13 @@
 // arithmetic of spec/format.md step 19d, checked on hand-computed cases.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <cmath>
+#include <vector>
+
+#include "covariance_storage.hpp"
+#include "sogmm/inference.hpp"
 
 #include "sogmm/gmm.hpp"
 
@@ -56,6 +62,51 @@ TEST(StoredCholesky, SubtractsEachProductInTurnAsTheSpecSays) {
   double l[16];
   ASSERT_TRUE(sogmm::stored_cholesky(a, l));
   EXPECT_EQ(l[10], std::sqrt((a22 - x * x) - y * y));
+}
+
+TEST(StoredCholesky, CovarianceStorageAcceptsATargetOnlyEigenFactors) {
+  // The EM makes its covariances positive definite by Eigen's LLT, which
+  // subtracts a summed square (a22 - (x^2 + y^2) > 0 here) where the spec
+  // subtracts in turn (exactly 0): store_covariance must still store it (by
+  // the eigenvalue floor), not throw (found in review).
+  const double x = 0.6790183630976147, y = 0.7341212663503303, a22 = 0.9999999711315767;
+  const double a[16] = {1, 0, x, 0,  //
+                        0, 1, y, 0,  //
+                        x, y, a22, 0,  //
+                        0, 0, 0, 1};
+  ASSERT_FALSE(sogmm::stored_cholesky(a));
+  const Eigen::LLT<Eigen::Matrix4d> llt(Eigen::Map<const Eigen::Matrix4d>(a).eval());
+  ASSERT_EQ(llt.info(), Eigen::Success);
+  float out[16];
+  ASSERT_NO_THROW(sogmm::detail::store_covariance(a, out));
+  double stored[16];
+  for (int i = 0; i < 16; ++i) stored[i] = out[i];
+  EXPECT_TRUE(sogmm::stored_cholesky(stored));
+}
+
+TEST(StoredCholesky, AModelValidByItsSymmetricPartCanBeQueried) {
+  // Asymmetric within validate's tolerance (1e-5): the lower triangle alone
+  // (c32 = 1 + 5e-7) is not positive definite, the symmetric part
+  // (1 - 4.25e-6) is, and that is what validate tests and a file holds, so
+  // sampling and scoring must use it too (found in review).
+  sogmm::Gmm g;
+  g.resize(1);
+  g.weights[0] = 1.0f;
+  for (int i = 0; i < 4; ++i) g.means[i] = 0.0f;
+  for (int i = 0; i < 16; ++i) g.covariances[i] = (i % 5 == 0) ? 1.0f : 0.0f;
+  g.covariances[4 * 2 + 3] = 1.0f - 9e-6f;  // c23 (upper)
+  g.covariances[4 * 3 + 2] = 1.0f + 5e-7f;  // c32 (lower)
+  g.support_size = 1;
+  ASSERT_NO_THROW(sogmm::validate(g));
+  double lower[16];
+  for (int i = 0; i < 16; ++i) lower[i] = g.covariances[i];
+  ASSERT_FALSE(sogmm::stored_cholesky(lower));
+  std::vector<float> pts(4 * 50);
+  ASSERT_NO_THROW(sogmm::sample(g, 50, 1, 4, pts.data()));
+  for (float v : pts) EXPECT_TRUE(std::isfinite(v));
+  std::vector<double> scores(50);
+  ASSERT_NO_THROW(sogmm::score_samples(g, pts.data(), 50, 4, scores.data()));
+  for (double v : scores) EXPECT_TRUE(std::isfinite(v));
 }
 
 }  // namespace
