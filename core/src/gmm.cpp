@@ -59,8 +59,7 @@ std::string validation_error(const Gmm& gmm, double weight_tolerance) {
     // c22 = 4.7e-41, c23 = 2.6e-9, c32 = 0). For a symmetric matrix, every
     // model the library makes, the symmetric part is the matrix itself.
     double sym[16];
-    for (int r = 0; r < 4; ++r)
-      for (int q = 0; q < 4; ++q) sym[r * 4 + q] = static_cast<float>((c(r, q) + c(q, r)) / 2.0);
+    stored_symmetric_part(gmm.covariance(k), sym);
     if (!stored_cholesky(sym)) {
       msg << "component " << k << " has a covariance that is not positive definite";
       return msg.str();

@@ -18,12 +18,9 @@ namespace sogmm::detail {
 /// file holds (the matrix itself for every model the library makes; a model
 /// given as arrays may be asymmetric within validate's tolerance).
 inline Eigen::Matrix4d covariance_of(const Gmm& gmm, std::size_t k) {
-  const float* c = gmm.covariance(k);
-  Eigen::Matrix4d s;
-  for (int r = 0; r < 4; ++r)
-    for (int q = 0; q < 4; ++q)
-      s(r, q) = static_cast<float>((static_cast<double>(c[4 * r + q]) + c[4 * q + r]) / 2.0);
-  return s;
+  double s[16];
+  stored_symmetric_part(gmm.covariance(k), s);
+  return Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(s);
 }
 /// Component k's mean, in double.
 inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
@@ -37,13 +34,16 @@ inline Eigen::Vector4d mean_of(const Gmm& gmm, std::size_t k) {
 /// spatial covariance (the same arithmetic on the same entries). Throws
 /// Error(Numeric) for a model that was never validated and is not positive
 /// definite.
-inline Eigen::Matrix4d cholesky_of(const Gmm& gmm, std::size_t k) {
-  const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> a = covariance_of(gmm, k);
+/// `c` is covariance_of(gmm, k), passed in by a caller that needs it too.
+inline Eigen::Matrix4d cholesky_of(const Eigen::Matrix4d& c, std::size_t k) {
+  const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> a = c;
   double l[16];
   if (!stored_cholesky(a.data(), l))
     throw Error(ErrorCode::Numeric, "covariance of component " + std::to_string(k) + " is not positive definite");
   return Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(l);
 }
+/// The same for component k of `gmm`.
+inline Eigen::Matrix4d cholesky_of(const Gmm& gmm, std::size_t k) { return cholesky_of(covariance_of(gmm, k), k); }
 
 /// The Cholesky factorisation of a covariance (or a block of one), checked:
 /// validate() accepts the float32 model, yet a sub-block or a derived matrix

@@ -26,7 +26,6 @@ using Mat3 = Eigen::Matrix3d;
 using detail::covariance_of;
 using detail::mean_of;
 
-
 // Draws between progress reports.
 constexpr std::size_t kPointsPerChunk = 64;
 

@@ -107,7 +107,7 @@ std::vector<double> pack_model(const Gmm& gmm, int dims, bool background, int th
   detail::parallel_for(m, detail::team_size(threads), 64, [&](std::size_t k, int) {
     double* out = &params[k * kQueryStride];
     const Mat4 c = covariance_of(gmm, k);
-    const Mat4 l = detail::cholesky_of(gmm, k);
+    const Mat4 l = detail::cholesky_of(c, k);
     const double lw = log_weight(gmm.weights[k]);
     if (dims == 4) {
       pack_density<4>(mean_of(gmm, k), l, lw, out);

@@ -1,4 +1,5 @@
-// The library's one positive-definiteness test (see sogmm/gmm.hpp).
+// The library's one positive-definiteness test and the stored covariance it
+// applies to (see sogmm/gmm.hpp).
 #include <cmath>
 
 #include "sogmm/gmm.hpp"
@@ -27,6 +28,12 @@ bool stored_cholesky(const double* a, double* l_out) {
       for (int j = 0; j < 4; ++j) l_out[i * 4 + j] = l[i][j];
   }
   return true;
+}
+
+void stored_symmetric_part(const float* c, double* s) {
+  for (int r = 0; r < 4; ++r)
+    for (int q = 0; q < 4; ++q)
+      s[r * 4 + q] = static_cast<float>((static_cast<double>(c[r * 4 + q]) + c[q * 4 + r]) / 2.0);
 }
 
 }  // namespace sogmm

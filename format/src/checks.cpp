@@ -24,23 +24,13 @@ std::size_t first_non_finite(const std::vector<float>& v) {
   return i;
 }
 
-// (A + A^T) / 2 of a float32 matrix, each entry rounded to float32 (section
-// 5.1): exact on a symmetric matrix; the same rounding in every reader.
-void symmetric_part(const float* c, double* s) {
-  for (int r = 0; r < 4; ++r) {
-    for (int q = 0; q < 4; ++q) {
-      s[r * 4 + q] = static_cast<float>((static_cast<double>(c[r * 4 + q]) + c[q * 4 + r]) / 2.0);
-    }
-  }
-}
-
 }  // namespace
 
 void symmetrize(Gmm& g) {
   double s[16];
   for (std::size_t k = 0; k < g.size(); ++k) {
     float* c = g.covariances.data() + 16 * k;
-    symmetric_part(c, s);
+    stored_symmetric_part(c, s);  // section 5.1
     std::copy(s, s + 16, c);
   }
   // The returned model keeps the library's invariant (see check_values).
@@ -87,7 +77,7 @@ void check_values(const Gmm& g) {
     if (asym > kSymmetryTolerance * scale) {
       numeric("not_symmetric", "covariance of component " + std::to_string(k) + " is not symmetric");
     }
-    symmetric_part(g.covariance(k), a);  // what a reader returns, so what it tests
+    stored_symmetric_part(g.covariance(k), a);  // what a reader returns, so what it tests
     if (!stored_cholesky(a)) {
       numeric("not_spd", "covariance of component " + std::to_string(k) + " is not positive definite");
     }

@@ -48,6 +48,12 @@ struct Gmm {
 /// the factor L (row-major, zero above the diagonal; a = L L^T).
 bool stored_cholesky(const double* a, double* l = nullptr);
 
+/// The covariance a file holds and validate() tests (spec/format.md 5.1): the
+/// symmetric part of `c` (row-major 4 x 4 float32), each entry
+/// (c_ij + c_ji) / 2 rounded to float32, widened into `s` (row-major). For a
+/// symmetric matrix, every model the library makes, it is the matrix itself.
+void stored_symmetric_part(const float* c, double* s);
+
 /// Checks the invariants of a model: M >= 1, array lengths agree with M, all
 /// values finite, weights >= 0 summing to 1 within `weight_tolerance`, every
 /// covariance symmetric (relative 1e-5) and positive definite (stored_cholesky
