@@ -320,12 +320,29 @@ void make_positive_definite(Working& w, std::size_t k, const RegDiagonal& reg, d
   }
 }
 
-void pack_all(Working& w, const RegDiagonal& reg, double data_scale2, std::vector<float>& params,
-              std::vector<double>& exact) {
+// Packs every component and returns the shift taken out of their constants:
+// the largest constant (log w + log det U - 2 log 2 pi) is subtracted from
+// each, in double, before rounding to float32, and the E-step adds it back to
+// the log-likelihood. Only differences of constants reach the
+// responsibilities, and the constants the kernels round then do not depend on
+// where the data's scale puts them: a 4-D scaling by a power of two changes
+// every constant by -4 ln s, which the shift absorbs, so the fit and its
+// log-likelihood are the same to double rounding (~1e-15; unshifted, each
+// float32 constant near 10 rounds differently, ~5e-7).
+double pack_all(Working& w, const RegDiagonal& reg, double data_scale2, std::vector<float>& params,
+                std::vector<double>& exact) {
   params.assign(w.size() * kParamStride, 0.f);
   exact.assign(w.size() * kParamStride, 0.0);
   for (std::size_t k = 0; k < w.size(); ++k)
     make_positive_definite(w, k, reg, data_scale2, &params[k * kParamStride], &exact[k * kParamStride]);
+  double shift = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < w.size(); ++k) shift = std::max(shift, exact[k * kParamStride + 14]);
+  for (std::size_t k = 0; k < w.size(); ++k) {
+    double& c = exact[k * kParamStride + 14];
+    c -= shift;
+    params[k * kParamStride + 14] = static_cast<float>(c);
+  }
+  return shift;
 }
 
 // M-step for one component from its statistics, which are centred at the
@@ -415,7 +432,8 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   double pairs_evaluated = 0.0;
   double previous = -std::numeric_limits<double>::infinity();
   // The first model's kernel parameters; each iteration packs the next.
-  pack_all(w, reg, data_scale2, params, exact);
+  double shift = pack_all(w, reg, data_scale2, params, exact);  // of the log-densities in params
+  double next_shift = 0.0;
   std::vector<float> next_params;
   std::vector<double> next_exact;
   for (int iter = 1; iter <= options.max_iter; ++iter) {
@@ -477,7 +495,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
           iteration_pairs += slot_pairs[s];
         }
       }
-      mean_ll = total_ll / static_cast<double>(n);
+      mean_ll = total_ll / static_cast<double>(n) + shift;
       require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
                                                               std::to_string(iter));
 
@@ -505,7 +523,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       // components evaluated in double (e.g. the first step of a large
       // scene, from point-sized seeds; never on the shared room-sized
       // frames, whose components stay below a third of the threshold).
-      pack_all(w, reg, data_scale2, next_params, next_exact);
+      next_shift = pack_all(w, reg, data_scale2, next_params, next_exact);
       promoted = false;
       for (std::size_t k = 0; k < m; ++k)
         if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {
@@ -516,6 +534,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
     pairs_evaluated += iteration_pairs;
     params.swap(next_params);
     exact.swap(next_exact);
+    shift = next_shift;
 
     rep.iterations = iter;
     rep.log_likelihood = mean_ll;

@@ -59,7 +59,10 @@ def measure(name, sogmm, seq, frames, a, map_flags, work):
     append = run_json(sogmm, ["fit", "--sequence", seq, "-o", os.path.join(work, name + "_append.sogmm")] + common)
     out = os.path.join(work, name + "_map.sogmm")
     csv_path = os.path.join(work, name + "_map.csv")
-    m = run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + common + map_flags)
+    # A --bandwidth among the map flags replaces the common one for the map
+    # only (its batches' fits); the own fits keep --bandwidth.
+    map_common = common if "--bandwidth" not in map_flags else common[:-2]
+    m = run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + map_common + map_flags)
     rows = list(csv.DictReader(open(csv_path)))
     selected = [int(r["frame"]) for r in rows]
     check = selected[:: a.accuracy_step]

@@ -179,7 +179,8 @@ def test_trajectory_errors_name_the_line(tmp_path):
 def test_matches_the_cli_sequential_fit_up_to_weight_rounding(sequence, tmp_path):
     """Against `sogmm fit --sequence` (a chain of merges, one float32 rounding of
     every weight per merge): means and covariances bit for bit, weights within
-    k - 1 roundings for k frames, the same mean log-likelihood within 1e-9."""
+    k - 1 roundings for k frames, the mean log-likelihood within what those
+    roundings allow."""
     cli = os.environ.get("SOGMM_CLI")
     if not cli or not os.path.isfile(cli):
         pytest.skip("SOGMM_CLI (the sogmm tool) not given; ctest sets it")
@@ -195,7 +196,9 @@ def test_matches_the_cli_sequential_fit_up_to_weight_rounding(sequence, tmp_path
     ulps = np.abs(chain.weights_.view(np.int32).astype(np.int64) - ours.weights_.view(np.int32))
     assert ulps.max() <= len(frames) - 1
     x = ours.sample(5000, seed=1)
-    assert abs(chain.score(x) - ours.score(x)) <= 1e-9
+    # Weights u ulps apart differ by a factor within 1 +- u 2^-23, and so does
+    # every point's mixture density: the scores by at most u 2^-23 nats.
+    assert abs(chain.score(x) - ours.score(x)) <= ulps.max() * 2.0**-23 + 1e-12
     # The same provenance: fit record (settings, EM sums, camera) and key/values.
     ci, oi = chain.info(), ours.info()
     del ci["created_unix_ms"], oi["created_unix_ms"]
