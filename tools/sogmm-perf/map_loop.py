@@ -20,12 +20,13 @@ For each sequence (the synthetic room loop of `sogmm demo --write-frame
      its fitting pixels and 26.45 dB at d = 4, same view, no motion. A map
      built from other frames' pixels can only be held to the second.
   4. insert time: median of novelty + fit + merge ms over frames 290-299 vs
-     10-19 of the CSV (target ratio <= 1.5; only for sequences of >= 300 frames).
+     10-19 of the CSV (target ratio <= 1.5; only for sequences of >= 300 frames),
+     each frame's time the fastest of --timing-runs builds of the same map.
 Prints a table and one JSON line per sequence.
 
 Usage (from the repository root):
     python3 tools/sogmm-perf/map_loop.py [--sogmm build/tools/sogmm/sogmm] [--loop-dir /tmp/sogmm_loop]
-        [--frames 300] [--decimate 5] [--bandwidth 0.02] [--accuracy-step 10] [--heldout-decimate 4]
+        [--frames 300] [--decimate 5] [--bandwidth 0.02] [--accuracy-step 10] [--heldout-decimate 4] [--timing-runs 5]
         [-- MAP FLAGS...]
 Anything after `--` goes to `sogmm map` (e.g. -- --fusion hellinger --threshold 3).
 """
@@ -48,8 +49,13 @@ def run_json(sogmm, args):
     return json.loads(p.stdout)
 
 
-def median_ms(rows, lo, hi):
-    v = [float(r["ms_novelty"]) + float(r["ms_fit"]) + float(r["ms_merge"]) for r in rows if lo <= int(r["frame"]) < hi]
+def insert_ms(row):
+    return float(row["ms_novelty"]) + float(row["ms_fit"]) + float(row["ms_merge"])
+
+
+def median_ms(ms, lo, hi):
+    """Median over frames [lo, hi) of the per-frame insert times `ms` (frame -> ms)."""
+    v = [t for f, t in ms.items() if lo <= f < hi]
     return statistics.median(v) if v else float("nan")
 
 
@@ -64,6 +70,16 @@ def measure(name, sogmm, seq, frames, a, map_flags, work):
     map_common = common if "--bandwidth" not in map_flags else common[:-2]
     m = run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + map_common + map_flags)
     rows = list(csv.DictReader(open(csv_path)))
+    # Insert time: a frame that only runs the novelty test takes ~2 ms, where
+    # one run's figure moves by 2x with the scheduler (the ratio of two
+    # medians of one run measured 0.8 to 2.5 on an idle machine). The map is
+    # deterministic, so the same work is timed --timing-runs times and each
+    # frame keeps its fastest.
+    ms = {int(r["frame"]): insert_ms(r) for r in rows}
+    for _ in range(a.timing_runs - 1):
+        run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + map_common + map_flags)
+        for r in csv.DictReader(open(csv_path)):
+            ms[int(r["frame"])] = min(ms[int(r["frame"])], insert_ms(r))
     selected = [int(r["frame"]) for r in rows]
     check = selected[:: a.accuracy_step]
     if selected[-1] not in check:
@@ -103,7 +119,7 @@ def measure(name, sogmm, seq, frames, a, map_flags, work):
         per.append({"frame": k, "psnr_map": r["psnr"], "psnr_own": own["psnr"], "psnr_append": app["psnr"],
                     "mre_map": r["mre"], "mre_own": own["mre"], "mre_append": app["mre"],
                     "psnr_map_heldout": map_h["psnr"], "psnr_own_heldout": own_h["psnr"]})
-    early, late = median_ms(rows, 10, 20), median_ms(rows, 290, 300)
+    early, late = median_ms(ms, 10, 20), median_ms(ms, 290, 300)
     return {
         "sequence": name,
         "frames": len(rows),
@@ -137,6 +153,8 @@ def main():
     ap.add_argument("--data", default=os.path.join(os.path.dirname(root), "shared", "data", "rgbd"))
     ap.add_argument("--decimate", type=int, default=5)
     ap.add_argument("--bandwidth", type=float, default=0.02)
+    ap.add_argument("--timing-runs", type=int, default=5,
+                    help="build each map this many times; a frame's insert time is its fastest")
     ap.add_argument("--accuracy-step", type=int, default=10, help="evaluate every N-th frame against its own fit")
     ap.add_argument("--heldout-decimate", type=int, default=None,
                     help="decimation of the held-out pixel grid (default: --decimate minus 1)")
