@@ -8,7 +8,8 @@ row per seed (M, EM iterations, converged, final mean log-likelihood) and a
 summary: seeds converged, mean log-likelihood, mean iterations, mean EM seconds.
 
 Usage: converge_d2.py [--sogmm build/tools/sogmm/sogmm [--sogmm OTHER ...]]
-                      [--seeds 10] [--decimate 2] [--bandwidth 0.02] [--max-iter N]
+                      [--seeds 10] [--decimate 2] [--bandwidth 0.02] [--max-iter N] [-- FIT FLAGS...]
+Anything after `--` goes to every `sogmm fit` (e.g. -- --dequantise-depth).
 """
 import argparse
 import json
@@ -29,7 +30,9 @@ def main():
     ap.add_argument("--decimate", type=int, default=2)
     ap.add_argument("--bandwidth", type=float, default=0.02)
     ap.add_argument("--max-iter", type=int, help="override the default max_iter")
-    a = ap.parse_args()
+    argv = sys.argv[1:]
+    fit_flags = argv[argv.index("--") + 1:] if "--" in argv else []
+    a = ap.parse_args(argv[: argv.index("--")] if "--" in argv else argv)
     bins = a.sogmm or [os.path.join(root, "build", "tools", "sogmm", "sogmm")]
     if not os.path.isdir(a.data):
         print("SKIP: %s is absent (the shared RGB-D frames)" % a.data)
@@ -45,6 +48,7 @@ def main():
                                             "--seed", str(seed), "--json", "-q", "-o", os.path.join(tmp, "m.sogmm")]
                 if a.max_iter:
                     cmd += ["--max-iter", str(a.max_iter)]
+                cmd += fit_flags
                 p = subprocess.run(cmd, capture_output=True, text=True)
                 if p.returncode != 0:
                     sys.exit("converge_d2: %s failed: %s" % (" ".join(cmd), p.stderr.strip()))
@@ -53,7 +57,8 @@ def main():
                 print("%s seed %d: M %d, %d iterations, converged %s, LL %.5f, EM %.2f s" %
                       (b, seed, j["n_components"], j["em_iterations"], j["converged"], j["log_likelihood"],
                        j["seconds_em"]), file=sys.stderr, flush=True)
-    print("d = %d, bandwidth %g, seeds 0..%d" % (a.decimate, a.bandwidth, a.seeds - 1))
+    print("d = %d, bandwidth %g, seeds 0..%d%s" % (a.decimate, a.bandwidth, a.seeds - 1,
+                                                   ", fit flags " + " ".join(fit_flags) if fit_flags else ""))
     print()
     print("| binary | converged | mean LL | min LL | max LL | mean iterations | max iterations | mean EM s |")
     print("|---|---|---|---|---|---|---|---|")
