@@ -14,13 +14,16 @@ import (
 const (
 	OptMapNovelty          Key = C.SOGMM_OPT_MAP_NOVELTY
 	OptMapNoveltyThreshold Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
-	OptMapBatchSize        Key = C.SOGMM_OPT_MAP_BATCH_SIZE
-	OptMapFusion           Key = C.SOGMM_OPT_MAP_FUSION
-	OptMapFusionMethod     Key = C.SOGMM_OPT_MAP_FUSION_METHOD
-	OptMapFusionThreshold  Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
-	OptMapWarmStart        Key = C.SOGMM_OPT_MAP_WARM_START
-	FusionHellinger            = C.SOGMM_FUSION_HELLINGER
-	FusionKL                   = C.SOGMM_FUSION_KL
+	// OptMapNoveltyBandwidthScale (f64, (0, 1], default 0.7): with novelty on,
+	// the batches of novel points are fitted with OptBandwidth times this.
+	OptMapNoveltyBandwidthScale Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
+	OptMapBatchSize             Key = C.SOGMM_OPT_MAP_BATCH_SIZE
+	OptMapFusion                Key = C.SOGMM_OPT_MAP_FUSION
+	OptMapFusionMethod          Key = C.SOGMM_OPT_MAP_FUSION_METHOD
+	OptMapFusionThreshold       Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
+	OptMapWarmStart             Key = C.SOGMM_OPT_MAP_WARM_START
+	FusionHellinger                 = C.SOGMM_FUSION_HELLINGER
+	FusionKL                        = C.SOGMM_FUSION_KL
 )
 
 // Map is an owned sogmm_map: an incremental world map that fits only the

@@ -55,6 +55,8 @@ void validate(const MapOptions& o) {
           "map: novelty_threshold " + checked::exact(o.novelty_threshold) + " is not finite");
   require(o.batch_size >= 1 && o.batch_size <= kMaxPoints, ErrorCode::InvalidArgument,
           "map: batch_size " + std::to_string(o.batch_size) + " is not in [1, " + std::to_string(kMaxPoints) + "]");
+  require(o.novelty_bandwidth_scale > 0 && o.novelty_bandwidth_scale <= 1, ErrorCode::InvalidArgument,
+          "map: novelty_bandwidth_scale " + checked::exact(o.novelty_bandwidth_scale) + " is not in (0, 1]");
   require(std::isfinite(o.fusion_threshold) && o.fusion_threshold > 0, ErrorCode::InvalidArgument,
           "map: fusion_threshold " + checked::exact(o.fusion_threshold) + " is not finite and > 0");
   require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
@@ -62,6 +64,7 @@ void validate(const MapOptions& o) {
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
           ErrorCode::InvalidArgument, "map: unknown fusion method");
   require_usable_bandwidth(o.fit.bandwidth);
+  require_usable_bandwidth(o.fit.bandwidth * o.novelty_bandwidth_scale);
   require(!o.warm_start || o.fit.n_init == 1, ErrorCode::InvalidArgument,
           "map: a warm start is one run: fit.n_init must be 1, got " + std::to_string(o.fit.n_init));
   validate(o.depth);
@@ -256,12 +259,16 @@ std::size_t Map::flush(const ProgressSink& progress) {
       cloud.xyzg.push_back(q[3]);
     }
   }
+  // Novel points: a finer mode count (MapOptions::novelty_bandwidth_scale
+  // says why).
+  FitOptions batch_options = s.options.fit;
+  if (s.options.novelty) batch_options.bandwidth *= s.options.novelty_bandwidth_scale;
   // Warm start: the last fit moved from its camera to this batch's
   // (world <- previous camera, then this camera <- world).
   const bool warm = s.options.warm_start && s.previous_fit.size() > 0;
   FitResult r = warm ? fit_warm(cloud.view(), transform(transform(s.previous_fit, s.previous_pose), to_last),
-                                s.options.fit, progress)
-                     : fit(cloud.view(), s.options.fit, progress);
+                                batch_options, progress)
+                     : fit(cloud.view(), batch_options, progress);
   const double ms_fit = ms_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
 

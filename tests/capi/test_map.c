@@ -145,6 +145,15 @@ static void bad_input(void) {
   EXPECT_STATUS(sogmm_options_set_i64(o, SOGMM_OPT_MAP_FUSION_METHOD, 2), SOGMM_E_INVALID_ARG);
   EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_FUSION_THRESHOLD, 0.0), SOGMM_E_INVALID_ARG);
   EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_THRESHOLD, NAN), SOGMM_E_INVALID_ARG);
+  {
+    double scale = 0.0;
+    REQUIRE_OK(sogmm_options_get_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, &scale));
+    EXPECT_TRUE(scale == 0.7);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, 0.0), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, 1.5), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, NAN), SOGMM_E_INVALID_ARG);
+    REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, 1.0));
+  }
   EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY, 1.0), SOGMM_E_INVALID_ARG); /* an i64 key */
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_MIN, 5.0));
   EXPECT_STATUS(sogmm_map_create(&map, o), SOGMM_E_INVALID_ARG);

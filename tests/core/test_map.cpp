@@ -312,6 +312,56 @@ TEST(MapTest, NoveltyScoreIsLocalToEachPoint) {
   EXPECT_EQ(one[0], both[1]);
 }
 
+// With novelty on, the batches are fitted with the bandwidth times
+// novelty_bandwidth_scale; with novelty off, each frame with the bandwidth.
+// With identity poses a batch of two frames is their points one after the
+// other, so the map must hold exactly fit() of that cloud at that bandwidth.
+TEST(MapTest, NovelPointsAreFittedWithTheScaledBandwidth) {
+  const std::vector<float> a = make_frame(3000, 8), b = make_frame(3000, 9, 2.0);
+  std::vector<float> both(a);
+  both.insert(both.end(), b.begin(), b.end());
+  for (double scale : {0.7, 1.0, 0.5}) {
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    MapOptions o = options(true, false);
+    o.novelty_bandwidth_scale = scale;
+    sogmm::FitOptions f = o.fit;
+    f.bandwidth = o.fit.bandwidth * scale;
+    Map pooled(o);
+    pooled.insert_points(view(a), kIdentity);
+    pooled.insert_points(view(b), kIdentity);
+    pooled.flush();
+    const sogmm::FitResult want = sogmm::fit(view(both), f);
+    ASSERT_EQ(pooled.size(), want.gmm.size());
+    EXPECT_EQ(pooled.model().gmm.means, want.gmm.means);
+    EXPECT_EQ(pooled.model().gmm.covariances, want.gmm.covariances);
+    Map single(o);
+    single.insert_points(view(a), kIdentity);
+    single.flush();
+    EXPECT_EQ(single.model().gmm.means, sogmm::fit(view(a), f).gmm.means);
+    // Novelty off (append everything): the bandwidth itself.
+    o.novelty = false;
+    Map append(o);
+    append.insert_points(view(a), kIdentity);
+    EXPECT_EQ(append.model().gmm.means, sogmm::fit(view(a), o.fit).gmm.means);
+  }
+  // The scales give different mode counts here, so the test tells them apart.
+  sogmm::FitOptions f = options(true, false).fit;
+  const std::size_t k1 = sogmm::fit(view(both), f).gmm.size();
+  f.bandwidth *= 0.5;
+  EXPECT_LT(k1, sogmm::fit(view(both), f).gmm.size());
+  // Out of (0, 1]: refused, naming the option.
+  MapOptions o = options(true, false);
+  for (double bad : {0.0, -0.5, 1.5, std::nan("")}) {
+    o.novelty_bandwidth_scale = bad;
+    EXPECT_THROW(
+        try { Map m(o); } catch (const sogmm::Error& e) {
+          EXPECT_NE(std::string(e.what()).find("novelty_bandwidth_scale"), std::string::npos) << e.what();
+          throw;
+        },
+        sogmm::Error);
+  }
+}
+
 TEST(MapTest, BatchSizeTriggersTheFlush) {
   MapOptions o = options(true, false);
   o.batch_size = 5000;

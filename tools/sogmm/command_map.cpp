@@ -179,6 +179,9 @@ Command add_map_command(CLI::App& root) {
                   "novelty threshold (nats): points whose 3-D log-likelihood is below it are new")
       ->capture_default_str();
   app->add_option("--batch", s->options.batch_size, "novel points that trigger a fit")->capture_default_str();
+  app->add_option("--novelty-bandwidth-scale", s->options.novelty_bandwidth_scale,
+                  "novel points are fitted with --bandwidth times this, in (0, 1] (--no-novelty: the bandwidth)")
+      ->capture_default_str();
   app->add_flag("--no-novelty", s->no_novelty, "every point is new: fit each frame whole (append everything)");
   app->add_option("--fusion", s->fusion, "fuse close components: off, hellinger or kl")
       ->capture_default_str()

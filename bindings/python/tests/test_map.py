@@ -166,3 +166,25 @@ def test_warm_start_fits_each_frame_from_the_previous_fit():
         got.means_[g0.n_components_:], cold1.transform(POSES[1]).means_)  # the warm start did something
     with pytest.raises(sogmm.InvalidArgumentError):
         sogmm.Map(novelty=False, warm_start=True, n_init=2, **FIT)
+
+
+@pytest.mark.parametrize("scale", [1.0, 0.5])
+def test_novel_points_are_fitted_with_the_scaled_bandwidth(scale):
+    # Two frames in one batch, identity poses: the batch is the frames' points
+    # one after the other, fitted at bandwidth x novelty_bandwidth_scale.
+    a, b = blobs(n_per=300, seed=0), blobs(n_per=300, seed=1) + np.float32([3, 0, 0, 0])
+    with sogmm.Map(novelty_bandwidth_scale=scale, batch_size=100000, **FIT) as m:
+        m.insert_points(a, np.eye(4))
+        m.insert_points(b, np.eye(4))
+        m.flush()
+        got = m.export()
+    fit = dict(FIT, bandwidth=FIT["bandwidth"] * scale)
+    want = sogmm.SOGMM(**fit).fit(np.concatenate([a, b]))
+    assert got.n_components_ == want.n_components_
+    assert got.means_.tobytes() == want.means_.tobytes()
+
+
+def test_novelty_bandwidth_scale_out_of_range_raises():
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(sogmm.InvalidArgumentError, match="NOVELTY_BANDWIDTH_SCALE|novelty_bandwidth_scale"):
+            sogmm.Map(novelty_bandwidth_scale=bad)

@@ -210,6 +210,9 @@ typedef int32_t sogmm_key;
                                              * insert fits its whole frame (append everything) */
 #define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601 /* f64, finite; default 3.0 nats: points whose 3-D log-likelihood
                                              * under the local submap is below it are novel */
+#define SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE 607 /* f64, (0, 1]; default 0.7: with MAP_NOVELTY 1 the batches
+                                                   * of novel points are fitted with SOGMM_OPT_BANDWIDTH times
+                                                   * this (with MAP_NOVELTY 0 each frame with the bandwidth) */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default HELLINGER */

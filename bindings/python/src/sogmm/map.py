@@ -49,6 +49,10 @@ class Map:
             local map is below it are new (default 3.0, the authors').
         batch_size: new points that trigger a fit (default 12288: one frame
             decimated by 5).
+        novelty_bandwidth_scale: with novelty on, the batches of new points are
+            fitted with the bandwidth times this, in (0, 1] (default 0.7: a map
+            component serves closer views than the one it was fitted from, and
+            a batch pools the slivers of many frames; core/include/sogmm/map.hpp).
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
@@ -68,19 +72,20 @@ class Map:
 
     def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
                  fusion: str | None = None, fusion_threshold: float = 0.3, warm_start: bool = False,
+                 novelty_bandwidth_scale: float = 0.7,
                  depth_scale: float = 1000.0, depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1,
                  **fit_params):
         self._ptr = None
         self._finalizer = None
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                           fit_params) as o:
+                           fit_params, novelty_bandwidth_scale) as o:
             out = c_void_p()
             check(lib.sogmm_map_create(byref(out), o.ptr))
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale=0.7) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
@@ -92,6 +97,7 @@ class Map:
         if isinstance(decimate, bool) or int(decimate) != decimate or int(decimate) < 1:
             raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer >= 1")
         f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
+               _ffi.OPT_MAP_NOVELTY_BANDWIDTH_SCALE: novelty_bandwidth_scale,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
@@ -267,7 +273,7 @@ class Map:
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
         map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,
-                        warm_start=False)
+                        warm_start=False, novelty_bandwidth_scale=0.7)
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

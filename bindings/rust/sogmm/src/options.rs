@@ -216,6 +216,10 @@ impl OptionsBuilder {
         map_novelty(bool) => SOGMM_OPT_MAP_NOVELTY as i64 i64::from;
         /// Map: points with a 3-D log-likelihood below this (nats) are novel (default 3.0).
         map_novelty_threshold(f64) => SOGMM_OPT_MAP_NOVELTY_THRESHOLD as f64 |v| v;
+        /// Map: with novelty on, the batches of novel points are fitted with the
+        /// bandwidth times this, in (0, 1] (default 0.7); outside: `build` fails
+        /// with `Status::InvalidArg`.
+        map_novelty_bandwidth_scale(f64) => SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE as f64 |v| v;
         /// Map: pending novel points that trigger a fit (default 12288).
         map_batch_size(i64) => SOGMM_OPT_MAP_BATCH_SIZE as i64 |v| v;
         /// Map: fuse new components into close ones (default false).
