@@ -238,3 +238,31 @@ func TestModelQueryContexts(t *testing.T) {
 		t.Fatalf("cancelled score: %v", err)
 	}
 }
+
+// OptMapNoveltyBandwidthScale is range-checked and reaches the map's fits: a
+// finer scale gives the same batch more components.
+func TestNoveltyBandwidthScale(t *testing.T) {
+	for _, bad := range []float64{0, 1.5} {
+		if _, err := NewOptions(F64(OptMapNoveltyBandwidthScale, bad)); err == nil {
+			t.Fatalf("scale %g was accepted", bad)
+		}
+	}
+	count := func(scale float64) uint64 {
+		m := newTestMap(t, Bandwidth(0.05), I64(OptMapBatchSize, 100000), F64(OptMapNoveltyBandwidthScale, scale))
+		defer m.Close()
+		if err := m.InsertPoints(twoBlobs(600), yawPose(0, 0, 0, 0)); err != nil {
+			t.Fatal(err)
+		}
+		if err := m.Flush(); err != nil {
+			t.Fatal(err)
+		}
+		st, err := m.Stats()
+		if err != nil {
+			t.Fatal(err)
+		}
+		return st.Components
+	}
+	if fine, coarse := count(0.1), count(1.0); fine <= coarse {
+		t.Fatalf("scale 0.1 gave %d components, scale 1 %d", fine, coarse)
+	}
+}

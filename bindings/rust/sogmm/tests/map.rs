@@ -218,3 +218,27 @@ fn warm_start_from_a_fit_of_the_same_points() {
     let e = Model::fit_warm_with_progress(&pts, &cold, None, |_| ControlFlow::Break(())).unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
 }
+
+#[test]
+fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
+    for bad in [0.0, 1.5, f64::NAN] {
+        let e = Options::builder().map_novelty_bandwidth_scale(bad).build().unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "{bad}: {e}");
+    }
+    // The same two frames in one batch: a finer scale, at least as many modes.
+    let count = |scale: f64| {
+        let o = Options::builder()
+            .map_batch_size(100_000)
+            .map_novelty_bandwidth_scale(scale)
+            .bandwidth(0.05)
+            .threads(2)
+            .build()
+            .unwrap();
+        let mut map = Map::new(Some(&o)).unwrap();
+        map.insert_points(&blobs(3000, 7), &IDENTITY).unwrap();
+        map.flush().unwrap();
+        map.stats().unwrap().n_components
+    };
+    let (fine, coarse) = (count(0.1), count(1.0));
+    assert!(fine > coarse, "scale 0.1: {fine} components, scale 1: {coarse}");
+}
