@@ -278,7 +278,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   batch.gmm = transform(r.gmm, last);
   batch.fit.known = true;
   const FitOptions& fo = s.options.fit;
-  batch.fit.bandwidth = fo.n_components > 0 ? 0.0 : fo.bandwidth;
+  batch.fit.bandwidth = fo.n_components > 0 ? 0.0 : batch_options.bandwidth;  // the one used
   batch.fit.n_components_requested = fo.n_components;
   batch.fit.tol = fo.em.tol;
   record_reg_covar(batch, r.em.reg_covar);

@@ -158,7 +158,8 @@ Command add_map_command(CLI::App& root) {
   app->footer(
       "Each frame's points are moved to the world with the frame's camera-to-world pose and scored with the\n"
       "3-D log-likelihood of the map's local components; points below --threshold are novel. Once --batch\n"
-      "novel points are pending they are fitted (the usual self-organizing fit) and merged; with --fusion new\n"
+      "novel points are pending they are fitted (the usual self-organizing fit at --bandwidth times\n"
+      "--novelty-bandwidth-scale) and merged; with --fusion new\n"
       "components close to existing ones (Hellinger or symmetric KL distance below --fusion-threshold) are\n"
       "merged into them. --no-novelty fits every frame whole (the append-everything map of sogmm fit\n"
       "--sequence). Progress goes to stderr (a live line on a terminal, lines with --progress); the per-frame\n"

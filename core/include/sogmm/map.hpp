@@ -20,8 +20,8 @@
 //    (1 cm, and its 26 neighbours) of a point already pending, are novel and
 //    become pending; the others are dropped.
 // 2. flush: once batch_size points are pending (or at flush()), the pending
-//    points are fitted with the usual self-organizing fit (sogmm/fit.hpp; the
-//    bandwidth times MapOptions::novelty_bandwidth_scale) in
+//    points are fitted with the usual self-organizing fit (sogmm/fit.hpp; with
+//    novelty on, at the bandwidth times MapOptions::novelty_bandwidth_scale) in
 //    the camera frame of the latest frame that contributed to the batch, moved
 //    to the world frame by its pose and merged into the map (merge() of
 //    sogmm/model.hpp: weights by support size, metadata by spec/format.md 2.2).

@@ -225,7 +225,7 @@ fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
         let e = Options::builder().map_novelty_bandwidth_scale(bad).build().unwrap_err();
         assert_eq!(e.status(), Status::InvalidArg, "{bad}: {e}");
     }
-    // The same two frames in one batch: a finer scale, at least as many modes.
+    // The same frame as one batch: a finer scale gives strictly more components.
     let count = |scale: f64| {
         let o = Options::builder()
             .map_batch_size(100_000)

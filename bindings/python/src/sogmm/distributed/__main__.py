@@ -7,7 +7,7 @@
 --reduce merge (default): every frame is fitted whole and the fits are merged in
 the world frame (the model of `sogmm fit --sequence`). --reduce map: one
 incremental map per tile, with the map flags of `sogmm map` (--threshold,
---batch, --no-novelty, --fusion, --fusion-threshold); --tile-size 0 gives the
+--batch, --no-novelty, --fusion, --fusion-threshold, --novelty-bandwidth-scale); --tile-size 0 gives the
 `sogmm map` of the whole sequence (one task), smaller tiles more parallelism.
 
 Exit status 0 on success, 1 with one line on stderr on bad input or a failed job.
@@ -57,6 +57,8 @@ def _parser() -> argparse.ArgumentParser:
     mg.add_argument("--threshold", type=float, default=m.novelty_threshold,
                     help="novelty threshold (nats): points whose 3-D log-likelihood is below it are new")
     mg.add_argument("--batch", type=int, default=m.batch_size, help="novel points that trigger a fit")
+    mg.add_argument("--novelty-bandwidth-scale", type=float, default=m.novelty_bandwidth_scale,
+                    help="novel points are fitted with --bandwidth times this, in (0, 1]")
     mg.add_argument("--no-novelty", action="store_true", help="every point is new: fit each frame whole")
     mg.add_argument("--fusion", choices=("off", "hellinger", "kl"), default=m.fusion, help="fuse close components")
     mg.add_argument("--fusion-threshold", type=float, default=m.fusion_threshold,
@@ -96,7 +98,9 @@ def main(argv=None) -> int:
     map_flags = [f for f, v in (("--threshold", a.threshold != MapSettings.novelty_threshold),
                                 ("--batch", a.batch != MapSettings.batch_size), ("--no-novelty", a.no_novelty),
                                 ("--fusion", a.fusion != MapSettings.fusion),
-                                ("--fusion-threshold", a.fusion_threshold != MapSettings.fusion_threshold)) if v]
+                                ("--fusion-threshold", a.fusion_threshold != MapSettings.fusion_threshold),
+                                ("--novelty-bandwidth-scale",
+                                 a.novelty_bandwidth_scale != MapSettings.novelty_bandwidth_scale)) if v]
     if a.decimate is None:
         a.decimate = 5 if a.reduce == "map" else FitSettings.decimate
     try:
@@ -104,7 +108,7 @@ def main(argv=None) -> int:
             raise SogmmError(f"{map_flags[0]} is a map flag: give --reduce map")
         map_settings = None if a.reduce != "map" else MapSettings(
             novelty=not a.no_novelty, novelty_threshold=a.threshold, batch_size=a.batch, fusion=a.fusion,
-            fusion_threshold=a.fusion_threshold)
+            fusion_threshold=a.fusion_threshold, novelty_bandwidth_scale=a.novelty_bandwidth_scale)
         frames_per_task = _frames_per_task(a.frames_per_task)
         settings = FitSettings(bandwidth=a.bandwidth, n_components=a.components, seed=a.seed, n_init=a.n_init,
                                threads=a.threads, tol=a.tol, max_iter=a.max_iter, reg_covar=a.reg_covar,
