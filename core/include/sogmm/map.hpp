@@ -88,12 +88,13 @@ struct MapOptions {
   /// every later view of its surface, closer ones too, and a batch pools the
   /// novel slivers of ~40 frames, which share (range, gray) modes: at the
   /// frame's bandwidth a batch got about one frame's worth of components
-  /// (137 against 113) for a far larger area, and on the synthetic loop the
-  /// worst frame lost 1.8-2.3 dB against its own fit over three seeds. 0.7
-  /// (0.014 for the default 0.02) brings every frame within 0.41 dB (0.09 dB
-  /// on held-out pixels) at 4.9% of append-everything's components
-  /// (tools/sogmm-perf/map_loop.py); scaling only the batches of several
-  /// frames left 1.20 dB.
+  /// (137 against 113) for a far larger area. On the synthetic loop, every
+  /// third frame scored against its own fit (tools/sogmm-perf/map_loop.py
+  /// --accuracy-step 3): at scale 1, 49 of 101 frames lose more than 0.5 dB
+  /// (worst 3.50 dB, median 0.41 dB); at 0.7 (0.014 for the default 0.02),
+  /// 8 of 101 (worst 2.04 dB, frames 6-27 next to the first frame's batch;
+  /// median -1.08 dB: the map is better), at 4.9% of append-everything's
+  /// components. Scaling only the batches of several frames did less.
   double novelty_bandwidth_scale = 0.7;
   DepthOptions depth;               ///< back-projection of insert_rgbd frames
   bool fusion = false;              ///< fuse new components into close map components
