@@ -61,13 +61,15 @@ def median_ms(ms, lo, hi):
 
 def measure(name, sogmm, seq, frames, a, map_flags, work):
     traj = os.path.join(seq, "trajectory.log")
-    common = ["--trajectory", traj, "--frames", frames, "--decimate", a.decimate, "--bandwidth", a.bandwidth]
-    append = run_json(sogmm, ["fit", "--sequence", seq, "-o", os.path.join(work, name + "_append.sogmm")] + common)
+    common = ["--trajectory", traj, "--frames", frames, "--decimate", a.decimate]
+    own_bandwidth = ["--bandwidth", a.bandwidth]
+    append = run_json(sogmm, ["fit", "--sequence", seq, "-o", os.path.join(work, name + "_append.sogmm")] + common +
+                      own_bandwidth)
     out = os.path.join(work, name + "_map.sogmm")
     csv_path = os.path.join(work, name + "_map.csv")
     # A --bandwidth among the map flags replaces the common one for the map
     # only (its batches' fits); the own fits keep --bandwidth.
-    map_common = common if "--bandwidth" not in map_flags else common[:-2]
+    map_common = common + ([] if "--bandwidth" in map_flags else own_bandwidth)
     m = run_json(sogmm, ["map", seq, "-o", out, "--csv", csv_path, "--quiet"] + map_common + map_flags)
     rows = list(csv.DictReader(open(csv_path)))
     # Insert time: a frame that only runs the novelty test takes ~2 ms, where

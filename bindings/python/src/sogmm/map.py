@@ -85,7 +85,7 @@ class Map:
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params, novelty_bandwidth_scale=0.7) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
