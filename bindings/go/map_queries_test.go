@@ -3,6 +3,7 @@ package sogmm
 import (
 	"context"
 	"errors"
+	"math"
 	"slices"
 	"testing"
 )
@@ -264,5 +265,50 @@ func TestNoveltyBandwidthScale(t *testing.T) {
 	}
 	if fine, coarse := count(0.1), count(1.0); fine <= coarse {
 		t.Fatalf("scale 0.1 gave %d components, scale 1 %d", fine, coarse)
+	}
+}
+
+// OptMapRevisitRefitRatio is range-checked and reaches the map: a wall seen
+// in one gray (one batch), then again in 8 gray stripes, has many more modes
+// than the map has components there, so a second fit replaces them at the
+// default ratio and not at ratio 0.
+func TestRevisitRefitRatio(t *testing.T) {
+	for _, bad := range []float64{0.5, -1, math.NaN(), math.Inf(1)} {
+		if _, err := NewOptions(F64(OptMapRevisitRefitRatio, bad)); err == nil {
+			t.Fatalf("ratio %g was accepted", bad)
+		}
+	}
+	const w, h = 64, 48
+	depth := make([]uint16, w*h)
+	plain := make([]uint8, w*h)
+	striped := make([]uint8, w*h)
+	for i := range depth {
+		depth[i] = 1500
+		plain[i] = 128
+		striped[i] = uint8(32 * (((i % w) / 4) % 8))
+	}
+	fits := func(opts ...Option) uint64 {
+		m := newTestMap(t, append([]Option{Bandwidth(0.02), I64(OptMapBatchSize, w*h)}, opts...)...)
+		defer m.Close()
+		for _, gray := range [][]uint8{plain, striped} {
+			f := Frame{Depth: depth, Gray8: gray, Width: w, Height: h, Fx: 60, Fy: 60, Cx: 32, Cy: 24}
+			if err := m.InsertRGBD(f, yawPose(0, 0, 0, 0)); err != nil {
+				t.Fatal(err)
+			}
+		}
+		st, err := m.Stats()
+		if err != nil {
+			t.Fatal(err)
+		}
+		if st.Pending != 0 {
+			t.Fatalf("%d points pending", st.Pending)
+		}
+		return st.Flushes
+	}
+	if got := fits(); got != 2 {
+		t.Fatalf("default ratio: %d fits, want 2 (the revisit refits)", got)
+	}
+	if got := fits(F64(OptMapRevisitRefitRatio, 0)); got != 1 {
+		t.Fatalf("ratio 0: %d fits, want 1", got)
 	}
 }

@@ -37,6 +37,7 @@ const KeySpec kKeys[] = {
     SOGMM_I64_OPTION(SOGMM_OPT_MAP_NOVELTY, map_novelty),
     SOGMM_F64_OPTION(SOGMM_OPT_MAP_NOVELTY_THRESHOLD, map_novelty_threshold),
     SOGMM_F64_OPTION(SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, map_novelty_bandwidth_scale),
+    SOGMM_F64_OPTION(SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, map_revisit_refit_ratio),
     SOGMM_I64_OPTION(SOGMM_OPT_MAP_BATCH_SIZE, map_batch_size),
     SOGMM_I64_OPTION(SOGMM_OPT_MAP_FUSION, map_fusion),
     SOGMM_I64_OPTION(SOGMM_OPT_MAP_FUSION_METHOD, map_fusion_method),

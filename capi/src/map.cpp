@@ -17,6 +17,7 @@ sogmm::MapOptions map_options(const sogmm_options& o) {
   m.novelty = o.map_novelty != 0;
   m.novelty_threshold = o.map_novelty_threshold;
   m.novelty_bandwidth_scale = o.map_novelty_bandwidth_scale;
+  m.revisit_refit_ratio = o.map_revisit_refit_ratio;
   m.batch_size = static_cast<std::size_t>(o.map_batch_size);
   m.fusion = o.map_fusion != 0;
   m.fusion_method = o.map_fusion_method == SOGMM_FUSION_KL ? sogmm::FusionMethod::KL : sogmm::FusionMethod::Hellinger;

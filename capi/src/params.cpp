@@ -107,6 +107,9 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_QUERY_TRUNCATION_NATS: check_f64(key, v, std::isfinite(v) && v >= 0, ">= 0, finite"); break;
       case SOGMM_OPT_MAP_NOVELTY_THRESHOLD: check_f64(key, v, std::isfinite(v), "finite"); break;
       case SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: check_f64(key, v, v > 0 && v <= 1, "in (0, 1]"); break;
+      case SOGMM_OPT_MAP_REVISIT_REFIT_RATIO:
+        check_f64(key, v, v == 0 || (std::isfinite(v) && v >= 1), "0 (off) or >= 1, finite");
+        break;
       case SOGMM_OPT_MAP_FUSION_THRESHOLD: check_f64(key, v, std::isfinite(v) && v > 0, "> 0, finite"); break;
       default: break;
     }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "map_state.hpp"
@@ -48,6 +49,57 @@ bool same_camera(const Camera& a, const Camera& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy;
 }
 
+// A fit made in the camera frame of `pose` as a world-frame model with its
+// fit record, as the CLI's make_model() builds it (the seed recorded is the
+// options' seed).
+Model world_model(const Map::State& s, const FitResult& r, const Pose& pose, double bandwidth, bool from_rgbd) {
+  Model batch;
+  batch.gmm = transform(r.gmm, pose);
+  batch.fit.known = true;
+  const FitOptions& fo = s.options.fit;
+  batch.fit.bandwidth = bandwidth;
+  batch.fit.n_components_requested = fo.n_components;
+  batch.fit.tol = fo.em.tol;
+  record_reg_covar(batch, r.em.reg_covar);
+  batch.fit.max_iter = fo.em.max_iter;
+  batch.fit.n_iter = r.em.iterations;
+  batch.fit.converged = r.em.converged;
+  batch.fit.log_likelihood = r.em.log_likelihood;
+  batch.fit.seed = fo.seed;
+  if (from_rgbd && s.camera) {
+    batch.camera.known = true;
+    batch.camera.camera = *s.camera;
+    batch.camera.decimation = s.options.depth.decimate;
+    batch.camera.depth_scale = s.options.depth.depth_scale;
+    batch.camera.depth_min = s.options.depth.depth_min;
+    batch.camera.depth_max = s.options.depth.depth_max;
+  }
+  batch.key_values.emplace_back(kCoordinateFrameKey, "world");
+  return batch;
+}
+
+// What the map's searches are built from; swapped out whole by a revisit
+// refit, and back when the insert that ran it fails later.
+struct Searchable {
+  Model model;
+  ComponentIndex index;
+  std::vector<detail::Marginal3> marginals;
+};
+
+// The map after a revisit refit, built without touching the map: the seen
+// components dropped, the refit's merged in, index and marginals rebuilt.
+Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, const Pose& pose, bool from_rgbd) {
+  Model batch = world_model(s, plan.fit, pose, plan.bandwidth, from_rgbd);
+  Model kept = s.model;
+  kept.gmm = detail::without_components(s.model.gmm, plan.replaced);
+  Searchable out{kept.gmm.size() == 0 ? std::move(batch) : merge(kept, batch), ComponentIndex(s.options.index_sigmas),
+                 {}};
+  out.marginals.reserve(out.model.gmm.size());
+  for (std::size_t k = 0; k < out.model.gmm.size(); ++k) out.marginals.push_back(detail::marginal3(out.model.gmm, k));
+  out.index.build(out.model.gmm);
+  return out;
+}
+
 }  // namespace
 
 void validate(const MapOptions& o) {
@@ -59,6 +111,9 @@ void validate(const MapOptions& o) {
           "map: novelty_bandwidth_scale " + checked::exact(o.novelty_bandwidth_scale) + " is not in (0, 1]");
   require(std::isfinite(o.fusion_threshold) && o.fusion_threshold > 0, ErrorCode::InvalidArgument,
           "map: fusion_threshold " + checked::exact(o.fusion_threshold) + " is not finite and > 0");
+  require(o.revisit_refit_ratio == 0 || (std::isfinite(o.revisit_refit_ratio) && o.revisit_refit_ratio >= 1),
+          ErrorCode::InvalidArgument,
+          "map: revisit_refit_ratio " + checked::exact(o.revisit_refit_ratio) + " is neither 0 (off) nor finite and >= 1");
   require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
           "map: index_sigmas " + checked::exact(o.index_sigmas) + " is not in (0, 100]");
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
@@ -91,6 +146,7 @@ MapStats Map::stats() const {
   t.n_frames = s_->frames.size();
   t.n_flushes = s_->n_flushes;
   t.n_fused = s_->n_fused;
+  t.n_refits = s_->n_refits;
   return t;
 }
 
@@ -126,6 +182,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   novel.pose = pose;
   novel.from_rgbd = from_rgbd;
   std::vector<std::uint64_t> novel_voxels;
+  std::vector<double> ll;
   if (!s.options.novelty) {
     novel.xyzg.assign(points.data, points.data + 4 * points.size);
   } else {
@@ -133,7 +190,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     // earlier frame's pending point lies near it (that surface is already
     // waiting for the next fit).
     const std::vector<double> world = to_world(points, pose);
-    std::vector<double> ll(points.size, -std::numeric_limits<double>::infinity());
+    ll.assign(points.size, -std::numeric_limits<double>::infinity());
     if (s.model.gmm.size() > 0) map.local_log_likelihood(world.data(), points.size, ll.data());
     // Per point: 0 explained, 1 novel, 2 novel without a voxel (far out).
     std::vector<std::uint8_t> state(points.size, 0);
@@ -157,6 +214,37 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   f.n_novel = novel.xyzg.size() / 4;
   require(s.n_pending <= kMaxPoints - f.n_novel, ErrorCode::Limit,
           "map: more than " + std::to_string(kMaxPoints) + " points pending");
+  // Revisit refit (MapOptions::revisit_refit_ratio): fitted first, committed
+  // with the previous searchable map kept aside until the insert succeeds.
+  std::optional<Searchable> before_refit;
+  if (from_rgbd) {
+    const auto t1 = std::chrono::steady_clock::now();
+    std::optional<detail::RevisitRefit> plan = detail::plan_revisit_refit(s, points, pose, ll, f.index, progress);
+    if (!plan) {
+      f.ms_novelty += ms_since(t1);  // the check (a mode count) is part of the novelty test
+    } else {
+      f.ms_fit += ms_since(t1);
+      const auto t2 = std::chrono::steady_clock::now();
+      Searchable next = after_refit(s, *plan, pose, from_rgbd);
+      before_refit = Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals)};
+      s.model = std::move(next.model);
+      s.index = std::move(next.index);
+      s.marginals = std::move(next.marginals);
+      ++s.n_flushes;
+      ++s.n_refits;
+      f.n_replaced = plan->replaced.size();
+      f.ms_merge += ms_since(t2);
+    }
+  }
+  // Undoes the refit when a later step of this insert fails.
+  auto undo_refit = [&] {
+    if (!before_refit) return;
+    s.model = std::move(before_refit->model);
+    s.index = std::move(before_refit->index);
+    s.marginals = std::move(before_refit->marginals);
+    --s.n_flushes;
+    --s.n_refits;
+  };
   if (f.n_novel > 0) {
     s.pending.push_back(std::move(novel));
     s.n_pending += f.n_novel;
@@ -179,6 +267,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
         // a pending one), so erasing them restores the set exactly.
         for (const std::uint64_t key : novel_voxels) s.pending_voxels.erase(key);
       }
+      undo_refit();
       throw;
     }
   }
@@ -272,31 +361,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   const double ms_fit = ms_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
 
-  // The batch as a world-frame model with its fit record, as the CLI's
-  // make_model() builds it (the seed recorded is the options' seed).
-  Model batch;
-  batch.gmm = transform(r.gmm, last);
-  batch.fit.known = true;
-  const FitOptions& fo = s.options.fit;
-  batch.fit.bandwidth = fo.n_components > 0 ? 0.0 : batch_options.bandwidth;  // the one used
-  batch.fit.n_components_requested = fo.n_components;
-  batch.fit.tol = fo.em.tol;
-  record_reg_covar(batch, r.em.reg_covar);
-  batch.fit.max_iter = fo.em.max_iter;
-  batch.fit.n_iter = r.em.iterations;
-  batch.fit.converged = r.em.converged;
-  batch.fit.log_likelihood = r.em.log_likelihood;
-  batch.fit.seed = fo.seed;
-  if (from_rgbd && s.camera) {
-    batch.camera.known = true;
-    batch.camera.camera = *s.camera;
-    batch.camera.decimation = s.options.depth.decimate;
-    batch.camera.depth_scale = s.options.depth.depth_scale;
-    batch.camera.depth_min = s.options.depth.depth_min;
-    batch.camera.depth_max = s.options.depth.depth_max;
-  }
-  batch.key_values.emplace_back(kCoordinateFrameKey, "world");
-
+  Model batch = world_model(s, r, last, s.options.fit.n_components > 0 ? 0.0 : batch_options.bandwidth, from_rgbd);
   const std::size_t first = s.model.gmm.size();
   Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);
   std::vector<std::size_t> changed;

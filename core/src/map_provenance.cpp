@@ -33,7 +33,8 @@ std::string frames_text(const std::vector<FrameStats>& frames) {
 std::string options_text(const MapOptions& o) {
   return "novelty=" + std::to_string(o.novelty ? 1 : 0) + " novelty_threshold=" + checked::exact(o.novelty_threshold) +
          " batch_size=" + std::to_string(o.batch_size) +
-         " novelty_bandwidth_scale=" + checked::exact(o.novelty_bandwidth_scale) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
+         " novelty_bandwidth_scale=" + checked::exact(o.novelty_bandwidth_scale) +
+         " revisit_refit_ratio=" + checked::exact(o.revisit_refit_ratio) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
          " fusion_method=" + (o.fusion_method == FusionMethod::Hellinger ? "hellinger" : "kl") +
          " fusion_threshold=" + checked::exact(o.fusion_threshold) + " index_sigmas=" + checked::exact(o.index_sigmas) +
          " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0);

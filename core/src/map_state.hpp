@@ -68,6 +68,18 @@ std::uint64_t pending_voxel_key(const std::int64_t voxel[3]);
 /// Whether a pending point lies in the voxel or one of its 26 neighbours.
 bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::int64_t voxel[3]);
 
+/// A revisit refit worked out but not committed (map_revisit.cpp).
+struct RevisitRefit {
+  std::vector<std::size_t> replaced;  ///< map components the frame sees (ascending), to be replaced
+  std::size_t n_modes = 0;            ///< modes of the frame's explained points at the batch bandwidth
+  std::size_t n_points = 0;           ///< the frame's explained points in the fit
+  std::size_t n_samples = 0;          ///< samples of the replaced mass the frame does not see, in the fit
+  double replaced_mass = 0.0;         ///< points the replaced components stood for
+  double bandwidth = 0.0;             ///< the fit's bandwidth (0: fixed K)
+  std::uint64_t support = 0;          ///< points of the fit
+  FitResult fit;                      ///< in the frame's camera frame
+};
+
 /// Novel points of one frame waiting for a fit, in that frame's camera frame.
 struct PendingFrame {
   Pose pose{};
@@ -92,6 +104,7 @@ struct Map::State {
   std::vector<FrameStats> frames;
   std::uint64_t n_flushes = 0;
   std::uint64_t n_fused = 0;
+  std::uint64_t n_refits = 0;
   std::optional<Camera> camera;  ///< fixed by the first RGB-D frame
   /// options.warm_start: the last flush's fit in its camera frame, and that
   /// camera's pose (empty before the first flush).
@@ -101,3 +114,21 @@ struct Map::State {
 };
 
 }  // namespace sogmm
+
+namespace sogmm::detail {
+
+/// The revisit refit of one frame (MapOptions::revisit_refit_ratio), fitted
+/// but not committed, or nothing when it does not apply: novelty off, ratio
+/// 0, no camera (points-only inserts), an empty map, no map component on the
+/// frame's surfaces, no explained point, fewer modes than the ratio asks, or
+/// too much mass to sample. `points` is the frame in its camera frame, `ll`
+/// their novelty scores. Fit errors propagate (nothing has changed).
+std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const PointsView& points, const Pose& pose,
+                                               const std::vector<double>& ll, std::uint64_t frame_index,
+                                               const ProgressSink& progress);
+
+/// `gmm` without the components `removed`; the others keep their mass in
+/// points (weights renormalised, support size scaled). Empty when all go.
+Gmm without_components(const Gmm& gmm, const std::vector<std::size_t>& removed);
+
+}  // namespace sogmm::detail

@@ -154,6 +154,17 @@ static void bad_input(void) {
     EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, NAN), SOGMM_E_INVALID_ARG);
     REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, 1.0));
   }
+  {
+    double ratio = 0.0;
+    REQUIRE_OK(sogmm_options_get_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, &ratio));
+    EXPECT_TRUE(ratio == 1.5);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.5), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, -1.0), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, NAN), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, INFINITY), SOGMM_E_INVALID_ARG);
+    REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.0));
+    REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 2.0));
+  }
   EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_NOVELTY, 1.0), SOGMM_E_INVALID_ARG); /* an i64 key */
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_MIN, 5.0));
   EXPECT_STATUS(sogmm_map_create(&map, o), SOGMM_E_INVALID_ARG);
@@ -214,12 +225,48 @@ static void bad_input(void) {
   sogmm_options_free(o);
 }
 
+/* The revisit refit key reaches the map: a wall first seen in one gray, then
+ * seen again with 8 gray stripes (many more modes than the map has components
+ * there) is refitted at the default ratio (a second fit, nothing pending) and
+ * not at ratio 0. */
+static void revisit_refit(void) {
+  enum { W = 64, H = 48 };
+  uint16_t* depth = malloc(W * H * sizeof(uint16_t));
+  uint8_t* plain = malloc(W * H);
+  uint8_t* striped = malloc(W * H);
+  for (int i = 0; i < W * H; ++i) {
+    depth[i] = 1500;
+    plain[i] = 128;
+    striped[i] = (uint8_t)(32 * (((i % W) / 4) % 8));
+  }
+  for (int r = 0; r < 2; ++r) { /* r = 0: default ratio (1.5); r = 1: ratio 0 */
+    sogmm_options* o = NULL;
+    sogmm_map* map = NULL;
+    sogmm_map_stats st;
+    REQUIRE_OK(sogmm_options_create(&o));
+    REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, W * H)); /* the first frame is one batch */
+    if (r == 1) REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.0));
+    REQUIRE_OK(sogmm_map_create(&map, o));
+    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, plain, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, striped, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(sogmm_map_get_stats(map, &st));
+    EXPECT_TRUE(st.n_frames == 2 && st.n_pending == 0);
+    EXPECT_TRUE(st.n_flushes == (r == 0 ? 2u : 1u));
+    sogmm_map_free(map);
+    sogmm_options_free(o);
+  }
+  free(depth);
+  free(plain);
+  free(striped);
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: %s SCRATCH_DIR\n", argv[0]);
     return 2;
   }
   bad_input();
+  revisit_refit();
 #ifdef SOGMM_CAPI_HAVE_FORMAT
   insert_frames_and_check(argv[1]);
 #else

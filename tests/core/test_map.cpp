@@ -545,3 +545,181 @@ TEST(MapTest, ProvenanceRoundTrip) {
 }
 
 }  // namespace
+
+namespace {
+
+// A world-frame model of a wall at z = 1.5 m drawn coarsely: two wide flat
+// components at x = -0.5 and 0.5 (sigma 0.3 m in x and y: about a fifth of
+// each lies beyond the edges of RefitScene's view, |x| > 0.8 m, |y| > 0.6 m)
+// and a small one far to the side (x = 5).
+sogmm::Model coarse_wall() {
+  sogmm::Model m;
+  m.gmm.resize(3);
+  m.gmm.weights = {0.4f, 0.4f, 0.2f};
+  m.gmm.means = {-0.5f, 0.0f, 1.5f, 0.5f, 0.5f, 0.0f, 1.5f, 0.5f, 5.0f, 0.0f, 1.5f, 0.5f};
+  std::fill(m.gmm.covariances.begin(), m.gmm.covariances.end(), 0.0f);
+  const float wide[4] = {0.09f, 0.09f, 4e-6f, 0.04f}, small[4] = {0.01f, 0.01f, 4e-6f, 0.04f};
+  for (int i = 0; i < 4; ++i) {
+    m.gmm.covariances[5 * i] = m.gmm.covariances[16 + 5 * i] = wide[i];
+    m.gmm.covariances[32 + 5 * i] = small[i];
+  }
+  m.gmm.support_size = 3000;
+  m.key_values = {{sogmm::kCoordinateFrameKey, "world"}};
+  return m;
+}
+
+// An RGB-D view of that wall (64 x 48, f = 60: |x| <= 0.8 m, |y| <= 0.6 m at
+// 1.5 m) with gray stripes of 8 levels: a frame that has many more modes
+// than the coarse map has components on it. An 8 x 8 pixel box at 1 m in a
+// corner is new to the map (its points are novel).
+struct RefitScene {
+  sogmm::Camera cam{64, 48, 60.0, 60.0, 32.0, 24.0};
+  std::vector<std::uint16_t> depth = std::vector<std::uint16_t>(64 * 48, 1500);
+  std::vector<float> gray = std::vector<float>(64 * 48);
+  RefitScene() {
+    for (int v = 0; v < 48; ++v)
+      for (int u = 0; u < 64; ++u) {
+        gray[64 * v + u] = static_cast<float>(((u / 4) % 8) / 8.0);
+        if (u < 8 && v < 8) depth[64 * v + u] = 1000;
+      }
+  }
+  sogmm::RgbdView frame() const { return {depth.data(), gray.data(), cam}; }
+};
+
+MapOptions refit_options(double ratio, int threads = 2) {
+  MapOptions o = options(true, false);
+  o.revisit_refit_ratio = ratio;
+  o.fit.em.threads = threads;
+  return o;
+}
+
+// Whether component k of `a` appears (bitwise mean and covariance) in `b`.
+bool has_component(const sogmm::Gmm& b, const sogmm::Gmm& a, std::size_t k) {
+  for (std::size_t j = 0; j < b.size(); ++j)
+    if (std::equal(a.mean(k), a.mean(k) + 4, b.mean(j)) && std::equal(a.covariance(k), a.covariance(k) + 16, b.covariance(j)))
+      return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(MapTest, RevisitRefitReplacesWhatTheFrameSeesAndKeepsTheRest) {
+  const sogmm::Model wall = coarse_wall();
+  const RefitScene scene;
+  Map map = Map::from_model(wall, refit_options(1.5));
+  const double log_before_outside = [&] {
+    const double x[3] = {1.0, 0.0, 1.5};  // on the wall, beyond the view's edge
+    double ll = 0;
+    map.local_log_likelihood(x, 1, &ll);
+    return ll;
+  }();
+  const sogmm::FrameStats f = map.insert_rgbd(scene.frame(), kIdentity);
+  // Both wall components are on the frame's surface; the far one is not.
+  EXPECT_EQ(f.n_replaced, 2u);
+  EXPECT_EQ(map.stats().n_refits, 1u);
+  EXPECT_EQ(map.stats().n_flushes, 1u);
+  const sogmm::Gmm& g = map.model().gmm;
+  EXPECT_FALSE(has_component(g, wall.gmm, 0));
+  EXPECT_FALSE(has_component(g, wall.gmm, 1));
+  ASSERT_TRUE(has_component(g, wall.gmm, 2));
+  EXPECT_GT(g.size(), 3u);  // the striped frame has many more modes
+  // The far component keeps its mass in points (0.2 x 3000), and the refit
+  // holds the frame's explained points plus the sampled mass beyond the view
+  // (about a fifth of the replaced 2400).
+  std::size_t far = 0;
+  for (std::size_t j = 0; j < g.size(); ++j)
+    if (std::equal(wall.gmm.mean(2), wall.gmm.mean(2) + 4, g.mean(j))) far = j;
+  EXPECT_NEAR(g.weights[far] * static_cast<double>(g.support_size), 600.0, 1.0);
+  const std::size_t explained = f.n_points - f.n_novel;
+  EXPECT_GT(explained, f.n_points / 2);
+  EXPECT_GE(g.support_size, 600u + explained + 200u);
+  EXPECT_LE(g.support_size, 600u + f.n_points + 2400u);
+  // The unseen half of the wall is still mapped (no hole where the replaced
+  // components reached beyond the view).
+  const double x[3] = {1.0, 0.0, 1.5};
+  double ll = 0;
+  map.local_log_likelihood(x, 1, &ll);
+  EXPECT_GT(ll, map.options().novelty_threshold) << "before the refit: " << log_before_outside;
+  // Where the frame sees the wall, the refit follows its stripes: gray is
+  // regressed closer to the frame's than the coarse map's constant 0.5.
+  std::vector<float> xyz;
+  std::vector<float> truth;
+  for (int u = 2; u < 62; u += 4) {
+    const double z = 1.5, xw = (u - 32.0) * z / 60.0;
+    xyz.insert(xyz.end(), {static_cast<float>(xw), 0.0f, static_cast<float>(z)});
+    truth.push_back(scene.gray[64 * 24 + u]);
+  }
+  std::vector<float> mean(truth.size());
+  sogmm::regress_gray(g, xyz.data(), truth.size(), mean.data(), nullptr);
+  double se_map = 0, se_const = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    se_map += (mean[i] - truth[i]) * (mean[i] - truth[i]);
+    se_const += (0.5 - truth[i]) * (0.5 - truth[i]);
+  }
+  EXPECT_LT(se_map, 0.25 * se_const);
+}
+
+TEST(MapTest, RevisitRefitIsOffAtRatioZeroAndBelowTheRatio) {
+  const sogmm::Model wall = coarse_wall();
+  const RefitScene scene;
+  for (double ratio : {0.0, 1000.0}) {
+    SCOPED_TRACE(ratio);
+    Map map = Map::from_model(wall, refit_options(ratio));
+    const sogmm::FrameStats f = map.insert_rgbd(scene.frame(), kIdentity);
+    EXPECT_EQ(f.n_replaced, 0u);
+    EXPECT_EQ(map.stats().n_refits, 0u);
+    EXPECT_EQ(map.model().gmm.weights, wall.gmm.weights);
+    EXPECT_EQ(map.model().gmm.means, wall.gmm.means);
+  }
+  // Points-only inserts carry no camera: no refit.
+  Map map = Map::from_model(wall, refit_options(1.0));
+  const sogmm::PointCloud cloud = sogmm::backproject(scene.frame(), sogmm::DepthOptions{});
+  map.insert_points(cloud.view(), kIdentity);
+  EXPECT_EQ(map.stats().n_refits, 0u);
+  // Validation.
+  for (double bad : {0.5, -1.0, double(NAN), double(INFINITY)}) {
+    MapOptions o;
+    o.revisit_refit_ratio = bad;
+    expect_error([&] { Map m(o); }, ErrorCode::InvalidArgument, {"revisit_refit_ratio"}, "bad ratio");
+  }
+}
+
+TEST(MapTest, RevisitRefitIsTheSameForAnyThreadCountAndUndoneWhenCancelled) {
+  const sogmm::Model wall = coarse_wall();
+  const RefitScene scene;
+  Map one = Map::from_model(wall, refit_options(1.5, 1));
+  Map two = Map::from_model(wall, refit_options(1.5, 2));
+  one.insert_rgbd(scene.frame(), kIdentity);
+  two.insert_rgbd(scene.frame(), kIdentity);
+  ASSERT_EQ(one.stats().n_refits, 1u);
+  EXPECT_EQ(one.model().gmm.weights, two.model().gmm.weights);
+  EXPECT_EQ(one.model().gmm.means, two.model().gmm.means);
+  EXPECT_EQ(one.model().gmm.covariances, two.model().gmm.covariances);
+  EXPECT_EQ(one.model().gmm.support_size, two.model().gmm.support_size);
+
+  Map map = Map::from_model(wall, refit_options(1.5));
+  const sogmm::ProgressSink cancel = [](const sogmm::Progress&) { return true; };
+  expect_error([&] { map.insert_rgbd(scene.frame(), kIdentity, cancel); }, ErrorCode::Cancelled, {"cancelled"},
+               "cancelled refit");
+  EXPECT_EQ(map.model().gmm.means, wall.gmm.means);
+  EXPECT_EQ(map.stats().n_refits, 0u);
+  EXPECT_EQ(map.frames().size(), 0u);
+  // A later step of the insert failing undoes the refit too: a batch of 1
+  // flushes this frame's novel points, and a cancelling callback that lets
+  // the refit's fit through (its first fit) stops the flush's.
+  MapOptions o = refit_options(1.5);
+  o.batch_size = 1;
+  Map undo = Map::from_model(wall, o);
+  int fits = 0;
+  sogmm::Stage last = sogmm::Stage::Em;
+  const sogmm::ProgressSink second = [&](const sogmm::Progress& p) {
+    if (p.stage == sogmm::Stage::ModeCount && last != sogmm::Stage::ModeCount) ++fits;
+    last = p.stage;
+    return fits >= 2;
+  };
+  expect_error([&] { undo.insert_rgbd(scene.frame(), kIdentity, second); }, ErrorCode::Cancelled, {"cancelled"},
+               "cancelled flush after a refit");
+  EXPECT_EQ(undo.model().gmm.means, wall.gmm.means);
+  EXPECT_EQ(undo.stats().n_refits, 0u);
+  EXPECT_EQ(undo.stats().n_flushes, 0u);
+}

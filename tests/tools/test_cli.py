@@ -385,12 +385,15 @@ def mode_map(tmp):
     summary, progress = run_json(["map", d] + base + ["-o", out, "--progress"], with_stderr=True)
     check(progress.count("novel") >= n, "map --progress: one line per frame expected: %r" % progress[-500:])
     rows = open(os.path.join(tmp, "loop.csv")).read().strip().split("\n")
-    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge",
+    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced",
           "map CSV header: %r" % rows[0])
     check(len(rows) == n + 1, "map CSV: %d rows for %d frames" % (len(rows) - 1, n))
     table = [r.split(",") for r in rows[1:]]
     check([int(r[0]) for r in table] == list(range(n)), "map CSV frame column")
     check(all(int(r[2]) <= int(r[1]) for r in table), "map CSV: more novel points than points")
+    # A refit replaces components that exist: never more than the map held before the frame.
+    check(all(int(r[9]) <= int(p[3]) for p, r in zip(table, table[1:])) and int(table[0][9]) == 0,
+          "map CSV: a frame replaced more components than the map had")
     check(int(table[0][2]) == int(table[0][1]), "map CSV: the first frame is all novel")
     # The last frame revisits the first: almost nothing of it is new.
     check(int(table[-1][2]) < 0.2 * int(table[-1][1]), "map CSV: the loop's last frame is %s/%s novel" %

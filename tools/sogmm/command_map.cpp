@@ -38,14 +38,15 @@ struct Row {
   std::size_t frame, points, novel, components, pending;
   bool flushed;
   double ms_novelty, ms_fit, ms_merge;
+  std::size_t replaced;  // components a revisit refit replaced
 };
 
 std::string csv_text(const std::vector<Row>& rows) {
-  std::string out = "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge\n";
+  std::string out = "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced\n";
   char buf[256];
   for (const Row& r : rows) {
-    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%zu,%zu,%d,%.3f,%.3f,%.3f\n", r.frame, r.points, r.novel,
-                  r.components, r.pending, r.flushed ? 1 : 0, r.ms_novelty, r.ms_fit, r.ms_merge);
+    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%zu,%zu,%d,%.3f,%.3f,%.3f,%zu\n", r.frame, r.points, r.novel,
+                  r.components, r.pending, r.flushed ? 1 : 0, r.ms_novelty, r.ms_fit, r.ms_merge, r.replaced);
     out += buf;
   }
   return out;
@@ -90,7 +91,7 @@ int run_map(MapState& s) {
     const FrameStats& st = f.stats;
     const std::size_t pending = map.pending();
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
-                    st.ms_fit, st.ms_merge});
+                    st.ms_fit, st.ms_merge, st.n_replaced});
     points += st.n_points;
     novel += st.n_novel;
     ms_novelty += st.ms_novelty;
@@ -128,6 +129,7 @@ int run_map(MapState& s) {
     j["support_size"] = model.gmm.support_size;
     j["n_flushes"] = st.n_flushes;
     j["n_fused"] = st.n_fused;
+    j["n_refits"] = st.n_refits;
     j["final_flush_components"] = added;
     j["ms_novelty"] = ms_novelty;
     j["ms_fit"] = ms_fit;
@@ -138,11 +140,12 @@ int run_map(MapState& s) {
     return 0;
   }
   std::printf(
-      "Mapped %zu frames of %s (frames %s): %zu points, %zu novel (%.1f%%), %llu fits, %llu components fused; the "
+      "Mapped %zu frames of %s (frames %s): %zu points, %zu novel (%.1f%%), %llu fits (%llu revisit refits), %llu components fused; the "
       "map has %zu components (support size %llu). Time: novelty %.2f s, fit %.2f s, merge %.2f s, final flush %.2f "
       "s. Wrote %s (%s), %s and %s.\n",
       rows.size(), s.src.sequence.c_str(), frames.c_str(), points, novel, points ? 100.0 * novel / points : 0.0,
-      static_cast<unsigned long long>(st.n_flushes), static_cast<unsigned long long>(st.n_fused), model.gmm.size(),
+      static_cast<unsigned long long>(st.n_flushes), static_cast<unsigned long long>(st.n_refits),
+      static_cast<unsigned long long>(st.n_fused), model.gmm.size(),
       static_cast<unsigned long long>(model.gmm.support_size), ms_novelty / 1000, ms_fit / 1000, ms_merge / 1000,
       ms_flush / 1000, s.output.c_str(), human_bytes(bytes).c_str(), csv.c_str(), plot.c_str());
   return 0;
@@ -159,11 +162,13 @@ Command add_map_command(CLI::App& root) {
       "Each frame's points are moved to the world with the frame's camera-to-world pose and scored with the\n"
       "3-D log-likelihood of the map's local components; points below --threshold are novel. Once --batch\n"
       "novel points are pending they are fitted (the usual self-organizing fit at --bandwidth times\n"
-      "--novelty-bandwidth-scale) and merged; with --fusion new\n"
+      "--novelty-bandwidth-scale) and merged. A frame whose explained points have --revisit-refit-ratio\n"
+      "times as many modes as the map has components on its surfaces refits them (its points plus samples\n"
+      "of what it does not see replace them). With --fusion new\n"
       "components close to existing ones (Hellinger or symmetric KL distance below --fusion-threshold) are\n"
       "merged into them. --no-novelty fits every frame whole (the append-everything map of sogmm fit\n"
       "--sequence). Progress goes to stderr (a live line on a terminal, lines with --progress); the per-frame\n"
-      "CSV (frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge) and an SVG plot\n"
+      "CSV (frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced) and an SVG plot\n"
       "of components and time against frame go next to the map unless --csv/--plot say where.\n"
       "Evaluate the result with sogmm eval MAP --sequence DIR --trajectory LOG.\n\n"
       "Examples:\n"
@@ -182,6 +187,10 @@ Command add_map_command(CLI::App& root) {
   app->add_option("--batch", s->options.batch_size, "novel points that trigger a fit")->capture_default_str();
   app->add_option("--novelty-bandwidth-scale", s->options.novelty_bandwidth_scale,
                   "novel points are fitted with --bandwidth times this, in (0, 1] (--no-novelty: the bandwidth)")
+      ->capture_default_str();
+  app->add_option("--revisit-refit-ratio", s->options.revisit_refit_ratio,
+                  "refit what a frame sees when its explained points have this many times as many modes as the "
+                  "map has components there, 0 or >= 1 (0: off)")
       ->capture_default_str();
   app->add_flag("--no-novelty", s->no_novelty, "every point is new: fit each frame whole (append everything)");
   app->add_option("--fusion", s->fusion, "fuse close components: off, hellinger or kl")

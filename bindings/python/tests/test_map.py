@@ -188,3 +188,36 @@ def test_novelty_bandwidth_scale_out_of_range_raises():
     for bad in (0.0, 1.5, float("nan")):
         with pytest.raises(sogmm.InvalidArgumentError, match="NOVELTY_BANDWIDTH_SCALE|novelty_bandwidth_scale"):
             sogmm.Map(novelty_bandwidth_scale=bad)
+
+
+def _wall(striped: bool):
+    """A 64 x 48 view of a wall at 1.5 m, in one gray or in 8 gray stripes."""
+    cam = sogmm.Camera(64, 48, 60.0, 60.0, 32.0, 24.0)
+    depth = np.full((48, 64), 1500, np.uint16)
+    u = np.broadcast_to(np.arange(64), (48, 64))
+    gray = (32 * ((u // 4) % 8)).astype(np.uint8) if striped else np.full((48, 64), 128, np.uint8)
+    return depth, np.repeat(gray[:, :, None], 3, axis=2), cam
+
+
+@pytest.mark.parametrize("ratio, fits", [(1.5, 2), (0.0, 1)])
+def test_a_revisit_with_many_more_modes_refits_what_it_sees(ratio, fits):
+    # The first (plain) frame is one batch; the striped revisit has many more
+    # modes than the map has components on the wall: a second fit replaces
+    # them, unless the refit is off.
+    with sogmm.Map(batch_size=64 * 48, revisit_refit_ratio=ratio) as m:
+        m.insert_rgbd(*_wall(False), np.eye(4))
+        plain = m.export()
+        m.insert_rgbd(*_wall(True), np.eye(4))
+        st = m.stats()
+        assert st["n_flushes"] == fits and st["n_pending"] == 0
+        after = m.export()
+    if fits == 2:
+        assert after.n_components_ > plain.n_components_
+    else:
+        assert after.means_.tobytes() == plain.means_.tobytes()
+
+
+def test_revisit_refit_ratio_out_of_range_raises():
+    for bad in (0.5, -1.0, float("nan"), float("inf")):
+        with pytest.raises(sogmm.InvalidArgumentError, match="REVISIT_REFIT_RATIO|revisit_refit_ratio"):
+            sogmm.Map(revisit_refit_ratio=bad)

@@ -53,6 +53,12 @@ class Map:
             fitted with the bandwidth times this, in (0, 1] (default 0.7: a map
             component serves closer views than the one it was fitted from, and
             a batch pools the slivers of many frames; core/include/sogmm/map.hpp).
+        revisit_refit_ratio: 0 (off) or >= 1 (default 1.5): an RGB-D frame
+            whose points the map explains, with at least this many times as
+            many modes as the map has components on its surfaces, replaces
+            those components by a fit of its points plus samples of their mass
+            it does not see (the map keeps the finest view of each surface, not
+            the first; core/include/sogmm/map.hpp).
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
@@ -72,20 +78,20 @@ class Map:
 
     def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
                  fusion: str | None = None, fusion_threshold: float = 0.3, warm_start: bool = False,
-                 novelty_bandwidth_scale: float = 0.7,
+                 novelty_bandwidth_scale: float = 0.7, revisit_refit_ratio: float = 1.5,
                  depth_scale: float = 1000.0, depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1,
                  **fit_params):
         self._ptr = None
         self._finalizer = None
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                           fit_params, novelty_bandwidth_scale) as o:
+                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio) as o:
             out = c_void_p()
             check(lib.sogmm_map_create(byref(out), o.ptr))
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params, novelty_bandwidth_scale) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
@@ -98,6 +104,7 @@ class Map:
             raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer >= 1")
         f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
                _ffi.OPT_MAP_NOVELTY_BANDWIDTH_SCALE: novelty_bandwidth_scale,
+               _ffi.OPT_MAP_REVISIT_REFIT_RATIO: revisit_refit_ratio,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
@@ -273,7 +280,7 @@ class Map:
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
         map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,
-                        warm_start=False, novelty_bandwidth_scale=0.7)
+                        warm_start=False, novelty_bandwidth_scale=0.7, revisit_refit_ratio=1.5)
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

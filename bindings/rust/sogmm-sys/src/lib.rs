@@ -98,6 +98,7 @@ pub const SOGMM_OPT_QUERY_TRUNCATION_NATS: sogmm_key = 501;
 pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
 pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
 pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
+pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
 pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;

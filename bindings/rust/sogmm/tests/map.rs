@@ -3,7 +3,7 @@
 use std::ops::ControlFlow;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use sogmm::{Map, Model, Options, Pose, Stage, Status};
+use sogmm::{Color, Frame, Map, Model, Options, Pose, Stage, Status};
 
 const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
 
@@ -241,4 +241,45 @@ fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
     };
     let (fine, coarse) = (count(0.1), count(1.0));
     assert!(fine > coarse, "scale 0.1: {fine} components, scale 1: {coarse}");
+}
+
+#[test]
+fn revisit_refit_ratio_is_checked_and_reaches_the_map() {
+    for bad in [0.5, -1.0, f64::NAN, f64::INFINITY] {
+        let e = Options::builder().map_revisit_refit_ratio(bad).build().unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "{bad}: {e}");
+    }
+    // A wall seen in one gray (one batch), then again in 8 gray stripes: many
+    // more modes than the map has components there, so a second fit replaces
+    // them at the default ratio and not at ratio 0.
+    let (w, h) = (64u32, 48u32);
+    let depth = vec![1500u16; (w * h) as usize];
+    let plain = vec![128u8; (w * h) as usize];
+    let striped: Vec<u8> = (0..w * h).map(|i| (32 * (((i % w) / 4) % 8)) as u8).collect();
+    let fits = |ratio: Option<f64>| {
+        let mut b = Options::builder().map_batch_size(i64::from(w * h));
+        if let Some(r) = ratio {
+            b = b.map_revisit_refit_ratio(r);
+        }
+        let o = b.build().unwrap();
+        let mut map = Map::new(Some(&o)).unwrap();
+        for gray in [&plain, &striped] {
+            let frame = Frame {
+                depth: &depth,
+                color: Color::Gray8(gray),
+                width: w,
+                height: h,
+                fx: 60.0,
+                fy: 60.0,
+                cx: 32.0,
+                cy: 24.0,
+            };
+            map.insert_frame(&frame, &IDENTITY).unwrap();
+        }
+        let st = map.stats().unwrap();
+        assert_eq!(st.n_pending, 0);
+        st.n_flushes
+    };
+    assert_eq!(fits(None), 2);
+    assert_eq!(fits(Some(0.0)), 1);
 }

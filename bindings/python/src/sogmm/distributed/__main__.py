@@ -59,6 +59,9 @@ def _parser() -> argparse.ArgumentParser:
     mg.add_argument("--batch", type=int, default=m.batch_size, help="novel points that trigger a fit")
     mg.add_argument("--novelty-bandwidth-scale", type=float, default=m.novelty_bandwidth_scale,
                     help="novel points are fitted with --bandwidth times this, in (0, 1]")
+    mg.add_argument("--revisit-refit-ratio", type=float, default=m.revisit_refit_ratio,
+                    help="refit what a frame sees when its explained points have this many times as many modes "
+                         "as the map has components there, 0 (off) or >= 1")
     mg.add_argument("--no-novelty", action="store_true", help="every point is new: fit each frame whole")
     mg.add_argument("--fusion", choices=("off", "hellinger", "kl"), default=m.fusion, help="fuse close components")
     mg.add_argument("--fusion-threshold", type=float, default=m.fusion_threshold,
@@ -100,7 +103,9 @@ def main(argv=None) -> int:
                                 ("--fusion", a.fusion != MapSettings.fusion),
                                 ("--fusion-threshold", a.fusion_threshold != MapSettings.fusion_threshold),
                                 ("--novelty-bandwidth-scale",
-                                 a.novelty_bandwidth_scale != MapSettings.novelty_bandwidth_scale)) if v]
+                                 a.novelty_bandwidth_scale != MapSettings.novelty_bandwidth_scale),
+                                ("--revisit-refit-ratio", a.revisit_refit_ratio != MapSettings.revisit_refit_ratio))
+                 if v]
     if a.decimate is None:
         a.decimate = 5 if a.reduce == "map" else FitSettings.decimate
     try:
@@ -108,7 +113,8 @@ def main(argv=None) -> int:
             raise SogmmError(f"{map_flags[0]} is a map flag: give --reduce map")
         map_settings = None if a.reduce != "map" else MapSettings(
             novelty=not a.no_novelty, novelty_threshold=a.threshold, batch_size=a.batch, fusion=a.fusion,
-            fusion_threshold=a.fusion_threshold, novelty_bandwidth_scale=a.novelty_bandwidth_scale)
+            fusion_threshold=a.fusion_threshold, novelty_bandwidth_scale=a.novelty_bandwidth_scale,
+            revisit_refit_ratio=a.revisit_refit_ratio)
         frames_per_task = _frames_per_task(a.frames_per_task)
         settings = FitSettings(bandwidth=a.bandwidth, n_components=a.components, seed=a.seed, n_init=a.n_init,
                                threads=a.threads, tol=a.tol, max_iter=a.max_iter, reg_covar=a.reg_covar,

@@ -46,7 +46,7 @@ class MapSettings:
     False is --no-novelty, ``novelty_threshold`` --threshold, ``batch_size``
     --batch, ``fusion`` --fusion ("off", "hellinger", "kl"),
     ``fusion_threshold`` --fusion-threshold, ``novelty_bandwidth_scale``
-    --novelty-bandwidth-scale."""
+    --novelty-bandwidth-scale, ``revisit_refit_ratio`` --revisit-refit-ratio."""
 
     novelty: bool = True
     novelty_threshold: float = 3.0
@@ -54,12 +54,14 @@ class MapSettings:
     fusion: str = "off"
     fusion_threshold: float = 0.3
     novelty_bandwidth_scale: float = 0.7
+    revisit_refit_ratio: float = 1.5
 
     def new_map(self, fit: FitSettings) -> Map:
         """An empty ``sogmm.Map`` with these map options and the fit and depth settings."""
         return Map(novelty=self.novelty, novelty_threshold=self.novelty_threshold, batch_size=self.batch_size,
                    fusion=self.fusion, fusion_threshold=self.fusion_threshold,
-                   novelty_bandwidth_scale=self.novelty_bandwidth_scale, depth_scale=fit.depth_scale,
+                   novelty_bandwidth_scale=self.novelty_bandwidth_scale,
+                   revisit_refit_ratio=self.revisit_refit_ratio, depth_scale=fit.depth_scale,
                    depth_min=fit.depth_min, depth_trunc=fit.depth_max, decimate=fit.decimate,
                    bandwidth=fit.bandwidth, n_components=fit.n_components, seed=fit.seed, n_init=fit.n_init,
                    n_threads=fit.threads, tol=fit.tol, max_iter=fit.max_iter, reg_covar=fit.reg_covar,

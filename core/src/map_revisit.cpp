@@ -1,0 +1,174 @@
+// The revisit refit of the map (MapOptions::revisit_refit_ratio): a frame that
+// sees part of the map and would fit that part with many more components than
+// the map spends on it replaces those components with a fit of its own points
+// plus samples of their mass that it does not see.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "map_state.hpp"
+#include "sogmm/inference.hpp"
+#include "sogmm/mean_shift.hpp"
+
+namespace sogmm::detail {
+namespace {
+
+// Relative depth tolerance of "on the observed surface": a world point whose
+// camera depth is within this fraction of the depth observed at its pixel
+// lies on what the frame sees (3%: 5 cm at 1.65 m, a few times the depth
+// noise and the thickness of surface components, and the same at any scale).
+constexpr double kSurfaceTolerance = 0.03;
+
+// Where a camera-frame point lies relative to the frame's depth image.
+enum class Seen { Outside, OnSurface, FreeSpace, Hidden };
+
+// The frame's observed depth per pixel of the decimated camera (the nearest
+// of its points), and the classification of other points against it.
+class DepthView {
+ public:
+  DepthView(const Camera& decimated_camera, const DepthOptions& depth, const PointsView& frame)
+      : cam_(decimated_camera), depth_(depth),
+        observed_(static_cast<std::size_t>(cam_.width) * static_cast<std::size_t>(cam_.height),
+                  std::numeric_limits<float>::infinity()) {
+    for (std::size_t i = 0; i < frame.size; ++i) {
+      std::size_t at = 0;
+      if (pixel(frame[i], &at)) observed_[at] = std::min(observed_[at], frame[i][2]);
+    }
+  }
+
+  Seen classify(const float* p) const {
+    std::size_t at = 0;
+    const double z = p[2];
+    if (!(z > depth_.depth_min && z <= depth_.depth_max) || !pixel(p, &at)) return Seen::Outside;
+    const double o = observed_[at];
+    if (!std::isfinite(o)) return Seen::Outside;  // no depth there: the frame says nothing
+    const double tol = kSurfaceTolerance * o;
+    if (z < o - tol) return Seen::FreeSpace;
+    if (z > o + tol) return Seen::Hidden;
+    return Seen::OnSurface;
+  }
+
+ private:
+  bool pixel(const float* p, std::size_t* at) const {
+    const double z = p[2];
+    if (!(z > 0)) return false;
+    const double u = std::nearbyint(cam_.fx * p[0] / z + cam_.cx), v = std::nearbyint(cam_.fy * p[1] / z + cam_.cy);
+    if (!(u >= 0 && v >= 0 && u < cam_.width && v < cam_.height)) return false;
+    *at = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam_.width) + static_cast<std::size_t>(u);
+    return true;
+  }
+
+  Camera cam_;
+  DepthOptions depth_;
+  std::vector<float> observed_;
+};
+
+void to_camera(const Pose& world_to_camera, const float* w, float* c) {
+  for (int r = 0; r < 3; ++r)
+    c[r] = static_cast<float>(world_to_camera[4 * r] * w[0] + world_to_camera[4 * r + 1] * w[1] +
+                              world_to_camera[4 * r + 2] * w[2] + world_to_camera[4 * r + 3]);
+  c[3] = w[3];
+}
+
+}  // namespace
+
+std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const PointsView& points, const Pose& pose,
+                                               const std::vector<double>& ll, std::uint64_t frame_index,
+                                               const ProgressSink& progress) {
+  const MapOptions& o = s.options;
+  if (!o.novelty || o.revisit_refit_ratio <= 0 || !s.camera || s.model.gmm.size() == 0) return std::nullopt;
+  const DepthView view(decimated(*s.camera, o.depth.decimate), o.depth, points);
+  const Pose to_camera_pose = inverse_rigid(pose);
+  const Gmm& map = s.model.gmm;
+
+  // The map components the frame sees: means on its observed surface.
+  RevisitRefit plan;
+  for (std::size_t k = 0; k < map.size(); ++k) {
+    float c[4];
+    to_camera(to_camera_pose, map.mean(k), c);
+    if (view.classify(c) == Seen::OnSurface) plan.replaced.push_back(k);
+  }
+  if (plan.replaced.empty()) return std::nullopt;
+
+  // The frame's points the map explains (the novel ones wait for a batch as
+  // usual), and the number of modes the fit would give them.
+  PointCloud cloud;
+  for (std::size_t i = 0; i < points.size; ++i)
+    if (ll[i] >= o.novelty_threshold) cloud.xyzg.insert(cloud.xyzg.end(), points[i], points[i] + 4);
+  plan.n_points = cloud.size();
+  if (plan.n_points == 0) return std::nullopt;
+  FitOptions fo = o.fit;
+  fo.bandwidth *= o.novelty_bandwidth_scale;
+  if (fo.n_components == 0) {
+    const std::vector<double> features = range_gray_features(cloud.view());
+    const MeanShiftResult modes = fo.mode_counter == ModeCounter::FlatBinned
+                                      ? mean_shift_flat(features, fo.bandwidth, fo.mean_shift)
+                                      : mean_shift_gaussian_blurring(features, fo.bandwidth);
+    plan.n_modes = modes.size();
+  } else {
+    plan.n_modes = fo.n_components;
+  }
+  if (static_cast<double>(plan.n_modes) < o.revisit_refit_ratio * static_cast<double>(plan.replaced.size()))
+    return std::nullopt;
+
+  // The replaced components' mass that the frame does not see (outside its
+  // view, hidden behind its surfaces or where it has no depth) survives as
+  // samples: as many as the points it stands for (weight x support size).
+  // Samples in what the frame sees as free space are dropped, and those on
+  // its surfaces are replaced by the frame's own points.
+  Gmm sub;
+  sub.resize(plan.replaced.size());
+  double mass = 0.0;
+  for (std::size_t j = 0; j < plan.replaced.size(); ++j) {
+    const std::size_t k = plan.replaced[j];
+    sub.weights[j] = map.weights[k];
+    mass += map.weights[k];
+    std::copy_n(map.mean(k), 4, sub.means.data() + 4 * j);
+    std::copy_n(map.covariance(k), 16, sub.covariances.data() + 16 * j);
+  }
+  for (float& w : sub.weights) w = static_cast<float>(w / mass);
+  plan.replaced_mass = mass * static_cast<double>(map.support_size);
+  const double n_samples = std::round(plan.replaced_mass);
+  // A map whose replaced mass would not fit in one fit is left alone.
+  if (!(n_samples <= static_cast<double>(kMaxPoints - plan.n_points))) return std::nullopt;
+  const std::size_t n = static_cast<std::size_t>(n_samples);
+  std::vector<float> samples(4 * n);
+  // The seed depends on the map's seed and the frame only: the same inserts
+  // give the same map.
+  if (n > 0) sample(sub, n, o.fit.seed ^ (0x9E3779B97F4A7C15ULL * (frame_index + 1)), 4, samples.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    float c[4];
+    to_camera(to_camera_pose, samples.data() + 4 * i, c);
+    const Seen where = view.classify(c);
+    if (where == Seen::Outside || where == Seen::Hidden) cloud.xyzg.insert(cloud.xyzg.end(), c, c + 4);
+  }
+  plan.n_samples = cloud.size() - plan.n_points;
+
+  plan.fit = fit(cloud.view(), fo, progress);
+  plan.bandwidth = fo.n_components > 0 ? 0.0 : fo.bandwidth;
+  plan.support = cloud.size();
+  return plan;
+}
+
+Gmm without_components(const Gmm& gmm, const std::vector<std::size_t>& removed) {
+  std::vector<bool> drop(gmm.size(), false);
+  for (std::size_t k : removed) drop[k] = true;
+  Gmm out;
+  double kept = 0.0;
+  for (std::size_t k = 0; k < gmm.size(); ++k) {
+    if (drop[k]) continue;
+    out.weights.push_back(gmm.weights[k]);
+    kept += gmm.weights[k];
+    out.means.insert(out.means.end(), gmm.mean(k), gmm.mean(k) + 4);
+    out.covariances.insert(out.covariances.end(), gmm.covariance(k), gmm.covariance(k) + 16);
+  }
+  if (out.size() == 0) return out;
+  // The kept components keep their mass in points: weights renormalised over
+  // them, support size the map's times their share.
+  for (float& w : out.weights) w = static_cast<float>(w / kept);
+  const double support = std::round(static_cast<double>(gmm.support_size) * std::min(kept, 1.0));
+  out.support_size = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(support));
+  return out;
+}
+
+}  // namespace sogmm::detail
