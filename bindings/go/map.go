@@ -17,7 +17,7 @@ const (
 	// OptMapNoveltyBandwidthScale (f64, (0, 1], default 0.7): with novelty on,
 	// the batches of novel points are fitted with OptBandwidth times this.
 	OptMapNoveltyBandwidthScale Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
-	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.5): an RGB-D
+	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.25): an RGB-D
 	// insert whose explained points have at least this many times as many
 	// modes as the map has components on its surfaces replaces those
 	// components by a fit of its points plus samples of their unseen mass.

@@ -56,7 +56,7 @@ struct sogmm_options {
   std::int64_t map_novelty = 1;
   double map_novelty_threshold = 3.0;
   double map_novelty_bandwidth_scale = 0.7;
-  double map_revisit_refit_ratio = 1.5;
+  double map_revisit_refit_ratio = 1.25;
   std::int64_t map_batch_size = 12288;
   std::int64_t map_fusion = 0;
   std::int64_t map_fusion_method = SOGMM_FUSION_HELLINGER;

@@ -19,18 +19,6 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-// Sets the OpenMP thread count of the calling thread for the duration of a
-// fit and restores the caller's setting afterwards, even on error.
-class ScopedOmpThreads {
- public:
-  explicit ScopedOmpThreads(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
-  ~ScopedOmpThreads() { omp_set_num_threads(saved_); }
-  ScopedOmpThreads(const ScopedOmpThreads&) = delete;
-  ScopedOmpThreads& operator=(const ScopedOmpThreads&) = delete;
-
- private:
-  int saved_;
-};
 }  // namespace
 
 FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress) {
@@ -57,7 +45,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
               std::to_string(options.n_init));
   // Every parallel loop of the fit (mode count, seeding, EM) uses this many.
   const int threads = detail::team_size(options.em.threads);
-  const ScopedOmpThreads scoped_threads(threads);
+  const detail::ScopedOmpThreads scoped_threads(threads);
   const ProgressScope progress_scope(progress);
 
   FitResult result;

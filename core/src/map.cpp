@@ -233,6 +233,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       ++s.n_flushes;
       ++s.n_refits;
       f.n_replaced = plan->replaced.size();
+      f.flushed = true;  // ran a fit
       f.ms_merge += ms_since(t2);
     }
   }
@@ -245,31 +246,33 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     --s.n_flushes;
     --s.n_refits;
   };
-  if (f.n_novel > 0) {
-    s.pending.push_back(std::move(novel));
-    s.n_pending += f.n_novel;
-    s.pending_voxels.insert(novel_voxels.begin(), novel_voxels.end());
-  }
-  s.frames.push_back(f);
-  // Novelty off: each frame is its own batch (append everything).
-  // flush() records its fit and merge times on this frame's stats.
-  if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) {
-    try {
-      map.flush(progress);
-    } catch (...) {
-      // A failed or cancelled fit leaves the map as it was before this insert
-      // (flush() itself commits nothing on failure): undo the frame.
-      s.frames.pop_back();
-      if (f.n_novel > 0) {
-        s.pending.pop_back();
-        s.n_pending -= f.n_novel;
-        // Each of these voxels was new to the set (its points were not near
-        // a pending one), so erasing them restores the set exactly.
-        for (const std::uint64_t key : novel_voxels) s.pending_voxels.erase(key);
-      }
-      undo_refit();
-      throw;
+  // From here on any failure (a failed or cancelled flush, which itself
+  // commits nothing; an allocation) undoes the whole insert.
+  bool pushed_pending = false, pushed_frame = false;
+  try {
+    if (f.n_novel > 0) {
+      s.pending.push_back(std::move(novel));
+      pushed_pending = true;
+      s.n_pending += f.n_novel;
+      s.pending_voxels.insert(novel_voxels.begin(), novel_voxels.end());
     }
+    s.frames.push_back(f);
+    pushed_frame = true;
+    // Novelty off: each frame is its own batch (append everything).
+    // flush() records its fit and merge times on this frame's stats.
+    if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) map.flush(progress);
+  } catch (...) {
+    if (pushed_frame) s.frames.pop_back();
+    if (pushed_pending) {
+      s.pending.pop_back();
+      s.n_pending -= f.n_novel;
+      // Each of these voxels was new to the set (its points were not near a
+      // pending one), so erasing them restores the set exactly (also after a
+      // partial insert).
+      for (const std::uint64_t key : novel_voxels) s.pending_voxels.erase(key);
+    }
+    undo_refit();
+    throw;
   }
   s.frames.back().n_components = s.model.gmm.size();
   return s.frames.back();

@@ -121,4 +121,26 @@ void local_log_likelihood(const ComponentIndex& index, const std::vector<Margina
   });
 }
 
+void dominant_component(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
+                        const double* xyz, std::size_t n, std::int64_t* out) {
+  const int team = team_size(threads);
+  std::vector<std::vector<std::uint32_t>> scratch(team);
+  std::vector<ComponentIndex::Cursor> cursors(team);
+  parallel_for(n, team, 256, [&](std::size_t i, int t) {
+    std::vector<std::uint32_t>& ids = scratch[t];
+    index.query_point(xyz + 3 * i, ids, cursors[t]);
+    double best = -std::numeric_limits<double>::infinity();
+    std::int64_t arg = -1;
+    // Ties go to the lowest id (ids ascend), whatever the team size.
+    for (std::uint32_t id : ids) {
+      const double lp = marginals[id].log_count + log_density(marginals[id], xyz + 3 * i);
+      if (lp > best) {
+        best = lp;
+        arg = id;
+      }
+    }
+    out[i] = arg;
+  });
+}
+
 }  // namespace sogmm::detail

@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "map_state.hpp"
+#include "parallel.hpp"
+#include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/mean_shift.hpp"
 
@@ -76,46 +78,74 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
                                                const std::vector<double>& ll, std::uint64_t frame_index,
                                                const ProgressSink& progress) {
   const MapOptions& o = s.options;
-  if (!o.novelty || o.revisit_refit_ratio <= 0 || !s.camera || s.model.gmm.size() == 0) return std::nullopt;
+  const Gmm& map = s.model.gmm;
+  // A fixed K has no mode count to compare; a warm start's restore after a
+  // load assumes a map that only grows by appends; a map of unknown support
+  // (0) has no mass to sample.
+  if (!o.novelty || o.revisit_refit_ratio <= 0 || o.warm_start || o.fit.n_components > 0 || !s.camera ||
+      map.size() == 0 || map.support_size == 0)
+    return std::nullopt;
   const DepthView view(decimated(*s.camera, o.depth.decimate), o.depth, points);
   const Pose to_camera_pose = inverse_rigid(pose);
-  const Gmm& map = s.model.gmm;
 
   // The map components the frame sees: means on its observed surface.
   RevisitRefit plan;
+  std::vector<bool> replaced(map.size(), false);
   for (std::size_t k = 0; k < map.size(); ++k) {
     float c[4];
     to_camera(to_camera_pose, map.mean(k), c);
-    if (view.classify(c) == Seen::OnSurface) plan.replaced.push_back(k);
+    if (view.classify(c) == Seen::OnSurface) {
+      plan.replaced.push_back(k);
+      replaced[k] = true;
+    }
   }
   if (plan.replaced.empty()) return std::nullopt;
 
   // The frame's points the map explains (the novel ones wait for a batch as
-  // usual), and the number of modes the fit would give them.
+  // usual) whose dominant component is replaced: the points under a kept
+  // component stay its mass, not the refit's.
+  std::vector<double> world;
+  std::vector<std::size_t> explained;
+  for (std::size_t i = 0; i < points.size; ++i) {
+    if (!(ll[i] >= o.novelty_threshold)) continue;
+    explained.push_back(i);
+    const float* p = points[i];
+    for (int r = 0; r < 3; ++r)
+      world.push_back(pose[4 * r] * p[0] + pose[4 * r + 1] * p[1] + pose[4 * r + 2] * p[2] + pose[4 * r + 3]);
+  }
+  std::vector<std::int64_t> owner(explained.size());
+  dominant_component(s.index, s.marginals, o.fit.em.threads, world.data(), explained.size(), owner.data());
   PointCloud cloud;
-  for (std::size_t i = 0; i < points.size; ++i)
-    if (ll[i] >= o.novelty_threshold) cloud.xyzg.insert(cloud.xyzg.end(), points[i], points[i] + 4);
+  for (std::size_t j = 0; j < explained.size(); ++j)
+    if (owner[j] >= 0 && replaced[static_cast<std::size_t>(owner[j])])
+      cloud.xyzg.insert(cloud.xyzg.end(), points[explained[j]], points[explained[j]] + 4);
   plan.n_points = cloud.size();
-  if (plan.n_points == 0) return std::nullopt;
+  const double needed = o.revisit_refit_ratio * static_cast<double>(plan.replaced.size());
+  // A fit of n points has at most n modes.
+  if (static_cast<double>(plan.n_points) < needed) return std::nullopt;
+
+  // The number of modes a fit would give those points: the mode count of
+  // fit() with the batch bandwidth and the fit's threads (not reported to
+  // the progress sink: an insert that runs no fit calls none; it takes
+  // milliseconds).
   FitOptions fo = o.fit;
   fo.bandwidth *= o.novelty_bandwidth_scale;
-  if (fo.n_components == 0) {
+  {
+    const detail::ScopedOmpThreads threads(team_size(fo.em.threads));
     const std::vector<double> features = range_gray_features(cloud.view());
     const MeanShiftResult modes = fo.mode_counter == ModeCounter::FlatBinned
                                       ? mean_shift_flat(features, fo.bandwidth, fo.mean_shift)
                                       : mean_shift_gaussian_blurring(features, fo.bandwidth);
     plan.n_modes = modes.size();
-  } else {
-    plan.n_modes = fo.n_components;
   }
-  if (static_cast<double>(plan.n_modes) < o.revisit_refit_ratio * static_cast<double>(plan.replaced.size()))
-    return std::nullopt;
+  if (static_cast<double>(plan.n_modes) < needed) return std::nullopt;
 
   // The replaced components' mass that the frame does not see (outside its
   // view, hidden behind its surfaces or where it has no depth) survives as
-  // samples: as many as the points it stands for (weight x support size).
-  // Samples in what the frame sees as free space are dropped, and those on
-  // its surfaces are replaced by the frame's own points.
+  // samples: as many as the points it stands for (weight x support size),
+  // drawn untruncated so that a refit does not shrink it. Samples in what the
+  // frame sees as free space are dropped, and those on its surfaces are
+  // replaced by the frame's own points.
   Gmm sub;
   sub.resize(plan.replaced.size());
   double mass = 0.0;
@@ -126,6 +156,7 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
     std::copy_n(map.mean(k), 4, sub.means.data() + 4 * j);
     std::copy_n(map.covariance(k), 16, sub.covariances.data() + 16 * j);
   }
+  if (!(mass > 0)) return std::nullopt;
   for (float& w : sub.weights) w = static_cast<float>(w / mass);
   plan.replaced_mass = mass * static_cast<double>(map.support_size);
   const double n_samples = std::round(plan.replaced_mass);
@@ -135,7 +166,9 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   std::vector<float> samples(4 * n);
   // The seed depends on the map's seed and the frame only: the same inserts
   // give the same map.
-  if (n > 0) sample(sub, n, o.fit.seed ^ (0x9E3779B97F4A7C15ULL * (frame_index + 1)), 4, samples.data());
+  if (n > 0)
+    sample(sub, n, o.fit.seed ^ (0x9E3779B97F4A7C15ULL * (frame_index + 1)), 4, samples.data(),
+           std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < n; ++i) {
     float c[4];
     to_camera(to_camera_pose, samples.data() + 4 * i, c);
@@ -144,8 +177,15 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   }
   plan.n_samples = cloud.size() - plan.n_points;
 
-  plan.fit = fit(cloud.view(), fo, progress);
-  plan.bandwidth = fo.n_components > 0 ? 0.0 : fo.bandwidth;
+  // The refit improves the map; when its fit fails on the data (a limit, a
+  // numeric failure) the map keeps its components. A cancel propagates.
+  try {
+    plan.fit = fit(cloud.view(), fo, progress);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::Cancelled) throw;
+    return std::nullopt;
+  }
+  plan.bandwidth = fo.bandwidth;
   plan.support = cloud.size();
   return plan;
 }

@@ -44,6 +44,12 @@ inline double log_density(const Marginal3& c, const double x[3]) {
 void local_log_likelihood(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
                           const double* xyz, std::size_t n, double* out);
 
+/// The component with the largest term weight x N(x | mu, Sigma_xx) among
+/// those whose index box holds each of n world points (3 doubles each), into
+/// out (n ids; -1 where no box holds the point). Ties: the lowest id.
+void dominant_component(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
+                        const double* xyz, std::size_t n, std::int64_t* out);
+
 /// Fuses the components [first, gmm.size()) of `gmm` into the close
 /// components of [0, first) (found through `index`, which covers exactly
 /// those) as MapOptions say; removes the fused ones from `gmm`. Returns the

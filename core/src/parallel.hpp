@@ -25,6 +25,20 @@
 
 namespace sogmm::detail {
 
+/// Sets the OpenMP thread count of the calling thread for its lifetime and
+/// restores the caller's setting afterwards, even on error (fit(), the warm
+/// start and the map's mode-count check run their parallel loops under one).
+class ScopedOmpThreads {
+ public:
+  explicit ScopedOmpThreads(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
+  ~ScopedOmpThreads() { omp_set_num_threads(saved_); }
+  ScopedOmpThreads(const ScopedOmpThreads&) = delete;
+  ScopedOmpThreads& operator=(const ScopedOmpThreads&) = delete;
+
+ private:
+  int saved_;
+};
+
 /// Threads per processor above which no team grows (see team_size).
 inline constexpr int kThreadsPerProcessor = 4;
 

@@ -27,18 +27,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The caller's OpenMP thread count is restored on every exit (as fit()).
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int n) : saved_(omp_get_max_threads()) { omp_set_num_threads(n); }
-  ~ScopedThreads() { omp_set_num_threads(saved_); }
-  ScopedThreads(const ScopedThreads&) = delete;
-  ScopedThreads& operator=(const ScopedThreads&) = delete;
-
- private:
-  int saved_;
-};
-
 double median(std::vector<double> v) {
   const std::size_t h = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + h, v.end());
@@ -143,7 +131,7 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
   else
     require_usable_bandwidth(options.bandwidth);
   const int threads = detail::team_size(options.em.threads);
-  const ScopedThreads scoped(threads);
+  const detail::ScopedOmpThreads scoped(threads);
   EmOptions em = options.em;
   em.threads = threads;
 

@@ -157,7 +157,7 @@ static void bad_input(void) {
   {
     double ratio = 0.0;
     REQUIRE_OK(sogmm_options_get_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, &ratio));
-    EXPECT_TRUE(ratio == 1.5);
+    EXPECT_TRUE(ratio == 1.25);
     EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.5), SOGMM_E_INVALID_ARG);
     EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, -1.0), SOGMM_E_INVALID_ARG);
     EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, NAN), SOGMM_E_INVALID_ARG);
@@ -239,7 +239,7 @@ static void revisit_refit(void) {
     plain[i] = 128;
     striped[i] = (uint8_t)(32 * (((i % W) / 4) % 8));
   }
-  for (int r = 0; r < 2; ++r) { /* r = 0: default ratio (1.5); r = 1: ratio 0 */
+  for (int r = 0; r < 2; ++r) { /* r = 0: default ratio (1.25); r = 1: ratio 0 */
     sogmm_options* o = NULL;
     sogmm_map* map = NULL;
     sogmm_map_stats st;

@@ -4,6 +4,8 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "sogmm/inference.hpp"
@@ -671,11 +673,32 @@ TEST(MapTest, RevisitRefitIsOffAtRatioZeroAndBelowTheRatio) {
     EXPECT_EQ(map.model().gmm.weights, wall.gmm.weights);
     EXPECT_EQ(map.model().gmm.means, wall.gmm.means);
   }
-  // Points-only inserts carry no camera: no refit.
+  // Points-only inserts carry no camera: no refit, even once an RGB-D frame
+  // (turned away from the wall: it sees none of it) has fixed the camera.
   Map map = Map::from_model(wall, refit_options(1.0));
+  map.insert_rgbd(scene.frame(), pose_y(3.14159265358979, 0, 0, 0));
+  ASSERT_EQ(map.stats().n_refits, 0u);
   const sogmm::PointCloud cloud = sogmm::backproject(scene.frame(), sogmm::DepthOptions{});
   map.insert_points(cloud.view(), kIdentity);
   EXPECT_EQ(map.stats().n_refits, 0u);
+  // The cases without a refit: a fixed K (no mode count to compare), a warm
+  // start, a map of unknown support size. Each insert succeeds.
+  {
+    MapOptions fixed_k = refit_options(1.0);
+    fixed_k.fit.n_components = 40;
+    MapOptions warm = refit_options(1.0);
+    warm.warm_start = true;
+    sogmm::Model unknown = wall;
+    unknown.gmm.support_size = 0;
+    const std::pair<const sogmm::Model*, MapOptions> cases[] = {
+        {&wall, fixed_k}, {&wall, warm}, {&unknown, refit_options(1.0)}};
+    for (const auto& [model, o] : cases) {
+      Map m = Map::from_model(*model, o);
+      m.insert_rgbd(scene.frame(), kIdentity);
+      EXPECT_EQ(m.stats().n_refits, 0u);
+      EXPECT_EQ(m.model().gmm.means, wall.gmm.means);
+    }
+  }
   // Validation.
   for (double bad : {0.5, -1.0, double(NAN), double(INFINITY)}) {
     MapOptions o;
@@ -697,19 +720,25 @@ TEST(MapTest, RevisitRefitIsTheSameForAnyThreadCountAndUndoneWhenCancelled) {
   EXPECT_EQ(one.model().gmm.covariances, two.model().gmm.covariances);
   EXPECT_EQ(one.model().gmm.support_size, two.model().gmm.support_size);
 
+  // Everything an insert may change, to compare before and after.
+  auto state = [](const Map& m) {
+    return std::make_tuple(m.model().gmm.weights, m.model().gmm.means, m.model().gmm.covariances,
+                           m.model().gmm.support_size, m.pending(), m.frames().size(), m.stats().n_refits,
+                           m.stats().n_flushes);
+  };
   Map map = Map::from_model(wall, refit_options(1.5));
+  const auto before = state(map);
   const sogmm::ProgressSink cancel = [](const sogmm::Progress&) { return true; };
   expect_error([&] { map.insert_rgbd(scene.frame(), kIdentity, cancel); }, ErrorCode::Cancelled, {"cancelled"},
                "cancelled refit");
-  EXPECT_EQ(map.model().gmm.means, wall.gmm.means);
-  EXPECT_EQ(map.stats().n_refits, 0u);
-  EXPECT_EQ(map.frames().size(), 0u);
+  EXPECT_TRUE(state(map) == before);
   // A later step of the insert failing undoes the refit too: a batch of 1
-  // flushes this frame's novel points, and a cancelling callback that lets
-  // the refit's fit through (its first fit) stops the flush's.
+  // flushes this frame's novel points (the box), and a cancelling callback
+  // that lets the refit's fit through (the first fit) stops the flush's.
   MapOptions o = refit_options(1.5);
   o.batch_size = 1;
   Map undo = Map::from_model(wall, o);
+  const auto undo_before = state(undo);
   int fits = 0;
   sogmm::Stage last = sogmm::Stage::Em;
   const sogmm::ProgressSink second = [&](const sogmm::Progress& p) {
@@ -719,7 +748,11 @@ TEST(MapTest, RevisitRefitIsTheSameForAnyThreadCountAndUndoneWhenCancelled) {
   };
   expect_error([&] { undo.insert_rgbd(scene.frame(), kIdentity, second); }, ErrorCode::Cancelled, {"cancelled"},
                "cancelled flush after a refit");
-  EXPECT_EQ(undo.model().gmm.means, wall.gmm.means);
-  EXPECT_EQ(undo.stats().n_refits, 0u);
-  EXPECT_EQ(undo.stats().n_flushes, 0u);
+  EXPECT_EQ(fits, 2);
+  EXPECT_TRUE(state(undo) == undo_before);
+  // The same insert then succeeds: refit and flush.
+  const sogmm::FrameStats f = undo.insert_rgbd(scene.frame(), kIdentity);
+  EXPECT_TRUE(f.flushed);
+  EXPECT_EQ(undo.stats().n_refits, 1u);
+  EXPECT_EQ(undo.stats().n_flushes, 2u);
 }

@@ -213,7 +213,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE 607 /* f64, (0, 1]; default 0.7: with MAP_NOVELTY 1 the batches
                                                    * of novel points are fitted with SOGMM_OPT_BANDWIDTH times
                                                    * this (with MAP_NOVELTY 0 each frame with the bandwidth) */
-#define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608 /* f64, 0 or >= 1, finite; default 1.5: with MAP_NOVELTY 1, an
+#define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608 /* f64, 0 or >= 1, finite; default 1.25: with MAP_NOVELTY 1, an
                                                * RGB-D insert whose points the map explains have at least this
                                                * many times as many modes as the map has components on its
                                                * surfaces refits them: those components are replaced by a fit

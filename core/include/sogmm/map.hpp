@@ -94,24 +94,12 @@ struct MapOptions {
   /// (worst 3.50 dB, median 0.41 dB); at 0.7 (0.014 for the default 0.02),
   /// 8 of 101 (worst 2.04 dB, frames 6-27 next to the first frame's batch;
   /// median -1.08 dB: the map is better), at 4.9% of append-everything's
-  /// components. Scaling only the batches of several frames did less.
+  /// components (before revisit_refit_ratio, which fixes frames 6-27).
+  /// Scaling only the batches of several frames did less.
   double novelty_bandwidth_scale = 0.7;
   DepthOptions depth;               ///< back-projection of insert_rgbd frames
   bool fusion = false;              ///< fuse new components into close map components
   FusionMethod fusion_method = FusionMethod::Hellinger;
-  /// Revisit refit, with novelty on and RGB-D inserts (the camera tells
-  /// what a frame sees): when the points of a frame that the map explains
-  /// have at least this many times as many modes (at the batch bandwidth) as
-  /// the map has components on the frame's surfaces, those components are
-  /// replaced by a fit of the frame's explained points plus samples of their
-  /// mass that the frame does not see (outside its view, hidden, or without
-  /// depth; as many as the points they stood for). The map keeps the finest
-  /// view of each surface it has had, not the first: the mode count of a
-  /// view varies with the view (52 modes for the synthetic loop's first
-  /// frame, which faces a wall, against 191 for frame 12 of nearly the same
-  /// surfaces), and without the refit a coarse first view fixed the map there
-  /// for good. 0 = off; else >= 1.
-  double revisit_refit_ratio = 1.5;
   double fusion_threshold = 0.3;    ///< fuse when the distance is below this (method's unit), > 0
   double index_sigmas = ComponentIndex::kDefaultSigmas;  ///< box radius of the index, (0, 100]
   /// Warm-start each flush's fit from the previous flush's model moved into
@@ -119,6 +107,30 @@ struct MapOptions {
   /// cold fit. Meant for novelty off, where a batch is one whole frame and
   /// consecutive frames overlap; needs fit.n_init == 1.
   bool warm_start = false;
+  /// Revisit refit, with novelty on and RGB-D inserts (the camera tells
+  /// what a frame sees): the map components whose mean lies on the frame's
+  /// observed surface (depth within 3% of the frame's at its pixel) are
+  /// replaced when the frame's explained points that they dominate have at
+  /// least this many times as many modes (mean shift at the batch bandwidth)
+  /// as they are components. The replacement is a fit of those points plus
+  /// samples (untruncated) of the replaced mass that the frame does not see:
+  /// outside its view, hidden behind its surfaces or where it has no depth,
+  /// as many as the points that mass stands for; samples in its free space
+  /// are dropped. Other components keep their mass. So the map keeps the
+  /// finest view of each surface it has had, not the first: the mode count
+  /// of a view varies with the view (52 modes for the synthetic loop's first
+  /// frame, which faces a wall, against 191 for frame 12 of nearly the same
+  /// surfaces), and without the refit a coarse first view fixed the map there
+  /// for good (loop, every third frame against its own fit: the worst frame
+  /// 2.04 dB below without, every frame at least 0.39 dB above with, at 8.1%
+  /// of append-everything's components; tools/sogmm-perf/map_loop.py). No refit with a fixed K (fit.n_components > 0:
+  /// no mode count to compare), with warm_start (whose restore after a load
+  /// assumes a map grown by appends only), for a map of unknown support size
+  /// (0) or for insert_points (no camera). A refit whose fit fails on the
+  /// data (a limit, a numeric failure) is skipped and the map kept; a cancel
+  /// propagates and undoes the insert. The check (one mode count) reports no
+  /// progress. 0 = off; else >= 1.
+  double revisit_refit_ratio = 1.25;
 };
 
 /// Throws Error(InvalidArgument) naming the field unless every option is in
@@ -134,12 +146,14 @@ struct FrameStats {
   std::size_t n_points = 0;         ///< points of the frame (after back-projection)
   std::size_t n_novel = 0;          ///< of which novel (all of them with novelty off)
   std::size_t n_components = 0;     ///< map components after this insert (and any flush it ran)
-  bool flushed = false;             ///< this insert ran a flush
+  bool flushed = false;             ///< this insert ran a fit: a flush or a revisit refit
   double ms_novelty = 0.0;          ///< novelty test, milliseconds
-  double ms_fit = 0.0;              ///< fit of a flush this insert ran
+  double ms_fit = 0.0;              ///< fits this insert ran (a refit's with its check and sampling)
   double ms_merge = 0.0;            ///< transform + merge + fusion (+ index) of that flush (and refit)
   /// Map components a revisit refit of this frame replaced (0: none ran;
-  /// MapOptions::revisit_refit_ratio). Its fit time is in ms_fit.
+  /// MapOptions::revisit_refit_ratio). Its fit time is in ms_fit. (The C
+  /// API's fixed frame-stats struct does not carry it; its `flushed` and
+  /// the map's n_flushes count refits.)
   std::size_t n_replaced = 0;
 };
 

@@ -53,7 +53,7 @@ class Map:
             fitted with the bandwidth times this, in (0, 1] (default 0.7: a map
             component serves closer views than the one it was fitted from, and
             a batch pools the slivers of many frames; core/include/sogmm/map.hpp).
-        revisit_refit_ratio: 0 (off) or >= 1 (default 1.5): an RGB-D frame
+        revisit_refit_ratio: 0 (off) or >= 1 (default 1.25): an RGB-D frame
             whose points the map explains, with at least this many times as
             many modes as the map has components on its surfaces, replaces
             those components by a fit of its points plus samples of their mass
@@ -78,7 +78,7 @@ class Map:
 
     def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
                  fusion: str | None = None, fusion_threshold: float = 0.3, warm_start: bool = False,
-                 novelty_bandwidth_scale: float = 0.7, revisit_refit_ratio: float = 1.5,
+                 novelty_bandwidth_scale: float = 0.7, revisit_refit_ratio: float = 1.25,
                  depth_scale: float = 1000.0, depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1,
                  **fit_params):
         self._ptr = None
@@ -280,7 +280,7 @@ class Map:
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
         map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,
-                        warm_start=False, novelty_bandwidth_scale=0.7, revisit_refit_ratio=1.5)
+                        warm_start=False, novelty_bandwidth_scale=0.7, revisit_refit_ratio=1.25)
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

@@ -223,7 +223,7 @@ impl OptionsBuilder {
         /// Map: an RGB-D insert whose explained points have at least this many
         /// times as many modes as the map has components on its surfaces
         /// replaces those components by a fit of its points plus samples of
-        /// their unseen mass; 0 (off) or >= 1 (default 1.5); else `build`
+        /// their unseen mass; 0 (off) or >= 1 (default 1.25); else `build`
         /// fails with `Status::InvalidArg`.
         map_revisit_refit_ratio(f64) => SOGMM_OPT_MAP_REVISIT_REFIT_RATIO as f64 |v| v;
         /// Map: pending novel points that trigger a fit (default 12288).

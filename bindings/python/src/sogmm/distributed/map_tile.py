@@ -54,7 +54,7 @@ class MapSettings:
     fusion: str = "off"
     fusion_threshold: float = 0.3
     novelty_bandwidth_scale: float = 0.7
-    revisit_refit_ratio: float = 1.5
+    revisit_refit_ratio: float = 1.25
 
     def new_map(self, fit: FitSettings) -> Map:
         """An empty ``sogmm.Map`` with these map options and the fit and depth settings."""
