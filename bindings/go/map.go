@@ -20,7 +20,8 @@ const (
 	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.25): an RGB-D
 	// insert whose explained points have at least this many times as many
 	// modes as the map has components on its surfaces replaces those
-	// components by a fit of its points plus samples of their unseen mass.
+	// components by a fit of its points plus samples of their unseen mass
+	// (not with a fixed K or OptMapWarmStart).
 	OptMapRevisitRefitRatio Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
 	OptMapBatchSize         Key = C.SOGMM_OPT_MAP_BATCH_SIZE
 	OptMapFusion            Key = C.SOGMM_OPT_MAP_FUSION

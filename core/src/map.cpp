@@ -183,6 +183,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   novel.from_rgbd = from_rgbd;
   std::vector<std::uint64_t> novel_voxels;
   std::vector<double> ll;
+  std::vector<std::int64_t> dominant;  // each point's dominant map component (revisit refit)
   if (!s.options.novelty) {
     novel.xyzg.assign(points.data, points.data + 4 * points.size);
   } else {
@@ -191,7 +192,10 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     // waiting for the next fit).
     const std::vector<double> world = to_world(points, pose);
     ll.assign(points.size, -std::numeric_limits<double>::infinity());
-    if (s.model.gmm.size() > 0) map.local_log_likelihood(world.data(), points.size, ll.data());
+    dominant.assign(points.size, -1);
+    if (s.model.gmm.size() > 0)
+      detail::local_log_likelihood(s.index, s.marginals, s.options.fit.em.threads, world.data(), points.size,
+                                   ll.data(), dominant.data());
     // Per point: 0 explained, 1 novel, 2 novel without a voxel (far out).
     std::vector<std::uint8_t> state(points.size, 0);
     std::vector<std::int64_t> voxels(3 * points.size, 0);
@@ -219,7 +223,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   std::optional<Searchable> before_refit;
   if (from_rgbd) {
     const auto t1 = std::chrono::steady_clock::now();
-    std::optional<detail::RevisitRefit> plan = detail::plan_revisit_refit(s, points, pose, ll, f.index, progress);
+    std::optional<detail::RevisitRefit> plan = detail::plan_revisit_refit(s, points, pose, ll, dominant, f.index, progress);
     if (!plan) {
       f.ms_novelty += ms_since(t1);  // the check (a mode count) is part of the novelty test
     } else {

@@ -85,7 +85,7 @@ bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::in
 }
 
 void local_log_likelihood(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
-                          const double* xyz, std::size_t n, double* out) {
+                          const double* xyz, std::size_t n, double* out, std::int64_t* dominant) {
   const double neg_inf = -std::numeric_limits<double>::infinity();
   const int team = team_size(threads);
   std::vector<std::vector<std::uint32_t>> scratch(team);
@@ -101,13 +101,18 @@ void local_log_likelihood(const ComponentIndex& index, const std::vector<Margina
     std::vector<double>& v = terms[t];
     v.clear();
     double best = neg_inf, best_count = neg_inf;
+    std::int64_t arg = -1;
     for (std::uint32_t id : ids) {
       const Marginal3& c = marginals[id];
       const double lp = c.log_count + log_density(c, xyz + 3 * i);
       v.push_back(lp);
-      best = std::max(best, lp);
+      if (lp > best) {  // ties: the lowest id (ids ascend)
+        best = lp;
+        arg = id;
+      }
       best_count = std::max(best_count, c.log_count);
     }
+    if (dominant) dominant[i] = arg;
     if (!(best > neg_inf)) {
       out[i] = neg_inf;
       return;
@@ -118,28 +123,6 @@ void local_log_likelihood(const ComponentIndex& index, const std::vector<Margina
       count += std::exp(marginals[ids[k]].log_count - best_count);
     }
     out[i] = best + std::log(sum) - best_count - std::log(count);
-  });
-}
-
-void dominant_component(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
-                        const double* xyz, std::size_t n, std::int64_t* out) {
-  const int team = team_size(threads);
-  std::vector<std::vector<std::uint32_t>> scratch(team);
-  std::vector<ComponentIndex::Cursor> cursors(team);
-  parallel_for(n, team, 256, [&](std::size_t i, int t) {
-    std::vector<std::uint32_t>& ids = scratch[t];
-    index.query_point(xyz + 3 * i, ids, cursors[t]);
-    double best = -std::numeric_limits<double>::infinity();
-    std::int64_t arg = -1;
-    // Ties go to the lowest id (ids ascend), whatever the team size.
-    for (std::uint32_t id : ids) {
-      const double lp = marginals[id].log_count + log_density(marginals[id], xyz + 3 * i);
-      if (lp > best) {
-        best = lp;
-        arg = id;
-      }
-    }
-    out[i] = arg;
   });
 }
 

@@ -75,7 +75,8 @@ void to_camera(const Pose& world_to_camera, const float* w, float* c) {
 }  // namespace
 
 std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const PointsView& points, const Pose& pose,
-                                               const std::vector<double>& ll, std::uint64_t frame_index,
+                                               const std::vector<double>& ll,
+                                               const std::vector<std::int64_t>& dominant, std::uint64_t frame_index,
                                                const ProgressSink& progress) {
   const MapOptions& o = s.options;
   const Gmm& map = s.model.gmm;
@@ -104,21 +105,10 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   // The frame's points the map explains (the novel ones wait for a batch as
   // usual) whose dominant component is replaced: the points under a kept
   // component stay its mass, not the refit's.
-  std::vector<double> world;
-  std::vector<std::size_t> explained;
-  for (std::size_t i = 0; i < points.size; ++i) {
-    if (!(ll[i] >= o.novelty_threshold)) continue;
-    explained.push_back(i);
-    const float* p = points[i];
-    for (int r = 0; r < 3; ++r)
-      world.push_back(pose[4 * r] * p[0] + pose[4 * r + 1] * p[1] + pose[4 * r + 2] * p[2] + pose[4 * r + 3]);
-  }
-  std::vector<std::int64_t> owner(explained.size());
-  dominant_component(s.index, s.marginals, o.fit.em.threads, world.data(), explained.size(), owner.data());
   PointCloud cloud;
-  for (std::size_t j = 0; j < explained.size(); ++j)
-    if (owner[j] >= 0 && replaced[static_cast<std::size_t>(owner[j])])
-      cloud.xyzg.insert(cloud.xyzg.end(), points[explained[j]], points[explained[j]] + 4);
+  for (std::size_t i = 0; i < points.size; ++i)
+    if (ll[i] >= o.novelty_threshold && dominant[i] >= 0 && replaced[static_cast<std::size_t>(dominant[i])])
+      cloud.xyzg.insert(cloud.xyzg.end(), points[i], points[i] + 4);
   plan.n_points = cloud.size();
   const double needed = o.revisit_refit_ratio * static_cast<double>(plan.replaced.size());
   // A fit of n points has at most n modes.
@@ -178,11 +168,12 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   plan.n_samples = cloud.size() - plan.n_points;
 
   // The refit improves the map; when its fit fails on the data (a limit, a
-  // numeric failure) the map keeps its components. A cancel propagates.
+  // numeric failure) the map keeps its components. A cancel and a bad
+  // option propagate.
   try {
     plan.fit = fit(cloud.view(), fo, progress);
   } catch (const Error& e) {
-    if (e.code() == ErrorCode::Cancelled) throw;
+    if (e.code() != ErrorCode::Limit && e.code() != ErrorCode::Numeric) throw;
     return std::nullopt;
   }
   plan.bandwidth = fo.bandwidth;

@@ -40,15 +40,12 @@ inline double log_density(const Marginal3& c, const double x[3]) {
 }
 
 /// Local submap log-likelihood (map.hpp, header comment) of n world points
-/// (3 doubles each) into out (n doubles).
+/// (3 doubles each) into out (n doubles). With `dominant`, also each point's
+/// dominant component into it (n ids): the one with the largest term
+/// weight x N(x | mu, Sigma_xx) among those whose box holds the point (ties:
+/// the lowest id), -1 where none does.
 void local_log_likelihood(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
-                          const double* xyz, std::size_t n, double* out);
-
-/// The component with the largest term weight x N(x | mu, Sigma_xx) among
-/// those whose index box holds each of n world points (3 doubles each), into
-/// out (n ids; -1 where no box holds the point). Ties: the lowest id.
-void dominant_component(const ComponentIndex& index, const std::vector<Marginal3>& marginals, int threads,
-                        const double* xyz, std::size_t n, std::int64_t* out);
+                          const double* xyz, std::size_t n, double* out, std::int64_t* dominant = nullptr);
 
 /// Fuses the components [first, gmm.size()) of `gmm` into the close
 /// components of [0, first) (found through `index`, which covers exactly
@@ -128,9 +125,11 @@ namespace sogmm::detail {
 /// 0, no camera (points-only inserts), an empty map, no map component on the
 /// frame's surfaces, no explained point, fewer modes than the ratio asks, or
 /// too much mass to sample. `points` is the frame in its camera frame, `ll`
-/// their novelty scores. Fit errors propagate (nothing has changed).
+/// and `dominant` their novelty scores and dominant components
+/// (local_log_likelihood). A cancel propagates (nothing has changed).
 std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const PointsView& points, const Pose& pose,
-                                               const std::vector<double>& ll, std::uint64_t frame_index,
+                                               const std::vector<double>& ll,
+                                               const std::vector<std::int64_t>& dominant, std::uint64_t frame_index,
                                                const ProgressSink& progress);
 
 /// `gmm` without the components `removed`; the others keep their mass in

@@ -550,24 +550,31 @@ TEST(MapTest, ProvenanceRoundTrip) {
 
 namespace {
 
-// A world-frame model of a wall at z = 1.5 m drawn coarsely: two wide flat
-// components at x = -0.5 and 0.5 (sigma 0.3 m in x and y: about a fifth of
-// each lies beyond the edges of RefitScene's view, |x| > 0.8 m, |y| > 0.6 m)
-// and a small one far to the side (x = 5).
-sogmm::Model coarse_wall() {
+// A world-frame model (support 3000) of three axis-aligned flat components
+// on the plane z = 1.5 m, at x = x[k] (y = 0, gray 0.5) with weights w[k]:
+// the first two with variances a (x, y, z, gray), the third with b.
+sogmm::Model flat_components(const float (&x)[3], const float (&w)[3], const float (&a)[4], const float (&b)[4]) {
   sogmm::Model m;
   m.gmm.resize(3);
-  m.gmm.weights = {0.4f, 0.4f, 0.2f};
-  m.gmm.means = {-0.5f, 0.0f, 1.5f, 0.5f, 0.5f, 0.0f, 1.5f, 0.5f, 5.0f, 0.0f, 1.5f, 0.5f};
+  m.gmm.weights = {w[0], w[1], w[2]};
+  m.gmm.means = {x[0], 0.0f, 1.5f, 0.5f, x[1], 0.0f, 1.5f, 0.5f, x[2], 0.0f, 1.5f, 0.5f};
   std::fill(m.gmm.covariances.begin(), m.gmm.covariances.end(), 0.0f);
-  const float wide[4] = {0.09f, 0.09f, 4e-6f, 0.04f}, small[4] = {0.01f, 0.01f, 4e-6f, 0.04f};
   for (int i = 0; i < 4; ++i) {
-    m.gmm.covariances[5 * i] = m.gmm.covariances[16 + 5 * i] = wide[i];
-    m.gmm.covariances[32 + 5 * i] = small[i];
+    m.gmm.covariances[5 * i] = m.gmm.covariances[16 + 5 * i] = a[i];
+    m.gmm.covariances[32 + 5 * i] = b[i];
   }
   m.gmm.support_size = 3000;
   m.key_values = {{sogmm::kCoordinateFrameKey, "world"}};
   return m;
+}
+
+// A wall at z = 1.5 m drawn coarsely: two wide flat components at x = -0.5
+// and 0.5 (sigma 0.3 m in x and y: about a fifth of each lies beyond the
+// edges of RefitScene's view, |x| > 0.8 m, |y| > 0.6 m) and a small one far
+// to the side (x = 5).
+sogmm::Model coarse_wall() {
+  return flat_components({-0.5f, 0.5f, 5.0f}, {0.4f, 0.4f, 0.2f}, {0.09f, 0.09f, 4e-6f, 0.04f},
+                         {0.01f, 0.01f, 4e-6f, 0.04f});
 }
 
 // An RGB-D view of that wall (64 x 48, f = 60: |x| <= 0.8 m, |y| <= 0.6 m at
@@ -578,11 +585,11 @@ struct RefitScene {
   sogmm::Camera cam{64, 48, 60.0, 60.0, 32.0, 24.0};
   std::vector<std::uint16_t> depth = std::vector<std::uint16_t>(64 * 48, 1500);
   std::vector<float> gray = std::vector<float>(64 * 48);
-  RefitScene() {
+  explicit RefitScene(bool box = true) {
     for (int v = 0; v < 48; ++v)
       for (int u = 0; u < 64; ++u) {
         gray[64 * v + u] = static_cast<float>(((u / 4) % 8) / 8.0);
-        if (u < 8 && v < 8) depth[64 * v + u] = 1000;
+        if (box && u < 8 && v < 8) depth[64 * v + u] = 1000;
       }
   }
   sogmm::RgbdView frame() const { return {depth.data(), gray.data(), cam}; }
@@ -618,6 +625,7 @@ TEST(MapTest, RevisitRefitReplacesWhatTheFrameSeesAndKeepsTheRest) {
   const sogmm::FrameStats f = map.insert_rgbd(scene.frame(), kIdentity);
   // Both wall components are on the frame's surface; the far one is not.
   EXPECT_EQ(f.n_replaced, 2u);
+  EXPECT_TRUE(f.flushed);  // a refit is a fit
   EXPECT_EQ(map.stats().n_refits, 1u);
   EXPECT_EQ(map.stats().n_flushes, 1u);
   const sogmm::Gmm& g = map.model().gmm;
@@ -659,6 +667,55 @@ TEST(MapTest, RevisitRefitReplacesWhatTheFrameSeesAndKeepsTheRest) {
     se_const += (0.5 - truth[i]) * (0.5 - truth[i]);
   }
   EXPECT_LT(se_map, 0.25 * se_const);
+}
+
+// The refit takes the frame's explained points that the replaced components
+// dominate, not those under a kept one: a kept component whose mean lies
+// beyond the view's edge (x = 0.9) but which dominates the frame's points
+// near it keeps them as its mass. Wall components of sigma 0.1 m (x) and
+// 0.2 m (y) at x = -/+0.3 hold almost no mass outside the view (3 sigma in
+// y), so the refit is those points (plus a few samples): the map's support
+// is the kept mass plus the dominated points, counted independently here.
+TEST(MapTest, RevisitRefitTakesOnlyThePointsTheReplacedComponentsDominate) {
+  const sogmm::Model m = flat_components({-0.3f, 0.3f, 0.9f}, {0.3f, 0.3f, 0.4f}, {0.01f, 0.04f, 4e-6f, 0.04f},
+                                         {0.01f, 0.09f, 4e-6f, 0.04f});
+  const RefitScene scene(false);
+  Map map = Map::from_model(m, refit_options(1.25));
+  // Independent truth: the frame's points (identity pose: world = camera),
+  // their novelty scores, and the component with the largest
+  // weight x N(x | mu, Sigma_xx) by Eigen.
+  const sogmm::PointCloud cloud = sogmm::backproject(scene.frame(), sogmm::DepthOptions{});
+  std::vector<double> xyz;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    for (int r = 0; r < 3; ++r) xyz.push_back(cloud.xyzg[4 * i + r]);
+  std::vector<double> ll(cloud.size());
+  map.local_log_likelihood(xyz.data(), cloud.size(), ll.data());
+  std::size_t dominated_by_wall = 0, dominated_by_edge = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!(ll[i] >= map.options().novelty_threshold)) continue;
+    const Eigen::Vector3d x(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    double best = -INFINITY;
+    std::size_t arg = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Eigen::Matrix3d c = cov_of(m.gmm, k).topLeftCorner<3, 3>();
+      const Eigen::Vector3d d = x - mean_of(m.gmm, k).head<3>();
+      const double lp = std::log(m.gmm.weights[k]) - 0.5 * d.dot(c.ldlt().solve(d)) -
+                        0.5 * std::log(c.determinant());
+      if (lp > best) {
+        best = lp;
+        arg = k;
+      }
+    }
+    (arg == 2 ? dominated_by_edge : dominated_by_wall) += 1;
+  }
+  ASSERT_GT(dominated_by_edge, 100u);  // the edge component reaches well into the view
+  const sogmm::FrameStats f = map.insert_rgbd(scene.frame(), kIdentity);
+  ASSERT_EQ(f.n_replaced, 2u);
+  const sogmm::Gmm& g = map.model().gmm;
+  ASSERT_TRUE(has_component(g, m.gmm, 2));
+  const std::uint64_t kept = static_cast<std::uint64_t>(std::round(3000.0 * static_cast<double>(0.4f)));
+  EXPECT_GE(g.support_size, kept + dominated_by_wall);
+  EXPECT_LE(g.support_size, kept + dominated_by_wall + 30);  // a few samples beyond the view's y edges
 }
 
 TEST(MapTest, RevisitRefitIsOffAtRatioZeroAndBelowTheRatio) {
@@ -732,6 +789,16 @@ TEST(MapTest, RevisitRefitIsTheSameForAnyThreadCountAndUndoneWhenCancelled) {
   expect_error([&] { map.insert_rgbd(scene.frame(), kIdentity, cancel); }, ErrorCode::Cancelled, {"cancelled"},
                "cancelled refit");
   EXPECT_TRUE(state(map) == before);
+  {
+    // The failed first RGB-D insert did not fix the camera: another camera is
+    // accepted (in a copy of the map, which stays as it was).
+    Map copy = Map::from_model(wall, refit_options(1.5));
+    expect_error([&] { copy.insert_rgbd(scene.frame(), kIdentity, cancel); }, ErrorCode::Cancelled, {"cancelled"},
+                 "cancelled refit");
+    sogmm::Camera other = scene.cam;
+    other.fx = other.fy = 50.0;
+    EXPECT_NO_THROW(copy.insert_rgbd({scene.depth.data(), scene.gray.data(), other}, kIdentity));
+  }
   // A later step of the insert failing undoes the refit too: a batch of 1
   // flushes this frame's novel points (the box), and a cancelling callback
   // that lets the refit's fit through (the first fit) stops the flush's.

@@ -214,11 +214,13 @@ typedef int32_t sogmm_key;
                                                    * of novel points are fitted with SOGMM_OPT_BANDWIDTH times
                                                    * this (with MAP_NOVELTY 0 each frame with the bandwidth) */
 #define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608 /* f64, 0 or >= 1, finite; default 1.25: with MAP_NOVELTY 1, an
-                                               * RGB-D insert whose points the map explains have at least this
-                                               * many times as many modes as the map has components on its
-                                               * surfaces refits them: those components are replaced by a fit
-                                               * of its points plus samples of their mass it does not see
-                                               * (MapOptions::revisit_refit_ratio says why). 0: off */
+                                               * RGB-D insert refits the map components on its surfaces when
+                                               * its explained points they dominate have at least this many
+                                               * times as many modes as they are components: they are replaced
+                                               * by a fit of those points plus samples of their mass it does
+                                               * not see (MapOptions::revisit_refit_ratio: details and why).
+                                               * 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START 1.
+                                               * A refit counts as a fit (flushed, n_flushes) */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default HELLINGER */

@@ -110,13 +110,16 @@ struct MapOptions {
   /// Revisit refit, with novelty on and RGB-D inserts (the camera tells
   /// what a frame sees): the map components whose mean lies on the frame's
   /// observed surface (depth within 3% of the frame's at its pixel) are
-  /// replaced when the frame's explained points that they dominate have at
-  /// least this many times as many modes (mean shift at the batch bandwidth)
-  /// as they are components. The replacement is a fit of those points plus
+  /// replaced when the frame's explained points that they dominate (largest
+  /// weight x density among the point's neighbourhood) have at least this
+  /// many times as many modes (mean shift at the batch bandwidth) as they are
+  /// components. The replacement is a fit of those points plus
   /// samples (untruncated) of the replaced mass that the frame does not see:
   /// outside its view, hidden behind its surfaces or where it has no depth,
   /// as many as the points that mass stands for; samples in its free space
-  /// are dropped. Other components keep their mass. So the map keeps the
+  /// are dropped, and so is the replaced mass on its surfaces where a kept
+  /// component dominates (those points stay that component's). Other
+  /// components keep their mass. So the map keeps the
   /// finest view of each surface it has had, not the first: the mode count
   /// of a view varies with the view (52 modes for the synthetic loop's first
   /// frame, which faces a wall, against 191 for frame 12 of nearly the same

@@ -58,7 +58,8 @@ class Map:
             many modes as the map has components on its surfaces, replaces
             those components by a fit of its points plus samples of their mass
             it does not see (the map keeps the finest view of each surface, not
-            the first; core/include/sogmm/map.hpp).
+            the first; not with a fixed ``n_components`` or ``warm_start``;
+            details in core/include/sogmm/map.hpp).
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.

@@ -223,8 +223,8 @@ impl OptionsBuilder {
         /// Map: an RGB-D insert whose explained points have at least this many
         /// times as many modes as the map has components on its surfaces
         /// replaces those components by a fit of its points plus samples of
-        /// their unseen mass; 0 (off) or >= 1 (default 1.25); else `build`
-        /// fails with `Status::InvalidArg`.
+        /// their unseen mass (not with a fixed K or a warm start); 0 (off) or
+        /// >= 1 (default 1.25); else `build` fails with `Status::InvalidArg`.
         map_revisit_refit_ratio(f64) => SOGMM_OPT_MAP_REVISIT_REFIT_RATIO as f64 |v| v;
         /// Map: pending novel points that trigger a fit (default 12288).
         map_batch_size(i64) => SOGMM_OPT_MAP_BATCH_SIZE as i64 |v| v;
