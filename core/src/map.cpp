@@ -375,21 +375,22 @@ std::size_t Map::flush(const ProgressSink& progress) {
   if (s.options.fusion && first > 0) changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
   const std::size_t added = merged.gmm.size() - first;
   const std::size_t fused = r.gmm.size() - added;
-  // Marginals of the changed and new components before anything is committed
-  // (the only step here that can throw on the data).
-  std::vector<detail::Marginal3> fresh;
-  for (std::size_t k = first; k < merged.gmm.size(); ++k) fresh.push_back(detail::marginal3(merged.gmm, k));
-  std::vector<detail::Marginal3> updated;
-  for (std::size_t k : changed) updated.push_back(detail::marginal3(merged.gmm, k));
+  // The marginals and index of the merged map, built on copies before
+  // anything is committed: a throw here (non-PD data, an allocation) leaves
+  // the map as it was, and the commit below only moves.
+  std::vector<detail::Marginal3> marginals = s.marginals;
+  ComponentIndex index = s.index;
+  for (std::size_t k : changed) {
+    marginals[k] = detail::marginal3(merged.gmm, k);
+    index.update(merged.gmm, k);
+  }
+  for (std::size_t k = first; k < merged.gmm.size(); ++k) marginals.push_back(detail::marginal3(merged.gmm, k));
+  index.add(merged.gmm, first);
 
   // Commit.
   s.model = std::move(merged);
-  for (std::size_t i = 0; i < changed.size(); ++i) {
-    s.marginals[changed[i]] = updated[i];
-    s.index.update(s.model.gmm, changed[i]);
-  }
-  s.marginals.insert(s.marginals.end(), fresh.begin(), fresh.end());
-  s.index.add(s.model.gmm, first);
+  s.marginals = std::move(marginals);
+  s.index = std::move(index);
   s.pending.clear();
   s.n_pending = 0;
   s.pending_voxels.clear();
