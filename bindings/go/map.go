@@ -52,6 +52,7 @@ type MapFrameStats struct {
 	Points, Novel, Components uint64 // Components: map size after the insert
 	Flushed                   bool
 	MsNovelty, MsFit, MsMerge float64
+	Replaced                  uint64 // components this insert's revisit refit replaced (0: none ran)
 	Pose                      [16]float64
 }
 
@@ -158,10 +159,16 @@ func (m *Map) Stats() (MapStats, error) {
 // FrameStats returns what the insert of frame i (insertion order) did.
 func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
 	var s C.sogmm_map_frame_stats
-	err := m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s) })
+	var replaced C.uint64_t
+	err := m.do(func(p *C.sogmm_map) C.sogmm_status {
+		if st := C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s); st != C.SOGMM_OK {
+			return st
+		}
+		return C.sogmm_map_get_frame_replaced(p, C.uint64_t(i), &replaced)
+	})
 	out := MapFrameStats{Points: uint64(s.n_points), Novel: uint64(s.n_novel), Components: uint64(s.n_components),
 		Flushed: s.flushed != 0, MsNovelty: float64(s.ms_novelty), MsFit: float64(s.ms_fit),
-		MsMerge: float64(s.ms_merge)}
+		MsMerge: float64(s.ms_merge), Replaced: uint64(replaced)}
 	for k := range out.Pose {
 		out.Pose[k] = float64(s.pose[k])
 	}

@@ -303,6 +303,17 @@ func TestRevisitRefitRatio(t *testing.T) {
 		if st.Pending != 0 {
 			t.Fatalf("%d points pending", st.Pending)
 		}
+		f0, err := m.FrameStats(0)
+		if err != nil {
+			t.Fatal(err)
+		}
+		f1, err := m.FrameStats(1)
+		if err != nil {
+			t.Fatal(err)
+		}
+		if f0.Replaced != 0 || (f1.Replaced > 0) != (st.Flushes == 2) || f1.Flushed != (st.Flushes == 2) {
+			t.Fatalf("frame stats %+v, %+v with %d fits", f0, f1, st.Flushes)
+		}
 		return st.Flushes
 	}
 	if got := fits(); got != 2 {

@@ -114,15 +114,30 @@ SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats
   SOGMM_CATCH
 }
 
+namespace {
+const sogmm::FrameStats& frame_of(const sogmm_map* map, uint64_t frame) {
+  const auto& frames = map->map.frames();
+  if (frame >= frames.size())
+    fail(SOGMM_E_INVALID_ARG, "frame " + std::to_string(frame) + " does not exist (" +
+                                  std::to_string(frames.size()) + " frames)");
+  return frames[static_cast<std::size_t>(frame)];
+}
+}  // namespace
+
+SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    require_nonnull(out, "out");
+    *out = frame_of(map, frame).n_replaced;
+  }
+  SOGMM_CATCH
+}
+
 SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame, sogmm_map_frame_stats* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
     require_nonnull(out, "out");
-    const auto& frames = map->map.frames();
-    if (frame >= frames.size())
-      fail(SOGMM_E_INVALID_ARG, "frame " + std::to_string(frame) + " does not exist (" +
-                                    std::to_string(frames.size()) + " frames)");
-    const sogmm::FrameStats& f = frames[static_cast<std::size_t>(frame)];
+    const sogmm::FrameStats& f = frame_of(map, frame);
     out->n_points = f.n_points;
     out->n_novel = f.n_novel;
     out->n_components = f.n_components;

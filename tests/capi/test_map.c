@@ -252,6 +252,19 @@ static void revisit_refit(void) {
     REQUIRE_OK(sogmm_map_get_stats(map, &st));
     EXPECT_TRUE(st.n_frames == 2 && st.n_pending == 0);
     EXPECT_TRUE(st.n_flushes == (r == 0 ? 2u : 1u));
+    {
+      uint64_t replaced0 = 99, replaced1 = 99;
+      sogmm_map_frame_stats fs;
+      REQUIRE_OK(sogmm_map_get_frame_replaced(map, 0, &replaced0));
+      REQUIRE_OK(sogmm_map_get_frame_replaced(map, 1, &replaced1));
+      REQUIRE_OK(sogmm_map_get_frame_stats(map, 1, &fs));
+      EXPECT_TRUE(replaced0 == 0);                         /* the first frame was a batch, not a refit */
+      EXPECT_TRUE(r == 0 ? replaced1 > 0 : replaced1 == 0); /* the refit replaced the plain wall's components */
+      EXPECT_TRUE(fs.flushed == (r == 0));                  /* a refit is a fit */
+      EXPECT_STATUS(sogmm_map_get_frame_replaced(map, 2, &replaced0), SOGMM_E_INVALID_ARG);
+      EXPECT_STATUS(sogmm_map_get_frame_replaced(map, 0, NULL), SOGMM_E_NULL_ARG);
+      EXPECT_STATUS(sogmm_map_get_frame_replaced(NULL, 0, &replaced0), SOGMM_E_NULL_ARG);
+    }
     sogmm_map_free(map);
     sogmm_options_free(o);
   }

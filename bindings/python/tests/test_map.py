@@ -210,6 +210,9 @@ def test_a_revisit_with_many_more_modes_refits_what_it_sees(ratio, fits):
         m.insert_rgbd(*_wall(True), np.eye(4))
         st = m.stats()
         assert st["n_flushes"] == fits and st["n_pending"] == 0
+        assert m.frame_stats(0)["n_replaced"] == 0
+        assert (m.frame_stats(1)["n_replaced"] > 0) == (fits == 2)
+        assert m.frame_stats(1)["flushed"] == (fits == 2)
         after = m.export()
     if fits == 2:
         assert after.n_components_ > plain.n_components_

@@ -652,6 +652,12 @@ SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats
  * SOGMM_E_INVALID_ARG. */
 SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame,
                                                  sogmm_map_frame_stats* out);
+/* Components that the revisit refit of frame `frame` replaced
+ * (SOGMM_OPT_MAP_REVISIT_REFIT_RATIO) into *out: 0 when the insert ran none
+ * (and for the frames of a loaded file). The frames with a non-zero count are
+ * the refits this handle ran; each is also a fit in `flushed` and
+ * n_flushes. frame >= n_frames -> SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out);
 
 /* New world-frame model (key "coordinate_frame" = "world") of the whole map
  * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:

@@ -154,9 +154,8 @@ struct FrameStats {
   double ms_fit = 0.0;              ///< fits this insert ran (a refit's with its check and sampling)
   double ms_merge = 0.0;            ///< transform + merge + fusion (+ index) of that flush (and refit)
   /// Map components a revisit refit of this frame replaced (0: none ran;
-  /// MapOptions::revisit_refit_ratio). Its fit time is in ms_fit. (The C
-  /// API's fixed frame-stats struct does not carry it; its `flushed` and
-  /// the map's n_flushes count refits.)
+  /// MapOptions::revisit_refit_ratio). Its fit time is in ms_fit. (C API:
+  /// sogmm_map_get_frame_replaced, beside the fixed frame-stats struct.)
   std::size_t n_replaced = 0;
 };
 

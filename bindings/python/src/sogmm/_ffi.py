@@ -207,6 +207,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
     "sogmm_map_get_stats": (STATUS, [HANDLE, POINTER(MapStats)]),
     "sogmm_map_get_frame_stats": (STATUS, [HANDLE, c_uint64, POINTER(MapFrameStats)]),
+    "sogmm_map_get_frame_replaced": (STATUS, [HANDLE, c_uint64, POINTER(c_uint64)]),
     "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
     "sogmm_map_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_map_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import weakref
-from ctypes import byref, c_int64, c_void_p
+from ctypes import byref, c_int64, c_uint64, c_void_p
 
 import numpy as np
 
@@ -27,7 +27,7 @@ __all__ = ["Map"]
 _FUSION = {None: None, "off": None, "hellinger": _ffi.FUSION_HELLINGER, "kl": _ffi.FUSION_KL}
 
 
-def _frame_dict(s: _ffi.MapFrameStats) -> dict:
+def _frame_dict(s: _ffi.MapFrameStats, n_replaced: int) -> dict:
     return {
         "n_points": int(s.n_points),
         "n_novel": int(s.n_novel),
@@ -36,6 +36,7 @@ def _frame_dict(s: _ffi.MapFrameStats) -> dict:
         "ms_novelty": float(s.ms_novelty),
         "ms_fit": float(s.ms_fit),
         "ms_merge": float(s.ms_merge),
+        "n_replaced": n_replaced,
         "pose": np.array(list(s.pose), dtype=np.float64).reshape(4, 4),
     }
 
@@ -198,13 +199,16 @@ class Map:
     def frame_stats(self, frame: int) -> dict:
         """What the insert of ``frame`` (insertion order; negative counts from
         the end) did: n_points, n_novel, n_components (after it), flushed,
-        ms_novelty, ms_fit, ms_merge and its pose (4 x 4)."""
+        ms_novelty, ms_fit, ms_merge, n_replaced (components its revisit refit
+        replaced, 0 when none ran) and its pose (4 x 4)."""
         n = len(self)
         if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not -n <= frame < n:
             raise InvalidArgumentError(f"frame {frame!r} does not exist ({n} frames)")
         s = _ffi.MapFrameStats()
         check(lib.sogmm_map_get_frame_stats(self._h(), int(frame) % n, byref(s)))
-        return _frame_dict(s)
+        replaced = c_uint64()
+        check(lib.sogmm_map_get_frame_replaced(self._h(), int(frame) % n, byref(replaced)))
+        return _frame_dict(s, int(replaced.value))
 
     def frames(self) -> list[dict]:
         """frame_stats of every frame, in insertion order."""

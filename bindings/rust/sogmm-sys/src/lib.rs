@@ -377,6 +377,7 @@ extern "C" {
         frame: u64,
         out: *mut sogmm_map_frame_stats,
     ) -> sogmm_status;
+    pub fn sogmm_map_get_frame_replaced(map: *const sogmm_map, frame: u64, out: *mut u64) -> sogmm_status;
     pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
     pub fn sogmm_map_score_samples_f32(
         map: *const sogmm_map,

@@ -42,6 +42,8 @@ pub struct MapFrameStats {
     pub ms_novelty: f64,
     pub ms_fit: f64,
     pub ms_merge: f64,
+    /// Map components this insert's revisit refit replaced (0: none ran).
+    pub n_replaced: u64,
     /// The camera-to-world pose given with the frame.
     pub pose: Pose,
 }
@@ -176,6 +178,9 @@ impl Map {
         let mut s = sys::sogmm_map_frame_stats::default();
         // SAFETY: valid handle and out-pointer.
         check(unsafe { sys::sogmm_map_get_frame_stats(self.raw(), frame, &mut s) })?;
+        let mut n_replaced = 0u64;
+        // SAFETY: valid handle and out-pointer; the frame exists (checked above).
+        check(unsafe { sys::sogmm_map_get_frame_replaced(self.raw(), frame, &mut n_replaced) })?;
         Ok(MapFrameStats {
             n_points: s.n_points,
             n_novel: s.n_novel,
@@ -184,6 +189,7 @@ impl Map {
             ms_novelty: s.ms_novelty,
             ms_fit: s.ms_fit,
             ms_merge: s.ms_merge,
+            n_replaced,
             pose: s.pose,
         })
     }

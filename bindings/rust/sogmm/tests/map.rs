@@ -278,6 +278,10 @@ fn revisit_refit_ratio_is_checked_and_reaches_the_map() {
         }
         let st = map.stats().unwrap();
         assert_eq!(st.n_pending, 0);
+        assert_eq!(map.frame_stats(0).unwrap().n_replaced, 0);
+        let refit = map.frame_stats(1).unwrap();
+        assert_eq!(refit.n_replaced > 0, st.n_flushes == 2, "{refit:?}");
+        assert_eq!(refit.flushed, st.n_flushes == 2);
         st.n_flushes
     };
     assert_eq!(fits(None), 2);
