@@ -96,12 +96,15 @@ double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisati
   };
   Mat4 lc;
   ++factorisations;
+  // A positive definite nearest rounding is kept at once when it is close
+  // enough, and otherwise stays the candidate to beat: it need not be among
+  // the ranked corners verified below.
+  double best = std::numeric_limits<double>::infinity();
   if (factor(to_matrix(nearest), lc)) {
     const double d = divergence(ls, lc);
-    if (d <= kPlainRoundingNats) {
-      write(nearest);
-      return d;
-    }
+    write(nearest);
+    if (d <= kPlainRoundingNats) return d;
+    best = d;
   }
   // Rank the 1024 corners (each entry rounded down or up) by the proxy, then
   // factor only the kVerified best: the exact divergence decides among them.
@@ -140,7 +143,6 @@ double best_rounding(const Mat4& s, const Mat4& ls, float* out, int& factorisati
   }
   // Ties go to the lower mask, so the choice is deterministic.
   std::partial_sort(ranked.begin(), ranked.begin() + kVerified, ranked.end());
-  double best = std::numeric_limits<double>::infinity();
   float candidate[10];
   for (int r = 0; r < kVerified; ++r) {
     const int mask = ranked[static_cast<std::size_t>(r)].second;

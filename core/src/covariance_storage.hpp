@@ -19,9 +19,11 @@ namespace sogmm::detail {
 /// 2. otherwise rank every combination of rounding each of the 10 distinct
 ///    entries down or up (1024 candidates) by the second-order divergence
 ///    tr(P E P E) / 4 of its rounding errors E (P = cov^-1; no factorisation),
-///    and keep, of the 8 best by that measure, the positive definite one with
-///    the smallest exact divergence: the rounding errors then cancel along
-///    the thin direction instead of swamping it;
+///    and keep, of the 8 best by that measure and the nearest rounding of
+///    step 1 (when positive definite), the positive definite one with the
+///    smallest exact divergence: the rounding errors then cancel along the
+///    thin direction instead of swamping it, and the result is never worse
+///    than plain rounding;
 /// 3. if none is positive definite, raise the eigenvalues of `cov` to at least
 ///    eps x its largest eigenvalue (eps = 2^-23, 2^-19, ..., 2^-3: a floor
 ///    relative to the component's own scale; x16 per attempt) and repeat 1-2.
