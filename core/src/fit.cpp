@@ -21,6 +21,14 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+MeanShiftResult count_modes(const PointsView& points, const FitOptions& options) {
+  const std::vector<double> features = range_gray_features(points);
+  detail::progress_poll();
+  return options.mode_counter == ModeCounter::FlatBinned
+             ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
+             : mean_shift_gaussian_blurring(features, options.bandwidth);
+}
+
 FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   // Limits first: nothing is read or allocated for an oversized request.
@@ -54,11 +62,7 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
   if (!fixed_k) {
     detail::progress_begin(Stage::ModeCount, 0);
     const auto t = std::chrono::steady_clock::now();
-    const std::vector<double> features = range_gray_features(points);
-    detail::progress_poll();
-    const MeanShiftResult modes = options.mode_counter == ModeCounter::FlatBinned
-                                      ? mean_shift_flat(features, options.bandwidth, options.mean_shift)
-                                      : mean_shift_gaussian_blurring(features, options.bandwidth);
+    const MeanShiftResult modes = count_modes(points, options);
     k = std::min<std::size_t>(std::max<std::size_t>(modes.size(), 1), points.size);
     require(k <= kMaxComponents, ErrorCode::Limit,
             "the mode count found " + std::to_string(k) + " components with bandwidth " +

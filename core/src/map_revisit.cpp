@@ -8,6 +8,7 @@
 
 #include "map_state.hpp"
 #include "parallel.hpp"
+#include "sogmm/camera.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/mean_shift.hpp"
@@ -25,18 +26,12 @@ constexpr double kSurfaceTolerance = 0.03;
 enum class Seen { Outside, OnSurface, FreeSpace, Hidden };
 
 // The frame's observed depth per pixel of the decimated camera (the nearest
-// of its points), and the classification of other points against it.
+// of its points: project_to_image's z-buffer), and the classification of
+// other points against it with the same pixel rule.
 class DepthView {
  public:
   DepthView(const Camera& decimated_camera, const DepthOptions& depth, const PointsView& frame)
-      : cam_(decimated_camera), depth_(depth),
-        observed_(static_cast<std::size_t>(cam_.width) * static_cast<std::size_t>(cam_.height),
-                  std::numeric_limits<float>::infinity()) {
-    for (std::size_t i = 0; i < frame.size; ++i) {
-      std::size_t at = 0;
-      if (pixel(frame[i], &at)) observed_[at] = std::min(observed_[at], frame[i][2]);
-    }
-  }
+      : cam_(decimated_camera), depth_(depth), observed_(observed_depth(frame, decimated_camera)) {}
 
   Seen classify(const float* p) const {
     std::size_t at = 0;
@@ -58,6 +53,12 @@ class DepthView {
     if (!(u >= 0 && v >= 0 && u < cam_.width && v < cam_.height)) return false;
     *at = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam_.width) + static_cast<std::size_t>(u);
     return true;
+  }
+
+  static std::vector<float> observed_depth(const PointsView& frame, const Camera& camera) {
+    std::vector<float> z(frame.size);
+    for (std::size_t i = 0; i < frame.size; ++i) z[i] = frame[i][2];
+    return project_to_image(frame, z.data(), camera, std::numeric_limits<float>::infinity());
   }
 
   Camera cam_;
@@ -109,10 +110,10 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   for (std::size_t i = 0; i < points.size; ++i)
     if (ll[i] >= o.novelty_threshold && dominant[i] >= 0 && replaced[static_cast<std::size_t>(dominant[i])])
       cloud.xyzg.insert(cloud.xyzg.end(), points[i], points[i] + 4);
-  plan.n_points = cloud.size();
+  const std::size_t n_points = cloud.size();
   const double needed = o.revisit_refit_ratio * static_cast<double>(plan.replaced.size());
   // A fit of n points has at most n modes.
-  if (static_cast<double>(plan.n_points) < needed) return std::nullopt;
+  if (static_cast<double>(n_points) < needed) return std::nullopt;
 
   // The number of modes a fit would give those points: the mode count of
   // fit() with the batch bandwidth and the fit's threads (not reported to
@@ -122,13 +123,8 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   fo.bandwidth *= o.novelty_bandwidth_scale;
   {
     const detail::ScopedOmpThreads threads(team_size(fo.em.threads));
-    const std::vector<double> features = range_gray_features(cloud.view());
-    const MeanShiftResult modes = fo.mode_counter == ModeCounter::FlatBinned
-                                      ? mean_shift_flat(features, fo.bandwidth, fo.mean_shift)
-                                      : mean_shift_gaussian_blurring(features, fo.bandwidth);
-    plan.n_modes = modes.size();
+    if (static_cast<double>(count_modes(cloud.view(), fo).size()) < needed) return std::nullopt;
   }
-  if (static_cast<double>(plan.n_modes) < needed) return std::nullopt;
 
   // The replaced components' mass that the frame does not see (outside its
   // view, hidden behind its surfaces or where it has no depth) survives as
@@ -148,10 +144,9 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   }
   if (!(mass > 0)) return std::nullopt;
   for (float& w : sub.weights) w = static_cast<float>(w / mass);
-  plan.replaced_mass = mass * static_cast<double>(map.support_size);
-  const double n_samples = std::round(plan.replaced_mass);
+  const double n_samples = std::round(mass * static_cast<double>(map.support_size));
   // A map whose replaced mass would not fit in one fit is left alone.
-  if (!(n_samples <= static_cast<double>(kMaxPoints - plan.n_points))) return std::nullopt;
+  if (!(n_samples <= static_cast<double>(kMaxPoints - n_points))) return std::nullopt;
   const std::size_t n = static_cast<std::size_t>(n_samples);
   std::vector<float> samples(4 * n);
   // The seed depends on the map's seed and the frame only: the same inserts
@@ -165,7 +160,6 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
     const Seen where = view.classify(c);
     if (where == Seen::Outside || where == Seen::Hidden) cloud.xyzg.insert(cloud.xyzg.end(), c, c + 4);
   }
-  plan.n_samples = cloud.size() - plan.n_points;
 
   // The refit improves the map; when its fit fails on the data (a limit, a
   // numeric failure) the map keeps its components. A cancel and a bad
@@ -177,7 +171,6 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
     return std::nullopt;
   }
   plan.bandwidth = fo.bandwidth;
-  plan.support = cloud.size();
   return plan;
 }
 

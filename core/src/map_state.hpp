@@ -74,12 +74,7 @@ bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::in
 /// A revisit refit worked out but not committed (map_revisit.cpp).
 struct RevisitRefit {
   std::vector<std::size_t> replaced;  ///< map components the frame sees (ascending), to be replaced
-  std::size_t n_modes = 0;            ///< modes of the frame's explained points at the batch bandwidth
-  std::size_t n_points = 0;           ///< the frame's explained points in the fit
-  std::size_t n_samples = 0;          ///< samples of the replaced mass the frame does not see, in the fit
-  double replaced_mass = 0.0;         ///< points the replaced components stood for
-  double bandwidth = 0.0;             ///< the fit's bandwidth (0: fixed K)
-  std::uint64_t support = 0;          ///< points of the fit
+  double bandwidth = 0.0;             ///< the fit's bandwidth (the batch bandwidth)
   FitResult fit;                      ///< in the frame's camera frame
 };
 

@@ -88,4 +88,11 @@ struct FitResult {
 /// that iteration's E-step mean. The result does not depend on the sink.
 FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress = {});
 
+/// The modes that fit() counts for `points` (its first stage, the number of
+/// components of a self-organizing fit): mean shift over the (range, gray)
+/// features with options.bandwidth, by options.mode_counter and
+/// options.mean_shift, on the calling thread's OpenMP team (fit() sets it to
+/// options.em.threads). Throws as the mean shift for an unusable bandwidth.
+MeanShiftResult count_modes(const PointsView& points, const FitOptions& options);
+
 }  // namespace sogmm
