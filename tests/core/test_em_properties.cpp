@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -230,10 +231,21 @@ TEST(EmProperties, BitIdenticalForOneTwoThreeThreads) {
 // - s a power of two: every float32 operation of the fit scales exactly, and
 //   the E-step's constants are shifted by their largest (em.cpp, pack_all),
 //   so the fit is the same and the log-likelihood moves by -4 ln s to double
-//   rounding: bound 1e-12 (the issue asks for 2e-7).
-// - other s: the float32 E-step rounds the centred points and the whitened
-//   coordinates differently at each scale; measured worst 6.2e-7 here before
-//   the shift, bound 1e-6.
+//   rounding: bound 1e-12.
+// - other s: the float32 E-step (unit roundoff u = 6e-8) rounds the centred
+//   points and the whitened coordinates differently at each scale, and the
+//   iterations carry that into the final log-likelihood. Bound 5e-6 (the
+//   issue's decision; a double E-step would remove it at 2x the EM cost).
+// The bound is a rounding bound, so it must hold for every kernel, and ctest
+// runs this suite under SOGMM_ISA=sse2, avx2 and the default
+// (tests/core/CMakeLists.txt). Why it also holds for AVX-512, which the CI
+// machine lacks: the kernels evaluate the same per-term float32 expressions
+// (em_kernel.cpp is one source compiled three times); AVX2 and AVX-512 both
+// fuse multiply-adds (fewer roundings than SSE2), and they differ only in the
+// lane width over which a block's statistics are summed, whose error bound
+// (n / w + log2 w) u sum|terms| shrinks as the width w grows. Measured worst
+// on this scene: SSE2 5.6e-7, AVX2 6.7e-7, AVX-512 1.54e-6 (AMD EPYC, at
+// s = 0.3): the bound leaves 3x over the largest of them.
 TEST(EmProperties, FourDimensionalScaleInvariance) {
   const std::vector<float> pts = frame_points();
   std::vector<double> grid(pts.size());  // integer multiples n of 10 x 2^-16
@@ -268,12 +280,12 @@ TEST(EmProperties, FourDimensionalScaleInvariance) {
     EXPECT_EQ(a.gmm.size(), b.gmm.size());
     EXPECT_EQ(a.em.iterations, b.em.iterations);
     const double deviation = b.em.log_likelihood - (a.em.log_likelihood - 4.0 * std::log(s));
-    EXPECT_NEAR(deviation, 0.0, pow2 ? 1e-12 : 1e-6);
+    EXPECT_NEAR(deviation, 0.0, pow2 ? 1e-12 : 5e-6) << "kernel " << b.em.kernel;
     (pow2 ? worst_pow2 : worst) = std::max(pow2 ? worst_pow2 : worst, std::fabs(deviation));
     std::printf("s = %g: M %zu, log-likelihood deviation %.2e\n", s, b.gmm.size(), deviation);
   }
-  std::printf("largest deviation: %.2e at powers of two (bound 1e-12), %.2e elsewhere (bound 1e-6)\n", worst_pow2,
-              worst);
+  std::printf("kernel %s: largest deviation %.2e at powers of two (bound 1e-12), %.2e elsewhere (bound 5e-6)\n",
+              a.em.kernel, worst_pow2, worst);
 }
 
 // The truncated E-step (truncation_nats = 25) stays within its documented
@@ -327,8 +339,8 @@ TEST(EmProperties, MultiWavePathMatchesTheSingleCopy) {
   }
 }
 
-// Every EM kernel the CPU supports gives the same result within 2.4e-6 nats
-// on the same input. SOGMM_ISA caps the kernel choice, which is made once
+// Every EM kernel the CPU supports gives the same result within
+// max(2.4e-6, 1e-9 |LL|) nats on the same input. SOGMM_ISA caps the kernel choice, which is made once
 // per process, so each kernel runs in a fresh child process (gtest's
 // "threadsafe" death-test style re-executes the test binary) and reports its
 // log-likelihood through a file; on a CPU without AVX2 or AVX-512 the cap
@@ -380,8 +392,13 @@ TEST(EmProperties, EveryKernelAgrees) {
     plane_ll.push_back(std::strtod(plane_text.c_str(), nullptr));
     std::remove(file.c_str());
   }
+  // Far from the origin the terms, and their rounding, grow with |LL|: the
+  // bound is max(2.4e-6, 1e-9 |LL|) nats per point (spec/api.md 4.3.1).
+  const auto bound = [](double reference) { return std::max(2.4e-6, 1e-9 * std::fabs(reference)); };
   for (std::size_t i = 1; i < ll.size(); ++i) {
-    EXPECT_NEAR(ll[i], ll[0], 2.4e-6) << "kernel " << i << " vs sse2";
-    EXPECT_NEAR(plane_ll[i], plane_ll[0], 2.4e-6) << "1 km plane: kernel " << i << " vs sse2";
+    EXPECT_NEAR(ll[i], ll[0], bound(ll[0])) << "kernel " << i << " vs sse2";
+    EXPECT_NEAR(plane_ll[i], plane_ll[0], bound(plane_ll[0])) << "1 km plane: kernel " << i << " vs sse2";
   }
+  std::printf("kernels vs sse2: frame %.2e, 1 km plane %.2e (LL %.6g, %.6g)\n", std::fabs(ll.back() - ll[0]),
+              std::fabs(plane_ll.back() - plane_ll[0]), ll[0], plane_ll[0]);
 }
