@@ -185,6 +185,18 @@ func Threads(n int64) Option { return I64(OptThreads, n) }
 // NInit runs of k-means++ + EM (default 1).
 func NInit(n int64) Option { return I64(OptNInit, n) }
 
+// DequantiseDepth forces the depth-quantisation floor on or off. The default,
+// DequantiseAuto, floors RGB-D frames (FitRGBD) and not point arrays.
+func DequantiseDepth(on bool) Option {
+	if on {
+		return I64(OptDequantiseDepth, 1)
+	}
+	return I64(OptDequantiseDepth, 0)
+}
+
+// DequantiseAuto is OptDequantiseDepth's default value (see sogmm.h).
+const DequantiseAuto = int64(C.SOGMM_DEQUANTISE_AUTO)
+
 // Decimation of RGB-D frames (default 1).
 func Decimation(d int64) Option { return I64(OptDecimation, d) }
 

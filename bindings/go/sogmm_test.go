@@ -6,6 +6,7 @@ import (
 	"math"
 	"os"
 	"path/filepath"
+	"reflect"
 	"runtime"
 	"slices"
 	"sort"
@@ -431,5 +432,61 @@ func TestFramePointsByHand(t *testing.T) {
 	f.Depth = []uint16{0, 0, 0, 0}
 	if none, err := f.Points(nil); err != nil || len(none) != 0 {
 		t.Fatalf("no valid pixel: %v %v", none, err)
+	}
+}
+
+// staircaseFrame: 8 fronto-parallel steps 10 cm apart, so the depth sits on
+// exact levels and the depth-quantisation floor changes the fit.
+func staircaseFrame() Frame {
+	const w, h = 96, 72
+	f := Frame{Width: w, Height: h, Fx: 77, Fy: 77, Cx: (w - 1) / 2.0, Cy: (h - 1) / 2.0}
+	f.Depth = make([]uint16, w*h)
+	f.Gray8 = make([]uint8, w*h)
+	for v := 0; v < h; v++ {
+		for u := 0; u < w; u++ {
+			f.Depth[v*w+u] = uint16(1000 + 100*(u/12))
+			f.Gray8[v*w+u] = uint8(60 + 2*u + v)
+		}
+	}
+	return f
+}
+
+// The library's default (DequantiseAuto) floors an RGB-D frame and not the
+// same points given as an array; DequantiseDepth forces either.
+func TestTheDepthFloorIsTheDefaultForFrames(t *testing.T) {
+	covariances := func(extra ...Option) []float32 {
+		o, err := NewOptions(append([]Option{Bandwidth(0.05), Seed(3), Threads(1), Decimation(2)}, extra...)...)
+		if err != nil {
+			t.Fatal(err)
+		}
+		defer o.Close()
+		m, err := FitRGBD(staircaseFrame(), o)
+		if err != nil {
+			t.Fatal(err)
+		}
+		defer m.Close()
+		c, err := m.Covariances()
+		if err != nil {
+			t.Fatal(err)
+		}
+		return c
+	}
+	o, err := NewOptions()
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	if v, _ := o.GetI64(OptDequantiseDepth); v != DequantiseAuto {
+		t.Fatalf("default dequantise_depth %v, want DequantiseAuto", v)
+	}
+	def, on, off := covariances(), covariances(DequantiseDepth(true)), covariances(DequantiseDepth(false))
+	if !reflect.DeepEqual(def, on) {
+		t.Fatal("the default fit of a frame differs from the floored one")
+	}
+	if reflect.DeepEqual(def, off) {
+		t.Fatal("the floor changed nothing: the test would be vacuous")
+	}
+	if err := o.Set(I64(OptDequantiseDepth, -2)); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("dequantise_depth -2: %v", err)
 	}
 }

@@ -19,7 +19,7 @@ sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
                        : sogmm::ModeCounter::FlatBinned;
   f.seed = static_cast<std::uint64_t>(o.seed);
   f.n_init = static_cast<int>(o.n_init);
-  f.dequantise_depth = o.dequantise_depth != 0;
+  f.dequantise_depth = static_cast<sogmm::Dequantise>(o.dequantise_depth);
   f.em.tol = o.tol;
   // SOGMM_REG_COVAR_AUTO (the default) leaves it unset: floors from the data.
   if (o.reg_covar != SOGMM_REG_COVAR_AUTO) f.em.reg_covar = o.reg_covar;
@@ -39,8 +39,10 @@ using sogmm_capi::require_nonnull;
 
 /// Runs the fit on checked points (a warm start from `initial` if not null)
 /// and wraps the result (fit report, fit parameters, timings) in a new handle.
+/// `from_depth_image`: the points are sogmm_fit_rgbd's (the automatic depth
+/// floor applies).
 sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o,
-                           const sogmm::Gmm* initial = nullptr) {
+                           const sogmm::Gmm* initial = nullptr, bool from_depth_image = false) {
   if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: nothing to fit");
   const std::size_t count = sogmm::checked::mul<std::size_t>(n, 4, "points");
   // The size limit first, so an oversized input is refused before it is read.
@@ -56,6 +58,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   sogmm::PointsView view;
   view.data = points;
   view.size = n;
+  view.from_depth_image = from_depth_image;
   sogmm::FitResult r = initial ? sogmm::fit_warm(view, *initial, fo, sogmm_capi::progress_sink(o))
                                 : sogmm::fit(view, fo, sogmm_capi::progress_sink(o));
 
@@ -139,7 +142,8 @@ SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, 
       fail(SOGMM_E_INVALID_DATA, "no pixel has a depth in the valid range after decimation");
 
     std::unique_ptr<sogmm_model> handle(
-        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), static_cast<std::size_t>(o.n_components), o));
+        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), static_cast<std::size_t>(o.n_components), o, nullptr,
+                      r.cloud.from_depth_image));
     sogmm::CameraInfo& ci = handle->model.camera;
     ci.known = true;
     ci.camera = r.camera;

@@ -33,7 +33,7 @@ struct sogmm_options {
   std::int64_t mode_counter = SOGMM_MODE_COUNTER_FLAT_BINNED;
   double truncation_nats = 0.0;  // SOGMM_OPT_TRUNCATION_NATS: 0 = exact E-step
   std::int64_t n_init = 1;       // SOGMM_OPT_N_INIT: runs, the best kept
-  std::int64_t dequantise_depth = 0;  // SOGMM_OPT_DEQUANTISE_DEPTH: 0 or 1
+  std::int64_t dequantise_depth = SOGMM_DEQUANTISE_AUTO;  // SOGMM_OPT_DEQUANTISE_DEPTH: -1, 0 or 1
   // RGB-D
   double depth_scale = 1000.0;
   double depth_min = 0.1;

@@ -134,6 +134,8 @@ SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key k
       case SOGMM_OPT_DECIMATION: check_i64(key, v, 1, 1024, "[1, 1024]"); break;
       case SOGMM_OPT_ZSTD_LEVEL: check_i64(key, v, 1, 22, "[1, 22]"); break;
       case SOGMM_OPT_DEQUANTISE_DEPTH:
+        check_i64(key, v, SOGMM_DEQUANTISE_AUTO, 1, "SOGMM_DEQUANTISE_AUTO (-1), 0 or 1");
+        break;
       case SOGMM_OPT_FLOAT64:
       case SOGMM_OPT_COMPRESS:
       case SOGMM_OPT_VERIFY_CHECKSUMS:

@@ -135,6 +135,7 @@ void for_each_valid_pixel(const RgbdView& frame, const DepthOptions& options, Vi
 
 PointCloud backproject(const RgbdView& frame, const DepthOptions& options) {
   PointCloud cloud;
+  cloud.from_depth_image = true;
   for_each_valid_pixel(frame, options, [&](const Camera& cam, int u, int v, double z, float g) {
     cloud.xyzg.push_back(static_cast<float>((u - cam.cx) * z / cam.fx));
     cloud.xyzg.push_back(static_cast<float>((v - cam.cy) * z / cam.fy));

@@ -29,6 +29,10 @@ MeanShiftResult count_modes(const PointsView& points, const FitOptions& options)
              : mean_shift_gaussian_blurring(features, options.bandwidth);
 }
 
+bool dequantises(Dequantise setting, const PointsView& points) {
+  return setting == Dequantise::On || (setting == Dequantise::Auto && points.from_depth_image);
+}
+
 FitResult fit(const PointsView& points, const FitOptions& options, const ProgressSink& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   // Limits first: nothing is read or allocated for an oversized request.
@@ -75,7 +79,8 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
   em.threads = threads;
   // Quantised depth lets components collapse onto single depth levels (see
   // DepthQuantisation); on request, fit the dequantised depths instead.
-  if (options.dequantise_depth && em.quantisation.empty()) em.quantisation = DepthQuantisation::detect(points);
+  if (dequantises(options.dequantise_depth, points) && em.quantisation.empty())
+    em.quantisation = DepthQuantisation::detect(points);
   const EmIterationCallback on_iteration = [](int iteration, double ll) {
     detail::progress_event(static_cast<std::uint64_t>(iteration), ll);
   };

@@ -192,7 +192,8 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
     for (float& w : start.weights) w = static_cast<float>(w / total);
   }
 
-  if (options.dequantise_depth && em.quantisation.empty()) em.quantisation = DepthQuantisation::detect(points);
+  if (dequantises(options.dequantise_depth, points) && em.quantisation.empty())
+    em.quantisation = DepthQuantisation::detect(points);
   detail::progress_begin(Stage::Em, static_cast<std::uint64_t>(em.max_iter));
   const EmIterationCallback on_iteration = [](int iteration, double ll) {
     detail::progress_event(static_cast<std::uint64_t>(iteration), ll);

@@ -131,19 +131,30 @@ TEST(DepthQuantisation, EmWithTheFloorDoesNotCollapseOntoLevels) {
   EXPECT_GT(sd, sp + 0.03);
 }
 
-// fit() applies the floor only when asked (FitOptions::dequantise_depth), and
-// then exactly as fit_em with the detected quantisation does.
-TEST(DepthQuantisation, FitAppliesTheFloorOnlyWhenAsked) {
+// fit() applies the floor by default to points from a depth image
+// (PointsView::from_depth_image), to other points only when asked
+// (FitOptions::dequantise_depth), never when told not to; and then exactly as
+// fit_em with the detected quantisation does.
+TEST(DepthQuantisation, FitAppliesTheFloorToDepthImagesByDefault) {
   const std::vector<float> stored = scene(7, false);
+  sogmm::PointsView from_image = view(stored);
+  from_image.from_depth_image = true;
   sogmm::FitOptions o;
   o.n_components = 300;
   o.seed = 3;
   o.em.threads = 1;
+  ASSERT_EQ(o.dequantise_depth, sogmm::Dequantise::Auto);
   const sogmm::FitResult off = sogmm::fit(view(stored), o);
-  o.dequantise_depth = true;
+  const sogmm::FitResult image_default = sogmm::fit(from_image, o);
+  o.dequantise_depth = sogmm::Dequantise::On;
   const sogmm::FitResult on = sogmm::fit(view(stored), o);
+  o.dequantise_depth = sogmm::Dequantise::Off;
+  const sogmm::FitResult image_off = sogmm::fit(from_image, o);
+  o.dequantise_depth = sogmm::Dequantise::On;
   EXPECT_GE(collapsed_along_the_ray(off.gmm, off.em.reg_covar.spatial), 2);
   EXPECT_EQ(collapsed_along_the_ray(on.gmm, on.em.reg_covar.spatial), 0);
+  EXPECT_EQ(image_default.gmm.covariances, on.gmm.covariances);
+  EXPECT_EQ(image_off.gmm.covariances, off.gmm.covariances);
 
   const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(stored), 300, 3);
   sogmm::EmOptions floored = o.em;

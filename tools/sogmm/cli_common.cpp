@@ -56,9 +56,15 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
                  "runs of k-means++ + EM with seeds seed, seed+1, ...; the highest log-likelihood is kept")
       ->capture_default_str()
       ->check(CLI::Range(1, kMaxRuns));
-  app.add_flag("--dequantise-depth", o.dequantise_depth,
-               "floor variances along viewing rays at the depth quantisation (structured-light depth); "
-               "faster EM convergence, lower training likelihood");
+  // Frames are back-projected depth images, so the library's automatic
+  // default already floors them; the flags force it either way.
+  auto* on = app.add_flag_callback(
+      "--dequantise-depth", [&o] { o.dequantise_depth = Dequantise::On; },
+      "floor variances along viewing rays at the depth quantisation (the default for depth images)");
+  auto* off = app.add_flag_callback(
+      "--no-dequantise-depth", [&o] { o.dequantise_depth = Dequantise::Off; },
+      "the paper's plain EM on quantised depth (components may collapse onto single depth levels)");
+  on->excludes(off);
   app.add_option("--threads", o.em.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();

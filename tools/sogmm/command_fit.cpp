@@ -120,7 +120,7 @@ int run_single(const FitState& s) {
                                                               {"source_color", to_metadata_string(s.src.color)},
                                                               {"coordinate_frame", "camera"}};
   if (s.fit.n_init > 1) key_values.emplace_back("n_init", std::to_string(s.fit.n_init));
-  if (s.fit.dequantise_depth) key_values.emplace_back("dequantise_depth", "1");
+  if (dequantises(s.fit.dequantise_depth, cloud.view())) key_values.emplace_back("dequantise_depth", "1");
   const Model model = make_model(std::move(r.gmm), kept, r.em, camera, s.depth_options, std::move(key_values));
   const std::uint64_t bytes = save_model(s.output, model);
   Totals t;

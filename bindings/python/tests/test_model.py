@@ -326,3 +326,31 @@ def test_dequantise_depth_reaches_the_fit():
     floored = sogmm.SOGMM(dequantise_depth=True, **params).fit(pts)
     np.testing.assert_array_equal(plain.means_, again.means_)
     assert not np.array_equal(plain.means_, floored.means_)
+
+
+def _staircase_frame():
+    # 8 fronto-parallel steps 10 cm apart: exact depth levels, so the
+    # quantisation is detected and the floor changes the fit.
+    width, height = 96, 72
+    v, u = np.mgrid[0:height, 0:width]
+    depth = (1000 + 100 * (u // 12)).astype(np.uint16)
+    gray = (60 + 2 * u + v).astype(np.uint8)
+    return depth, gray, sogmm.Camera(width, height, 77.0, 77.0, (width - 1) / 2, (height - 1) / 2)
+
+
+def test_the_depth_floor_is_the_default_for_frames_and_not_for_arrays():
+    # The library's default (SOGMM_DEQUANTISE_AUTO): a frame is floored, the
+    # same points given as an array are not (issue 29 item 1).
+    depth, gray, cam = _staircase_frame()
+    params = dict(bandwidth=0.05, seed=3, n_threads=1)
+    assert sogmm.SOGMM().get_params()["dequantise_depth"] is None
+    default = sogmm.SOGMM(**params).fit_rgbd(depth, gray, cam, decimate=2)
+    on = sogmm.SOGMM(dequantise_depth=True, **params).fit_rgbd(depth, gray, cam, decimate=2)
+    off = sogmm.SOGMM(dequantise_depth=False, **params).fit_rgbd(depth, gray, cam, decimate=2)
+    np.testing.assert_array_equal(default.covariances_, on.covariances_)
+    assert not np.array_equal(default.covariances_, off.covariances_)
+    pts = sogmm.rgbd_to_points(depth, gray, cam, decimate=2)
+    array_default = sogmm.SOGMM(**params).fit(pts)
+    np.testing.assert_array_equal(array_default.covariances_, off.covariances_)
+    np.testing.assert_array_equal(sogmm.SOGMM(dequantise_depth=True, **params).fit(pts).covariances_,
+                                  on.covariances_)

@@ -1,7 +1,8 @@
 """FitSettings.dequantise_depth (the CLI's --dequantise-depth) reaches the fit:
 a frame fitted by fit_frame, and a tile map built by MapSettings.new_map, equal
 bit for bit what SOGMM / Map give with dequantise_depth=True, and differ from
-the plain fit. The frame is a staircase of 8 fronto-parallel steps 10 cm apart
+the plain fit (dequantise_depth=False; None, the default, floors frames
+too). The frame is a staircase of 8 fronto-parallel steps 10 cm apart
 (exact depth levels, so the quantisation is detected and the flat steps'
 variances along the rays are floored). No Ray cluster is needed."""
 
@@ -17,7 +18,7 @@ from sogmm.distributed import FitSettings, Frame, MapSettings
 from sogmm.distributed import __main__ as cli
 from sogmm.distributed.frame_fit import camera_dict, fit_frame, read_images
 
-PLAIN = FitSettings(bandwidth=0.05, decimate=2, seed=3)
+PLAIN = FitSettings(bandwidth=0.05, decimate=2, seed=3, dequantise_depth=False)
 DEQ = dataclasses.replace(PLAIN, dequantise_depth=True)
 
 
@@ -79,4 +80,5 @@ def test_the_command_line_flag_sets_it(monkeypatch, sequence, tmp_path):
     args = ["--sequence", str(sequence), "--trajectory", str(sequence / "trajectory.log"), "-o", str(tmp_path / "o"),
             "-q"]
     assert cli.main(args) == 1 and cli.main(args + ["--dequantise-depth"]) == 1
-    assert [s.dequantise_depth for s in seen] == [False, True]
+    assert cli.main(args + ["--no-dequantise-depth"]) == 1
+    assert [s.dequantise_depth for s in seen] == [None, True, False]

@@ -169,11 +169,14 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_N_INIT 109       /* i64, [1, 1000]; default 1: runs of k-means++ + EM. Run r (from 0)
                                     * is seeded with SEED + r; the run with the highest final mean
                                     * log-likelihood is kept (ties: the earliest). Cost grows linearly. */
-#define SOGMM_OPT_DEQUANTISE_DEPTH 110 /* i64, 0 or 1; default 0 = the paper's plain EM. 1: when the
-                                        * camera-frame depth sits on discrete levels (structured-light
-                                        * sensors), floor each component's variance along its viewing ray
-                                        * at the level's bin variance, so components do not collapse onto
-                                        * single levels (faster convergence; lower training likelihood) */
+#define SOGMM_OPT_DEQUANTISE_DEPTH 110 /* i64, SOGMM_DEQUANTISE_AUTO (-1, default), 0 or 1. 1: when the
+                                        * camera-frame depth sits on discrete levels (a 16-bit depth image),
+                                        * floor each component's variance along its viewing ray at the
+                                        * level's bin variance, so components do not collapse onto single
+                                        * levels (every seed converges; higher held-out likelihood, lower
+                                        * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
+                                        * points of sogmm_fit_rgbd, 0 for points given as arrays */
+#define SOGMM_DEQUANTISE_AUTO (-1)
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 

@@ -34,6 +34,14 @@ enum class ModeCounter {
 
 /// Parameters of a fit. Set `n_components` > 0 for the fixed-K baseline
 /// (the paper's FC), which skips the mode count.
+/// FitOptions::dequantise_depth. The values are the C API's
+/// (SOGMM_OPT_DEQUANTISE_DEPTH: SOGMM_DEQUANTISE_AUTO, 0, 1).
+enum class Dequantise : int {
+  Auto = -1,  ///< on for points from a depth image, off otherwise
+  Off = 0,    ///< the paper's plain EM
+  On = 1,     ///< floor whenever the camera-frame depth is quantised
+};
+
 struct FitOptions {
   double bandwidth = 0.02;          ///< mean-shift bandwidth sigma (the one SOGMM parameter)
   std::size_t n_components = 0;     ///< 0 = self-organizing; K > 0 = fixed-K fit
@@ -47,19 +55,24 @@ struct FitOptions {
   /// per point from seed to seed, so a few runs buy a better optimum at a
   /// proportional cost (scikit-learn's GaussianMixture(n_init)).
   int n_init = 1;
-  /// Fit the dequantised depths (default false: the paper's plain EM). Depth
-  /// from structured-light sensors sits on discrete levels (the shared
-  /// livingroom frames: 191 levels, 4 mm apart at 1 m); plain EM then folds
-  /// components onto single levels one by one and converges slowly (3 of 10
-  /// seeds within 100 iterations at d = 2). When true and the camera-frame
-  /// depth is detected as quantised (DepthQuantisation::detect), every M-step
-  /// floors each component's variance along its viewing ray at the level's
-  /// bin variance: 10 of 10 seeds converge, and held-out likelihood on points
-  /// spread within their bins rises, at the cost of a lower training
-  /// likelihood (tools/sogmm-perf/em_trace.cpp).
-  bool dequantise_depth = false;
+  /// The depth-quantisation floor. Depth from a 16-bit image sits on
+  /// discrete levels (the shared livingroom frames: 191 levels, 4 mm apart at
+  /// 1 m); plain EM then folds components onto single levels one by one,
+  /// which raises the training likelihood without bound and converges slowly
+  /// (3 of 10 seeds within 100 iterations at d = 2). With the floor, when the
+  /// camera-frame depth is detected as quantised (DepthQuantisation::detect
+  /// measures the levels themselves, so a step that grows with range is
+  /// followed), every M-step floors each component's variance along its
+  /// viewing ray at the level's bin variance: every seed converges and the
+  /// likelihood of held-out pixels is higher (spec/api.md 4.3.1).
+  /// Auto (default): on for points back-projected from a depth image
+  /// (PointsView::from_depth_image), off for points given without a camera.
+  Dequantise dequantise_depth = Dequantise::Auto;
   EmOptions em;                     ///< EM tolerances and threads
 };
+
+/// Whether the depth floor applies to these points under these options.
+bool dequantises(Dequantise setting, const PointsView& points);
 
 /// Upper bound of FitOptions::n_init.
 inline constexpr int kMaxRuns = 1000;

@@ -11,6 +11,10 @@ namespace sogmm {
 struct PointsView {
   const float* data = nullptr;  ///< 4 * size floats
   std::size_t size = 0;         ///< number of points N
+  /// True for camera-frame points back-projected from a depth image
+  /// (backproject()): the automatic depth floor (FitOptions::dequantise_depth)
+  /// applies to them and to no other points.
+  bool from_depth_image = false;
 
   const float* operator[](std::size_t i) const { return data + 4 * i; }
 };
@@ -18,8 +22,9 @@ struct PointsView {
 /// Owning cloud: 4 floats per point.
 struct PointCloud {
   std::vector<float> xyzg;
+  bool from_depth_image = false;  ///< as PointsView::from_depth_image
   std::size_t size() const { return xyzg.size() / 4; }
-  PointsView view() const { return {xyzg.data(), size()}; }
+  PointsView view() const { return {xyzg.data(), size(), from_depth_image}; }
 };
 
 /// Throws Error(InvalidData) when the view is empty or holds NaN/Inf, naming

@@ -559,11 +559,13 @@ class SOGMM(GMM):
         truncation_nats: 0 (default) = exact E-step; > 0 = truncated E-step that
             skips components provably more than this many nats below every
             point's best in a block (25 is a good value for full frames).
-        dequantise_depth: False (default) = the paper's plain EM. True: when the
-            camera-frame depth sits on discrete levels (structured-light
-            sensors), floor each component's variance along its viewing ray at
-            the level's bin variance, so components do not collapse onto single
-            levels (converges in fewer iterations; lower training likelihood).
+        dequantise_depth: None (default) = the library's automatic choice: on
+            for ``fit_rgbd`` (points back-projected from a depth image), off for
+            ``fit`` of an array. True: when the camera-frame depth sits on
+            discrete levels, floor each component's variance along its viewing
+            ray at the level's bin variance, so components do not collapse onto
+            single levels (every seed converges; higher held-out likelihood,
+            lower training likelihood). False: the paper's plain EM.
         n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
             the highest final mean log-likelihood is kept (as scikit-learn's
             GaussianMixture(n_init)). 1 (default) = the paper's single run.
@@ -574,7 +576,7 @@ class SOGMM(GMM):
     def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float | str = "auto",
                  max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
                  mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1,
-                 dequantise_depth: bool = False):
+                 dequantise_depth: bool | None = None):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -634,7 +636,8 @@ class SOGMM(GMM):
             _ffi.OPT_SEED: seed,
             _ffi.OPT_THREADS: int(self.n_threads),
             _ffi.OPT_N_INIT: int(self.n_init),
-            _ffi.OPT_DEQUANTISE_DEPTH: int(bool(self.dequantise_depth)),
+            _ffi.OPT_DEQUANTISE_DEPTH: (_ffi.DEQUANTISE_AUTO if self.dequantise_depth is None
+                                        else int(bool(self.dequantise_depth))),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
         }
         f64.update(extra_f64 or {})

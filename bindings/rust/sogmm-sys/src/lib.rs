@@ -80,8 +80,11 @@ pub const SOGMM_OPT_THREADS: sogmm_key = 106;
 pub const SOGMM_OPT_MODE_COUNTER: sogmm_key = 107;
 pub const SOGMM_OPT_TRUNCATION_NATS: sogmm_key = 108;
 pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
-/// i64, 0 or 1: floor variances along viewing rays at the depth quantisation (see sogmm.h).
+/// i64, SOGMM_DEQUANTISE_AUTO (default), 0 or 1: floor variances along viewing rays at the depth
+/// quantisation (see sogmm.h).
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
+/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for sogmm_fit_rgbd, off for arrays.
+pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
 pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
 pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
 pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;

@@ -185,6 +185,9 @@ impl OptionsBuilder {
         truncation_nats(f64) => SOGMM_OPT_TRUNCATION_NATS as f64 |v| v;
         /// Runs of k-means++ + EM (default 1).
         n_init(i64) => SOGMM_OPT_N_INIT as i64 |v| v;
+        /// Forces the depth-quantisation floor on or off; the default
+        /// (sogmm_sys::SOGMM_DEQUANTISE_AUTO) floors RGB-D frames and not arrays.
+        dequantise_depth(bool) => SOGMM_OPT_DEQUANTISE_DEPTH as i64 i64::from;
         /// Raw depth units per metre (default 1000).
         depth_scale(f64) => SOGMM_OPT_DEPTH_SCALE as f64 |v| v;
         /// Nearest valid depth in metres, exclusive (default 0.1).

@@ -264,3 +264,39 @@ fn frame_to_points_by_hand() {
     };
     assert!(none.to_points(None).unwrap().is_empty());
 }
+
+/// The library's default (SOGMM_DEQUANTISE_AUTO) floors an RGB-D frame: the
+/// same model as `dequantise_depth(true)`, not that of `dequantise_depth(false)`.
+/// The frame is 8 fronto-parallel steps 10 cm apart (exact depth levels).
+#[test]
+fn the_depth_floor_is_the_default_for_frames() {
+    let (w, h) = (96u32, 72u32);
+    let depth: Vec<u16> = (0..w * h).map(|i| 1000 + 100 * ((i % w) / 12) as u16).collect();
+    let gray: Vec<u8> = (0..w * h).map(|i| (60 + 2 * (i % w) + i / w) as u8).collect();
+    let frame = Frame {
+        depth: &depth,
+        color: Color::Gray8(&gray),
+        width: w,
+        height: h,
+        fx: 77.0,
+        fy: 77.0,
+        cx: (w as f64 - 1.0) / 2.0,
+        cy: (h as f64 - 1.0) / 2.0,
+    };
+    let covariances = |floor: Option<bool>| {
+        let mut b = Options::builder().bandwidth(0.05).seed(3).threads(1).decimation(2);
+        if let Some(on) = floor {
+            b = b.dequantise_depth(on);
+        }
+        let m = Model::fit_rgbd(&frame, Some(&b.build().unwrap())).unwrap();
+        m.covariances().unwrap()
+    };
+    let defaults = Options::new().unwrap();
+    assert_eq!(
+        defaults.get_i64(sogmm::sys::SOGMM_OPT_DEQUANTISE_DEPTH).unwrap(),
+        sogmm::sys::SOGMM_DEQUANTISE_AUTO
+    );
+    let (default, on, off) = (covariances(None), covariances(Some(true)), covariances(Some(false)));
+    assert_eq!(default, on);
+    assert_ne!(default, off, "the floor changed nothing: the test would be vacuous");
+}

@@ -77,8 +77,10 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--reg-covar", type=lambda v: v if v == "auto" else float(v), default=d.reg_covar,
                    help="auto (default) or a value added to all four diagonals")
     g.add_argument("--truncate", type=float, default=d.truncate)
-    g.add_argument("--dequantise-depth", action="store_true",
-                   help="floor variances along viewing rays at the depth quantisation (structured-light depth)")
+    g.add_argument("--dequantise-depth", action="store_const", const=True, default=None,
+                   help="floor variances along viewing rays at the depth quantisation (the default for frames)")
+    g.add_argument("--no-dequantise-depth", dest="dequantise_depth", action="store_const", const=False,
+                   help="the paper's plain EM on quantised depth")
     g.add_argument("--decimate", type=int, default=None, help="default 1, 5 with --reduce map (as sogmm map)")
     g.add_argument("--depth-scale", type=float, default=d.depth_scale)
     g.add_argument("--depth-min", type=float, default=d.depth_min)

@@ -33,9 +33,10 @@ class FitSettings:
     max_iter: int = 100
     reg_covar: float | str = "auto"  # as sogmm.SOGMM
     truncate: float = 0.0
-    #: ``--dequantise-depth``: floor variances along viewing rays at the depth
-    #: quantisation (SOGMM(dequantise_depth=True)); False = the paper's plain EM.
-    dequantise_depth: bool = False
+    #: ``--dequantise-depth`` / ``--no-dequantise-depth``: the depth-quantisation
+    #: floor (SOGMM(dequantise_depth=...)); None = the library's default (on
+    #: for frames).
+    dequantise_depth: bool | None = None
     decimate: int = 1
     depth_scale: float = 1000.0
     depth_min: float = 0.1
