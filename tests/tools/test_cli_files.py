@@ -58,6 +58,15 @@ def read(path):
         return f.read()
 
 
+def restore(path, data):
+    """Puts a file back as it was (a regular file with these bytes)."""
+    if os.path.lexists(path) and (os.path.islink(path) or read(path) != data):
+        os.remove(path)
+    if not os.path.exists(path):
+        with open(path, "wb") as f:
+            f.write(data)
+
+
 def write_log(path, blocks):
     """A Redwood .log of (frame id, 16 numbers) blocks, in the given order."""
     with open(path, "w") as f:
@@ -110,15 +119,18 @@ def writers(tmp, seq, traj, model):
     run(["fit", "--sequence", seq, "--trajectory", traj, "--decimate", 10, "--components", 3, "-q", "-o", traj],
         expect=2)
     check(read(traj) == traj_bytes, "fit -o equal to --trajectory: the trajectory was overwritten")
+    restore(traj, traj_bytes)  # so that a failure here does not spoil the checks after it
     alias = os.path.join(tmp, "traj_alias.log")
     os.symlink(traj, alias)
     run(base + ["-o", alias], expect=2)
-    check(read(traj) == traj_bytes, "map -o LINK-TO-TRAJECTORY: the trajectory was overwritten")
+    check(read(traj) == traj_bytes and os.path.islink(alias), "map -o LINK-TO-TRAJECTORY: the trajectory was overwritten")
+    restore(traj, traj_bytes)
     hard = os.path.join(tmp, "model_hard.sogmm")
     os.link(model, hard)
     model_bytes = read(model)
     run(["sample", model, "-n", 100, "-o", hard], expect=2)
     check(read(model) == model_bytes, "sample -o HARDLINK-TO-MODEL: the model was overwritten")
+    restore(model, model_bytes)
 
     # An output folder that cannot be written: found before the run (no frame
     # is mapped: --progress would print a line per frame).
