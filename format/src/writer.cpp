@@ -305,6 +305,11 @@ std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& optio
   return detail::encode(model, options, detail::Tweaks{});
 }
 
+void write_file(const std::string& path, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  detail::atomic_write(path, size, [bytes, size](const detail::ByteSink& sink) { sink(bytes, size); });
+}
+
 void save(const std::string& path, const Model& model, const WriteOptions& options) {
   const detail::EncodedFile file(model, options, detail::Tweaks{});
   detail::atomic_write(path, file.size(), [&file](const detail::ByteSink& sink) { file.emit(sink); });

@@ -91,6 +91,33 @@ TEST_F(SavePaths, DanglingLinkCreatesItsTarget) {
   EXPECT_TRUE(sogmm::test::bit_equal(fmt::load(target), m));
 }
 
+// format::write_file (what the tools write CSV, SVG, PLY and PNG with, issue
+// 36) is save()'s mechanism: through a link, the link kept; a FIFO target is
+// refused and stays a FIFO (a rename would have replaced it).
+TEST_F(SavePaths, WriteFileGoesThroughALinkAndRefusesAFifo) {
+  const std::string target = dir_ + "/rows.csv";
+  ASSERT_EQ(::symlink("rows.csv", (dir_ + "/link.csv").c_str()), 0);  // dangling, relative
+  const std::string text = "frame,points\n0,12\n";
+  fmt::write_file(dir_ + "/link.csv", text.data(), text.size());
+  EXPECT_TRUE(is_link(dir_ + "/link.csv"));
+  const std::vector<std::uint8_t> back = slurp(target);
+  EXPECT_EQ(std::string(back.begin(), back.end()), text);
+
+  const std::string fifo = dir_ + "/out.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    fmt::write_file(fifo, text.data(), text.size());
+    ADD_FAILURE() << "a FIFO was written over";
+  } catch (const sogmm::Error& e) {
+    EXPECT_EQ(e.code(), sogmm::ErrorCode::Io) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+  struct stat st;
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(files().size(), 3u);  // link.csv, rows.csv, out.fifo: no temporary file left
+}
+
 TEST_F(SavePaths, CapiSaveThroughALinkKeepsTheLink) {
   const sogmm::Model src = sogmm::test::synthetic_model(5, 4, false);
   sogmm_model* h = nullptr;

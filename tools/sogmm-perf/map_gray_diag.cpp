@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       const tools::LoadedFrame lf = tools::load_frame(f.depth, f.color);
       camera = tools::resolve_camera(in.camera, lf);
       const PointCloud c = backproject(lf.view(camera), o.depth);
-      const Pose& pose = in.poses[f.index];
+      const Pose& pose = in.poses[k];
       const std::vector<double> w = world_xyz(c, pose);
       std::vector<double> ll(c.size(), -INFINITY);
       if (map.size() > 0) map.local_log_likelihood(w.data(), c.size(), ll.data());

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <new>
 
+#include "file_util.hpp"
 #include "sigint_cancel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
@@ -14,6 +15,14 @@
 #include <memory>
 
 namespace sogmm::tools {
+
+namespace {
+// Read here rather than by sogmm::read_intrinsics_json so that a FIFO or a
+// device given as --intrinsics is refused at once (read_input_file).
+Camera read_intrinsics(const std::string& path) {
+  return parse_intrinsics_json(read_input_file(path, "intrinsics file"), path);
+}
+}  // namespace
 
 void add_camera_flags(CLI::App& app, CameraFlags& c, DepthOptions& d) {
   app.add_option("--intrinsics", c.intrinsics, "Open3D PinholeCameraIntrinsic JSON file");
@@ -34,7 +43,7 @@ Camera resolve_camera(const CameraFlags& f, const LoadedFrame& frame) {
   const bool explicit_camera = f.fx > 0 || f.fy > 0 || f.width > 0 || f.height > 0;
   if (!f.intrinsics.empty()) {
     require(!explicit_camera, ErrorCode::InvalidArgument, "give either --intrinsics or --fx/--fy/--cx/--cy, not both");
-    cam = read_intrinsics_json(f.intrinsics);
+    cam = read_intrinsics(f.intrinsics);
   } else {
     require(explicit_camera, ErrorCode::InvalidArgument,
             "no camera: give --intrinsics FILE or --fx --fy --cx --cy (and optionally --width --height)");
@@ -111,6 +120,13 @@ void add_frame_source_flags(CLI::App& app, FrameSource& f, const std::string& se
                  sequence_use + "folder with depth/*.png and color/*.{jpg,png} (instead of --depth/--color)");
   app.add_option("--trajectory", f.trajectory, "with --sequence: Redwood .log camera-to-world poses");
   app.add_option("--frames", f.frames, "with --sequence: I, A:B (B excluded) or A:B:STEP; default all");
+  add_pair_by_order_flag(app, f.pair_by_order);
+}
+
+void add_pair_by_order_flag(CLI::App& app, bool& pair_by_order) {
+  app.add_flag("--pair-by-order", pair_by_order,
+               "with --sequence: pair images and poses by file order, ignoring the frame numbers of the image "
+               "names and of the trajectory (default: by number, mismatches refused)");
 }
 
 void add_data_range_flag(CLI::App& app, double& data_range) {
@@ -144,7 +160,7 @@ Camera camera_from_flags(const CameraFlags& f) {
   const bool explicit_camera = f.fx > 0 || f.fy > 0 || f.width > 0 || f.height > 0;
   if (!f.intrinsics.empty()) {
     require(!explicit_camera, ErrorCode::InvalidArgument, "give either --intrinsics or --fx/--fy/--cx/--cy, not both");
-    return read_intrinsics_json(f.intrinsics);
+    return read_intrinsics(f.intrinsics);
   }
   require(f.width > 0 && f.height > 0 && f.fx > 0 && f.fy > 0, ErrorCode::InvalidArgument,
           "camera flags need all of --width --height --fx --fy --cx --cy (or --intrinsics FILE)");

@@ -44,10 +44,13 @@ void add_fit_flags(CLI::App& app, FitOptions& options);
 struct FrameSource {
   std::string depth, color;
   std::string sequence, trajectory, frames;
+  bool pair_by_order = false;  ///< --pair-by-order (see sequence.hpp, pair_frames)
 };
 /// Adds the five flags. `sequence_use` is prefixed to the help of the
 /// sequence flags (e.g. "with MODEL: "), where a command restricts them.
 void add_frame_source_flags(CLI::App& app, FrameSource& source, const std::string& sequence_use = "");
+/// Adds --pair-by-order (commands that take --sequence without the other flags).
+void add_pair_by_order_flag(CLI::App& app, bool& pair_by_order);
 
 /// Everything `sogmm eval` reports about one fit.
 struct Evaluation {

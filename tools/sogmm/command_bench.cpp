@@ -15,6 +15,7 @@
 #include "bench/octomap_adapter.hpp"
 #include "bench/runner.hpp"
 #include "cli_common.hpp"
+#include "file_util.hpp"
 #include "sogmm/error.hpp"
 
 #ifndef SOGMM_BENCH_PLOT_SCRIPT
@@ -155,6 +156,13 @@ Command add_bench_command(CLI::App& root) {
                 !bench::octomap_available())
               notes.push_back("OctoMap rows skipped: this sogmm was built without liboctomap.");
 
+            // The output folder first, so that a run of minutes does not end in an I/O error.
+            std::error_code ec;
+            fs::create_directories(s->out, ec);
+            require(fs::is_directory(s->out), ErrorCode::Io, "cannot create output folder " + s->out);
+            const std::string csv = (fs::path(s->out) / "results.csv").string();
+            check_output_path(csv);
+
             std::vector<bench::BenchRow> rows;
             for (const FramePaths& f : frames) {
               const LoadedFrame frame = load_frame(f.depth, f.color);
@@ -174,10 +182,6 @@ Command add_bench_command(CLI::App& root) {
               rows.insert(rows.end(), frame_rows.begin(), frame_rows.end());
             }
 
-            std::error_code ec;
-            fs::create_directories(s->out, ec);
-            require(fs::is_directory(s->out), ErrorCode::Io, "cannot create output folder " + s->out);
-            const std::string csv = (fs::path(s->out) / "results.csv").string();
             bench::write_csv(csv, rows);
             notes.push_back("CSV: " + csv);
 

@@ -169,13 +169,11 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
 
 int run_model_sequence(const EvalState& s, const CLI::App& app) {
   const Model model = load_model(s.model);
-  const std::vector<SequenceFrame> frames = list_sequence(s.src.sequence);
-  const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
+  const std::vector<SequenceFrame> frames = list_sequence(s.src.sequence, s.src.pair_by_order);
   const std::vector<std::size_t> selected =
       parse_frame_range(s.src.frames.empty() ? std::string(":") : s.src.frames, frames.size());
-  require(poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
-          s.src.trajectory + ": has " + std::to_string(poses.size()) + " poses but frame " +
-              std::to_string(selected.back()) + " is selected");
+  const std::vector<Pose> poses = poses_of_frames(read_trajectory_log(s.src.trajectory), s.src.trajectory, frames,
+                                                  selected, s.src.pair_by_order);
   if (key_value(model, "coordinate_frame") == "camera")
     std::fprintf(stderr, "sogmm: note: %s is a single-frame model in its camera's coordinates; it is moved with "
                  "the inverse of each frame's pose as if it were in world coordinates\n", s.model.c_str());
@@ -185,7 +183,8 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     flags.intrinsics = guess;
   const DepthOptions d = depth_options_for(app, s.depth_options, model);
   std::vector<FrameScore> scores;
-  for (const std::size_t i : selected) {
+  for (std::size_t k = 0; k < selected.size(); ++k) {
+    const std::size_t i = selected[k];
     const SequenceFrame& f = frames[i];
     const LoadedFrame frame = load_frame(f.depth, f.color);
     const Camera camera = camera_flags_given(flags) ? resolve_camera(flags, frame) : camera_for(flags, model, s.model);
@@ -193,7 +192,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
             f.depth + ": image size differs from the camera (give --intrinsics)");
     const PointCloud cloud = backproject_nonempty(frame, camera, d, f.depth);
     const Camera dc = decimated(camera, d.decimate);
-    const Gmm local = transform(model.gmm, inverse_rigid(poses[i]));
+    const Gmm local = transform(model.gmm, inverse_rigid(poses[k]));
     FrameScore sc;
     sc.frame = i;
     sc.depth = f.depth;

@@ -196,7 +196,8 @@ Command add_fit_command(CLI::App& root) {
       "Progress goes to stderr (a live line on a terminal, plain lines with --progress, nothing with --quiet);\n"
       "a one-paragraph summary goes to stdout. The model is saved atomically with its metadata (fit\n"
       "parameters, camera, decimation, depth scale and range, producer, creation time).\n"
-      "A sequence is DIR/depth/*.png + DIR/color/*.{jpg,png} (paired in name order); each frame is fitted,\n"
+      "A sequence is DIR/depth/*.png + DIR/color/*.{jpg,png} (paired with each other and with the poses by the\n"
+      "frame number of their names, 00012.png: the pose '12 ...'; --pair-by-order: by file order); each frame is fitted,\n"
       "moved to the world frame with its camera-to-world pose from the Redwood .log trajectory and merged.\n\n"
       "Examples:\n"
       "  sogmm fit --depth ../shared/data/rgbd/livingroom/depth/00000.png \\\n"
@@ -217,7 +218,9 @@ Command add_fit_command(CLI::App& root) {
                 "--n-init 1)");
   CLI::App* a = app;
   return {app, [s, a]() {
-            check_output_path(s->output);
+            std::vector<NamedFile> inputs = sequence_inputs(s->src, s->camera);
+            inputs.insert(inputs.end(), {{"--depth", s->src.depth}, {"--color", s->src.color}});
+            check_outputs(inputs, {{"-o", s->output}});
             const SigintCancel ctrl_c;  // Ctrl-C cancels the fits; the output is written only after them
             const bool single = !s->src.depth.empty() || !s->src.color.empty();
             require(single != !s->src.sequence.empty(), ErrorCode::InvalidArgument,

@@ -73,11 +73,9 @@ std::string plot_text(const std::vector<Row>& rows, const std::string& title) {
 }
 
 int run_map(MapState& s) {
-  check_output_path(s.output);
   const std::string csv = s.csv.empty() ? beside(s.output, ".csv") : s.csv;
   const std::string plot = s.plot.empty() ? beside(s.output, ".svg") : s.plot;
-  check_output_path(csv);
-  check_output_path(plot);
+  check_outputs(sequence_inputs(s.src, s.camera), {{"-o", s.output}, {"--csv", csv}, {"--plot", plot}});
   s.options.novelty = !s.no_novelty;
   s.options.fusion = s.fusion != "off";
   s.options.fusion_method = s.fusion == "kl" ? FusionMethod::KL : FusionMethod::Hellinger;
@@ -179,6 +177,7 @@ Command add_map_command(CLI::App& root) {
   app->add_option("DIR", s->src.sequence, "sequence folder: depth/*.png and color/*.{jpg,png}")->required();
   app->add_option("--trajectory", s->src.trajectory, "Redwood .log camera-to-world poses")->required();
   app->add_option("--frames", s->src.frames, "I, A:B (B excluded) or A:B:STEP; default all");
+  add_pair_by_order_flag(*app, s->src.pair_by_order);
   add_camera_flags(*app, s->camera, s->options.depth);
   add_fit_flags(*app, s->options.fit);
   app->add_option("--threshold", s->options.novelty_threshold,

@@ -52,7 +52,9 @@ double percentile_99(const std::vector<float>& v) {
 }
 
 int run_render(const RenderState& s, const CLI::App& app) {
-  check_output_path(s.output);
+  check_outputs({{"MODEL", s.model}, {"--depth", s.depth}, {"--color", s.color}, {"--trajectory", s.trajectory},
+                 {"--intrinsics", s.camera.intrinsics}},
+                {{"-o", s.output}});
   const Model model = load_model(s.model);
   Gmm gmm = model.gmm;
   std::string view_note;

@@ -51,8 +51,7 @@ Command add_sample_command(CLI::App& root) {
                     "sample: --truncation must be >= 0 and --sigmas > 0");
             require(s->subdivisions >= 0 && s->subdivisions <= 4, ErrorCode::InvalidArgument,
                     "sample: --subdivisions must be in 0..4");
-            if (!s->output.empty()) check_output_path(s->output);
-            if (!s->ellipsoids.empty()) check_output_path(s->ellipsoids);
+            check_outputs({{"MODEL", s->model}}, {{"-o", s->output}, {"--ellipsoids", s->ellipsoids}});
             const Model model = load_model(s->model);
             if (!s->output.empty()) {
               std::size_t n = s->n > 0 ? static_cast<std::size_t>(s->n)

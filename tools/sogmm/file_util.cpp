@@ -1,58 +1,128 @@
 #include "file_util.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
 #include "sogmm/error.hpp"
+#include "sogmm/format.hpp"
 
 namespace sogmm::tools {
 
-void check_output_path(const std::string& path) {
-  namespace fs = std::filesystem;
-  require(!path.empty(), ErrorCode::InvalidArgument, "empty output path");
-  const fs::path target(path);
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::error_code ec;
-  require(fs::is_directory(parent, ec), ErrorCode::Io,
-          path + ": cannot write (folder " + parent.string() + " does not exist)");
-  require(!fs::is_directory(target, ec), ErrorCode::Io, path + ": cannot write (is a folder)");
+namespace fs = std::filesystem;
+
+namespace {
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  return "not a regular file";
 }
 
+// The same file as far as can be told before it exists: equal when both
+// exist and are one inode (hard links, symbolic links), else when their
+// paths resolve to the same name.
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
+  const fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return a == b;
+  const fs::path cb = fs::weakly_canonical(b, ec);
+  return ec ? a == b : ca == cb;
+}
+}  // namespace
+
 void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
-  check_output_path(path);
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  require(fd >= 0, ErrorCode::Io, path + ": cannot write (" + std::strerror(errno) + ")");
-  const auto* p = static_cast<const unsigned char*>(data);
-  std::size_t left = size;
-  int err = 0;
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
+  try {
+    format::write_file(path, data, size);
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    throw Error(e.code(), what.find(path) != std::string::npos ? what : path + ": " + what);
+  }
+}
+
+void check_output_path(const std::string& path) {
+  require(!path.empty(), ErrorCode::InvalidArgument, "empty output path");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {  // through symbolic links: the file a write replaces
+    require(S_ISREG(st.st_mode), ErrorCode::Io,
+            path + ": cannot write (it is " + kind_of(st.st_mode) + ", not a regular file)");
+  }
+  // The folder of the final target: a temporary file is created there.
+  std::error_code ec;
+  fs::path target(path);
+  for (int hops = 0; hops < 40 && fs::is_symlink(target, ec); ++hops) {
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) break;
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  require(fs::is_directory(parent, ec), ErrorCode::Io,
+          path + ": cannot write (folder " + parent.string() + " does not exist)");
+  // Creating a file is the one test that holds for every reason it can fail
+  // (permissions, ACLs, a read-only file system, root's exemptions).
+  std::string probe = (parent / ".sogmm-probe-XXXXXX").string();
+  const int fd = ::mkstemp(&probe[0]);
+  require(fd >= 0, ErrorCode::Io,
+          path + ": cannot write in folder " + parent.string() + " (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+void check_outputs(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const NamedFile& out = outputs[i];
+    if (out.path.empty()) continue;
+    check_output_path(out.path);
+    for (const NamedFile& in : inputs)
+      require(in.path.empty() || !same_file(out.path, in.path), ErrorCode::InvalidArgument,
+              out.flag + " " + out.path + " is also the input " + in.flag + " " + in.path +
+                  ": writing it would destroy the input");
+    for (std::size_t j = 0; j < i; ++j)
+      require(outputs[j].path.empty() || !same_file(out.path, outputs[j].path), ErrorCode::InvalidArgument,
+              out.flag + " " + out.path + " is the same file as " + outputs[j].flag + " " + outputs[j].path +
+                  ": give each output its own file");
+  }
+}
+
+std::string read_input_file(const std::string& path, const std::string& what) {
+  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  require(fd >= 0, ErrorCode::Io, path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
+  struct stat st {};
+  const bool stat_ok = ::fstat(fd, &st) == 0;
+  if (!stat_ok || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw Error(ErrorCode::Io, path + ": cannot read " + what + " (" +
+                                   (stat_ok ? std::string("it is ") + kind_of(st.st_mode) + ", not a regular file"
+                                            : std::string("cannot stat it")) +
+                                   ")");
+  }
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      if (errno == EINTR) continue;
-      err = errno;
-      break;
+      const int err = errno;
+      ::close(fd);
+      throw Error(ErrorCode::Io, path + ": cannot read " + what + " (" + std::strerror(err) + ")");
     }
-    p += n;
-    left -= static_cast<std::size_t>(n);
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
   }
-  if (err == 0 && ::fsync(fd) != 0) err = errno;
-  if (::close(fd) != 0 && err == 0) err = errno;
-  if (err == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) err = errno;
-  if (err != 0) {
-    std::remove(tmp.c_str());
-    throw Error(ErrorCode::Io, path + ": write failed (" + std::strerror(err) + ")");
-  }
+  ::close(fd);
+  return text;
 }
 
 std::uint64_t file_size_or_zero(const std::string& path) {
   std::error_code ec;
-  const auto n = std::filesystem::file_size(path, ec);
+  const auto n = fs::file_size(path, ec);
   return ec ? 0 : static_cast<std::uint64_t>(n);
 }
 

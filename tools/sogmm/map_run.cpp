@@ -47,12 +47,10 @@ SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera
   SequenceInput in;
   in.dir = src.sequence;
   in.trajectory = src.trajectory;
-  in.frames = list_sequence(src.sequence);
-  in.poses = read_trajectory(src.trajectory);
+  in.frames = list_sequence(src.sequence, src.pair_by_order);
   in.selected = parse_frame_range(src.frames.empty() ? std::string(":") : src.frames, in.frames.size());
-  require(in.poses.size() >= in.selected.back() + 1, ErrorCode::InvalidData,
-          src.trajectory + ": has " + std::to_string(in.poses.size()) + " poses but frame " +
-              std::to_string(in.selected.back()) + " is selected");
+  in.poses = poses_of_frames(read_trajectory_log(src.trajectory), src.trajectory, in.frames, in.selected,
+                             src.pair_by_order);
   in.camera = camera;
   if (!camera_flags_given(in.camera)) {
     const std::string guess = (std::filesystem::path(src.sequence) / "intrinsics.json").string();
@@ -61,6 +59,13 @@ SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera
     in.camera.intrinsics = guess;
   }
   return in;
+}
+
+std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags& camera) {
+  std::string intrinsics = camera.intrinsics;
+  if (intrinsics.empty() && !src.sequence.empty())
+    intrinsics = (std::filesystem::path(src.sequence) / "intrinsics.json").string();
+  return {{"--trajectory", src.trajectory}, {"--intrinsics", intrinsics}};
 }
 
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
@@ -80,7 +85,7 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptio
     // The tool's check first: its message names the file and the depth range.
     backproject_nonempty(frame, camera, depth, r.file.depth);
     try {
-      r.stats = map.insert_rgbd(frame.view(camera), in.poses[r.file.index],
+      r.stats = map.insert_rgbd(frame.view(camera), in.poses[k],
                                 recording(progress.fit_callback(r.label), r.fit));
     } catch (const Error& e) {
       rethrow_naming(e, r.file.depth);

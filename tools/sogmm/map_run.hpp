@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "file_util.hpp"
 #include "sequence.hpp"
 #include "sogmm/map.hpp"
 
@@ -35,13 +36,18 @@ struct MapRunFrame {
 struct SequenceInput {
   std::string dir, trajectory;
   std::vector<SequenceFrame> frames;
-  std::vector<Pose> poses;
   std::vector<std::size_t> selected;
+  std::vector<Pose> poses;  ///< poses[k]: the pose of frames[selected[k]] (poses_of_frames)
   CameraFlags camera;
 };
-/// Lists, reads and checks them (errors name the file; more selected
-/// frames than poses -> Error(InvalidData)).
+/// Lists, reads and checks them (errors name the file; a selected frame
+/// without its pose -> Error(InvalidData)); images and poses are paired by
+/// frame number unless src.pair_by_order (sequence.hpp).
 SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera);
+
+/// The files a sequence run reads that an output must not replace: the
+/// trajectory and the intrinsics (--intrinsics, else DIR/intrinsics.json).
+std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags& camera);
 
 /// Inserts every selected frame into `map` in order: loads it (a missing or
 /// unreadable file -> Error(Io) naming it), checks the camera against the

@@ -4,7 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "file_util.hpp"
@@ -34,7 +35,26 @@ std::vector<std::string> list_images(const fs::path& dir, const std::vector<std:
 }
 }  // namespace
 
-std::vector<SequenceFrame> list_sequence(const std::string& dir) {
+namespace {
+const char kOrderHint[] = " (give --pair-by-order to pair files by order)";
+
+// The frame number of an image name: the name without extension as a
+// decimal number (00012.png: 12), -1 when it is not one.
+long long frame_number(const std::string& path) {
+  const std::string stem = fs::path(path).stem().string();
+  if (stem.empty() || stem.size() > 18 || stem.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoll(stem);
+}
+
+long long numbered(const std::string& path) {
+  const long long id = frame_number(path);
+  require(id >= 0, ErrorCode::InvalidData,
+          path + ": the name is not a frame number (as 00012.png), so it cannot be paired by number" + kOrderHint);
+  return id;
+}
+}  // namespace
+
+std::vector<SequenceFrame> list_sequence(const std::string& dir, bool pair_by_order) {
   require(fs::is_directory(dir), ErrorCode::Io, dir + ": no such folder (expected DIR/depth and DIR/color)");
   const auto depth = list_images(fs::path(dir) / "depth", {".png"});
   const auto color = list_images(fs::path(dir) / "color", {".jpg", ".jpeg", ".png"});
@@ -43,7 +63,24 @@ std::vector<SequenceFrame> list_sequence(const std::string& dir) {
           dir + ": " + std::to_string(depth.size()) + " depth images but " + std::to_string(color.size()) +
               " color images");
   std::vector<SequenceFrame> frames(depth.size());
-  for (std::size_t i = 0; i < depth.size(); ++i) frames[i] = {i, depth[i], color[i]};
+  if (pair_by_order) {
+    for (std::size_t i = 0; i < depth.size(); ++i) frames[i] = {i, -1, depth[i], color[i]};
+    return frames;
+  }
+  std::map<long long, std::string> color_of;
+  for (const std::string& c : color)
+    require(color_of.emplace(numbered(c), c).second, ErrorCode::InvalidData,
+            c + ": a second color image of frame " + std::to_string(numbered(c)));
+  std::set<long long> depth_ids;
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    const long long id = numbered(depth[i]);
+    require(depth_ids.insert(id).second, ErrorCode::InvalidData,
+            depth[i] + ": a second depth image of frame " + std::to_string(id));
+    const auto c = color_of.find(id);
+    require(c != color_of.end(), ErrorCode::InvalidData,
+            depth[i] + ": no color image of frame " + std::to_string(id) + " in " + dir + "/color" + kOrderHint);
+    frames[i] = {i, id, depth[i], c->second};
+  }
   return frames;
 }
 
@@ -88,10 +125,9 @@ std::vector<std::size_t> parse_frame_range(const std::string& text, std::size_t 
   return out;
 }
 
-std::vector<Pose> read_trajectory(const std::string& path) {
-  std::ifstream in(path);
-  require(fs::is_regular_file(path) && in.good(), ErrorCode::Io, path + ": cannot open trajectory (no such file)");
-  std::vector<Pose> poses;
+Trajectory read_trajectory_log(const std::string& path) {
+  std::istringstream in(read_input_file(path, "trajectory"));
+  Trajectory t;
   std::string line;
   int line_no = 0;
   auto next_line = [&](std::string& out) {
@@ -102,10 +138,11 @@ std::vector<Pose> read_trajectory(const std::string& path) {
     return false;
   };
   while (next_line(line)) {
+    long long id = 0;
     {
       std::istringstream h(line);
-      long long a = 0, b = 0, c = 0;
-      require(static_cast<bool>(h >> a >> b >> c), ErrorCode::InvalidData,
+      long long b = 0, c = 0;
+      require(static_cast<bool>(h >> id >> b >> c), ErrorCode::InvalidData,
               path + ":" + std::to_string(line_no) + ": expected a header line 'i j n'");
     }
     Pose p{};
@@ -120,12 +157,39 @@ std::vector<Pose> read_trajectory(const std::string& path) {
     // Rigid by the rule every pose in the library follows (kPoseTolerance).
     const std::string problem = rigid_pose_error(p);
     require(problem.empty(), ErrorCode::InvalidData,
-            path + ":" + std::to_string(line_no) + ": pose " + std::to_string(poses.size()) +
+            path + ":" + std::to_string(line_no) + ": pose " + std::to_string(t.poses.size()) +
                 " is not a rigid transform: " + problem);
-    poses.push_back(p);
+    t.poses.push_back(p);
+    t.ids.push_back(id);
   }
-  require(!poses.empty(), ErrorCode::InvalidData, path + ": no pose in the trajectory");
-  return poses;
+  require(!t.poses.empty(), ErrorCode::InvalidData, path + ": no pose in the trajectory");
+  return t;
+}
+
+std::vector<Pose> read_trajectory(const std::string& path) { return read_trajectory_log(path).poses; }
+
+std::vector<Pose> poses_of_frames(const Trajectory& trajectory, const std::string& path,
+                                  const std::vector<SequenceFrame>& frames, const std::vector<std::size_t>& selected,
+                                  bool pair_by_order) {
+  std::vector<Pose> out;
+  if (pair_by_order) {
+    require(trajectory.poses.size() >= selected.back() + 1, ErrorCode::InvalidData,
+            path + ": has " + std::to_string(trajectory.poses.size()) + " poses but frame " +
+                std::to_string(selected.back()) + " is selected");
+    for (const std::size_t i : selected) out.push_back(trajectory.poses[i]);
+    return out;
+  }
+  std::map<long long, std::size_t> block_of;
+  for (std::size_t k = 0; k < trajectory.ids.size(); ++k)
+    require(block_of.emplace(trajectory.ids[k], k).second, ErrorCode::InvalidData,
+            path + ": two poses of frame " + std::to_string(trajectory.ids[k]) + kOrderHint);
+  for (const std::size_t i : selected) {
+    const auto b = block_of.find(frames[i].id);
+    require(b != block_of.end(), ErrorCode::InvalidData,
+            path + ": no pose of frame " + std::to_string(frames[i].id) + " (" + frames[i].depth + ")" + kOrderHint);
+    out.push_back(trajectory.poses[b->second]);
+  }
+  return out;
 }
 
 void write_trajectory(const std::string& path, const std::vector<Pose>& poses) {

@@ -4,8 +4,10 @@ back-projection (through sogmm_fit_rgbd), and the C++ CLI as a reference."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +45,17 @@ def test_camera_json_errors(tmp_path):
         bad.write_text(text)
         with pytest.raises(sogmm.FormatError, match=needle):
             sogmm.Camera.from_json(bad)
+
+
+def test_camera_json_refuses_a_fifo_at_once(tmp_path):
+    # Opening a FIFO for reading waits for a writer: a child process with a
+    # time limit turns a hang into a failure instead of blocking the suite.
+    fifo = tmp_path / "intr.fifo"
+    os.mkfifo(fifo)
+    code = (f"import sogmm\ntry:\n    sogmm.Camera.from_json({str(fifo)!r})\n"
+            "except sogmm.SogmmIOError as e:\n    print(e)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and "it is a FIFO, not a regular file" in p.stdout, p.stdout + p.stderr
 
 
 def test_camera_validation():

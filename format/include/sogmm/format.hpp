@@ -83,6 +83,16 @@ Model from_bytes(const void* data, std::size_t size, const ReadOptions& options 
 /// any) is untouched and no temporary file is left; throws Error(Io).
 void save(const std::string& path, const Model& model, const WriteOptions& options = {});
 
+/// Writes any file (not only a model: the tools' CSV, SVG, PLY, PNG and
+/// trajectories) by the one mechanism save() uses: `size` bytes from `data`
+/// go to a temporary file next to the final target of `path` (a symbolic link
+/// is written through, so it keeps pointing at the new file), fsync'ed and
+/// renamed over it with the replaced file's permission bits. Refuses a target
+/// that exists and is not a regular file (a device, a FIFO, a folder): it is
+/// never replaced. On failure the previous file is untouched and no temporary
+/// file is left; throws Error(Io) naming the file.
+void write_file(const std::string& path, const void* data, std::size_t size);
+
 /// Reads and fully verifies a .sogmm file. Throws Error(Io) when it cannot be
 /// read or is not a regular file (a FIFO, a device or a directory is refused
 /// at once, never waited on). The file is read piecewise: header first, then

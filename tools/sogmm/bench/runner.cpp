@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "file_util.hpp"
 #include "ndt_map.hpp"
 #include "octomap_adapter.hpp"
 #include "sogmm/error.hpp"
@@ -247,8 +247,7 @@ std::string markdown_table(const std::vector<BenchRow>& rows) {
 }
 
 void write_csv(const std::string& path, const std::vector<BenchRow>& rows) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  require(static_cast<bool>(f), ErrorCode::Io, "cannot write " + path);
+  std::ostringstream f;
   f << "frame,method,family,parameter,n_points,n_elements,psnr,psnr_paper,mre,precision,recall,fscore,"
        "memory_bytes,file_bytes,build_seconds,gray_fallbacks,note\n";
   for (const BenchRow& r : rows) {
@@ -259,8 +258,8 @@ void write_csv(const std::string& path, const std::vector<BenchRow>& rows) {
       << (r.file_bytes < 0 ? std::string() : std::to_string(r.file_bytes)) << ',' << num(r.build_seconds, "%.6f")
       << ',' << r.gray_fallbacks << ',' << csv_field(r.note) << '\n';
   }
-  f.flush();
-  require(static_cast<bool>(f), ErrorCode::Io, "cannot write " + path);
+  const std::string text = f.str();
+  tools::write_file_atomic(path, text.data(), text.size());
 }
 
 }  // namespace sogmm::bench

@@ -18,6 +18,7 @@ import numpy as np
 from ctypes import byref, c_size_t
 
 from . import _ffi
+from ._input_file import read_input_file
 from .errors import FormatError, InvalidArgumentError
 
 __all__ = ["Camera", "rgbd_to_points"]
@@ -64,10 +65,10 @@ class Camera:
         """Reads Open3D's PinholeCameraIntrinsic JSON: {"width", "height",
         "intrinsic_matrix": 9 numbers, column-major}.
 
-        A missing file raises FileNotFoundError (an OSError); a malformed one
-        raises FormatError naming the field."""
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
+        A missing file raises FileNotFoundError (an OSError), a FIFO or any
+        other file that is not regular SogmmIOError (also an OSError) at
+        once; a malformed one raises FormatError naming the field."""
+        text = read_input_file(path, "intrinsics file")
         try:
             doc = json.loads(text)
         except json.JSONDecodeError as e:

@@ -25,6 +25,7 @@ from ..camera import Camera
 from ..errors import SogmmError
 from .frame_fit import FitSettings
 from .map_tile import MapSettings
+from .output_check import check_output
 from .runner import build_map
 from .sequence import load_frames
 
@@ -33,7 +34,12 @@ def _parser() -> argparse.ArgumentParser:
     d = FitSettings()
     ap = argparse.ArgumentParser(prog="python -m sogmm.distributed", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--sequence", required=True, help="DIR/depth/*.png + DIR/color/*.{jpg,png} (paired in name order)")
+    ap.add_argument("--sequence", required=True,
+                    help="DIR/depth/*.png + DIR/color/*.{jpg,png} (paired with each other and with the poses by "
+                         "the frame number of their names, 00012.png: pose 12)")
+    ap.add_argument("--pair-by-order", action="store_true",
+                    help="pair images and poses by file order, ignoring frame numbers (default: by number, "
+                         "mismatches refused)")
     ap.add_argument("--trajectory", required=True, help="Redwood .log camera-to-world poses")
     ap.add_argument("--frames", default=":", help="I, A:B (B excluded) or A:B:STEP; default all")
     ap.add_argument("-o", "--output", required=True, help="output map (.sogmm, world frame)")
@@ -123,10 +129,15 @@ def main(argv=None) -> int:
                                truncate=a.truncate, dequantise_depth=a.dequantise_depth, decimate=a.decimate,
                                depth_scale=a.depth_scale, depth_min=a.depth_min, depth_max=a.depth_max)
         intrinsics = a.intrinsics or str(Path(a.sequence) / "intrinsics.json")
-        if not os.path.isfile(intrinsics):
+        if not a.intrinsics and not os.path.lexists(intrinsics):
             raise SogmmError(f"no camera: give --intrinsics FILE (or put intrinsics.json in {a.sequence})")
+        check_output("-o", a.output, [("--trajectory", a.trajectory), ("--intrinsics", intrinsics)])
         camera = Camera.from_json(intrinsics)
-        frames = load_frames(a.sequence, a.trajectory, a.frames)
+        frames = load_frames(a.sequence, a.trajectory, a.frames, a.pair_by_order)
+        try:
+            import ray  # noqa: F401  (build_map imports it; asked here for a one-line error)
+        except ImportError:
+            raise SogmmError("Ray is not installed: pip install 'sogmm[ray]'") from None
         meta = {"sequence": a.sequence, "trajectory": a.trajectory}  # as sogmm fit --sequence and sogmm map
         r = build_map(frames, settings, camera, workers=a.workers, address=a.address, fan_in=a.fan_in,
                       tile_size=a.tile_size, on_error=a.on_error, max_retries=a.max_retries, progress=not a.quiet,

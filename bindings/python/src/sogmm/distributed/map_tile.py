@@ -79,37 +79,135 @@ def _map_partial(saved: GMM, frames: list[int]) -> dict:
             "map_frames": [meta["map_frames"]], "map_options": meta["map_options"]}
 
 
+class _TileMap:
+    """A tile's ``sogmm.Map`` and the log of what built it, so that a failure
+    is charged to the frame that caused it, not to the frame whose insert
+    happened to trigger a fit.
+
+    A failed insert undoes itself but leaves the points of earlier frames
+    pending, and an insert that fills the batch fits those together with its
+    own: its error may belong to an earlier frame. So a frame is refused only
+    by an insert or a fit that holds its points alone: on a failed insert
+    with other frames pending, those are fitted first (frame by frame if
+    together they cannot be, rebuilding the map from the log, as no call
+    drops pending points) and the frame is inserted again alone."""
+
+    def __init__(self, settings: FitSettings, map_settings: MapSettings, camera: Camera):
+        self._settings, self._map_settings, self._camera = settings, map_settings, camera
+        self.map = map_settings.new_map(settings)
+        self._log = []  # the frames inserted, or None for an explicit flush, in order
+        self._batch = []  # log entries whose points are pending
+
+    @property
+    def inserted(self) -> list[int]:
+        return [frame.index for frame in self._log if frame is not None]
+
+    def close(self) -> None:
+        self.map.close()
+
+    def _insert(self, frame: Frame, images=None) -> None:
+        depth, color = images if images is not None else read_images(frame)  # a replay reads them again
+        self.map.insert_rgbd(depth, color, self._camera, np.asarray(frame.pose).reshape(4, 4))
+        self._log.append(frame)
+        self._batch = [] if self.map.n_pending_ == 0 else self._batch + [self._log[-1]]
+
+    def _flush(self) -> None:
+        self.map.flush()
+        self._log.append(None)
+        self._batch = []
+
+    def _rebuild(self, log: list) -> None:
+        """Replays ``log`` into a new map (the same calls give the same map)."""
+        self.map.close()
+        self.map = self._map_settings.new_map(self._settings)
+        self._log, self._batch = [], []
+        for frame in log:
+            if frame is None:
+                self._flush()
+            else:
+                self._insert(frame)
+
+    def settle(self) -> dict:
+        """Fits every pending point; returns {frame id: error} of the pending
+        frames that cannot be fitted even alone (they are left out)."""
+        if not self._batch:
+            return {}
+        try:
+            self._flush()
+            return {}
+        except SogmmError:
+            pass
+        batch = self._batch
+        errors = {}
+        self._rebuild(self._log[:len(self._log) - len(batch)])  # the map before the batch: nothing pending
+        for frame in batch:
+            before = list(self._log)
+            try:
+                self._insert(frame)
+                self._flush()
+            except SogmmError as e:
+                errors[frame.index] = _describe(e)
+                self._rebuild(before)
+        return errors
+
+    def add(self, frame: Frame, images) -> dict:
+        """Inserts a frame. Returns {frame id: error} of the frames left out:
+        this one when the map refuses it alone (the map is then unchanged),
+        and pending ones that could not be fitted even alone."""
+        try:
+            self._insert(frame, images)
+            return {}
+        except SogmmError as e:
+            if not self._batch:  # nothing else was pending: the error is this frame's
+                return {frame.index: _describe(e)}
+        errors = self.settle()
+        try:
+            self._insert(frame, images)
+        except SogmmError as e:
+            errors[frame.index] = _describe(e)
+        return errors
+
+
+def _describe(e: Exception) -> str:
+    return f"{type(e).__name__}: {e}"
+
+
 def map_tile(frames: list[Frame], settings: FitSettings, map_settings: MapSettings,
              camera: dict) -> tuple[list[dict], dict | None]:
     """(per-frame infos, partial map of the tile or None) of one tile: its
     frames inserted in id order into one map. A bad frame (unreadable, or the
-    map refuses it, e.g. no valid depth) gets an info with ``error`` and is
-    left out, as the map leaves itself unchanged on a failed insert."""
-    infos, inserted = [], []
-    cam = Camera(**camera)
-    with map_settings.new_map(settings) as m:
+    map refuses it, e.g. no valid depth, or its points cannot be fitted) gets
+    an info with ``error`` and is left out; the error is always the frame's
+    own (see :class:`_TileMap`), never that of frames still pending."""
+    infos = {}
+    tile = _TileMap(settings, map_settings, Camera(**camera))
+    try:
         for f in sorted(frames, key=lambda f: f.index):
             test_hold(f.index)
             start = time.perf_counter()
-            info = {"frame": f.index, "pid": os.getpid(), "error": None, "bytes": 0}
+            info = infos[f.index] = {"frame": f.index, "pid": os.getpid(), "error": None, "bytes": 0}
             try:
-                depth, color = read_images(f)
-                m.insert_rgbd(depth, color, cam, np.asarray(f.pose).reshape(4, 4))
-                inserted.append(f.index)
-            except (SogmmError, OSError, ValueError) as e:
-                info["error"] = f"{type(e).__name__}: {e}"
+                left_out = tile.add(f, read_images(f))
+            except (OSError, ValueError) as e:  # unreadable images
+                left_out = {f.index: _describe(e)}
+            for frame, error in left_out.items():
+                infos[frame]["error"] = error
             info["seconds"] = time.perf_counter() - start
-            infos.append(info)
+        start = time.perf_counter()
+        for frame, error in tile.settle().items():
+            infos[frame]["error"] = error
+        inserted = tile.inserted
+        infos = [infos[k] for k in sorted(infos)]
         if not inserted:
             return infos, None
-        start = time.perf_counter()
-        m.flush()
         # The library writes the provenance (map_frames, map_options, fit
         # record, camera) only into a file: save it and read it back.
         with tempfile.TemporaryDirectory(prefix="sogmm_tile_") as d:
             path = os.path.join(d, "tile.sogmm")
-            m.save(path, compress=False)
+            tile.map.save(path, compress=False)
             part = _map_partial(GMM.load(path), inserted)
-        infos[-1]["seconds"] += time.perf_counter() - start
+    finally:
+        tile.close()
+    infos[-1]["seconds"] += time.perf_counter() - start
     infos[-1]["bytes"] = size_bytes(part)
     return infos, part
