@@ -185,30 +185,38 @@ function readHead(data, maxDecodedBytes, verifyChecksums) {
   return { m, major, minor, fileLength, metaLength, cols };
 }
 
-// Steps 17-18 for one array: decode (codec, filter, order) and check the CRC.
+const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
+
+// Steps 17-18 for one array: decode (codec, then filter and order undone in
+// one pass) and check the CRC-32C of the canonical bytes.
 function decodeArray(data, r, rows, cols, name, verifyChecksums) {
   const width = r.dtype === 1 ? 8 : 4;
   const n = rows * cols;
   const stored = data.subarray(Number(r.offset), Number(r.offset + r.stored_length));
-  let bytes = r.codec === 1 ? decodeZstd(stored, n * width) : stored;
-  if (r.filter === 1) { // byte k of element i is at k * n + i
-    const joined = new Uint8Array(n * width);
-    for (let k = 0; k < width; k++) {
-      for (let i = 0; i < n; i++) joined[i * width + k] = bytes[k * n + i];
-    }
-    bytes = joined;
-  }
-  if (r.order === 1) { // element (m, c) at c * M + m
-    const comp = new Uint8Array(n * width);
+  const bytes = r.codec === 1 ? decodeZstd(stored, n * width) : stored;
+  let canonical = bytes;
+  if (r.filter === 1 || r.order === 1) {
+    canonical = new Uint8Array(n * width);
     for (let c = 0; c < cols; c++) {
-      for (let m = 0; m < rows; m++) comp.set(bytes.subarray((c * rows + m) * width, (c * rows + m + 1) * width), (m * cols + c) * width);
+      for (let m = 0; m < rows; m++) {
+        const e = r.order === 1 ? c * rows + m : m * cols + c; // element (m, c) before the order is undone
+        const d = (m * cols + c) * width;
+        if (r.filter === 1) { // byte k of element e is at k * n + e
+          for (let k = 0; k < width; k++) canonical[d + k] = bytes[k * n + e];
+        } else {
+          for (let k = 0; k < width; k++) canonical[d + k] = bytes[e * width + k];
+        }
+      }
     }
-    bytes = comp;
   }
-  if (verifyChecksums && crc32c(bytes) !== r.crc32c) formatError('checksum_mismatch', `${name} CRC-32C`);
+  if (verifyChecksums && crc32c(canonical) !== r.crc32c) formatError('checksum_mismatch', `${name} CRC-32C`);
   // Section 5.6: float32 values; an F64 value rounds to nearest (Float32Array does).
+  if (LITTLE_ENDIAN) {
+    const copy = new Uint8Array(canonical); // a fresh, aligned copy (Buffer.slice would share)
+    return width === 4 ? new Float32Array(copy.buffer) : Float32Array.from(new Float64Array(copy.buffer));
+  }
   const out = new Float32Array(n);
-  const dv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const dv = new DataView(canonical.buffer, canonical.byteOffset, canonical.byteLength);
   for (let i = 0; i < n; i++) out[i] = width === 8 ? dv.getFloat64(8 * i, true) : dv.getFloat32(4 * i, true);
   return out;
 }

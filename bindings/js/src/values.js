@@ -3,6 +3,8 @@
 import { fail } from './errors.js';
 
 const UPPER = [[0, 0], [0, 1], [0, 2], [0, 3], [1, 1], [1, 2], [1, 3], [2, 2], [2, 3], [3, 3]];
+const UPPER_AT = UPPER.map(([i, j]) => 4 * i + j);
+const UPPER_MIRROR = UPPER.map(([i, j]) => 4 * j + i);
 
 function numeric(reason, message) {
   fail('numeric', reason, message);
@@ -44,7 +46,7 @@ export function checkValues(weights, means, stored, M, packed) {
   const a = new Float64Array(16);
   for (let k = 0; k < M; k++) {
     if (packed) {
-      UPPER.forEach(([i, j], t) => { a[4 * i + j] = a[4 * j + i] = stored[10 * k + t]; });
+      for (let t = 0; t < 10; t++) a[UPPER_AT[t]] = a[UPPER_MIRROR[t]] = stored[10 * k + t];
     } else {
       let scale = 0;
       let asym = 0;

@@ -183,9 +183,11 @@ function showMetadata(model, name, frames) {
   if (model.camera) lines.push(`camera: ${Object.entries(model.camera).map(([k, v]) => `${k}=${fmt(v)}`).join(' ')}`);
   if (model.pose) lines.push(`pose: [${model.pose.map(fmt).join(' ')}]`);
   for (const [k, v] of model.key_values) {
-    lines.push(k === 'map_frames' ? `map_frames: ${frames.length} frames` : `${k}: ${v}`);
+    const shown = v.length > 160 ? `${v.slice(0, 160)}... (${v.length} characters)` : v;
+    lines.push(k === 'map_frames' ? `map_frames: ${frames.length} frames` : `${k}: ${shown}`);
   }
   $('meta').textContent = lines.join('\n');
+  $('meta').style.display = 'block';
 }
 
 function showComponent(model, k) {
@@ -205,7 +207,7 @@ function showError(e) {
   const what = e instanceof SogmmError ? `Cannot read this file: ${e.reason} (${e.category})\n${e.message}` : `Viewer error: ${e && e.message}`;
   $('error').textContent = what;
   $('error').style.display = 'block';
-  $('meta').textContent = '';
+  $('meta').style.display = 'none';
   $('frames').style.display = 'none';
   state.status = 'error';
   state.reason = e instanceof SogmmError ? e.reason : 'viewer_error';
@@ -228,7 +230,7 @@ function setFrame(f) {
   draw();
 }
 
-function frameCamera(model) {
+function frameCamera(model, overhead) {
   const box = new THREE.Box3();
   const p = new THREE.Vector3();
   const M = Number(model.n_components);
@@ -236,8 +238,10 @@ function frameCamera(model) {
   const centre = box.getCenter(new THREE.Vector3());
   const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.1);
   controls.target.copy(centre);
-  // The viewpoint of the camera the data came from, backed off a little.
-  camera.position.set(centre.x, centre.y + 0.15 * size, centre.z + 0.9 * size);
+  // A frame: the viewpoint of its camera, backed off a little. A map (world
+  // frame, a room seen from inside): from above, so its cameras show.
+  if (overhead) camera.position.set(centre.x, centre.y + 0.75 * size, centre.z + 0.45 * size);
+  else camera.position.set(centre.x, centre.y + 0.15 * size, centre.z + 0.9 * size);
   camera.near = size / 1000;
   camera.far = size * 100;
   camera.updateProjectionMatrix();
@@ -285,7 +289,7 @@ function load(bytes, name) {
   } else {
     $('frames').style.display = 'none';
   }
-  frameCamera(model);
+  frameCamera(model, frames.length > 0);
   renderer.render(scene, camera);
   // Reading one pixel waits for the GPU: the first frame is really drawn.
   renderer.getContext().readPixels(0, 0, 1, 1, 0x1908, 0x1401, new Uint8Array(4));
