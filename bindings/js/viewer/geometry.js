@@ -1,6 +1,7 @@
 // Small dense linear algebra for the viewer: symmetric eigen-decomposition
-// (cyclic Jacobi, n <= 4), Cholesky factors for sampling, and the instance
-// transform that maps the unit sphere onto a component's k-sigma ellipsoid.
+// (cyclic Jacobi, n <= 4) for the picked component's eigenvalues, Cholesky
+// factors for sampling and for the instance transform that maps the unit
+// sphere onto a component's k-sigma ellipsoid.
 
 /** Eigenvalues (ascending) and eigenvectors (columns of v, row-major n x n) of symmetric a. */
 export function symmetricEigen(a, n) {
@@ -47,27 +48,29 @@ export function symmetricEigen(a, n) {
   return { values, vectors };
 }
 
-/** The 3x3 spatial block of component k's 4x4 covariance (row-major Float32Array of M x 16). */
-export function spatialCovariance(cov, k) {
-  const o = 16 * k;
-  return [cov[o], cov[o + 1], cov[o + 2], cov[o + 4], cov[o + 5], cov[o + 6], cov[o + 8], cov[o + 9], cov[o + 10]];
-}
-
 /**
  * Column-major 4x4 (three.js Matrix4.elements order) mapping the unit sphere
- * onto the k-sigma ellipsoid of component c: mean + V diag(k sqrt(lambda)).
+ * onto the k-sigma ellipsoid of component c: x = mean + k L u with L L^T the
+ * spatial covariance (Cholesky), so {x : (x - mean)^T S^-1 (x - mean) = k^2}.
+ * No eigen-decomposition: L maps the sphere onto the same ellipsoid.
  */
 export function ellipsoidMatrix(cov, means, c, sigmas, out, offset) {
-  const { values, vectors } = symmetricEigen(spatialCovariance(cov, c), 3);
-  for (let j = 0; j < 3; j++) {
-    const r = sigmas * Math.sqrt(Math.max(values[j], 0));
-    for (let i = 0; i < 3; i++) out[offset + 4 * j + i] = vectors[3 * i + j] * r;
-    out[offset + 4 * j + 3] = 0;
-  }
-  out[offset + 12] = means[4 * c];
-  out[offset + 13] = means[4 * c + 1];
-  out[offset + 14] = means[4 * c + 2];
-  out[offset + 15] = 1;
+  const o = 16 * c;
+  const a = cov[o];
+  const b = cov[o + 4];
+  const d = cov[o + 5];
+  const e = cov[o + 8];
+  const f = cov[o + 9];
+  const g = cov[o + 10];
+  const l00 = Math.sqrt(Math.max(a, 0));
+  const l10 = l00 > 0 ? b / l00 : 0;
+  const l20 = l00 > 0 ? e / l00 : 0;
+  const l11 = Math.sqrt(Math.max(d - l10 * l10, 0));
+  const l21 = l11 > 0 ? (f - l20 * l10) / l11 : 0;
+  const l22 = Math.sqrt(Math.max(g - l20 * l20 - l21 * l21, 0));
+  // Columns of k L (column-major: out[4 j + i] = row i of column j).
+  out.set([sigmas * l00, sigmas * l10, sigmas * l20, 0, 0, sigmas * l11, sigmas * l21, 0, 0, 0, sigmas * l22, 0,
+    means[4 * c], means[4 * c + 1], means[4 * c + 2], 1], offset);
 }
 
 /** Lower Cholesky factor (row-major 4x4) of a positive definite 4x4. */

@@ -11,16 +11,29 @@ import { parseMapFrames } from './provenance.js';
 
 const BACKGROUND = 0x101418;
 const SAMPLE_COUNT = 100000;
+const LARGE = 20000; // components above which drawing is coarser
 const $ = (id) => document.getElementById(id);
 const state = { status: 'loading', reason: null, drawn: 0, frame: null, frames: 0, timings: {} };
 window.sogmmViewer = state;
 
 // --- scene -------------------------------------------------------------
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-renderer.setPixelRatio(window.devicePixelRatio || 1);
-renderer.setSize(window.innerWidth, window.innerHeight);
-renderer.setClearColor(BACKGROUND, 1);
-$('view').appendChild(renderer.domElement);
+// Multisampling costs software WebGL (headless Chromium) several times the
+// fill: a model of more than LARGE components is drawn without it, so that
+// its first frame stays fast. The canvas is replaced when that changes.
+let renderer = null;
+function useRenderer(antialias) {
+  if (renderer && renderer.antialias === antialias) return;
+  if (renderer) {
+    renderer.dispose();
+    renderer.domElement.remove();
+  }
+  renderer = new THREE.WebGLRenderer({ antialias, preserveDrawingBuffer: true });
+  renderer.antialias = antialias;
+  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  renderer.setSize(window.innerWidth, window.innerHeight);
+  renderer.setClearColor(BACKGROUND, 1);
+  $('view').appendChild(renderer.domElement);
+}
 const scene = new THREE.Scene();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404040, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.2);
@@ -32,16 +45,16 @@ const world = new THREE.Group();
 world.rotation.x = Math.PI;
 scene.add(world);
 const camera = new THREE.PerspectiveCamera(50, window.innerWidth / window.innerHeight, 0.01, 1000);
-const controls = new OrbitControls(camera, renderer.domElement);
+const controls = new OrbitControls(camera, $('view'));
 let frameRequested = false;
 function draw() {
   if (frameRequested) return;
   frameRequested = true;
-  requestAnimationFrame(() => { frameRequested = false; renderer.render(scene, camera); });
+  requestAnimationFrame(() => { frameRequested = false; if (renderer) renderer.render(scene, camera); });
 }
 controls.addEventListener('change', draw);
 window.addEventListener('resize', () => {
-  renderer.setSize(window.innerWidth, window.innerHeight);
+  if (renderer) renderer.setSize(window.innerWidth, window.innerHeight);
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
   draw();
@@ -204,6 +217,7 @@ function showComponent(model, k) {
 
 function showError(e) {
   clearScene();
+  useRenderer(renderer ? renderer.antialias : true);
   const what = e instanceof SogmmError ? `Cannot read this file: ${e.reason} (${e.category})\n${e.message}` : `Viewer error: ${e && e.message}`;
   $('error').textContent = what;
   $('error').style.display = 'block';
@@ -263,8 +277,10 @@ function load(bytes, name) {
   const t1 = performance.now();
   clearScene();
   const M = Number(model.n_components);
-  const detail = M > 20000 ? 0 : 1; // 20 or 80 triangles an ellipsoid
-  const mesh = new THREE.InstancedMesh(new THREE.IcosahedronGeometry(1, detail), new THREE.MeshLambertMaterial(), M);
+  // 80 triangles an ellipsoid; a large map (software rendering must draw it
+  // within a second) gets octahedra, 8 triangles, still shaded ellipsoids.
+  const shape = M > LARGE ? new THREE.OctahedronGeometry(1, 0) : new THREE.IcosahedronGeometry(1, 1);
+  const mesh = new THREE.InstancedMesh(shape, new THREE.MeshLambertMaterial({ flatShading: M > LARGE }), M);
   placeInstances(mesh, model, Number(document.querySelector('input[name=sigma]:checked').value));
   colourInstances(mesh, model, document.querySelector('input[name=colour]:checked').value);
   world.add(mesh);
@@ -290,11 +306,13 @@ function load(bytes, name) {
     $('frames').style.display = 'none';
   }
   frameCamera(model, frames.length > 0);
+  useRenderer(M <= LARGE);
+  const tScene = performance.now();
   renderer.render(scene, camera);
   // Reading one pixel waits for the GPU: the first frame is really drawn.
   renderer.getContext().readPixels(0, 0, 1, 1, 0x1908, 0x1401, new Uint8Array(4));
   const t2 = performance.now();
-  state.timings = { parseMs: t1 - t0, firstFrameMs: t2 - t1, totalMs: t2 - t0 };
+  state.timings = { parseMs: t1 - t0, sceneMs: tScene - t1, renderMs: t2 - tScene, firstFrameMs: t2 - t1, totalMs: t2 - t0 };
   state.status = 'ready';
 }
 
@@ -322,10 +340,10 @@ $('frame').addEventListener('input', (e) => setFrame(Number(e.target.value)));
 
 const raycaster = new THREE.Raycaster();
 let downAt = null;
-renderer.domElement.addEventListener('pointerdown', (e) => { downAt = [e.clientX, e.clientY]; });
-renderer.domElement.addEventListener('pointerup', (e) => {
+$('view').addEventListener('pointerdown', (e) => { downAt = [e.clientX, e.clientY]; });
+$('view').addEventListener('pointerup', (e) => {
   if (!current || !downAt || Math.hypot(e.clientX - downAt[0], e.clientY - downAt[1]) > 4) return;
-  const r = renderer.domElement.getBoundingClientRect();
+  const r = $('view').getBoundingClientRect();
   raycaster.setFromCamera(new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1), camera);
   const hit = raycaster.intersectObject(current.mesh, false).find((h) => h.instanceId < current.mesh.count);
   if (hit) showComponent(current.model, hit.instanceId);
@@ -353,6 +371,7 @@ if (/^[A-Za-z0-9+/=]+$/.test(text) && text.length > 0) {
   for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
   load(bytes, embedded.dataset.name || 'model.sogmm');
 } else {
+  useRenderer(true);
   state.status = 'empty';
   $('status').textContent = 'drop a .sogmm file here';
   draw();
