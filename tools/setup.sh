@@ -28,7 +28,7 @@ DEBIAN_PACKAGES=(
 )
 # node >= 20 and npm for bindings/js (the JavaScript reader, the viewer); a
 # machine's own newer node is kept.
-command -v node >/dev/null || DEBIAN_PACKAGES+=(nodejs npm)
+{ command -v node && command -v npm; } >/dev/null || DEBIAN_PACKAGES+=(nodejs npm)
 need_install=()
 for p in "${DEBIAN_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need_install+=("$p")

@@ -106,21 +106,41 @@ function frames(st) {
   return out;
 }
 
+// The frame as fzstd decodes it, with a window of max(128 KiB, the content
+// size rounded up to a power of two). A larger declared window is lowered:
+// the content size bounds the history a frame can refer to, and a hostile
+// descriptor must not make the decoder allocate up to 2 GiB for a few bytes.
+// A single-segment frame (window = content size) gets a window descriptor
+// too: fzstd drops a block's output beyond its window without an error, and
+// with a full 128 KiB block buffer that excess reaches the content-size
+// check instead (libzstd rejects such a frame).
+function withWindow(frame, f) {
+  let log = 17;
+  while (2 ** log < f.contentSize) log++;
+  const descriptor = (log - 10) << 3;
+  if (f.windowAt >= 0) {
+    if (2 ** log >= f.window) return frame;
+    const copy = frame.slice();
+    copy[f.windowAt - f.start] = descriptor;
+    return copy;
+  }
+  const fhd = frame[4];
+  const dictBytes = [0, 1, 2, 4][fhd & 3];
+  const wide = f.contentSize >= 2 ** 32;
+  const head = [0x28, 0xb5, 0x2f, 0xfd, (fhd & 0x17) | ((wide ? 3 : 2) << 6), descriptor];
+  for (let i = 0; i < dictBytes; i++) head.push(frame[5 + i]);
+  let size = f.contentSize;
+  for (let i = 0; i < (wide ? 8 : 4); i++) { head.push(size % 256); size = Math.floor(size / 256); }
+  const out = new Uint8Array(head.length + frame.length - f.header);
+  out.set(head);
+  out.set(frame.subarray(f.header), head.length);
+  return out;
+}
+
 // One frame's content, exactly contentSize bytes, or a rejection.
 function decodeFrame(st, f) {
   if (f.window > MAX_WINDOW) failed('window larger than 2^31 bytes');
-  let bytes = st.subarray(f.start, f.end);
-  if (f.windowAt >= 0) {
-    // The content size bounds the history a frame can refer to: lower a
-    // larger declared window so that a hostile descriptor cannot make the
-    // decoder allocate up to 2 GiB for a few bytes of content.
-    let log = 17;
-    while (2 ** log < f.contentSize) log++;
-    if (2 ** log < f.window) {
-      bytes = bytes.slice();
-      bytes[f.windowAt - f.start] = (log - 10) << 3;
-    }
-  }
+  const bytes = withWindow(st.subarray(f.start, f.end), f);
   const out = new Uint8Array(f.contentSize);
   let n = 0;
   const d = new Decompress((chunk) => {
