@@ -24,7 +24,11 @@ DEBIAN_PACKAGES=(
   clang libclang-rt-14-dev libomp-14-dev          # fuzzing and sanitizers (clang's OpenMP)
   abigail-tools                                   # abidw/abidiff: ABI baseline check (tools/abi, ctest abi_*)
   python3 python3-pip python3-venv
+  chromium                                        # headless browser of the viewer test (ctest viewer.browser)
 )
+# node >= 20 and npm for bindings/js (the JavaScript reader, the viewer); a
+# machine's own newer node is kept.
+{ command -v node && command -v npm; } >/dev/null || DEBIAN_PACKAGES+=(nodejs npm)
 need_install=()
 for p in "${DEBIAN_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need_install+=("$p")
@@ -48,6 +52,11 @@ for tool in cargo go; do
   PATH="$PATH:$HOME/.cargo/bin:/usr/local/go/bin" command -v "$tool" >/dev/null ||
     echo "setup: $tool not found: the ctest $tool-based binding tests will be skipped" >&2
 done
+
+# The pinned npm packages of bindings/js (package-lock.json): fzstd, three,
+# esbuild, playwright-core. Nothing downloads a browser: the test uses
+# Debian's /usr/bin/chromium.
+(cd bindings/js && npm ci --no-audit --no-fund --loglevel=error)
 
 if [ "${1:-}" = "--no-build" ]; then exit 0; fi
 BUILD_DIR=${SOGMM_BUILD_DIR:-build}

@@ -1,11 +1,13 @@
 """Mutation test: seeded, deterministic mutations of the valid conformance
 vectors, each judged by the C++ reader (sogmm_conformance_batch) and by the
-independent Python reader (python_reader/sogmm_reader.py, in process).
+independent Python reader (python_reader/sogmm_reader.py, in process) and,
+with --js-batch, by the JavaScript reader (bindings/js/bin/batch.js, run by node).
 
-Both must give the same verdict, the same (category, reason) on a rejection
+All must give the same verdict, the same (category, reason) on a rejection
 and equal canonical dumps on an acceptance. Exit 0 when they never disagree.
 
     python3 mutation_test.py --batch BIN --vectors spec/conformance [--count 3000] [--seed 1]
+                             [--node NODE --js-batch bindings/js/bin/batch.js]
 
 Mutations (spec/format.md names): bytes of the metadata block set to random
 or boundary values (u8, u16, u32 at aligned and unaligned positions, doubles
@@ -169,6 +171,8 @@ def main():
     ap.add_argument("--count", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--show", type=int, default=20, help="disagreements to print")
+    ap.add_argument("--js-batch", help="bindings/js/bin/batch.js: also judge every mutant with the JavaScript reader")
+    ap.add_argument("--node", default="node", help="node executable for --js-batch")
     ap.add_argument("--keep", help="write the mutants to this folder (default: a temporary one)")
     a = ap.parse_args()
     vectors = pathlib.Path(a.vectors)
@@ -195,17 +199,28 @@ def main():
         if len(lines) != len(mutants):
             print(f"batch reader printed {len(lines)} lines for {len(mutants)} files")
             return 1
+        js_lines = None
+        if a.js_batch:
+            js = subprocess.run([a.node, a.js_batch, str(pathlib.Path(tmp) / "list")], check=True,
+                                capture_output=True, text=True)
+            js_lines = js.stdout.splitlines()
+            if len(js_lines) != len(mutants):
+                print(f"JavaScript batch reader printed {len(js_lines)} lines for {len(mutants)} files")
+                return 1
         verdicts = collections.Counter()
         disagreements = []
-        for (path, base, kinds, data), line in zip(mutants, lines):
+        for i, ((path, base, kinds, data), line) in enumerate(zip(mutants, lines)):
             c = cpp_verdict(line)
-            p = python_verdict(data)
             verdicts[c[1] if c[0] == "reject" else c[0]] += 1
-            if c != p:
-                what = "verdict" if c[0] != p[0] else "reason" if c[0] == "reject" else "dump"
-                shown = [x if v == "reject" or v == "error" else "(dump)" for v, x in (c, p)]
-                disagreements.append(f"{path.name} ({base}, {kinds}): {what}: C++ {c[0]} {shown[0]} / "
-                                     f"Python {p[0]} {shown[1]}")
+            others = [("Python", python_verdict(data))]
+            if js_lines is not None:
+                others.append(("JS", cpp_verdict(js_lines[i])))
+            for reader, p in others:
+                if c != p:
+                    what = "verdict" if c[0] != p[0] else "reason" if c[0] == "reject" else "dump"
+                    shown = [x if v == "reject" or v == "error" else "(dump)" for v, x in (c, p)]
+                    disagreements.append(f"{path.name} ({base}, {kinds}): {what}: C++ {c[0]} {shown[0]} / "
+                                         f"{reader} {p[0]} {shown[1]}")
     print(f"{a.count} mutants (seed {a.seed}): " + ", ".join(f"{k} {n}" for k, n in verdicts.most_common()))
     for d in disagreements[:a.show]:
         print("DISAGREE " + d)

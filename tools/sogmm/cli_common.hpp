@@ -94,6 +94,7 @@ Command add_fit_command(CLI::App& root);
 Command add_map_command(CLI::App& root);
 Command add_render_command(CLI::App& root);
 Command add_sample_command(CLI::App& root);
+Command add_view_command(CLI::App& root);
 
 /// True when any of the named options was given on the command line.
 bool any_given(const CLI::App& app, std::initializer_list<const char*> names);

@@ -1,0 +1,11 @@
+# Rebuilds the viewer page and compares it with the committed one.
+execute_process(COMMAND ${NODE} ${JS}/viewer/build.mjs ${OUT} RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "viewer build failed")
+endif()
+file(SHA256 ${OUT} rebuilt)
+file(SHA256 ${COMMITTED} committed)
+if(NOT rebuilt STREQUAL committed)
+  message(FATAL_ERROR "${COMMITTED} is stale: run `npm run build-viewer` in bindings/js and commit it")
+endif()
+message(STATUS "viewer page matches its sources")
