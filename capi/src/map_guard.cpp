@@ -17,19 +17,22 @@ namespace {
                          "a map is changed by one call at a time");
 }
 
+// Marks the map held by one changing call if no call uses it.
+bool take_alone(sogmm_map* map) noexcept {
+  std::int64_t idle = 0;
+  return map->users.compare_exchange_strong(idle, -1, std::memory_order_acquire, std::memory_order_relaxed);
+}
+
 }  // namespace
 
 MapWriter::MapWriter(sogmm_map* map, const char* call) : map_(map) {
-  std::int64_t idle = 0;
-  if (!map_->users.compare_exchange_strong(idle, -1, std::memory_order_acquire, std::memory_order_relaxed))
-    busy(call, "another call is using the map");
+  if (!take_alone(map_)) busy(call, "another call is using the map");
 }
 
 MapWriter::~MapWriter() { map_->users.store(0, std::memory_order_release); }
 
 bool take_for_free(sogmm_map* map) noexcept {
-  std::int64_t idle = 0;
-  if (map->users.compare_exchange_strong(idle, -1, std::memory_order_acquire, std::memory_order_relaxed)) return true;
+  if (take_alone(map)) return true;
   set_error(SOGMM_E_BUSY,
             "map busy: sogmm_map_free did not free the map, which another call is using (on another thread, or "
             "the call whose progress callback is running); free it once no call uses it");
