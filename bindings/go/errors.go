@@ -28,6 +28,7 @@ const (
 	ErrNotFound       Status = C.SOGMM_E_NOT_FOUND
 	ErrInternal       Status = C.SOGMM_E_INTERNAL
 	ErrCancelled      Status = C.SOGMM_E_CANCELLED // a progress func or the context stopped the call
+	ErrBusy           Status = C.SOGMM_E_BUSY      // map busy: another call is using the Map (see Map)
 )
 
 // ErrClosed is returned by methods of a handle after Close.

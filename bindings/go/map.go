@@ -35,11 +35,15 @@ const (
 // Map is an owned sogmm_map: an incremental world map that fits only the
 // parts of each posed frame it does not yet explain (core/include/sogmm/map.hpp).
 // Poses are row-major 4 x 4 camera-to-world rigid transforms. Inserts,
-// flushes and Close need exclusive use; the queries (Stats, Export,
-// ScoreSamples, RegressGray, Sample, Save) only read the map and may run
-// concurrently with each other.
+// flushes and Close need exclusive use; the queries (Stats, FrameStats,
+// Export, ScoreSamples, RegressGray, Sample, Save) only read the map and may
+// run concurrently with each other. A call that breaks this rule, from
+// another goroutine or from the progress func of a call on the same map,
+// returns an error with ErrBusy ("map busy: ...") and changes nothing; Close
+// then leaves the map open (close it after that call returns).
 type Map struct {
-	ptr *C.sogmm_map
+	ptr   *C.sogmm_map
+	guard mapGuard
 }
 
 // MapStats are the totals of a map.
@@ -85,9 +89,15 @@ func LoadMap(path string, o *Options) (*Map, error) {
 	return wrapMap(o, func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status { return C.sogmm_map_load(out, cp, op) })
 }
 
-// Close frees the map; idempotent.
+// Close frees the map; idempotent. While another call uses the map (on
+// another goroutine, or from that call's progress func) it does nothing: the
+// map stays open and usable (ErrBusy rule of Map).
 func (m *Map) Close() {
-	if m == nil || m.ptr == nil {
+	if m == nil || m.guard.take(true, "Close") != nil {
+		return
+	}
+	defer m.guard.release(true)
+	if m.ptr == nil {
 		return
 	}
 	runtime.SetFinalizer(m, nil)
@@ -117,6 +127,10 @@ func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.s
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the
 // frame's camera-to-world pose.
 func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
+	return m.insertPoints(points, pose, nil)
+}
+
+func (m *Map) insertPoints(points []float32, pose [16]float64, progress *mapProgress) error {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return err
@@ -124,7 +138,7 @@ func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
 	if n == 0 { // C sees a nil slice as a NULL pointer; the problem is the empty frame
 		return &Error{Status: ErrInvalidData, Message: "points: an empty frame (no point)"}
 	}
-	return m.do(func(p *C.sogmm_map) C.sogmm_status {
+	return m.change("InsertPoints", progress, func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_points_f32(p, floats(points), C.size_t(n), (*C.double)(&pose[0]))
 	})
 }
@@ -132,11 +146,15 @@ func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
 // InsertRGBD inserts an RGB-D frame (decimation and depth range from the
 // options the map was created with) with its camera-to-world pose.
 func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
+	return m.insertRGBD(f, pose, nil)
+}
+
+func (m *Map) insertRGBD(f Frame, pose [16]float64, progress *mapProgress) error {
 	color, format, err := f.colorArgs()
 	if err != nil {
 		return err
 	}
-	return m.do(func(p *C.sogmm_map) C.sogmm_status {
+	return m.change("InsertRGBD", progress, func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_rgbd(p, (*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format,
 			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy),
 			(*C.double)(&pose[0]))
@@ -144,14 +162,18 @@ func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
 }
 
 // Flush fits the pending novel points now.
-func (m *Map) Flush() error {
-	return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
+func (m *Map) Flush() error { return m.flush(nil) }
+
+func (m *Map) flush(progress *mapProgress) error {
+	return m.change("Flush", progress, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
 }
 
 // Stats returns the map's totals.
 func (m *Map) Stats() (MapStats, error) {
 	var s C.sogmm_map_stats
-	err := m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_stats(p, &s) })
+	err := m.read("Stats", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_stats(p, &s) })
+	})
 	return MapStats{uint64(s.n_components), uint64(s.n_pending), uint64(s.n_frames), uint64(s.n_flushes),
 		uint64(s.n_fused)}, err
 }
@@ -160,11 +182,13 @@ func (m *Map) Stats() (MapStats, error) {
 func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
 	var s C.sogmm_map_frame_stats
 	var replaced C.uint64_t
-	err := m.do(func(p *C.sogmm_map) C.sogmm_status {
-		if st := C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s); st != C.SOGMM_OK {
-			return st
-		}
-		return C.sogmm_map_get_frame_replaced(p, C.uint64_t(i), &replaced)
+	err := m.read("FrameStats", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status {
+			if st := C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s); st != C.SOGMM_OK {
+				return st
+			}
+			return C.sogmm_map_get_frame_replaced(p, C.uint64_t(i), &replaced)
+		})
 	})
 	out := MapFrameStats{Points: uint64(s.n_points), Novel: uint64(s.n_novel), Components: uint64(s.n_components),
 		Flushed: s.flushed != 0, MsNovelty: float64(s.ms_novelty), MsFit: float64(s.ms_fit),
@@ -178,17 +202,23 @@ func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
 // Export returns the map (box nil) or the components whose 3-sigma box meets
 // box (x_min, y_min, z_min, x_max, y_max, z_max) as a world-frame Model.
 func (m *Map) Export(box *[6]float32) (*Model, error) {
-	if m == nil || m.ptr == nil {
-		return nil, ErrClosed
-	}
-	defer runtime.KeepAlive(m)
-	var b *C.float
-	if box != nil {
-		b = (*C.float)(&box[0])
-	}
-	return newModel(nil, func(out **C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_map_export(out, m.ptr, b)
+	var model *Model
+	err := m.read("Export", func() error {
+		if m.ptr == nil {
+			return ErrClosed
+		}
+		defer runtime.KeepAlive(m)
+		var b *C.float
+		if box != nil {
+			b = (*C.float)(&box[0])
+		}
+		var err error
+		model, err = newModel(nil, func(out **C.sogmm_model, _ *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_map_export(out, m.ptr, b)
+		})
+		return err
 	})
+	return model, err
 }
 
 // Save writes the map as a world-frame .sogmm file with frame provenance
@@ -201,5 +231,7 @@ func (m *Map) Save(path string, o *Options) error {
 		return err
 	}
 	defer runtime.KeepAlive(o)
-	return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_save(p, cp, op) })
+	return m.read("Save", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_save(p, cp, op) })
+	})
 }

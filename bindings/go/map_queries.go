@@ -35,8 +35,10 @@ func (m *Map) scoreSamples(points []float32, dims int, o *Options) ([]float64, e
 	if err != nil {
 		return nil, err
 	}
-	err = m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_map_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
+	err = m.read("ScoreSamples", func() error {
+		return m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_map_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
+		})
 	})
 	if err != nil {
 		return nil, err
@@ -72,8 +74,10 @@ func (m *Map) regressGray(xyz []float32, o *Options) (mean, variance []float32, 
 		return nil, nil, err
 	}
 	mean, variance = make([]float32, n), make([]float32, n)
-	err = m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_map_regress_gray_f32(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
+	err = m.read("RegressGray", func() error {
+		return m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_map_regress_gray_f32(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
+		})
 	})
 	if err != nil {
 		return nil, nil, err
@@ -88,8 +92,10 @@ func (m *Map) Sample(n int, seed uint64, dims int, o *Options) ([]float32, error
 	if err != nil {
 		return nil, err
 	}
-	err = m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_map_sample_f32(p, C.size_t(n), C.uint64_t(seed), C.int32_t(dims), op, floats(out))
+	err = m.read("Sample", func() error {
+		return m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_map_sample_f32(p, C.size_t(n), C.uint64_t(seed), C.int32_t(dims), op, floats(out))
+		})
 	})
 	if err != nil {
 		return nil, err
@@ -106,16 +112,16 @@ func (m *Map) SampleContext(ctx context.Context, n int, seed uint64, dims int, o
 // fit the insert may run (as FitContext). A cancelled insert leaves the map
 // as it was.
 func (m *Map) InsertPointsContext(ctx context.Context, points []float32, pose [16]float64, fn ProgressFunc) error {
-	return withMapProgress(ctx, m, fn, func() error { return m.InsertPoints(points, pose) })
+	return m.insertPoints(points, pose, &mapProgress{ctx, fn})
 }
 
 // InsertRGBDContext is InsertRGBD with cancellation and progress as InsertPointsContext.
 func (m *Map) InsertRGBDContext(ctx context.Context, f Frame, pose [16]float64, fn ProgressFunc) error {
-	return withMapProgress(ctx, m, fn, func() error { return m.InsertRGBD(f, pose) })
+	return m.insertRGBD(f, pose, &mapProgress{ctx, fn})
 }
 
 // FlushContext is Flush with cancellation and progress; a cancelled flush
 // keeps the pending points.
 func (m *Map) FlushContext(ctx context.Context, fn ProgressFunc) error {
-	return withMapProgress(ctx, m, fn, m.Flush)
+	return m.flush(&mapProgress{ctx, fn})
 }

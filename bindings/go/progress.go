@@ -122,12 +122,12 @@ func (s *progressState) finish(err error) error {
 	return err
 }
 
-// withMapProgress runs run with the progress callback of m set to report to
+// withMapProgress runs f on m's handle with the progress callback of m set to report to
 // fn and watch ctx (sogmm_map_set_progress) and removed again afterwards;
 // errors and panics as withProgress. The caller must have exclusive use of
 // m, as for any insert.
-func withMapProgress(ctx context.Context, m *Map, fn ProgressFunc, run func() error) error {
-	state := &progressState{ctx: ctx, fn: fn}
+func withMapProgress(mp *mapProgress, m *Map, f func(p *C.sogmm_map) C.sogmm_status) error {
+	state := &progressState{ctx: mp.ctx, fn: mp.fn}
 	h := cgo.NewHandle(state)
 	defer h.Delete()
 	if err := m.do(func(p *C.sogmm_map) C.sogmm_status {
@@ -135,9 +135,16 @@ func withMapProgress(ctx context.Context, m *Map, fn ProgressFunc, run func() er
 	}); err != nil {
 		return err
 	}
-	// Removed (before the handle is deleted) on every path; cannot fail on an open map.
+	// Removed (before the handle is deleted) on every path; cannot fail on an
+	// open map that this call holds alone (Map.change).
 	defer m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
-	return state.finish(run())
+	return state.finish(m.do(f))
+}
+
+// mapProgress is the context and progress func of a map insert or flush.
+type mapProgress struct {
+	ctx context.Context
+	fn  ProgressFunc
 }
 
 // FitContext is Fit with cancellation: it stops within about 50 ms once ctx

@@ -96,6 +96,7 @@ SOGMM_API const char* sogmm_status_string(sogmm_status status) {
     case SOGMM_E_NOT_FOUND: return "not found";
     case SOGMM_E_INTERNAL: return "internal error";
     case SOGMM_E_CANCELLED: return "cancelled by the progress callback";
+    case SOGMM_E_BUSY: return "map busy: another call is using it";
     default: return "unknown status";
   }
 }

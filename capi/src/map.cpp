@@ -50,12 +50,15 @@ SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* op
   SOGMM_CATCH
 }
 
-SOGMM_API void sogmm_map_free(sogmm_map* map) { delete map; }
+SOGMM_API void sogmm_map_free(sogmm_map* map) {
+  if (map != nullptr && sogmm_capi::take_for_free(map)) delete map;
+}
 
 SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
                                                    const double* pose) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_points_f32");
     require_nonnull(points, "points");
     require_nonnull(pose, "pose");
     const sogmm::Pose p = pose_of(pose);
@@ -74,6 +77,7 @@ SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* dep
                                              double fy, double cx, double cy, const double* pose) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_rgbd");
     require_nonnull(pose, "pose");
     const sogmm::Pose p = pose_of(pose);
     const sogmm_capi::RgbdPoints r =
@@ -86,6 +90,7 @@ SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* dep
 SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_flush");
     map->map.flush(sogmm_capi::progress_sink(map->options));
   }
   SOGMM_CATCH
@@ -94,6 +99,7 @@ SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map) {
 SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_set_progress");
     map->options.progress = fn;
     map->options.progress_user_data = user_data;
   }
@@ -103,6 +109,7 @@ SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn 
 SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_stats");
     require_nonnull(out, "out");
     const sogmm::MapStats s = map->map.stats();
     out->n_components = s.n_components;
@@ -127,6 +134,7 @@ const sogmm::FrameStats& frame_of(const sogmm_map* map, uint64_t frame) {
 SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_frame_replaced");
     require_nonnull(out, "out");
     *out = frame_of(map, frame).n_replaced;
   }
@@ -136,6 +144,7 @@ SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64
 SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame, sogmm_map_frame_stats* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_frame_stats");
     require_nonnull(out, "out");
     const sogmm::FrameStats& f = frame_of(map, frame);
     out->n_points = f.n_points;
@@ -155,6 +164,7 @@ SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map,
     sogmm_capi::reset_out(out);
     require_nonnull(out, "out");
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_export");
     auto handle = std::make_unique<sogmm_model>();
     if (box == nullptr) {
       handle->model = map->map.model();
@@ -177,6 +187,7 @@ SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map,
 SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, const sogmm_options* options) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_save");
     require_nonnull(path, "path");
     // The model save path (atomic, same checks and errors) on the map's model.
     sogmm_model file;

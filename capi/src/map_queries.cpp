@@ -28,6 +28,7 @@ SOGMM_API sogmm_status sogmm_map_score_samples_f32(const sogmm_map* map, const f
                                                    int32_t dims, const sogmm_options* options, double* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_score_samples_f32");
     require_dims(dims);
     require_map_with_components(map);
     sogmm_capi::run_score_query(points, n, dims, options, out, [&](double* dst, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
@@ -41,6 +42,8 @@ SOGMM_API sogmm_status sogmm_map_regress_gray_f32(const sogmm_map* map, const fl
                                                   const sogmm_options* options, float* mean_out,
                                                   float* variance_out) {
   SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_regress_gray_f32");
     require_map_with_components(map);
     sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
                                   [&](float* mean, float* variance, const sogmm::QueryOptions& query, const sogmm::ProgressSink& sink) {
@@ -54,6 +57,7 @@ SOGMM_API sogmm_status sogmm_map_sample_f32(const sogmm_map* map, size_t n, uint
                                             const sogmm_options* options, float* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_sample_f32");
     require_dims(dims);
     require_map_with_components(map);
     if (n == 0) return SOGMM_OK;

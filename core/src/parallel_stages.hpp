@@ -24,6 +24,7 @@
 #include <omp.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -34,6 +35,45 @@
 #include "parallel.hpp"
 
 namespace sogmm::detail {
+
+/// The waits of parallel_stages: spin, then yield, then sleep on a condition
+/// variable. wake() after every change a waiter may wait for; it costs a
+/// fence and a load unless a thread sleeps.
+class StageWaiter {
+ public:
+  template <class Ready>
+  void wait(const Ready& ready) {
+    // About a stage's length of spinning and yielding first: most waits end
+    // there, and a sleep would add a wake-up's latency to every stage.
+    for (int spins = 0; spins < kSpins + kYields; ++spins) {
+      if (ready()) return;
+      if (spins > kSpins) std::this_thread::yield();
+    }
+    sleepers_.fetch_add(1, std::memory_order_seq_cst);
+    std::atomic_thread_fence(std::memory_order_seq_cst);  // pairs with wake()'s fence
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wakeup_.wait(lock, ready);
+    }
+    sleepers_.fetch_sub(1, std::memory_order_relaxed);
+  }
+  /// Call after the store a waiter waits for: either the waiter's check
+  /// after its increment sees the store, or this sees the increment and
+  /// wakes it (the mutex closes the gap between its check and its sleep).
+  void wake() {
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    if (sleepers_.load(std::memory_order_seq_cst) == 0) return;
+    { const std::lock_guard<std::mutex> lock(mutex_); }
+    wakeup_.notify_all();
+  }
+
+ private:
+  static constexpr int kSpins = 2000;
+  static constexpr int kYields = 200;
+  std::atomic<int> sleepers_{0};
+  std::mutex mutex_;
+  std::condition_variable wakeup_;
+};
 
 /// For s = 0 .. stages - 1: calls item(s, i, thread) for every i in
 /// [0, items(s)) on a team of `threads` threads, then between(s) on the
@@ -65,15 +105,18 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
   std::atomic<bool> failed{false};
   std::exception_ptr first_error;
   std::mutex error_mutex;
+  StageWaiter waiter;
   const auto fail = [&] {
     const std::lock_guard<std::mutex> lock(error_mutex);
     if (!first_error) first_error = std::current_exception();
     failed.store(true, std::memory_order_release);
+    waiter.wake();
   };
-  // Spins briefly, then yields the processor (a loaded machine needs it more).
+  // Spins briefly, then yields the processor (a loaded machine needs it
+  // more), then sleeps until woken: a wait longer than a stage (thread 0
+  // calling a slow progress sink) costs no processor time.
   const auto wait_until = [&](const auto& ready) {
-    for (int spins = 0; !ready() && !failed.load(std::memory_order_acquire); ++spins)
-      if (spins > 2000) std::this_thread::yield();
+    waiter.wait([&] { return ready() || failed.load(std::memory_order_acquire); });
   };
   // Thread 0 opens stage s by storing claim, then count, then open (each
   // release); a member reads count before claim, so a count of a later
@@ -96,6 +139,7 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
       }
       if (team.on()) team.item(thread, t0, wall_ns());
       done.fetch_add(1, std::memory_order_acq_rel);
+      if (thread != 0) waiter.wake();  // thread 0 may be waiting for the stage's last item
       c = claim.load(std::memory_order_acquire);
     }
   };
@@ -113,6 +157,7 @@ void parallel_stages(std::size_t stages, int threads, const Items& items, const 
           claim.store(s << 32, std::memory_order_release);
           count.store(n, std::memory_order_release);
           open.store(static_cast<std::int64_t>(s), std::memory_order_release);
+          waiter.wake();
           {
             const LoopTimer timer;
             run_items(s, 0);

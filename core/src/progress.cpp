@@ -40,12 +40,32 @@ const char* stage_name(Stage stage) {
   throw Error(ErrorCode::Cancelled, "cancelled by the progress callback during " + where);
 }
 
+// While the sink runs, the calling thread has no sink: a SOGMM call made
+// inside it starts without one, instead of reporting to the sink that is
+// running (which could call it again, without bound).
+class SinkRunning {
+ public:
+  SinkRunning() : saved_(t_state) { t_state = nullptr; }
+  ~SinkRunning() { t_state = saved_; }
+  SinkRunning(const SinkRunning&) = delete;
+  SinkRunning& operator=(const SinkRunning&) = delete;
+
+ private:
+  ProgressScope::State* saved_;
+};
+
 // Calls the sink with the current report; a true return cancels for good
-// (every later report point throws too).
+// (every later report point throws too). The interval to the next heartbeat
+// is timed from the sink's return, so a slow sink adds its own time once per
+// report, and the work between two heartbeats is kProgressIntervalMs
+// whatever the sink costs.
 void report(ProgressScope::State& s) {
   if (!s.cancelled) {
+    {
+      const SinkRunning running;
+      s.cancelled = s.sink(s.current);
+    }
     s.last_report = std::chrono::steady_clock::now();
-    s.cancelled = s.sink(s.current);
   }
   if (s.cancelled) throw_cancelled(s.current);
 }

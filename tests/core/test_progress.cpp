@@ -3,6 +3,7 @@
 // with Error(Cancelled) in the stage where it was given; scopes nest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "sogmm/error.hpp"
@@ -124,4 +125,25 @@ TEST(Progress, ScopesNestAndAnEmptySinkInstallsNothing) {
   EXPECT_EQ(outer, 0);
   sogmm::fit(v, options(1), {});  // an empty sink: the outer scope still reports
   EXPECT_GT(outer, 0);
+}
+
+// Inside a sink, the thread has no sink: a fit the sink runs reports neither
+// to it (which recursed without bound when the nested fit ran again from the
+// report) nor anywhere, and the outer reports go on after it (issue 36).
+TEST(Progress, CallsMadeInsideASinkRunWithoutOne) {
+  const std::vector<float> pts = cloud();
+  const sogmm::PointsView v{pts.data(), pts.size() / 4};
+  int depth = 0, max_depth = 0, calls = 0;
+  std::size_t nested_k = 0;
+  const sogmm::ProgressSink sink = [&](const sogmm::Progress&) {
+    ++calls;
+    max_depth = std::max(max_depth, ++depth);
+    if (depth < 3) nested_k = sogmm::fit(v, options(1)).gmm.size();  // no sink of its own
+    --depth;
+    return false;
+  };
+  sogmm::fit(v, options(1), sink);
+  EXPECT_GT(calls, 1);
+  EXPECT_EQ(max_depth, 1);
+  EXPECT_GT(nested_k, 0u);
 }

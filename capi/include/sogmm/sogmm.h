@@ -33,7 +33,11 @@
  * - Thread safety: distinct handles may be used from different threads at
  *   the same time. Functions taking a const handle only read it and may run
  *   concurrently on the same handle; a function taking a non-const handle
- *   needs exclusive use of that handle. sogmm_last_error is per thread.
+ *   needs exclusive use of that handle. A map (sogmm_map) checks this
+ *   itself: a call that would break the rule, from another thread or from
+ *   the progress callback of a call on that map, returns SOGMM_E_BUSY
+ *   ("map busy: ...") at once instead of racing or waiting. Other handles do
+ *   not check. sogmm_last_error is per thread.
  */
 #ifndef SOGMM_SOGMM_H
 #define SOGMM_SOGMM_H
@@ -111,6 +115,8 @@ typedef int32_t sogmm_status;
 #define SOGMM_E_NOT_FOUND (-10)       /* the requested value is not present (unknown metadata) */
 #define SOGMM_E_INTERNAL (-11)        /* unexpected internal error (a bug: please report) */
 #define SOGMM_E_CANCELLED (-12)       /* the progress callback returned non-zero (sogmm_progress_fn) */
+#define SOGMM_E_BUSY (-13)            /* map busy: another call is using the map (another thread's, or the
+                                       * call whose progress callback made this one; sogmm_map_*) */
 
 /* Static, never-NULL description of a status, e.g. "invalid argument".
  * Unknown codes give "unknown status". */
@@ -273,10 +279,14 @@ SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm
  * of each stage, after each EM iteration, and during long loops at most about
  * 20 ms apart (plus one work chunk, a few milliseconds), so that a cancel
  * takes effect within about 50 ms. Within a stage, `step` never decreases.
- * Rules: return quickly; do not call sogmm_* functions from the callback
- * (they would overwrite the thread's last error); never throw, longjmp or
- * unwind out of it. Results never depend on the callback (only whether the
- * call finishes). */
+ * The interval is timed from the callback's return: a slow callback slows
+ * the call by its own time only, and the call's worker threads sleep while
+ * they wait for it. Rules: return quickly; never throw, longjmp or unwind out
+ * of it. A sogmm_* function called from the callback runs without a
+ * callback (a nested fit reports to nothing, whatever its options say) and
+ * overwrites the thread's last error; a call on the map whose call is
+ * running the callback returns SOGMM_E_BUSY (sogmm_map_free refuses it).
+ * Results never depend on the callback (only whether the call finishes). */
 typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t total, double log_likelihood,
                                      void* user_data);
 
@@ -594,12 +604,26 @@ SOGMM_API sogmm_status sogmm_model_load_from_memory(sogmm_model** out, const voi
  * SOGMM_OPT_MAP_NOVELTY_THRESHOLD are pending, and once
  * SOGMM_OPT_MAP_BATCH_SIZE points are pending they are fitted and merged in
  * the world frame (optionally fused). With novelty and fusion off the map is
- * exactly the merge of every frame's own fit moved by its pose. */
+ * exactly the merge of every frame's own fit moved by its pose.
+ *
+ * Use guard: the calls taking a non-const map (inserts, flush,
+ * set_progress) need it alone; the calls taking a const map (statistics,
+ * export, save, queries) share it. A call that finds the map otherwise
+ * taken, by another thread or because it is made from the progress callback
+ * of a call on the same map, returns SOGMM_E_BUSY at once with the message
+ * "map busy: <function> cannot run while ..." and changes nothing (it never
+ * waits, so a callback cannot deadlock). This check comes right after the map
+ * NULL check. */
 
 /* Creates an empty map with the map, fit and RGB-D keys of `options` (NULL =
  * defaults). A depth range with DEPTH_MIN >= DEPTH_MAX -> SOGMM_E_INVALID_ARG. */
 SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* options);
-/* Releases `map`. NULL is a no-op. */
+/* Releases `map`. NULL is a no-op. Call it once no call uses the map: a
+ * free while another call on it runs (on another thread, or from that call's
+ * progress callback) does not free it and sets the thread's last error to
+ * "map busy: ..." (SOGMM_E_BUSY); free it after that call returns. Like any
+ * free, it must not race a call that has not started yet: a handle is freed
+ * by its last user. */
 SOGMM_API void sogmm_map_free(sogmm_map* map);
 
 /* Inserts a frame of n points (x, y, z, gray; n * 4 floats) in the camera

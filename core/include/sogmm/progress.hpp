@@ -36,15 +36,18 @@ struct Progress {
 /// Receives reports; returning true cancels: the operation throws
 /// Error(ErrorCode::Cancelled) within one report interval, after freeing
 /// everything and without writing any output. Reports come at the start of
-/// each stage, after each EM iteration and, during long loops, at most
-/// kProgressIntervalMs apart (plus one work chunk: a few milliseconds).
-/// Within a stage, steps never decrease. The sink must not call back into
-/// the same operation, and must return quickly. A sink that throws cancels
-/// with its own exception.
+/// each stage, after each EM iteration and, during long loops, once
+/// kProgressIntervalMs have passed since the sink last returned (plus one
+/// work chunk: a few milliseconds), so a slow sink slows the operation by its
+/// own time only. Within a stage, steps never decrease. While the sink runs
+/// its thread has no sink: a SOGMM call it makes starts without one (a
+/// nested fit reports nothing). A sink that throws cancels with its own
+/// exception.
 using ProgressSink = std::function<bool(const Progress&)>;
 
-/// Heartbeat period of long loops, in milliseconds. The clock only decides
-/// when the sink is called: results never depend on it.
+/// Heartbeat period of long loops, in milliseconds of work between the
+/// sink's return and its next call. The clock only decides when the sink is
+/// called: results never depend on it.
 inline constexpr int kProgressIntervalMs = 20;
 
 /// Installs `sink` for the SOGMM calls the constructing thread makes while

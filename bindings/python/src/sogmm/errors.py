@@ -23,6 +23,7 @@ __all__ = [
     "BufferTooSmallError",
     "NotFoundError",
     "InternalError",
+    "MapBusyError",
     "NotFittedError",
     "error_for_status",
 ]
@@ -106,6 +107,15 @@ class CancelledError(SogmmError):
     status = -12
 
 
+class MapBusyError(SogmmError, RuntimeError):
+    """Another call is using the :class:`sogmm.Map` ("map busy: ..."): a call
+    from another thread while one runs, or a call (``close()`` included) from
+    the progress callback of a call on the same map. Nothing was changed;
+    retry once that call has returned."""
+
+    status = -13
+
+
 class NotFittedError(SogmmError, AttributeError):
     """A fitted attribute or method was used before ``fit``."""
 
@@ -125,6 +135,7 @@ _BY_STATUS = {
         NotFoundError,
         InternalError,
         CancelledError,
+        MapBusyError,
     )
 }
 

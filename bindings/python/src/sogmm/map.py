@@ -10,7 +10,9 @@ algorithm is documented in core/include/sogmm/map.hpp.
 from __future__ import annotations
 
 import os
+import threading
 import weakref
+from contextlib import contextmanager
 from ctypes import byref, c_int64, c_uint64, c_void_p
 
 import numpy as np
@@ -18,7 +20,7 @@ import numpy as np
 from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
-from .errors import InvalidArgumentError
+from .errors import InvalidArgumentError, MapBusyError
 from .model import GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args, _write_options
 from .progress import ProgressArg, call_with_progress
 
@@ -39,6 +41,49 @@ def _frame_dict(s: _ffi.MapFrameStats, n_replaced: int) -> dict:
         "n_replaced": n_replaced,
         "pose": np.array(list(s.pose), dtype=np.float64).reshape(4, 4),
     }
+
+
+class _UseGuard:
+    """The Python side of the map's use guard (sogmm.h, "Use guard"): a call
+    that changes the map (insert, flush, close) needs it alone, calls that read
+    it share it, and a call that finds it otherwise taken raises MapBusyError
+    at once. The C library checks the same, but only inside its calls: this
+    also covers what Python does around them (the handle that close() frees,
+    the progress callback an insert installs and removes), so two threads,
+    or a callback calling back into its map, get the error and never free or
+    change the map under a running call."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._users = 0  # > 0: reading calls; -1: the one changing call
+
+    def _busy(self, what: str, conflict: str) -> MapBusyError:
+        return MapBusyError(f"map busy: Map.{what} cannot run while {conflict} (on another thread, or the call "
+                            f"whose progress callback is running); a map is changed by one call at a time", -13)
+
+    @contextmanager
+    def changing(self, what: str):
+        with self._lock:
+            if self._users != 0:
+                raise self._busy(what, "another call is using the map")
+            self._users = -1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._users = 0
+
+    @contextmanager
+    def reading(self, what: str):
+        with self._lock:
+            if self._users < 0:
+                raise self._busy(what, "a call changing the map runs")
+            self._users += 1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._users -= 1
 
 
 class Map:
@@ -76,6 +121,13 @@ class Map:
     a finite rigid transform -> InvalidArgumentError, an empty frame ->
     InvalidDataError, a frame of another size than the first RGB-D frame ->
     InvalidArgumentError. A failed insert leaves the map unchanged.
+
+    Threads and callbacks: one call changes a map at a time. An insert, flush
+    or close() while another call on the map runs (on another thread, or from
+    the progress callback of that call) raises :class:`sogmm.MapBusyError`
+    ("map busy: ...") and changes nothing; so does a query or statistics call
+    while an insert or flush runs. Queries and statistics may run on several
+    threads at once.
     """
 
     def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
@@ -85,6 +137,7 @@ class Map:
                  **fit_params):
         self._ptr = None
         self._finalizer = None
+        self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                            fit_params, novelty_bandwidth_scale, revisit_refit_ratio) as o:
@@ -127,11 +180,14 @@ class Map:
         return c_void_p(self._ptr)
 
     def close(self) -> None:
-        """Releases the C map now (otherwise done when the object is collected)."""
-        if self._finalizer is not None:
-            self._finalizer()
-        self._finalizer = None
-        self._ptr = None
+        """Releases the C map now (otherwise done when the object is
+        collected). MapBusyError while another call uses the map (from another
+        thread, or from that call's progress callback): close it after."""
+        with self._guard.changing("close"):
+            if self._finalizer is not None:
+                self._finalizer()
+            self._finalizer = None
+            self._ptr = None
 
     def __enter__(self) -> "Map":
         return self
@@ -140,15 +196,18 @@ class Map:
         self.close()
 
     # ---- inserting ---------------------------------------------------------
-    def _call(self, progress: ProgressArg, c_call) -> None:
+    def _call(self, what: str, progress: ProgressArg, c_call) -> None:
         """One mutating C call on the map, with ``progress`` (as in SOGMM.fit)
         reporting the fit it may run (sogmm_map_set_progress). A cancelled
-        call leaves the map as it was."""
-        if progress is None:
-            check(c_call())
-            return
-        h = self._h()
-        call_with_progress(None, progress, c_call, install=lambda cb: lib.sogmm_map_set_progress(h, cb, None))
+        call leaves the map as it was. ``c_call(h)`` gets the handle; the
+        call holds the map alone (MapBusyError otherwise)."""
+        with self._guard.changing(what):
+            h = self._h()
+            if progress is None:
+                check(c_call(h))
+                return
+            call_with_progress(None, progress, lambda: c_call(h),
+                               install=lambda cb: lib.sogmm_map_set_progress(h, cb, None))
 
     def insert_points(self, points, pose, progress: ProgressArg = None) -> dict:
         """Inserts (n, 4) points (x, y, z, gray) in the camera frame with the
@@ -156,8 +215,7 @@ class Map:
         (see :meth:`frame_stats`)."""
         x = _rows(points, (4,), "points")
         p = _pose(pose)
-        h = self._h()
-        self._call(progress, lambda: lib.sogmm_map_insert_points_f32(h, x, x.shape[0], p))
+        self._call("insert_points", progress, lambda h: lib.sogmm_map_insert_points_f32(h, x, x.shape[0], p))
         return self.frame_stats(-1)
 
     def insert_rgbd(self, depth, color, camera: Camera, pose, progress: ProgressArg = None) -> dict:
@@ -166,22 +224,21 @@ class Map:
         camera-to-world ``pose``; returns that frame's statistics."""
         f = prepare_frame(depth, color, camera, *self._depth)
         p = _pose(pose)
-        h = self._h()
-        self._call(progress, lambda: lib.sogmm_map_insert_rgbd(h, *f.frame_args(), p))
+        self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_rgbd(h, *f.frame_args(), p))
         return self.frame_stats(-1)
 
     def flush(self, progress: ProgressArg = None) -> int:
         """Fits the pending points now; returns the number of components added."""
         before = self.n_components_
-        h = self._h()
-        self._call(progress, lambda: lib.sogmm_map_flush(h))
+        self._call("flush", progress, lambda h: lib.sogmm_map_flush(h))
         return self.n_components_ - before
 
     # ---- statistics ----------------------------------------------------------
     def stats(self) -> dict:
         """n_components, n_pending, n_frames, n_flushes, n_fused."""
         s = _ffi.MapStats()
-        check(lib.sogmm_map_get_stats(self._h(), byref(s)))
+        with self._guard.reading("stats"):
+            check(lib.sogmm_map_get_stats(self._h(), byref(s)))
         return {name: int(getattr(s, name)) for name, _ in _ffi.MapStats._fields_}
 
     @property
@@ -205,9 +262,10 @@ class Map:
         if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not -n <= frame < n:
             raise InvalidArgumentError(f"frame {frame!r} does not exist ({n} frames)")
         s = _ffi.MapFrameStats()
-        check(lib.sogmm_map_get_frame_stats(self._h(), int(frame) % n, byref(s)))
         replaced = c_uint64()
-        check(lib.sogmm_map_get_frame_replaced(self._h(), int(frame) % n, byref(replaced)))
+        with self._guard.reading("frame_stats"):
+            check(lib.sogmm_map_get_frame_stats(self._h(), int(frame) % n, byref(s)))
+            check(lib.sogmm_map_get_frame_replaced(self._h(), int(frame) % n, byref(replaced)))
         return _frame_dict(s, int(replaced.value))
 
     def frames(self) -> list[dict]:
@@ -220,13 +278,13 @@ class Map:
         (x_min, y_min, z_min, x_max, y_max, z_max)) as a world-frame
         :class:`sogmm.GMM`; score, sample and regress with it."""
         out = c_void_p()
-        if box is None:
-            check(lib.sogmm_map_export(byref(out), self._h(), None))
-        else:
+        b = None
+        if box is not None:
             b = np.ascontiguousarray(np.asarray(box, dtype=np.float32))
             if b.shape != (6,):
                 raise InvalidArgumentError(f"box must hold 6 numbers (min xyz, max xyz), got shape {b.shape}")
-            check(lib.sogmm_map_export(byref(out), self._h(), b.ctypes.data_as(c_void_p)))
+        with self._guard.reading("export"):
+            check(lib.sogmm_map_export(byref(out), self._h(), None if b is None else b.ctypes.data_as(c_void_p)))
         return GMM._wrap(out)
 
     # World-frame queries on the map itself (no export, no copy): each answer
@@ -237,33 +295,30 @@ class Map:
     def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
                       n_threads: int = 0) -> np.ndarray:
         """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
-        h = self._h()
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
-        with _query_options(truncation_nats, n_threads) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(h, x, x.shape[0], x.shape[1],
-                                                                                     o.ptr, out))
+        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("score_samples"):
+            call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(self._h(), x, x.shape[0],
+                                                                                     x.shape[1], o.ptr, out))
         return out
 
     def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
                      n_threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
-        h = self._h()
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
         var = np.empty(x.shape[0], dtype=np.float32)
-        with _query_options(truncation_nats, n_threads) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(h, x, x.shape[0], o.ptr, mean,
-                                                                                    var))
+        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("regress_gray"):
+            call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(self._h(), x, x.shape[0], o.ptr,
+                                                                                    mean, var))
         return mean, var
 
     def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
                spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
         """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""
-        h = self._h()
         n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
-        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_map_sample_f32(h, n, seed, dims, o.ptr, out))
+        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o, self._guard.reading("sample"):
+            call_with_progress(o, progress, lambda: lib.sogmm_map_sample_f32(self._h(), n, seed, dims, o.ptr, out))
         return out
 
     # ---- files -------------------------------------------------------------------
@@ -271,7 +326,7 @@ class Map:
              zstd_level: int = 19) -> None:
         """Writes the map as a world-frame .sogmm file with its frame provenance
         (atomically). Pending points must be flushed first (InvalidArgumentError)."""
-        with _write_options(float64, compress, zstd_level) as o:
+        with _write_options(float64, compress, zstd_level) as o, self._guard.reading("save"):
             check(lib.sogmm_map_save(self._h(), os.fsencode(path), o.ptr))
 
     @classmethod
@@ -282,6 +337,7 @@ class Map:
         obj = cls.__new__(cls)
         obj._ptr = None
         obj._finalizer = None
+        obj._guard = _UseGuard()
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
         map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,

@@ -655,7 +655,9 @@ class SOGMM(GMM):
         sogmm.progress.STAGE_*); a truthy return cancels the fit with
         CancelledError, an exception it raises cancels and is re-raised. Ctrl-C
         cancels the fit and raises KeyboardInterrupt. A cancelled fit leaves
-        the estimator as it was.
+        the estimator as it was; a fit that had completed when Ctrl-C was seen
+        is kept (the estimator is fitted) and KeyboardInterrupt is raised after
+        it, with ``sogmm_completed = True`` (sogmm.progress).
 
         ``init``: warm start from a model of an earlier, overlapping cloud,
         already in these points' frame (e.g. ``prev.transform(relative_pose)``);
@@ -667,11 +669,12 @@ class SOGMM(GMM):
         out = c_void_p()
         with self._fit_options() as o:
             if init is None:
-                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr))
+                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr),
+                                   keep=lambda: self._attach(out))
             else:
                 call_with_progress(o, progress, lambda: lib.sogmm_fit_points_warm_f32(byref(out), x, x.shape[0],
-                                                                                       init._h(), o.ptr))
-        self._attach(out)
+                                                                                       init._h(), o.ptr),
+                                   keep=lambda: self._attach(out))
         return self
 
     def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = 1000.0, depth_min: float = 0.1,
@@ -684,8 +687,8 @@ class SOGMM(GMM):
         f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
         out = c_void_p()
         with self._fit_options(f.f64, f.i64) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr))
-        self._attach(out)
+            call_with_progress(o, progress, lambda: lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr),
+                               keep=lambda: self._attach(out))
         return self
 
     def __repr__(self) -> str:

@@ -13,6 +13,14 @@ that only records SIGINT; the callback sees the record and cancels, and
 KeyboardInterrupt is raised once the library has returned (cleanly, with
 nothing allocated left behind). Elsewhere, an exception the current handler
 raises inside the callback is caught and re-raised the same way.
+
+A Ctrl-C that comes too late to cancel (after the last report, or during a
+call that makes none, such as a map insert that runs no fit) finds the call
+completed: its result is kept (the fitted model attached, the frame in the
+map) and KeyboardInterrupt is raised after it, as Python does after a C call
+that finished, with ``sogmm_completed = True`` and a note saying so. Only a
+KeyboardInterrupt without that attribute means the call was cancelled and
+changed nothing.
 """
 from __future__ import annotations
 
@@ -85,14 +93,27 @@ def _sink(progress: ProgressArg):
     raise TypeError(f"progress must be None, True or a callable(stage, step, total, log_likelihood), got {progress!r}")
 
 
+def _interrupt_after_completed_call() -> KeyboardInterrupt:
+    e = KeyboardInterrupt()
+    e.sogmm_completed = True
+    note = "sogmm: the call had completed when Ctrl-C was seen; its result was kept"
+    if hasattr(e, "add_note"):  # Python >= 3.11
+        e.add_note(note)
+    return e
+
+
 def call_with_progress(options: Optional[_ffi.Options], progress: ProgressArg, c_call: Callable[[], int], *,
-                       install: Optional[Callable[[object], int]] = None) -> None:
+                       install: Optional[Callable[[object], int]] = None,
+                       keep: Optional[Callable[[], None]] = None) -> None:
     """Runs ``c_call()`` (one C call using ``options``, returning its status)
     with the progress callback set on ``options``; raises what the call or the
     callback raised, KeyboardInterrupt on Ctrl-C, CancelledError when the
     callable returned a truthy value. ``install(callback)`` replaces setting it
     on ``options`` (a map's inserts: sogmm_map_set_progress); it is called
-    again with a NULL PROGRESS_FN after the call to remove the callback."""
+    again with a NULL PROGRESS_FN after the call to remove the callback.
+    ``keep()`` runs when the C call succeeded, before anything is raised: it
+    takes what the call made (a model handle), so a call that completed is
+    never lost to a late Ctrl-C or callback exception."""
     sink = _sink(progress)
     state = {"error": None, "sigint": False}
 
@@ -127,8 +148,10 @@ def call_with_progress(options: Optional[_ffi.Options], progress: ProgressArg, c
             signal.signal(signal.SIGINT, previous)
         if isinstance(sink, _TqdmSink):
             sink.close()
+    if status == _ffi.OK and keep is not None:
+        keep()
     if state["error"] is not None:
         raise state["error"]
     if state["sigint"]:
-        raise KeyboardInterrupt
+        raise _interrupt_after_completed_call() if status == _ffi.OK else KeyboardInterrupt
     check(status)

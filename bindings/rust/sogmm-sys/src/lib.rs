@@ -66,6 +66,7 @@ pub const SOGMM_E_BUFFER_TOO_SMALL: sogmm_status = -9;
 pub const SOGMM_E_NOT_FOUND: sogmm_status = -10;
 pub const SOGMM_E_INTERNAL: sogmm_status = -11;
 pub const SOGMM_E_CANCELLED: sogmm_status = -12;
+pub const SOGMM_E_BUSY: sogmm_status = -13;
 
 // ---- option keys ----------------------------------------------------------
 pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;

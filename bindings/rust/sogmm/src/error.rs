@@ -23,6 +23,11 @@ pub enum Status {
     Internal,
     /// A progress callback asked to stop (SOGMM_E_CANCELLED).
     Cancelled,
+    /// Another call is using the map (SOGMM_E_BUSY, "map busy: ..."). Safe
+    /// code of this crate never gets it: `Map`'s changing methods take
+    /// `&mut self`, so no other call (another thread's, or the progress
+    /// closure's) can use the map meanwhile.
+    Busy,
     Unknown(i32),
 }
 
@@ -41,6 +46,7 @@ impl Status {
             sys::SOGMM_E_NOT_FOUND => Status::NotFound,
             sys::SOGMM_E_INTERNAL => Status::Internal,
             sys::SOGMM_E_CANCELLED => Status::Cancelled,
+            sys::SOGMM_E_BUSY => Status::Busy,
             other => Status::Unknown(other),
         }
     }
@@ -60,6 +66,7 @@ impl Status {
             Status::NotFound => sys::SOGMM_E_NOT_FOUND,
             Status::Internal => sys::SOGMM_E_INTERNAL,
             Status::Cancelled => sys::SOGMM_E_CANCELLED,
+            Status::Busy => sys::SOGMM_E_BUSY,
             Status::Unknown(c) => c,
         }
     }

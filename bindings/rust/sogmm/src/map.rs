@@ -51,6 +51,23 @@ pub struct MapFrameStats {
 /// An incremental world map. Inserting needs `&mut self`; the queries
 /// (`stats`, `export`, `score_samples`, `regress_gray`, `sample`, `save`)
 /// take `&self` and may run on many threads at once.
+///
+/// The C library refuses a call on a map that another call is using
+/// (SOGMM_E_BUSY, "map busy"); here the borrow rules already forbid it, so
+/// `Status::Busy` never comes from safe code. A progress closure cannot reach
+/// the map whose insert runs it:
+///
+/// ```compile_fail
+/// let mut map = sogmm::Map::new(None).unwrap();
+/// map.flush_with_progress(|_| {
+///     let _ = map.stats(); // error[E0502]: `map` is already borrowed as mutable
+///     std::ops::ControlFlow::Continue(())
+/// })
+/// .unwrap();
+/// ```
+///
+/// and dropping it from another thread while an insert runs needs the map
+/// by value, which the insert's `&mut` borrow prevents.
 pub struct Map {
     ptr: NonNull<sys::sogmm_map>,
 }
