@@ -168,6 +168,17 @@ func (m *Map) flush(progress *mapProgress) error {
 	return m.change("Flush", progress, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
 }
 
+// DiscardPending drops the points pending for a fit (they never become
+// components) and returns how many there were. The frames stay recorded. The
+// way out when a flush keeps failing and the map cannot be saved.
+func (m *Map) DiscardPending() (uint64, error) {
+	var dropped C.uint64_t
+	err := m.change("DiscardPending", nil, func(p *C.sogmm_map) C.sogmm_status {
+		return C.sogmm_map_discard_pending(p, &dropped)
+	})
+	return uint64(dropped), err
+}
+
 // Stats returns the map's totals.
 func (m *Map) Stats() (MapStats, error) {
 	var s C.sogmm_map_stats

@@ -102,3 +102,36 @@ func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
 		t.Fatalf("closed map: %v", err)
 	}
 }
+
+// DiscardPending is the way out of a map whose pending points cannot be saved.
+func TestMapDiscardPendingUnlocksSave(t *testing.T) {
+	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapBatchSize, 100000))
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	m, err := NewMap(o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer m.Close()
+	pts := twoBlobs(200)
+	if err := m.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
+		t.Fatal(err)
+	}
+	path := filepath.Join(t.TempDir(), "pending.sogmm")
+	if err := m.Save(path, nil); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("save with pending points: %v, want ErrInvalidArg", err)
+	}
+	n := uint64(len(pts) / 4)
+	if got, err := m.DiscardPending(); err != nil || got != n {
+		t.Fatalf("DiscardPending = %d (%v), want %d", got, err, n)
+	}
+	s, err := m.Stats()
+	if err != nil || s.Pending != 0 || s.Frames != 1 || s.Components != 0 {
+		t.Fatalf("stats after discard %+v (%v)", s, err)
+	}
+	if got, err := m.DiscardPending(); err != nil || got != 0 {
+		t.Fatalf("second DiscardPending = %d (%v), want 0", got, err)
+	}
+}

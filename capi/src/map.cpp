@@ -96,6 +96,16 @@ SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map) {
   SOGMM_CATCH
 }
 
+SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropped) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_discard_pending");
+    const std::size_t n = map->map.discard_pending();
+    if (dropped != nullptr) *dropped = n;
+  }
+  SOGMM_CATCH
+}
+
 SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data) {
   SOGMM_TRY {
     require_nonnull(map, "map");

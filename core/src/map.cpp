@@ -120,6 +120,11 @@ void validate(const MapOptions& o) {
           ErrorCode::InvalidArgument, "map: unknown fusion method");
   require_usable_bandwidth(o.fit.bandwidth);
   require_usable_bandwidth(o.fit.bandwidth * o.novelty_bandwidth_scale);
+  // A triggered fit of a fixed K needs K points: a smaller batch could only
+  // flush when one insert happened to bring K.
+  require(!o.novelty || o.fit.n_components <= o.batch_size, ErrorCode::InvalidArgument,
+          "map: batch_size " + std::to_string(o.batch_size) + " is below the fixed K = " +
+              std::to_string(o.fit.n_components) + " components a batch is fitted with");
   require(!o.warm_start || o.fit.n_init == 1, ErrorCode::InvalidArgument,
           "map: a warm start is one run: fit.n_init must be 1, got " + std::to_string(o.fit.n_init));
   validate(o.depth);
@@ -181,36 +186,33 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   detail::PendingFrame novel;
   novel.pose = pose;
   novel.from_rgbd = from_rgbd;
-  std::vector<std::uint64_t> novel_voxels;
+  std::vector<detail::PendingVoxel> novel_voxels;
   std::vector<double> ll;
   std::vector<std::int64_t> dominant;  // each point's dominant map component (revisit refit)
+  const std::vector<double> world = to_world(points, pose);
+  detail::require_float32_world(world, from_rgbd);
   if (!s.options.novelty) {
     novel.xyzg.assign(points.data, points.data + 4 * points.size);
   } else {
     // Novel: the map does not explain the point (below the threshold) and no
     // earlier frame's pending point lies near it (that surface is already
     // waiting for the next fit).
-    const std::vector<double> world = to_world(points, pose);
     ll.assign(points.size, -std::numeric_limits<double>::infinity());
     dominant.assign(points.size, -1);
     if (s.model.gmm.size() > 0)
       detail::local_log_likelihood(s.index, s.marginals, s.options.fit.em.threads, world.data(), points.size,
                                    ll.data(), dominant.data());
-    // Per point: 0 explained, 1 novel, 2 novel without a voxel (far out).
+    // Per point: 0 explained (or near a pending point), 1 novel.
     std::vector<std::uint8_t> state(points.size, 0);
-    std::vector<std::int64_t> voxels(3 * points.size, 0);
+    std::vector<detail::PendingVoxel> voxels(points.size);
     detail::parallel_for(points.size, detail::team_size(s.options.fit.em.threads), 1024, [&](std::size_t i, int) {
       if (ll[i] >= s.options.novelty_threshold) return;
-      std::int64_t* v = voxels.data() + 3 * i;
-      if (!detail::pending_voxel(world.data() + 3 * i, v)) {
-        state[i] = 2;
-      } else if (!detail::near_pending(s.pending_voxels, v)) {
-        state[i] = 1;
-      }
+      voxels[i] = detail::pending_voxel(world.data() + 3 * i);
+      if (!detail::near_pending(s.pending_voxels, voxels[i])) state[i] = 1;
     });
     for (std::size_t i = 0; i < points.size; ++i) {
       if (state[i] == 0) continue;
-      if (state[i] == 1) novel_voxels.push_back(detail::pending_voxel_key(voxels.data() + 3 * i));
+      novel_voxels.push_back(voxels[i]);
       novel.xyzg.insert(novel.xyzg.end(), points[i], points[i] + 4);
     }
   }
@@ -218,6 +220,8 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   f.n_novel = novel.xyzg.size() / 4;
   require(s.n_pending <= kMaxPoints - f.n_novel, ErrorCode::Limit,
           "map: more than " + std::to_string(kMaxPoints) + " points pending");
+  // Nothing is committed that a flush could not fit (issue 36).
+  detail::require_flushable(s, novel, from_rgbd);
   // Revisit refit (MapOptions::revisit_refit_ratio): fitted first, committed
   // with the previous searchable map kept aside until the insert succeeds.
   std::optional<Searchable> before_refit;
@@ -273,7 +277,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       // Each of these voxels was new to the set (its points were not near a
       // pending one), so erasing them restores the set exactly (also after a
       // partial insert).
-      for (const std::uint64_t key : novel_voxels) s.pending_voxels.erase(key);
+      for (const detail::PendingVoxel& key : novel_voxels) s.pending_voxels.erase(key);
     }
     undo_refit();
     throw;
@@ -327,6 +331,15 @@ FrameStats Map::insert_backprojected(const PointsView& points, const Camera& cam
   }
 }
 
+std::size_t Map::discard_pending() {
+  State& s = *s_;
+  const std::size_t dropped = s.n_pending;
+  s.pending.clear();
+  s.n_pending = 0;
+  s.pending_voxels.clear();
+  return dropped;
+}
+
 std::size_t Map::flush(const ProgressSink& progress) {
   State& s = *s_;
   if (s.n_pending == 0) return 0;
@@ -336,25 +349,9 @@ std::size_t Map::flush(const ProgressSink& progress) {
   // --sequence` does, and coordinates stay near the origin in float32.
   const Pose& last = s.pending.back().pose;
   const Pose to_last = inverse_rigid(last);
-  PointCloud cloud;
-  cloud.xyzg.reserve(4 * s.n_pending);
+  const PointCloud cloud = detail::batch_cloud(s.pending);
   bool from_rgbd = false;
-  for (std::size_t g = 0; g < s.pending.size(); ++g) {
-    const detail::PendingFrame& p = s.pending[g];
-    from_rgbd = from_rgbd || p.from_rgbd;
-    if (g + 1 == s.pending.size()) {
-      cloud.xyzg.insert(cloud.xyzg.end(), p.xyzg.begin(), p.xyzg.end());
-      continue;
-    }
-    const Pose rel = compose_poses(to_last, p.pose);
-    for (std::size_t i = 0; i < p.xyzg.size(); i += 4) {
-      const float* q = p.xyzg.data() + i;
-      for (int r = 0; r < 3; ++r)
-        cloud.xyzg.push_back(static_cast<float>(rel[4 * r] * q[0] + rel[4 * r + 1] * q[1] + rel[4 * r + 2] * q[2] +
-                                                rel[4 * r + 3]));
-      cloud.xyzg.push_back(q[3]);
-    }
-  }
+  for (const detail::PendingFrame& p : s.pending) from_rgbd = from_rgbd || p.from_rgbd;
   // Novel points: a finer mode count (MapOptions::novelty_bandwidth_scale
   // says why).
   FitOptions batch_options = s.options.fit;

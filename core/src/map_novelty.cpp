@@ -2,6 +2,7 @@
 // the local submap (sogmm/map.hpp).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "map_state.hpp"
@@ -54,32 +55,34 @@ Marginal3 marginal3(const Gmm& gmm, std::size_t m) {
 }
 
 namespace {
-constexpr std::int64_t kVoxelHalfRange = std::int64_t{1} << 20;
-}
+// -0.0 and 0.0 are one voxel: == says so, and the hash reads bits.
+double canonical(double v) { return v == 0.0 ? 0.0 : v; }
+}  // namespace
 
-bool pending_voxel(const double xyz[3], std::int64_t voxel[3]) {
-  for (int i = 0; i < 3; ++i) {
-    const double v = std::floor(xyz[i] / kPendingVoxel);
-    // One voxel of margin on each side keeps the neighbours' keys in range.
-    if (!(v > -static_cast<double>(kVoxelHalfRange) && v < static_cast<double>(kVoxelHalfRange - 1))) return false;
-    voxel[i] = static_cast<std::int64_t>(v);
+std::size_t PendingVoxelHash::operator()(const PendingVoxel& k) const {
+  std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+  for (double d : k.v) {
+    std::uint64_t bits = 0;
+    const double c = canonical(d);
+    std::memcpy(&bits, &c, sizeof bits);
+    h ^= bits + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
   }
-  return true;
+  return static_cast<std::size_t>(h);
 }
 
-std::uint64_t pending_voxel_key(const std::int64_t voxel[3]) {
-  std::uint64_t k = 0;
-  for (int i = 0; i < 3; ++i) k = (k << 21) | static_cast<std::uint64_t>(voxel[i] + kVoxelHalfRange);
-  return k;
+PendingVoxel pending_voxel(const double xyz[3]) {
+  PendingVoxel p;
+  for (int i = 0; i < 3; ++i) p.v[i] = canonical(std::floor(xyz[i] / kPendingVoxel));
+  return p;
 }
 
-bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::int64_t voxel[3]) {
+bool near_pending(const PendingVoxelSet& voxels, const PendingVoxel& voxel) {
   if (voxels.empty()) return false;
-  for (std::int64_t dx = -1; dx <= 1; ++dx)
-    for (std::int64_t dy = -1; dy <= 1; ++dy)
-      for (std::int64_t dz = -1; dz <= 1; ++dz) {
-        const std::int64_t v[3] = {voxel[0] + dx, voxel[1] + dy, voxel[2] + dz};
-        if (voxels.count(pending_voxel_key(v)) > 0) return true;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        const PendingVoxel n{{canonical(voxel.v[0] + dx), canonical(voxel.v[1] + dy), canonical(voxel.v[2] + dz)}};
+        if (voxels.count(n) > 0) return true;
       }
   return false;
 }

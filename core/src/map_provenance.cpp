@@ -40,6 +40,16 @@ std::string options_text(const MapOptions& o) {
          " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0);
 }
 
+// One count: decimal digits only. operator>> into an unsigned type reads a
+// sign and wraps it (-1 as 2^64 - 1), so the token is checked first.
+template <typename T>
+bool read_count(std::istream& in, T& out) {
+  std::string token;
+  if (!(in >> token) || token.find_first_not_of("0123456789") != std::string::npos) return false;
+  std::istringstream digits(token);
+  return static_cast<bool>(digits >> out) && digits.eof();
+}
+
 std::vector<FrameStats> parse_frames(const std::string& text) {
   std::vector<FrameStats> frames;
   std::istringstream in(text);
@@ -54,7 +64,8 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
     std::istringstream row(line);
     std::uint64_t index = 0;
     std::size_t n_points = 0, n_novel = 0;
-    if (!(row >> index >> n_points >> n_novel)) throw bad("expected 'index points novel' and 12 pose entries");
+    if (!(read_count(row, index) && read_count(row, n_points) && read_count(row, n_novel)))
+      throw bad("expected 'index points novel' (unsigned integers) and 12 pose entries");
     if (index != frames.size()) throw bad("frame index " + std::to_string(index) + ", expected " + std::to_string(frames.size()));
     if (n_novel > n_points) throw bad("more novel points than points");
     FrameStats f;
@@ -68,7 +79,8 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
     std::string rest;
     if (row >> rest) {
       std::istringstream count(rest);
-      if (!(count >> f.n_components) || !count.eof()) throw bad("expected a component count after the pose, got '" + rest + "'");
+      if (!read_count(count, f.n_components) || !count.eof())
+        throw bad("expected a component count after the pose, got '" + rest + "'");
       if (row >> rest) throw bad("unexpected '" + rest + "' after the component count");
     }
     f.pose[15] = 1.0;
@@ -130,6 +142,9 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   require(coordinate_frame(model) == "world", ErrorCode::InvalidArgument,
           "map: the model is in the " + coordinate_frame(model) + " frame; a map holds a world-frame model");
   validate(model.gmm);
+  require(model.gmm.support_size > 0, ErrorCode::InvalidArgument,
+          "map: the model's support size is 0 (unknown); a map weighs its components against new points by the "
+          "points they stand for: rebuild the model with its support size");
   Map map(options);
   State& s = *map.s_;
   s.model = model;

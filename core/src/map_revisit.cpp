@@ -82,10 +82,10 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   const MapOptions& o = s.options;
   const Gmm& map = s.model.gmm;
   // A fixed K has no mode count to compare; a warm start's restore after a
-  // load assumes a map that only grows by appends; a map of unknown support
-  // (0) has no mass to sample.
+  // load assumes a map that only grows by appends. (A map with components
+  // has a known support size: from_model refuses 0.)
   if (!o.novelty || o.revisit_refit_ratio <= 0 || o.warm_start || o.fit.n_components > 0 || !s.camera ||
-      map.size() == 0 || map.support_size == 0)
+      map.size() == 0)
     return std::nullopt;
   const DepthView view(decimated(*s.camera, o.depth.decimate), o.depth, points);
   const Pose to_camera_pose = inverse_rigid(pose);

@@ -62,14 +62,26 @@ std::vector<std::size_t> fuse_new_components(Gmm& gmm, std::size_t first, const 
 /// components the fit will give that surface.
 inline constexpr double kPendingVoxel = 0.01;
 
-/// The voxel of world point `xyz`; false when the point lies beyond +-2^20
-/// voxels (+-10 km) on an axis, where keys would alias (such a point is then
-/// never taken as pending).
-bool pending_voxel(const double xyz[3], std::int64_t voxel[3]);
-/// The key of a voxel (each coordinate in [-2^20, 2^20)).
-std::uint64_t pending_voxel_key(const std::int64_t voxel[3]);
+/// A pending voxel: floor(coordinate / kPendingVoxel) per axis, kept in double
+/// so that every finite world coordinate (any float32 pose, ~3.4e40 voxels)
+/// has its own key: a packed 64-bit key held only +-2^20 voxels (+-10 km), and
+/// beyond it no point was ever taken as pending (issue 36: the same frame
+/// inserted again at 500 km grew the map). Integers are exact in double up to
+/// 2^53 voxels (9e13 m); beyond, a neighbour may round onto the voxel itself,
+/// which only widens what counts as near.
+struct PendingVoxel {
+  double v[3];
+  bool operator==(const PendingVoxel& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
+};
+struct PendingVoxelHash {
+  std::size_t operator()(const PendingVoxel& k) const;
+};
+using PendingVoxelSet = std::unordered_set<PendingVoxel, PendingVoxelHash>;
+
+/// The voxel of world point `xyz` (finite).
+PendingVoxel pending_voxel(const double xyz[3]);
 /// Whether a pending point lies in the voxel or one of its 26 neighbours.
-bool near_pending(const std::unordered_set<std::uint64_t>& voxels, const std::int64_t voxel[3]);
+bool near_pending(const PendingVoxelSet& voxels, const PendingVoxel& voxel);
 
 /// A revisit refit worked out but not committed (map_revisit.cpp).
 struct RevisitRefit {
@@ -85,6 +97,21 @@ struct PendingFrame {
   std::vector<float> xyzg;
 };
 
+/// The points a flush fits: every pending frame (and `extra`, when given, as
+/// the latest) moved into the camera frame of the latest one, in float32.
+PointCloud batch_cloud(const std::vector<PendingFrame>& pending, const PendingFrame* extra = nullptr);
+
+/// Error(InvalidArgument) naming the point and axis unless every world
+/// coordinate (3 per point) of a frame is within float32 range.
+void require_float32_world(const std::vector<double>& world, bool from_rgbd);
+
+/// Throws, naming the cause, unless the batch pending after `novel` joins it
+/// is one a flush can fit: with a fixed K, at least K points when this insert
+/// triggers the fit (Error(InvalidArgument)); else the mode count's range
+/// rule (require_mode_count_range, Error(Limit)) on the batch in `novel`'s
+/// camera frame at the batch bandwidth. Nothing changes.
+void require_flushable(const Map::State& s, const PendingFrame& novel, bool from_rgbd);
+
 }  // namespace sogmm::detail
 
 namespace sogmm {
@@ -96,9 +123,9 @@ struct Map::State {
   std::vector<detail::Marginal3> marginals;  ///< one per component of model.gmm
   std::vector<detail::PendingFrame> pending;
   std::size_t n_pending = 0;
-  /// pending_voxel_key of every pending point: a later point in one of these
+  /// pending_voxel of every pending point: a later point in one of these
   /// voxels is already waiting for the fit and is not novel again.
-  std::unordered_set<std::uint64_t> pending_voxels;
+  detail::PendingVoxelSet pending_voxels;
   std::vector<FrameStats> frames;
   std::uint64_t n_flushes = 0;
   std::uint64_t n_fused = 0;

@@ -29,14 +29,7 @@ void require_usable_bandwidth(double bandwidth) {
           "5.3e-155 to 4.4e153), got " + checked::exact(bandwidth));
 }
 
-namespace {
-
-void check_inputs(const std::vector<double>& points2d, double bandwidth) {
-  require_usable_bandwidth(bandwidth);
-  require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
-          "mean shift needs a non-empty N x 2 array");
-  for (double v : points2d)
-    require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
+void require_mode_count_range(const std::vector<double>& points2d, double bandwidth) {
   // Grid and bin indices are (coordinate - origin) / bandwidth and
   // coordinate / bandwidth converted to 64-bit integers: bound both so that the
   // conversions are exact and defined (and the sparse grid's cell keys, at
@@ -57,6 +50,17 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
                 (axis == 0 ? "range" : "gray") + " values of the data (from " + checked::exact(lo) + " to " +
                 checked::exact(hi) + "): use a larger bandwidth");
   }
+}
+
+namespace {
+
+void check_inputs(const std::vector<double>& points2d, double bandwidth) {
+  require_usable_bandwidth(bandwidth);
+  require(!points2d.empty() && points2d.size() % 2 == 0, ErrorCode::InvalidData,
+          "mean shift needs a non-empty N x 2 array");
+  for (double v : points2d)
+    require(std::isfinite(v), ErrorCode::InvalidData, "mean shift input has a non-finite value");
+  require_mode_count_range(points2d, bandwidth);
 }
 
 // Centres of the occupied cells of the bin-seeding grid.

@@ -739,18 +739,15 @@ TEST(MapTest, RevisitRefitIsOffAtRatioZeroAndBelowTheRatio) {
   map.insert_points(cloud.view(), kIdentity);
   EXPECT_EQ(map.stats().n_refits, 0u);
   // The cases without a refit: a fixed K (no mode count to compare), a warm
-  // start, a map of unknown support size. Each insert succeeds.
+  // start. Each insert succeeds. (A map of unknown support size is refused
+  // at load: MapValidity.AModelOfUnknownSupportIsRefusedAsAMap.)
   {
     MapOptions fixed_k = refit_options(1.0);
     fixed_k.fit.n_components = 40;
     MapOptions warm = refit_options(1.0);
     warm.warm_start = true;
-    sogmm::Model unknown = wall;
-    unknown.gmm.support_size = 0;
-    const std::pair<const sogmm::Model*, MapOptions> cases[] = {
-        {&wall, fixed_k}, {&wall, warm}, {&unknown, refit_options(1.0)}};
-    for (const auto& [model, o] : cases) {
-      Map m = Map::from_model(*model, o);
+    for (const MapOptions& o : {fixed_k, warm}) {
+      Map m = Map::from_model(wall, o);
       m.insert_rgbd(scene.frame(), kIdentity);
       EXPECT_EQ(m.stats().n_refits, 0u);
       EXPECT_EQ(m.model().gmm.means, wall.gmm.means);

@@ -224,3 +224,33 @@ def test_revisit_refit_ratio_out_of_range_raises():
     for bad in (0.5, -1.0, float("nan"), float("inf")):
         with pytest.raises(sogmm.InvalidArgumentError, match="REVISIT_REFIT_RATIO|revisit_refit_ratio"):
             sogmm.Map(revisit_refit_ratio=bad)
+
+
+def test_discard_pending_unlocks_a_map_that_cannot_be_saved(tmp_path):
+    pts = blobs(n_per=50)
+    with sogmm.Map(batch_size=10_000, **FIT) as m:
+        m.insert_points(pts, np.eye(4))
+        with pytest.raises(sogmm.InvalidArgumentError):
+            m.save(tmp_path / "pending.sogmm")  # pending points: flush first
+        assert m.discard_pending() == len(pts)
+        assert m.n_pending_ == 0 and len(m) == 1 and m.n_components_ == 0
+        assert m.discard_pending() == 0
+        # The dropped points' voxels are forgotten: the same frame is new again.
+        assert m.insert_points(pts, np.eye(4))["n_novel"] == len(pts)
+        m.flush()
+        m.save(tmp_path / "map.sogmm")
+    assert (tmp_path / "map.sogmm").exists()
+
+
+def test_a_frame_far_from_the_pending_ones_fails_at_its_insert():
+    # Issue 36: on 9ad39ee the far frame went pending and every flush failed.
+    pts = blobs(n_per=50)
+    far = np.eye(4)
+    far[0, 3] = 1e10
+    with sogmm.Map(batch_size=10_000, **FIT) as m:
+        m.insert_points(pts, np.eye(4))
+        with pytest.raises(sogmm.SogmmError, match="flush"):
+            m.insert_points(pts, far)
+        assert len(m) == 1 and m.n_pending_ == len(pts)
+        m.flush()
+        assert m.n_components_ > 0

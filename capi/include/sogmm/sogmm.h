@@ -629,9 +629,19 @@ SOGMM_API void sogmm_map_free(sogmm_map* map);
 /* Inserts a frame of n points (x, y, z, gray; n * 4 floats) in the camera
  * frame with its camera-to-world `pose`. Errors (the map is unchanged):
  * n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA; pose not finite or not rigid ->
- * SOGMM_E_INVALID_ARG; n > 2^26 -> SOGMM_E_LIMIT; a fit this insert triggers
- * fails or is cancelled (sogmm_map_set_progress) -> its status, and the
- * insert is undone: the map is as before the call. */
+ * SOGMM_E_INVALID_ARG; n > 2^26 -> SOGMM_E_LIMIT. An insert commits only
+ * points a flush can fit; it refuses: a point beyond float32 range after the
+ * pose -> SOGMM_E_INVALID_ARG; with SOGMM_OPT_N_COMPONENTS = K > 0, a fit it
+ * would trigger on fewer than K points -> SOGMM_E_INVALID_ARG; else a batch
+ * (the pending points and this frame's new ones, in this frame's camera
+ * frame) whose range or gray values span more than 1e8 batch bandwidths
+ * (SOGMM_OPT_BANDWIDTH, times SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE with
+ * novelty on), the rule a fit of those points at that bandwidth applies ->
+ * SOGMM_E_LIMIT (e.g. a pose far from the pending frames': flush first). A
+ * fit this insert triggers that fails anyway or is cancelled
+ * (sogmm_map_set_progress) -> its status, and the insert is undone: the map
+ * is as before the call (the frame is not recorded, its points are not
+ * pending), so the call can be retried. */
 SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
                                                    const double* pose);
 /* Inserts an RGB-D frame (arguments as sogmm_fit_rgbd; decimation and depth
@@ -646,6 +656,12 @@ SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* dep
 /* Fits the pending points now (no-op when none are pending). A failed or
  * cancelled fit leaves the map and the pending points unchanged. */
 SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map);
+/* Drops the points pending for a fit (they never become components) and
+ * writes how many there were into *dropped (may be NULL). The frames stay
+ * recorded, and so does the camera the first RGB-D frame fixed. The way out
+ * when a flush keeps failing (e.g. cancelled, or a numeric failure) and the
+ * map cannot be saved. Needs exclusive use of the map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropped);
 /* Sets the progress callback of the fits that later inserts and flushes of
  * `map` run (fn = NULL removes it; rules of sogmm_progress_fn; user_data is
  * passed through and not owned). A non-zero return cancels the fit: the call
@@ -735,8 +751,10 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
 /* Reads a map saved by sogmm_map_save (or any world-frame .sogmm model: then
  * without frame provenance). Read keys of `options` apply, and its map, fit
  * and RGB-D keys govern later inserts (NULL = defaults). Errors as
- * sogmm_model_load; a camera-frame model -> SOGMM_E_INVALID_ARG; malformed
- * "map_frames" -> SOGMM_E_FORMAT. */
+ * sogmm_model_load; a camera-frame model or a model of support size 0
+ * (unknown: a flush could not weigh it against new points) ->
+ * SOGMM_E_INVALID_ARG; malformed "map_frames" (a count with a sign
+ * included) -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
 
 /* ---- buffers ---------------------------------------------------------- */

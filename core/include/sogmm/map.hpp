@@ -128,8 +128,7 @@ struct MapOptions {
   /// 2.04 dB below without, every frame at least 0.39 dB above with, at 8.1%
   /// of append-everything's components; tools/sogmm-perf/map_loop.py). No refit with a fixed K (fit.n_components > 0:
   /// no mode count to compare), with warm_start (whose restore after a load
-  /// assumes a map grown by appends only), for a map of unknown support size
-  /// (0) or for insert_points (no camera). A refit whose fit fails on the
+  /// assumes a map grown by appends only) or for insert_points (no camera). A refit whose fit fails on the
   /// data (a limit, a numeric failure) is skipped and the map kept; a cancel
   /// propagates and undoes the insert. The check (one mode count) reports no
   /// progress. 0 = off; else >= 1.
@@ -137,7 +136,8 @@ struct MapOptions {
 };
 
 /// Throws Error(InvalidArgument) naming the field unless every option is in
-/// range: finite threshold, batch_size in [1, kMaxPoints], fusion_threshold
+/// range: finite threshold, batch_size in [1, kMaxPoints] (and, with novelty
+/// and a fixed K, at least fit.n_components), fusion_threshold
 /// finite and > 0, index_sigmas in (0, 100], fit bandwidth usable, a valid
 /// DepthOptions (validate in sogmm/camera.hpp).
 void validate(const MapOptions& options);
@@ -192,8 +192,17 @@ class Map {
   /// its camera-to-world pose. Errors (nothing changes): empty frame or
   /// non-finite point -> Error(InvalidData); pose not rigid
   /// (rigid_pose_error) -> Error(InvalidArgument) naming the problem; more
-  /// than kMaxPoints points -> Error(Limit). A flush it triggers throws as
-  /// flush() and the insert is undone: the map is as before the call.
+  /// than kMaxPoints points -> Error(Limit). So that every commit can be
+  /// flushed, it also refuses (nothing changes) a point beyond float32 range
+  /// after the pose -> Error(InvalidArgument); with a fixed K
+  /// (fit.n_components > 0), a fit it would trigger on fewer than K points ->
+  /// Error(InvalidArgument); else a batch (the pending points and this
+  /// frame's new ones, in this frame's camera frame) beyond the mode count's
+  /// range at the batch bandwidth (require_mode_count_range in
+  /// sogmm/mean_shift.hpp) -> Error(Limit): the same rule a fit of those
+  /// points at that bandwidth applies. A flush it triggers that fails anyway
+  /// (a numeric failure, a cancel) throws as flush() and the insert is
+  /// undone: the map is as before the call, so the call can be retried.
   /// `progress` reports that fit and may cancel it (Error(Cancelled)).
   FrameStats insert_points(const PointsView& points, const Pose& camera_to_world, const ProgressSink& progress = {});
 
@@ -215,6 +224,12 @@ class Map {
   /// (sogmm::fit) propagates and leaves the map and the pending points as
   /// they were.
   std::size_t flush(const ProgressSink& progress = {});
+
+  /// Drops the pending points (they never become components) and returns how
+  /// many there were. The frames stay recorded (their n_novel counts the
+  /// points as they were then), and so does the camera an RGB-D frame fixed.
+  /// The way out when a flush keeps failing and the map cannot be saved.
+  std::size_t discard_pending();
 
   /// Components in the map.
   std::size_t size() const;
@@ -250,8 +265,11 @@ class Map {
   Model to_model() const;
   /// A map holding `model`'s components (which must be a world-frame model,
   /// else Error(InvalidArgument)) and, when present, the frame provenance of
-  /// kMapFramesKey (malformed -> Error(Format) naming the line). `options`
-  /// govern later inserts.
+  /// kMapFramesKey (malformed, or a number with a sign -> Error(Format)
+  /// naming the line). A model of support size 0 (unknown) ->
+  /// Error(InvalidArgument): every flush merges by support size and would
+  /// have to guess its weight against the new points' (merge() refuses it).
+  /// `options` govern later inserts.
   static Map from_model(const Model& model, const MapOptions& options = {});
 
   struct State;  ///< the implementation (core/src/map_state.hpp)

@@ -44,6 +44,13 @@ bool bandwidth_is_usable(double bandwidth);
 /// Throws Error(InvalidArgument) naming the exact value unless bandwidth_is_usable.
 void require_usable_bandwidth(double bandwidth);
 
+/// Throws Error(Limit) naming the axis and bandwidth when the mode count
+/// cannot index the 2-D features (range, gray) of `points2d` (N x 2,
+/// row-major, finite) at `bandwidth`: an axis spanning more than 1e8
+/// bandwidths, or a value beyond 1e15 bandwidths. Both mean shifts apply it;
+/// the map applies it to a batch before accepting the insert that forms it.
+void require_mode_count_range(const std::vector<double>& points2d, double bandwidth);
+
 /// Flat-kernel mean shift with bin seeding on 2-D data (N x 2, row-major), as
 /// scikit-learn's MeanShift(bin_seeding=True, min_bin_freq=1, cluster_all):
 /// seeds are the centres of occupied grid cells of size `bandwidth`; each moves

@@ -205,6 +205,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
         [HANDLE, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN],
     ),
     "sogmm_map_flush": (STATUS, [HANDLE]),
+    "sogmm_map_discard_pending": (STATUS, [HANDLE, POINTER(c_uint64)]),
     "sogmm_map_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
     "sogmm_map_get_stats": (STATUS, [HANDLE, POINTER(MapStats)]),
     "sogmm_map_get_frame_stats": (STATUS, [HANDLE, c_uint64, POINTER(MapFrameStats)]),

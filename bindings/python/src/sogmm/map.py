@@ -233,6 +233,15 @@ class Map:
         self._call("flush", progress, lambda h: lib.sogmm_map_flush(h))
         return self.n_components_ - before
 
+    def discard_pending(self) -> int:
+        """Drops the points pending for a fit (they never become components);
+        returns how many there were. The frames stay recorded. The way out
+        when a flush keeps failing and the map cannot be saved."""
+        dropped = c_uint64()
+        with self._guard.changing("discard_pending"):
+            check(lib.sogmm_map_discard_pending(self._h(), byref(dropped)))
+        return int(dropped.value)
+
     # ---- statistics ----------------------------------------------------------
     def stats(self) -> dict:
         """n_components, n_pending, n_frames, n_flushes, n_fused."""

@@ -374,6 +374,7 @@ extern "C" {
         pose: *const f64,
     ) -> sogmm_status;
     pub fn sogmm_map_flush(map: *mut sogmm_map) -> sogmm_status;
+    pub fn sogmm_map_discard_pending(map: *mut sogmm_map, dropped: *mut u64) -> sogmm_status;
     pub fn sogmm_map_set_progress(map: *mut sogmm_map, fn_: sogmm_progress_fn, user_data: *mut c_void) -> sogmm_status;
     pub fn sogmm_map_get_stats(map: *const sogmm_map, out: *mut sogmm_map_stats) -> sogmm_status;
     pub fn sogmm_map_get_frame_stats(

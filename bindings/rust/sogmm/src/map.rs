@@ -144,6 +144,16 @@ impl Map {
         check(unsafe { sys::sogmm_map_flush(self.ptr.as_ptr()) })
     }
 
+    /// Drops the points pending for a fit (they never become components) and
+    /// returns how many there were. The frames stay recorded. The way out when
+    /// a flush keeps failing and the map cannot be saved.
+    pub fn discard_pending(&mut self) -> Result<u64> {
+        let mut dropped = 0u64;
+        // SAFETY: exclusive through &mut self; `dropped` outlives the call.
+        check(unsafe { sys::sogmm_map_discard_pending(self.ptr.as_ptr(), &mut dropped) })?;
+        Ok(dropped)
+    }
+
     /// As `insert_points`, reporting the fit it may run to `on_progress`
     /// (see `Model::fit_with_progress`). `ControlFlow::Break(())` or a panic
     /// cancels: `Err` with `Status::Cancelled` (the panic resumes) and the

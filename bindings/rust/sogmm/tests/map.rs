@@ -287,3 +287,23 @@ fn revisit_refit_ratio_is_checked_and_reaches_the_map() {
     assert_eq!(fits(None), 2);
     assert_eq!(fits(Some(0.0)), 1);
 }
+
+#[test]
+fn discard_pending_unlocks_a_map_that_cannot_be_saved() {
+    let pts = blobs(300, 3);
+    let mut map = Map::new(Some(&map_options(true))).unwrap();
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    let dir = std::env::temp_dir().join(format!("sogmm_rust_discard_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("pending.sogmm");
+    // Pending points: no save (flush first).
+    assert_eq!(map.save(&path, None).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(map.discard_pending().unwrap(), 300);
+    let s = map.stats().unwrap();
+    assert_eq!((s.n_frames, s.n_pending, s.n_components), (1, 0, 0));
+    assert_eq!(map.discard_pending().unwrap(), 0);
+    // The dropped points' voxels are forgotten: the same frame is new again.
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    assert_eq!(map.frame_stats(1).unwrap().n_novel, 300);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,200 @@
+// Issue 36 through the C API: a map insert either commits points a flush can
+// fit or fails at that call with a status and a message naming the cause,
+// leaving the map unchanged; sogmm_map_discard_pending drops what is pending;
+// sogmm_map_load refuses a model of unknown support and signed counts in
+// "map_frames". Each case locked the map (every later flush failing, and the
+// save refusing) or was accepted wrongly on 9ad39ee.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sogmm/sogmm.h"
+#include "test_support.hpp"
+
+namespace {
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+std::string last_error() { return sogmm_last_error(); }
+
+std::vector<double> translated(double tx) {
+  return {1, 0, 0, tx, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+}
+
+// n points (x, y, z, gray) on a textured wall 1.5 m ahead, from a fixed LCG.
+std::vector<float> wall(std::size_t n, std::uint64_t seed) {
+  std::uint64_t s = seed;
+  auto next = [&] {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(s >> 40) / static_cast<double>(1ULL << 24);
+  };
+  std::vector<float> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = 0.6 * next() - 0.3, y = 0.6 * next() - 0.3;
+    p.insert(p.end(), {static_cast<float>(x), static_cast<float>(y), static_cast<float>(1.5 + 0.004 * next()),
+                       static_cast<float>(0.5 + 0.3 * std::sin(8.0 * x))});
+  }
+  return p;
+}
+
+struct MapHandle {
+  sogmm_map* map = nullptr;
+  explicit MapHandle(int64_t batch = 100000) {
+    sogmm_options* o = nullptr;
+    EXPECT_EQ(sogmm_options_create(&o), SOGMM_OK);
+    EXPECT_EQ(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, batch), SOGMM_OK);
+    EXPECT_EQ(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 2), SOGMM_OK);
+    EXPECT_EQ(sogmm_map_create(&map, o), SOGMM_OK);
+    sogmm_options_free(o);
+  }
+  ~MapHandle() { sogmm_map_free(map); }
+  sogmm_map_stats stats() const {
+    sogmm_map_stats s{};
+    EXPECT_EQ(sogmm_map_get_stats(map, &s), SOGMM_OK);
+    return s;
+  }
+  sogmm_status insert(const std::vector<float>& p, const std::vector<double>& pose) {
+    return sogmm_map_insert_points_f32(map, p.data(), p.size() / 4, pose.data());
+  }
+};
+
+void expect_same(const sogmm_map_stats& a, const sogmm_map_stats& b) {
+  EXPECT_EQ(a.n_components, b.n_components);
+  EXPECT_EQ(a.n_pending, b.n_pending);
+  EXPECT_EQ(a.n_frames, b.n_frames);
+  EXPECT_EQ(a.n_flushes, b.n_flushes);
+}
+
+TEST(CapiMapValidity, FarPosesFailAtTheInsertNotAtALaterFlush) {
+  const std::vector<float> a = wall(300, 1), b = wall(300, 2);
+  for (const double far : {1e10, 1e20}) {
+    SCOPED_TRACE(far);
+    MapHandle m;
+    ASSERT_EQ(m.insert(a, translated(far)), SOGMM_OK);
+    const sogmm_map_stats before = m.stats();
+    EXPECT_EQ(m.insert(b, translated(0)), SOGMM_E_LIMIT);
+    EXPECT_TRUE(has(last_error(), "pending") && has(last_error(), "flush")) << last_error();
+    expect_same(m.stats(), before);
+    EXPECT_EQ(sogmm_map_flush(m.map), SOGMM_OK) << last_error();
+    EXPECT_EQ(m.insert(b, translated(0)), SOGMM_OK) << last_error();
+    EXPECT_EQ(sogmm_map_flush(m.map), SOGMM_OK) << last_error();
+  }
+  MapHandle m;
+  EXPECT_EQ(m.insert(a, translated(1e39)), SOGMM_E_INVALID_ARG);
+  EXPECT_TRUE(has(last_error(), "float32")) << last_error();
+  EXPECT_EQ(m.stats().n_frames, 0u);
+  EXPECT_EQ(m.stats().n_pending, 0u);
+}
+
+// One point 2e6 m away: the map fits novel points at bandwidth x 0.7 = 0.014,
+// where 2e6 m is 1.4e8 bandwidths (the mode count takes 1e8); so does
+// sogmm_fit_points_f32 at 0.014, while at 0.02 both accept it.
+TEST(CapiMapValidity, AFarPointIsJudgedAsAFitAtTheBatchBandwidth) {
+  std::vector<float> pts = wall(300, 3);
+  pts.insert(pts.end(), {2.0e6f, 0.0f, 0.0f, 0.5f});
+  const std::size_t n = pts.size() / 4;
+  sogmm_options* o = nullptr;
+  ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
+  ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02 * 0.7), SOGMM_OK);
+  sogmm_model* fitted = nullptr;
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, o), SOGMM_E_LIMIT);
+  ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02), SOGMM_OK);
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, o), SOGMM_OK) << last_error();
+  sogmm_model_free(fitted);
+  sogmm_options_free(o);
+  MapHandle m;
+  EXPECT_EQ(m.insert(pts, translated(0)), SOGMM_E_LIMIT);
+  EXPECT_TRUE(has(last_error(), "batch bandwidth 0.01399")) << last_error();
+  EXPECT_EQ(m.stats().n_frames, 0u);
+}
+
+// fx = fy = 1e-30 on the first RGB-D frame: refused, and the camera is not fixed.
+TEST(CapiMapValidity, AnAbsurdFirstCameraIsRefusedAndFixesNothing) {
+  const uint32_t w = 64, h = 48;
+  std::vector<uint16_t> depth(w * h);
+  std::vector<uint8_t> gray(w * h);
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    depth[i] = static_cast<uint16_t>(1400 + (i % w) * 3);
+    gray[i] = static_cast<uint8_t>(80 + 100 * ((i / w) % 2));
+  }
+  MapHandle m;
+  const std::vector<double> pose = translated(0);
+  EXPECT_EQ(sogmm_map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 1e-30, 1e-30, 32, 24,
+                                  pose.data()),
+            SOGMM_E_LIMIT);
+  EXPECT_TRUE(has(last_error(), "intrinsics")) << last_error();
+  EXPECT_EQ(m.stats().n_frames, 0u);
+  EXPECT_EQ(sogmm_map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 60, 60, 32, 24,
+                                  pose.data()),
+            SOGMM_OK)
+      << last_error();
+}
+
+TEST(CapiMapValidity, AFixedKAboveTheBatchSizeIsRefusedAtCreate) {
+  sogmm_options* o = nullptr;
+  ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
+  ASSERT_EQ(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 100), SOGMM_OK);
+  ASSERT_EQ(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, 50), SOGMM_OK);
+  sogmm_map* map = nullptr;
+  EXPECT_EQ(sogmm_map_create(&map, o), SOGMM_E_INVALID_ARG);
+  EXPECT_EQ(map, nullptr);
+  EXPECT_TRUE(has(last_error(), "K = 100")) << last_error();
+  sogmm_options_free(o);
+}
+
+TEST(CapiMapValidity, DiscardPendingDropsThePendingPoints) {
+  MapHandle m;
+  const std::vector<float> a = wall(300, 4);
+  ASSERT_EQ(m.insert(a, translated(0)), SOGMM_OK);
+  const std::string dir = sogmm::test::make_scratch_dir("sogmm-discard");
+  const std::string path = dir + "/map.sogmm";
+  EXPECT_EQ(sogmm_map_save(m.map, path.c_str(), nullptr), SOGMM_E_INVALID_ARG);  // pending: flush first
+  uint64_t dropped = 7;
+  EXPECT_EQ(sogmm_map_discard_pending(m.map, &dropped), SOGMM_OK);
+  EXPECT_EQ(dropped, 300u);
+  EXPECT_EQ(m.stats().n_pending, 0u);
+  EXPECT_EQ(m.stats().n_frames, 1u);
+  EXPECT_EQ(sogmm_map_discard_pending(m.map, nullptr), SOGMM_OK);  // the count is optional
+  EXPECT_EQ(sogmm_map_discard_pending(nullptr, &dropped), SOGMM_E_NULL_ARG);
+  ASSERT_EQ(m.insert(a, translated(0)), SOGMM_OK);
+  ASSERT_EQ(sogmm_map_flush(m.map), SOGMM_OK);
+  EXPECT_EQ(sogmm_map_save(m.map, path.c_str(), nullptr), SOGMM_OK) << last_error();
+  sogmm::test::remove_scratch_dir(dir);
+}
+
+// A world-frame file of unknown support (0) and "map_frames" with signed counts.
+TEST(CapiMapValidity, LoadRefusesUnknownSupportAndSignedCounts) {
+  const float weight = 1.0f, mean[4] = {0, 0, 1, 0.5f};
+  float cov[16] = {};
+  for (int i = 0; i < 4; ++i) cov[5 * i] = 0.01f;
+  const std::string dir = sogmm::test::make_scratch_dir("sogmm-load");
+  const std::string path = dir + "/m.sogmm";
+  sogmm_map* map = nullptr;
+  for (const uint64_t support : {uint64_t{0}, uint64_t{10}}) {
+    sogmm_model* model = nullptr;
+    ASSERT_EQ(sogmm_model_from_arrays_f32(&model, 1, &weight, mean, cov, support), SOGMM_OK);
+    ASSERT_EQ(sogmm_model_set_value(model, "coordinate_frame", "world"), SOGMM_OK);
+    ASSERT_EQ(sogmm_model_save(model, path.c_str(), nullptr), SOGMM_OK) << last_error();
+    EXPECT_EQ(sogmm_map_load(&map, path.c_str(), nullptr), support == 0 ? SOGMM_E_INVALID_ARG : SOGMM_OK);
+    if (support == 0) {
+      EXPECT_TRUE(has(last_error(), "support size is 0")) << last_error();
+    }
+    sogmm_map_free(map);
+    map = nullptr;
+    for (const char* frames : {"0 -1 10 1 0 0 0 0 1 0 0 0 0 1 0 1\n", "0 10 10 1 0 0 0 0 1 0 0 0 0 1 0 -1\n"}) {
+      if (support == 0) break;
+      SCOPED_TRACE(frames);
+      ASSERT_EQ(sogmm_model_set_value(model, "map_frames", frames), SOGMM_OK);
+      ASSERT_EQ(sogmm_model_save(model, path.c_str(), nullptr), SOGMM_OK) << last_error();
+      EXPECT_EQ(sogmm_map_load(&map, path.c_str(), nullptr), SOGMM_E_FORMAT);
+      EXPECT_TRUE(has(last_error(), "map_frames")) << last_error();
+      EXPECT_EQ(map, nullptr);
+    }
+    sogmm_model_free(model);
+  }
+  sogmm::test::remove_scratch_dir(dir);
+}
+
+}  // namespace
