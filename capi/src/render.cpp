@@ -24,12 +24,14 @@ using sogmm_capi::require_nonnull;
 void render_into(const sogmm::Gmm& gmm, std::uint32_t width, std::uint32_t height, double fx, double fy, double cx,
                  double cy, const double* camera_to_world, const sogmm_options* options, float* depth_out,
                  float* gray_out, float* variance_out) {
-  require_nonnull(depth_out, "depth_out");
-  require_nonnull(gray_out, "gray_out");
+  // The size first: an empty image has no buffers to pass (bindings call
+  // with NULL outputs for it and get the size named).
   constexpr std::uint32_t kMax = static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max());
   if (width == 0 || height == 0 || width > kMax || height > kMax)
     fail(SOGMM_E_INVALID_ARG, "image size " + std::to_string(width) + " x " + std::to_string(height) +
                                   " (each must be in [1, 2^31 - 1])");
+  require_nonnull(depth_out, "depth_out");
+  require_nonnull(gray_out, "gray_out");
   const sogmm::Camera camera{static_cast<int>(width), static_cast<int>(height), fx, fy, cx, cy};
   std::array<double, 16> pose{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   if (camera_to_world != nullptr) pose = sogmm_capi::require_rigid(camera_to_world, "camera_to_world");

@@ -577,8 +577,10 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
  * the progress callback (SOGMM_STAGE_RENDERING; a cancel returns
  * SOGMM_E_CANCELLED with the outputs untouched). Moving model and pose
  * together by one rigid transform renders the same images (up to rounding).
- * Errors: model, depth_out or gray_out NULL -> SOGMM_E_NULL_ARG; width or
- * height 0 or > INT32_MAX, bad intrinsics, a pose that is not rigid,
+ * Errors (the image size before the output pointers): width or height 0 or
+ * > INT32_MAX ->
+ * SOGMM_E_INVALID_ARG; model, depth_out or gray_out NULL ->
+ * SOGMM_E_NULL_ARG; bad intrinsics, a pose that is not rigid,
  * DEPTH_MIN >= DEPTH_MAX -> SOGMM_E_INVALID_ARG; more than
  * SOGMM_MAX_RENDER_PIXELS pixels -> SOGMM_E_LIMIT. */
 SOGMM_API sogmm_status sogmm_model_render_f32(const sogmm_model* model, uint32_t width, uint32_t height, double fx,

@@ -292,7 +292,22 @@ impl Map {
             pose,
             Box::new(|c: &Camera, p, depth, gray, var| {
                 // SAFETY: render_into passes width * height floats of room in each image; `p` is 16 doubles or NULL.
-                unsafe { sys::sogmm_map_render_f32(self.raw(), c.width, c.height, c.fx, c.fy, c.cx, c.cy, p, o, depth, gray, var) }
+                unsafe {
+                    sys::sogmm_map_render_f32(
+                        self.raw(),
+                        c.width,
+                        c.height,
+                        c.fx,
+                        c.fy,
+                        c.cx,
+                        c.cy,
+                        p,
+                        o,
+                        depth,
+                        gray,
+                        var,
+                    )
+                }
             }),
         )
     }

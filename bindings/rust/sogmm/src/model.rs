@@ -6,8 +6,8 @@ use std::ptr::{self, NonNull};
 use sogmm_sys as sys;
 
 use crate::error::{check, Error, Result, Status};
-use crate::options::{opt_ptr, Options};
 use crate::map::Pose;
+use crate::options::{opt_ptr, Options};
 use crate::progress::{with_progress, Progress};
 use crate::render::{render_into, Camera, Rendered};
 use std::ops::ControlFlow;
@@ -573,7 +573,22 @@ impl Model {
             pose,
             Box::new(|c: &Camera, p, depth, gray, var| {
                 // SAFETY: render_into passes width * height floats of room in each image; `p` is 16 doubles or NULL.
-                unsafe { sys::sogmm_model_render_f32(self.raw(), c.width, c.height, c.fx, c.fy, c.cx, c.cy, p, o, depth, gray, var) }
+                unsafe {
+                    sys::sogmm_model_render_f32(
+                        self.raw(),
+                        c.width,
+                        c.height,
+                        c.fx,
+                        c.fy,
+                        c.cx,
+                        c.cy,
+                        p,
+                        o,
+                        depth,
+                        gray,
+                        var,
+                    )
+                }
             }),
         )
     }

@@ -30,7 +30,8 @@ pub struct Rendered {
 }
 
 /// The C call of a render: (camera, pose or NULL, depth, gray, variance).
-pub(crate) type RenderCall<'a> = dyn FnOnce(&Camera, *const f64, *mut f32, *mut f32, *mut f32) -> sys::sogmm_status + 'a;
+pub(crate) type RenderCall<'a> =
+    dyn FnOnce(&Camera, *const f64, *mut f32, *mut f32, *mut f32) -> sys::sogmm_status + 'a;
 
 /// Allocates the three images (after the pixel limit, so that no huge
 /// buffer is allocated for a call that must fail) and runs `call`.
@@ -41,13 +42,30 @@ pub(crate) fn render_into(camera: &Camera, pose: Option<&Pose>, call: Box<Render
         .ok_or_else(|| {
             Error::new(
                 Status::Limit,
-                format!("render: {} x {} pixels exceed {}", camera.width, camera.height, sys::SOGMM_MAX_RENDER_PIXELS),
+                format!(
+                    "render: {} x {} pixels exceed {}",
+                    camera.width,
+                    camera.height,
+                    sys::SOGMM_MAX_RENDER_PIXELS
+                ),
             )
         })?;
     let mut depth = vec![0.0f32; pixels];
     let mut gray = vec![0.0f32; pixels];
     let mut variance = vec![0.0f32; pixels];
     let p = pose.map_or(std::ptr::null(), |p| p.as_ptr());
-    check(call(camera, p, depth.as_mut_ptr(), gray.as_mut_ptr(), variance.as_mut_ptr()))?;
-    Ok(Rendered { width: camera.width, height: camera.height, depth, gray, variance })
+    check(call(
+        camera,
+        p,
+        depth.as_mut_ptr(),
+        gray.as_mut_ptr(),
+        variance.as_mut_ptr(),
+    ))?;
+    Ok(Rendered {
+        width: camera.width,
+        height: camera.height,
+        depth,
+        gray,
+        variance,
+    })
 }

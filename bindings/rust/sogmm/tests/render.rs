@@ -7,7 +7,14 @@ use std::ops::ControlFlow;
 use sogmm::{Camera, Map, Model, Options, Pose, Stage, Status};
 
 const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
-const CAM: Camera = Camera { width: 9, height: 7, fx: 10.0, fy: 12.0, cx: 4.0, cy: 3.0 };
+const CAM: Camera = Camera {
+    width: 9,
+    height: 7,
+    fx: 10.0,
+    fy: 12.0,
+    cx: 4.0,
+    cy: 3.0,
+};
 const CENTRE: usize = 3 * 9 + 4;
 
 /// One component at (0, 0, 1.5), gray 0.4, gray correlated with x (cov 0.002):
@@ -37,10 +44,22 @@ fn moving_model_and_pose_together_renders_the_same() {
     // A rotation of 0.7 rad about (1, 1, 0) / sqrt 2 (Rodrigues) and a shift.
     let (c, s, r) = (0.7f64.cos(), 0.7f64.sin(), std::f64::consts::FRAC_1_SQRT_2);
     let t: Pose = [
-        c + r * r * (1. - c), r * r * (1. - c), r * s, 1.0,
-        r * r * (1. - c), c + r * r * (1. - c), -r * s, -2.0,
-        -r * s, r * s, c, 0.5,
-        0., 0., 0., 1.,
+        c + r * r * (1. - c),
+        r * r * (1. - c),
+        r * s,
+        1.0,
+        r * r * (1. - c),
+        c + r * r * (1. - c),
+        -r * s,
+        -2.0,
+        -r * s,
+        r * s,
+        c,
+        0.5,
+        0.,
+        0.,
+        0.,
+        1.,
     ];
     let m = on_axis();
     let a = m.render(&CAM, None, None).unwrap();
@@ -52,7 +71,10 @@ fn moving_model_and_pose_together_renders_the_same() {
             continue;
         }
         shown += 1;
-        assert!((a.depth[i] - b.depth[i]).abs() < 1e-5 && (a.gray[i] - b.gray[i]).abs() < 1e-5, "pixel {i}");
+        assert!(
+            (a.depth[i] - b.depth[i]).abs() < 1e-5 && (a.gray[i] - b.gray[i]).abs() < 1e-5,
+            "pixel {i}"
+        );
     }
     assert!(shown > 0);
 }
@@ -70,7 +92,14 @@ fn blobs(n: usize, seed: u64) -> Vec<f32> {
 
 #[test]
 fn map_renders_as_its_export_with_progress_and_cancel() {
-    let cam = Camera { width: 40, height: 30, fx: 30.0, fy: 30.0, cx: 19.5, cy: 14.5 };
+    let cam = Camera {
+        width: 40,
+        height: 30,
+        fx: 30.0,
+        fy: 30.0,
+        cx: 19.5,
+        cy: 14.5,
+    };
     let opts = Options::builder().map_batch_size(100_000).threads(2).build().unwrap();
     let mut map = Map::new(Some(&opts)).unwrap();
     assert_eq!(map.render(&cam, None, None).unwrap_err().status(), Status::InvalidData);
@@ -100,13 +129,23 @@ fn bad_input_is_an_error() {
     let m = on_axis();
     let mut scaled = IDENTITY;
     scaled[0] = 2.0;
-    assert_eq!(m.render(&CAM, Some(&scaled), None).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        m.render(&CAM, Some(&scaled), None).unwrap_err().status(),
+        Status::InvalidArg
+    );
     let zero = Camera { width: 0, ..CAM };
     assert_eq!(m.render(&zero, None, None).unwrap_err().status(), Status::InvalidArg);
     let flat = Camera { fx: 0.0, ..CAM };
     assert_eq!(m.render(&flat, None, None).unwrap_err().status(), Status::InvalidArg);
-    let huge = Camera { width: 20000, height: 20000, ..CAM };
+    let huge = Camera {
+        width: 20000,
+        height: 20000,
+        ..CAM
+    };
     assert_eq!(m.render(&huge, None, None).unwrap_err().status(), Status::Limit);
     let reversed = Options::builder().depth_min(2.0).depth_max(1.0).build().unwrap();
-    assert_eq!(m.render(&CAM, None, Some(&reversed)).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        m.render(&CAM, None, Some(&reversed)).unwrap_err().status(),
+        Status::InvalidArg
+    );
 }
