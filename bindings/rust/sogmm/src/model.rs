@@ -568,29 +568,7 @@ impl Model {
     }
 
     fn render_raw(&self, camera: &Camera, pose: Option<&Pose>, o: *const sys::sogmm_options) -> Result<Rendered> {
-        render_into(
-            camera,
-            pose,
-            Box::new(|c: &Camera, p, depth, gray, var| {
-                // SAFETY: render_into passes width * height floats of room in each image; `p` is 16 doubles or NULL.
-                unsafe {
-                    sys::sogmm_model_render_f32(
-                        self.raw(),
-                        c.width,
-                        c.height,
-                        c.fx,
-                        c.fy,
-                        c.cx,
-                        c.cy,
-                        p,
-                        o,
-                        depth,
-                        gray,
-                        var,
-                    )
-                }
-            }),
-        )
+        render_into(sys::sogmm_model_render_f32, self.raw(), camera, pose, o)
     }
 
     /// A new model moved by a rigid 4 x 4 row-major transform.

@@ -29,13 +29,33 @@ pub struct Rendered {
     pub variance: Vec<f32>,
 }
 
-/// The C call of a render: (camera, pose or NULL, depth, gray, variance).
-pub(crate) type RenderCall<'a> =
-    dyn FnOnce(&Camera, *const f64, *mut f32, *mut f32, *mut f32) -> sys::sogmm_status + 'a;
+/// sogmm_model_render_f32 or sogmm_map_render_f32, over the handle type `H`.
+pub(crate) type RenderFn<H> = unsafe extern "C" fn(
+    *const H,
+    u32,
+    u32,
+    f64,
+    f64,
+    f64,
+    f64,
+    *const f64,
+    *const sys::sogmm_options,
+    *mut f32,
+    *mut f32,
+    *mut f32,
+) -> sys::sogmm_status;
 
 /// Allocates the three images (after the pixel limit, so that no huge
-/// buffer is allocated for a call that must fail) and runs `call`.
-pub(crate) fn render_into(camera: &Camera, pose: Option<&Pose>, call: Box<RenderCall<'_>>) -> Result<Rendered> {
+/// buffer is allocated for a call that must fail) and renders `handle` with
+/// `render` into them. `handle` must be a valid handle of its type and `o`
+/// valid options or NULL.
+pub(crate) fn render_into<H>(
+    render: RenderFn<H>,
+    handle: *const H,
+    camera: &Camera,
+    pose: Option<&Pose>,
+    o: *const sys::sogmm_options,
+) -> Result<Rendered> {
     let pixels = (camera.width as usize)
         .checked_mul(camera.height as usize)
         .filter(|&n| n <= sys::SOGMM_MAX_RENDER_PIXELS)
@@ -54,13 +74,25 @@ pub(crate) fn render_into(camera: &Camera, pose: Option<&Pose>, call: Box<Render
     let mut gray = vec![0.0f32; pixels];
     let mut variance = vec![0.0f32; pixels];
     let p = pose.map_or(std::ptr::null(), |p| p.as_ptr());
-    check(call(
-        camera,
-        p,
-        depth.as_mut_ptr(),
-        gray.as_mut_ptr(),
-        variance.as_mut_ptr(),
-    ))?;
+    let c = camera;
+    // SAFETY: width * height floats of room in each image; `p` is 16 doubles
+    // or NULL; `handle` and `o` as the caller promises.
+    check(unsafe {
+        render(
+            handle,
+            c.width,
+            c.height,
+            c.fx,
+            c.fy,
+            c.cx,
+            c.cy,
+            p,
+            o,
+            depth.as_mut_ptr(),
+            gray.as_mut_ptr(),
+            variance.as_mut_ptr(),
+        )
+    })?;
     Ok(Rendered {
         width: camera.width,
         height: camera.height,

@@ -79,17 +79,6 @@ fn moving_model_and_pose_together_renders_the_same() {
     assert!(shown > 0);
 }
 
-/// Deterministic cloud: three tight blobs (x, y, z, gray) from a fixed LCG.
-fn blobs(n: usize, seed: u64) -> Vec<f32> {
-    let centres = [[0.0, 0.0, 1.0, 0.2], [0.5, 0.0, 1.5, 0.5], [0.0, 0.5, 2.0, 0.8]];
-    let mut s = seed;
-    let mut next = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((s >> 40) as f32 / (1u64 << 24) as f32) - 0.5
-    };
-    (0..n).flat_map(|i| centres[i % 3].map(|c| c + 0.05 * next())).collect()
-}
-
 #[test]
 fn map_renders_as_its_export_with_progress_and_cancel() {
     let cam = Camera {
@@ -103,7 +92,9 @@ fn map_renders_as_its_export_with_progress_and_cancel() {
     let opts = Options::builder().map_batch_size(100_000).threads(2).build().unwrap();
     let mut map = Map::new(Some(&opts)).unwrap();
     assert_eq!(map.render(&cam, None, None).unwrap_err().status(), Status::InvalidData);
-    map.insert_points(&blobs(3000, 7), &IDENTITY).unwrap();
+    // Points drawn from a model stand for a frame.
+    let pts = on_axis().sample(3000, 7, 4).unwrap();
+    map.insert_points(&pts, &IDENTITY).unwrap();
     map.flush().unwrap();
     let a = map.render(&cam, Some(&IDENTITY), Some(&opts)).unwrap();
     let mut last = (None, 0u64);
