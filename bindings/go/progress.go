@@ -25,6 +25,7 @@ const (
 	StageSampling   Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
 	StageScoring    Stage = C.SOGMM_STAGE_SCORING    // scoring on a map; Step/Total: points scored / requested
 	StageRegression Stage = C.SOGMM_STAGE_REGRESSION // gray regression on a map; Step/Total: points done / requested
+	StageRendering  Stage = C.SOGMM_STAGE_RENDERING  // rendering an image; Step/Total: rows done / height
 )
 
 // Progress is one report. Total is 0 when unknown; LogLikelihood is the mean

@@ -29,6 +29,7 @@ const char* stage_name(Stage stage) {
     case Stage::Sampling: return "sampling";
     case Stage::Scoring: return "scoring";
     case Stage::Regression: return "gray regression";
+    case Stage::Rendering: return "rendering";
   }
   return "an unknown stage";
 }

@@ -222,6 +222,27 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
           "eval MODEL (%.6f) differs from eval --bandwidth (%.6f)" % (ev.get("psnr", 0), ref.get("psnr", 0)))
     p = run(["eval", model] + fargs)
     check("PSNR (honest)" in p.stdout and "F-score" in p.stdout, "eval MODEL human output")
+    check("MRE (mass-weighted)" in p.stdout and "held-out (d = %d minus d = %d)" % (dec + 1, dec) in p.stdout,
+          "eval MODEL human output: mass-weighted labels and per-pixel rows: %r" % p.stdout)
+    # The bandwidth as typed (6 significant digits), not the double's 17.
+    check("bandwidth %s)" % ("%.6g" % bandwidth) in p.stdout, "eval MODEL bandwidth: %r" % p.stdout)
+    # Per-pixel figures (issue 29): the model rendered from the frame's camera. A frame's own fit shows
+    # the surface it was fitted on, on the fitting grid and on the held-out grid (d + 1 minus d) alike:
+    # the coarse fits here (d = 10; 68 components on the synthetic frame, 9 cm depth MAE) stay within
+    # 20 cm on average, with few empty pixels; the same model gives the same figures whether it was
+    # saved first or not.
+    for key in ("", "_heldout"):
+        mae, empty, pix = ev.get("depth_mae" + key), ev.get("empty_share" + key), ev.get("pixel_psnr" + key)
+        check(mae is not None and 0 <= mae < 0.2 and empty is not None and 0 <= empty < 0.2 and
+              pix is not None and pix > min_psnr - 4, "eval MODEL per-pixel figures%s: %s" % (key, ev))
+        check(ref.get("depth_mae" + key) == mae and ref.get("pixel_psnr" + key) == pix,
+              "eval --bandwidth per-pixel figures%s differ from eval MODEL: %s vs %s" % (key, ref, ev))
+    check(ev.get("heldout_decimate") == dec + 1 and 0 < ev.get("n_pixels_heldout", 0) and
+          0 < ev.get("n_pixels", 0) <= n, "eval MODEL grids: %s" % ev)
+    ll, llh = ev.get("log_likelihood_fit_grid"), ev.get("log_likelihood_heldout")
+    check(ll is not None and llh is not None and math.isfinite(ll) and math.isfinite(llh) and llh < ll + 1.0,
+          "eval MODEL log-likelihoods: fit grid %s, held out %s" % (ll, llh))
+    check(ref.get("log_likelihood_heldout") == llh and "log_likelihood" in ref, "eval --bandwidth held-out LL: %s" % ref)
     # --data-range R: the honest PSNR is 10 log10(R^2 / MSE), so R = 2 adds 20 log10 2 dB; the
     # paper-compatible figure keeps the authors' range 2 whatever R is.
     ev2 = run_json(["eval", model] + fargs + ["--data-range", 2])
@@ -323,6 +344,20 @@ def exercise_sequence(tmp, d, ext, frames, dec, bandwidth, extra, human):
     if human:
         p = run(["eval", seq, "--sequence", d, "--trajectory", traj, "--frames", "0:%d" % frames])
         check("mean" in p.stdout, "eval --sequence table has no mean row")
+    # A world-frame model on one frame: refused without its pose; with --trajectory --frame it scores
+    # exactly as that frame's row of eval --sequence.
+    k = frames - 1
+    err_p = run(["eval", seq] + frame_args(d, k, ext) + intr, expect=2)
+    check("world coordinates" in err_p.stderr and "--frame" in err_p.stderr and err_p.stdout == "",
+          "eval of a world-frame model without a pose: %r" % err_p.stderr)
+    one = run_json(["eval", seq] + frame_args(d, k, ext) + intr + ["--trajectory", traj, "--frame", k])
+    row = rows[k] if len(rows) > k else {}
+    for key in ("n_points", "psnr", "depth_mae", "pixel_psnr", "depth_mae_heldout", "empty_share_heldout",
+                "log_likelihood_heldout"):
+        check(key in row and one.get(key) == row.get(key),
+              "eval --trajectory --frame %d: %s = %s, eval --sequence row %s" % (k, key, one.get(key), row.get(key)))
+    run(["eval", seq] + frame_args(d, k, ext) + intr + ["--trajectory", traj], expect=2)
+    run(["eval", seq] + frame_args(d, k, ext) + intr + ["--trajectory", traj, "--frame", 99], expect=2)
     out = os.path.join(tmp, "view.png")
     run(["render", seq, "--trajectory", traj, "--frame", frames - 1, "-o", out])
     img = read_png(out)

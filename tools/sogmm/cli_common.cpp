@@ -321,7 +321,7 @@ int run_guarded(const std::function<int()>& body) {
 #include <nlohmann/json.hpp>
 
 namespace sogmm::tools {
-void print_evaluation(const Evaluation& e, bool json) {
+void print_evaluation(const Evaluation& e, bool json, const nlohmann::json* extra) {
   const auto& f = e.fit;
   if (json) {
     nlohmann::json j;
@@ -345,6 +345,7 @@ void print_evaluation(const Evaluation& e, bool json) {
     j["seconds_seeding"] = f.seconds_seeding;
     j["seconds_em"] = f.seconds_em;
     j["seconds_total"] = f.seconds_total;
+    if (extra != nullptr) j.update(*extra);
     std::printf("%s\n", j.dump().c_str());
     return;
   }
@@ -360,9 +361,10 @@ void print_evaluation(const Evaluation& e, bool json) {
   std::printf("time total          %.3f s\n", f.seconds_total);
   std::printf("PSNR (honest)       %.2f dB (data range %g)\n", e.psnr.psnr, e.psnr.data_range);
   std::printf("PSNR (paper-compat) %.2f dB (+13.98 dB for the paper's 640x480 canvas)\n", e.psnr.psnr_paper);
-  std::printf("MRE                 %.4f m\n", e.reconstruction.mre);
-  std::printf("precision / recall  %.3f / %.3f (authors' naming)\n", e.reconstruction.precision, e.reconstruction.recall);
-  std::printf("F-score @ 0.01 m    %.3f\n", e.reconstruction.fscore);
+  std::printf("MRE (mass-weighted) %.4f m\n", e.reconstruction.mre);
+  std::printf("precision / recall  %.3f / %.3f (mass-weighted; authors' naming)\n", e.reconstruction.precision,
+              e.reconstruction.recall);
+  std::printf("F-score @ 0.01 m    %.3f (mass-weighted)\n", e.reconstruction.fscore);
   std::printf("model bytes (paper) %zu\n", e.model_bytes);
 }
 }  // namespace sogmm::tools

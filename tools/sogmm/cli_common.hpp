@@ -7,6 +7,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "image_io.hpp"
 #include "sogmm/camera.hpp"
@@ -80,8 +81,8 @@ namespace sogmm::tools {
 /// honest PSNR's peak; the paper figure always uses 2), mre, precision, recall,
 /// fscore, model_bytes, em_iterations, converged, log_likelihood, n_init,
 /// run, run_log_likelihoods, seconds_mode_count, seconds_seeding, seconds_em,
-/// seconds_total.
-void print_evaluation(const Evaluation& e, bool json);
+/// seconds_total, plus the members of `extra` (if given) in JSON mode.
+void print_evaluation(const Evaluation& e, bool json, const nlohmann::json* extra = nullptr);
 
 /// A subcommand: its CLI11 parser and what to run when it is chosen.
 struct Command {

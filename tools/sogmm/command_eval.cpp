@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "eval_pixels.hpp"
 #include "model_io.hpp"
 #include "sequence.hpp"
 #include "sogmm/error.hpp"
@@ -27,6 +28,7 @@ struct EvalState {
   DepthOptions depth_options;
   FitOptions fit;
   double data_range = 1.0;  // honest PSNR's peak (--data-range)
+  int frame = -1;           // --frame I of --trajectory (one frame of a world-frame model)
   bool json = false;
 };
 
@@ -85,13 +87,24 @@ struct FrameScore {
   PsnrResult psnr;
   ReconstructionResult rec;
   std::size_t n_samples = 0;
+  PixelFigures pixels;
 };
 
 nlohmann::json to_json(const FrameScore& f) {
-  return {{"frame", f.frame},         {"depth", f.depth},        {"n_points", f.n_points},
-          {"psnr", f.psnr.psnr},      {"psnr_paper", f.psnr.psnr_paper}, {"psnr_data_range", f.psnr.data_range},
-          {"mre", f.rec.mre},         {"precision", f.rec.precision},
-          {"recall", f.rec.recall},   {"fscore", f.rec.fscore},  {"n_samples", f.n_samples}};
+  nlohmann::json j = {{"frame", f.frame},         {"depth", f.depth},        {"n_points", f.n_points},
+                      {"psnr", f.psnr.psnr},      {"psnr_paper", f.psnr.psnr_paper}, {"psnr_data_range", f.psnr.data_range},
+                      {"mre", f.rec.mre},         {"precision", f.rec.precision},
+                      {"recall", f.rec.recall},   {"fscore", f.rec.fscore},  {"n_samples", f.n_samples}};
+  add_to_json(f.pixels, j);
+  return j;
+}
+
+// Bandwidth as the user would have typed it: 6 significant digits (0.014,
+// not the binary double's 0.013999999999999999).
+std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
 }
 
 void describe_model(const std::string& path, const Model& m, bool json, nlohmann::json& j) {
@@ -107,7 +120,7 @@ void describe_model(const std::string& path, const Model& m, bool json, nlohmann
   std::string how = "unknown fit";
   if (m.fit.known)
     how = m.fit.n_components_requested > 0 ? "fixed K = " + std::to_string(m.fit.n_components_requested)
-                                            : "bandwidth " + nlohmann::json(m.fit.bandwidth).dump();
+                                            : "bandwidth " + short_number(m.fit.bandwidth);
   std::printf("model               %s (%zu components, support size %llu, %s)\n", path.c_str(), m.gmm.size(),
               static_cast<unsigned long long>(m.gmm.support_size), how.c_str());
   std::printf("model bytes (paper) %zu; file %s\n", paper_model_bytes(m.gmm), human_bytes(bytes).c_str());
@@ -118,19 +131,31 @@ int run_fit_and_eval(const EvalState& s) {
   const Camera camera = resolve_camera(s.camera, frame);
   const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, s.src.depth);
   FitResult fitted = fit(cloud.view(), s.fit);
+  const PixelFigures pixels = pixel_figures(fitted.gmm, frame, camera, s.depth_options, s.data_range);
   const Evaluation e =
       evaluate(std::move(fitted), cloud.view(), decimated(camera, s.depth_options.decimate), s.fit.seed, s.data_range);
-  print_evaluation(e, s.json);
+  nlohmann::json extra;
+  add_to_json(pixels, extra);
+  print_evaluation(e, s.json, s.json ? &extra : nullptr);
+  if (!s.json) print_pixel_figures(pixels);
   return 0;
 }
 
 int run_model_frame(const EvalState& s, const CLI::App& app) {
   const Model model = load_model(s.model);
-  if (key_value(model, "coordinate_frame") == "world")
-    std::fprintf(stderr,
-                 "sogmm: note: %s is in world coordinates (a sequence model); evaluate it with --sequence DIR "
-                 "--trajectory FILE to move it into each frame's camera\n",
-                 s.model.c_str());
+  Gmm gmm = model.gmm;
+  if (!s.src.trajectory.empty()) {
+    const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
+    require(static_cast<std::size_t>(s.frame) < poses.size(), ErrorCode::InvalidArgument,
+            "eval: --frame must be in [0, " + std::to_string(poses.size()) + ") for " + s.src.trajectory);
+    gmm = transform(gmm, inverse_rigid(poses[static_cast<std::size_t>(s.frame)]));
+  } else {
+    // A world-frame model seen from the world origin scores nothing the
+    // frame saw: refuse instead of printing meaningless figures.
+    require(key_value(model, "coordinate_frame") != "world", ErrorCode::InvalidArgument,
+            "eval: " + s.model + " is in world coordinates (a sequence model or map): give --trajectory FILE "
+            "--frame I to score it from that frame's camera, or --sequence DIR --trajectory FILE for every frame");
+  }
   const LoadedFrame frame = load_frame(s.src.depth, s.src.color);
   Camera camera;
   if (camera_flags_given(s.camera)) {
@@ -148,9 +173,10 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
   FrameScore f;
   f.depth = s.src.depth;
   f.n_points = cloud.size();
-  f.psnr = psnr(model.gmm, cloud.view(), dc, s.data_range);
-  f.rec = reconstruction_metrics(model.gmm, cloud.view(), 0.01, s.fit.seed);
+  f.psnr = psnr(gmm, cloud.view(), dc, s.data_range);
+  f.rec = reconstruction_metrics(gmm, cloud.view(), 0.01, s.fit.seed);
   f.n_samples = cloud.size();
+  f.pixels = pixel_figures(gmm, frame, camera, d, s.data_range);
   nlohmann::json j = to_json(f);
   j.erase("frame");
   describe_model(s.model, model, s.json, j);
@@ -159,12 +185,31 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
     return 0;
   }
   std::printf("frame               %s, decimated by %d -> %zu points\n", s.src.depth.c_str(), d.decimate, f.n_points);
-  std::printf("PSNR (honest)       %.2f dB (data range %g)\n", f.psnr.psnr, f.psnr.data_range);
+  std::printf("PSNR (honest)       %.2f dB (data range %g), gray regressed at the frame's points\n", f.psnr.psnr,
+              f.psnr.data_range);
   std::printf("PSNR (paper-compat) %.2f dB (+13.98 dB for the paper's 640x480 canvas)\n", f.psnr.psnr_paper);
-  std::printf("MRE                 %.4f m\n", f.rec.mre);
-  std::printf("precision / recall  %.3f / %.3f (authors' naming)\n", f.rec.precision, f.rec.recall);
-  std::printf("F-score @ 0.01 m    %.3f\n", f.rec.fscore);
+  std::printf("MRE (mass-weighted) %.4f m, over samples of the model\n", f.rec.mre);
+  std::printf("precision / recall  %.3f / %.3f (mass-weighted; authors' naming)\n", f.rec.precision, f.rec.recall);
+  std::printf("F-score @ 0.01 m    %.3f (mass-weighted)\n", f.rec.fscore);
+  print_pixel_figures(f.pixels);
   return 0;
+}
+
+// Adds a frame's per-pixel figures / `frames` to the running mean `m`
+// (pixel counts are summed).
+void add_mean(const PixelFigures& f, std::size_t frames, PixelFigures& m) {
+  const double k = 1.0 / static_cast<double>(frames);
+  m.decimate = f.decimate;
+  for (auto [from, to] : {std::pair{&f.fit_grid, &m.fit_grid}, std::pair{&f.heldout, &m.heldout}}) {
+    to->n_observed += from->n_observed;
+    to->n_both += from->n_both;
+    to->depth_mae += from->depth_mae * k;
+    to->empty_share += from->empty_share * k;
+    to->psnr += from->psnr * k;
+  }
+  m.log_likelihood += f.log_likelihood * k;
+  m.log_likelihood_heldout += f.log_likelihood_heldout * k;
+  m.n_points_heldout += f.n_points_heldout;
 }
 
 int run_model_sequence(const EvalState& s, const CLI::App& app) {
@@ -198,6 +243,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     sc.depth = f.depth;
     sc.n_points = cloud.size();
     sc.psnr = psnr(local, cloud.view(), dc, s.data_range);
+    sc.pixels = pixel_figures(local, frame, camera, d, s.data_range);
     // As many samples as the model was fitted on, kept where this camera sees.
     const std::size_t n = static_cast<std::size_t>(
         std::min<std::uint64_t>(std::max<std::uint64_t>(model.gmm.support_size, cloud.size()), 4000000));
@@ -220,6 +266,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     mean.rec.precision += f.rec.precision / scores.size();
     mean.rec.recall += f.rec.recall / scores.size();
     mean.rec.fscore += f.rec.fscore / scores.size();
+    add_mean(f.pixels, scores.size(), mean.pixels);
   }
   nlohmann::json j;
   describe_model(s.model, model, s.json, j);
@@ -234,17 +281,23 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     return 0;
   }
   std::printf("frames of %s, decimated by %d; model moved into each camera with the inverse pose;\n"
-              "MRE/F-score use the samples each camera could see (n_samples: in view, not hidden behind the "
-              "frame's depth)\n",
-              s.src.sequence.c_str(), d.decimate);
-  std::printf("%-6s %-12s %8s %9s %9s %8s %7s %9s\n", "frame", "file", "points", "PSNR dB", "paper dB", "MRE m",
-              "F@1cm", "samples");
+              "MRE/F-score are mass-weighted: over the samples each camera could see (n_samples: in view, not "
+              "hidden behind the frame's depth);\n"
+              "per pixel: the rendered first surface vs the frame on the fitting grid (d = %d) and held out "
+              "(d = %d minus d = %d)\n",
+              s.src.sequence.c_str(), d.decimate, d.decimate, d.decimate + 1, d.decimate);
+  std::printf("%-6s %-12s %8s %9s %9s %8s %7s %9s | %8s %6s %7s | %8s %6s %7s\n", "frame", "file", "points",
+              "PSNR dB", "paper dB", "MRE m", "F@1cm", "samples", "MAE mm", "empty", "pix dB", "MAE mm", "empty",
+              "pix dB");
+  const auto row = [](const char* a, const std::string& b, const FrameScore& f) {
+    std::printf("%-6s %-12s %8zu %9.2f %9.2f %8.4f %7.3f %9zu | %8.2f %5.1f%% %7.2f | %8.2f %5.1f%% %7.2f\n", a,
+                b.c_str(), f.n_points, f.psnr.psnr, f.psnr.psnr_paper, f.rec.mre, f.rec.fscore, f.n_samples,
+                1000 * f.pixels.fit_grid.depth_mae, 100 * f.pixels.fit_grid.empty_share, f.pixels.fit_grid.psnr,
+                1000 * f.pixels.heldout.depth_mae, 100 * f.pixels.heldout.empty_share, f.pixels.heldout.psnr);
+  };
   for (const FrameScore& f : scores)
-    std::printf("%-6zu %-12s %8zu %9.2f %9.2f %8.4f %7.3f %9zu\n", f.frame,
-                std::filesystem::path(f.depth).filename().string().c_str(), f.n_points, f.psnr.psnr,
-                f.psnr.psnr_paper, f.rec.mre, f.rec.fscore, f.n_samples);
-  std::printf("%-6s %-12s %8zu %9.2f %9.2f %8.4f %7.3f %9zu\n", "mean", "(sum pts)", mean.n_points, mean.psnr.psnr,
-              mean.psnr.psnr_paper, mean.rec.mre, mean.rec.fscore, mean.n_samples);
+    row(std::to_string(f.frame).c_str(), std::filesystem::path(f.depth).filename().string(), f);
+  row("mean", "(sum pts)", mean);
   return 0;
 }
 
@@ -260,7 +313,13 @@ Command add_eval_command(CLI::App& root) {
       "With --sequence DIR --trajectory FILE a world-frame model (sogmm fit --sequence) is moved into each\n"
       "frame's camera with the inverse pose and scored per frame; MRE and F-score use the model's samples\n"
       "that the camera could see: in its frustum and not more than 5 cm behind the frame's depth at\n"
-      "their pixel (a depth camera sees the first surface only).\n\n"
+      "their pixel (a depth camera sees the first surface only): these are mass-weighted figures.\n"
+      "A world-frame model scored on one frame needs --trajectory FILE --frame I (its camera's pose).\n"
+      "Per visible pixel: the model is rendered from the frame's camera (the first surface along each\n"
+      "pixel's ray, as `sogmm render`) and compared with the frame: depth_mae (metres, over pixels valid in\n"
+      "both), empty_share (share of the frame's valid pixels the rendering leaves empty) and pixel_psnr (gray,\n"
+      "same pixels), on the fitting grid (decimation d) and on the held-out grid: the pixels of the d + 1\n"
+      "grid that are not on the d grid (*_heldout), with the mean log-likelihood per point on both grids.\n\n"
       "Examples:\n"
       "  sogmm eval --depth ../shared/data/rgbd/livingroom/depth/00000.png \\\n"
       "    --color ../shared/data/rgbd/livingroom/color/00000.jpg \\\n"
@@ -274,6 +333,8 @@ Command add_eval_command(CLI::App& root) {
   add_camera_flags(*app, s->camera, s->depth_options);
   add_fit_flags(*app, s->fit);
   add_data_range_flag(*app, s->data_range);
+  app->add_option("--frame", s->frame,
+                  "with MODEL, --depth/--color and --trajectory: the pose index of the frame (world-frame model)");
   app->add_flag("--json", s->json, "print one JSON object");
   CLI::App* a = app;
   return {app, [s, a]() {
@@ -295,8 +356,9 @@ Command add_eval_command(CLI::App& root) {
                       "eval: give --sequence or --depth/--color, not both");
               return run_model_sequence(*s, *a);
             }
-            require(s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
-                    "eval: --trajectory and --frames need --sequence");
+            require(s->src.frames.empty(), ErrorCode::InvalidArgument, "eval: --frames needs --sequence");
+            require(s->src.trajectory.empty() == (s->frame < 0), ErrorCode::InvalidArgument,
+                    "eval: with --depth/--color, --trajectory FILE and --frame I go together");
             require(!s->src.depth.empty() && !s->src.color.empty(), ErrorCode::InvalidArgument,
                     "eval: give --depth D --color C (or --sequence DIR --trajectory FILE) to evaluate " + s->model);
             return run_model_frame(*s, *a);

@@ -93,7 +93,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     std::vector<float> gray_truth(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) gray_truth[i] = cloud.xyzg[4 * i + 3];
     const std::vector<float> truth = project_to_image(cloud.view(), gray_truth.data(), dc, -1.f);
-    const RenderedView est = render_at_points(gmm, cloud.xyzg, dc);
+    const RenderedView est = panel_view(render_at_points(gmm, cloud.view(), dc));
     const PsnrResult p = psnr_images(truth.data(), est.gray.data(), truth.size(), s.data_range);
     const int scale = s.scale > 0 ? s.scale : std::max(1, (320 + dc.width - 1) / dc.width);
     char headline[256];
@@ -113,10 +113,14 @@ int run_render(const RenderState& s, const CLI::App& app) {
   std::string where;
   if (have_depth) {
     const PointCloud cloud = backproject_nonempty(frame, camera, d, s.depth);
-    view = render_at_points(gmm, cloud.xyzg, dc);
+    view = panel_view(render_at_points(gmm, cloud.view(), dc));
     where = "at the depth of " + s.depth;
   } else {
-    view = render_expected_surface(gmm, dc, d.depth_min, d.depth_max, s.max_mahalanobis);
+    RenderOptions o;
+    o.depth_min = d.depth_min;
+    o.depth_max = d.depth_max;
+    o.max_mahalanobis = s.max_mahalanobis;
+    view = panel_view(render_expected_surface(gmm, dc, o));
     where = "at the model's expected surface (first surface along each ray)";
   }
   std::size_t shown = 0;

@@ -1,5 +1,6 @@
-// Rendering a model into a camera: gray at given or expected depths, the
-// conditional standard deviation, and the side-by-side comparison picture.
+// Pictures of a rendered model (the rendering itself is in the core,
+// sogmm/render.hpp): gray, the conditional standard deviation as a heat map,
+// and the side-by-side comparison with a frame.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 
 #include "sogmm/camera.hpp"
 #include "sogmm/gmm.hpp"
+#include "sogmm/render.hpp"
 
 namespace sogmm::tools {
 
@@ -19,22 +21,9 @@ struct RenderedView {
   std::vector<float> gray, stddev, depth;
 };
 
-/// Regresses gray (and its standard deviation) at the given points (rows of
-/// 4 floats; the 4th is ignored) and projects them with a z-buffer.
-RenderedView render_at_points(const Gmm& gmm, const std::vector<float>& xyzg, const Camera& camera);
-
-/// The model's own expected surface, without a depth image. For each pixel
-/// ray x(t) = t d (d = ((u - cx)/fx, (v - cy)/fy, 1), t = depth), each
-/// component's 3-D marginal restricted to the ray is a scaled 1-D Gaussian in
-/// t. 1-D mean shift from every component peak on the ray in (depth_min,
-/// depth_max] climbs to a mode of that 1-D mixture; the pixel's depth is the
-/// nearest such mode: the first surface a camera would see, not the densest
-/// one (a dense wall behind a sparse object in front is occluded). A pixel
-/// whose ray stays outside the `max_mahalanobis`-sigma ellipsoid of every
-/// component shows nothing. Gray and its standard deviation are then
-/// regressed at the 3-D point of that depth.
-RenderedView render_expected_surface(const Gmm& gmm, const Camera& camera, double depth_min, double depth_max,
-                                     double max_mahalanobis = 3.0);
+/// The view of core images (sogmm/render.hpp) that the panels draw: NaN
+/// pixels become -1, the variance its square root.
+RenderedView panel_view(const RenderedImages& images);
 
 /// 8-bit gray image (one channel) of values in [0, 1]; -1 (empty) pixels are 0.
 std::vector<std::uint8_t> gray_to_u8(const std::vector<float>& values);

@@ -267,6 +267,7 @@ SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm
 #define SOGMM_STAGE_SCORING 6    /* sogmm_*_score_samples_f32*; step/total: points scored / requested
                                   * (the last report has step = total) */
 #define SOGMM_STAGE_REGRESSION 7 /* sogmm_*_regress_gray_f32*; step/total as SCORING */
+#define SOGMM_STAGE_RENDERING 8  /* sogmm_*_render_f32; step/total: image rows done / height */
 
 /* Progress callback. Return 0 to continue; any non-zero value cancels: the
  * call stops within one report interval, frees everything it allocated,
@@ -565,6 +566,41 @@ SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a
 SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_model* model,
                                              const double* pose);
 
+/* ---- rendering ---------------------------------------------------------- */
+/* The largest image a render takes (width * height), checked before anything
+ * is allocated: the limit of a frame's back-projection (2^26). */
+#define SOGMM_MAX_RENDER_PIXELS 67108864
+/* Renders what `model` shows from a pinhole camera (sogmm::render,
+ * core/include/sogmm/render.hpp): for each pixel of a width x height image
+ * with intrinsics fx, fy (> 0), cx, cy (all finite), the first surface along
+ * the pixel's ray: the nearest mode, at camera depth z in (SOGMM_OPT_DEPTH_MIN,
+ * SOGMM_OPT_DEPTH_MAX], of the model's spatial density along the ray, reached
+ * by 1-D mean shift from every component peak on the ray that lies within
+ * 3 standard deviations of its component; then the gray regressed at that
+ * point (sogmm_model_regress_gray_f32) and its variance.
+ * `camera_to_world` (16 doubles, row-major [R t; 0 0 0 1], rules as
+ * sogmm_model_set_pose; NULL = identity, the model in the camera's frame)
+ * places the camera in the model's frame. Outputs, row-major, width * height
+ * floats each, written only on success: `depth_out` (camera z, metres),
+ * `gray_out` and, if not NULL, `variance_out`. A pixel with nothing to show
+ * (no component near its ray, or no surface in the depth range) is NaN in
+ * all three (0 would be a valid gray, and a depth 0 a point at the camera).
+ * `options` (NULL = defaults): SOGMM_OPT_DEPTH_MIN / _MAX (default 0.1 and
+ * 3 m), SOGMM_OPT_THREADS (the images are bitwise the same for any count) and
+ * the progress callback (SOGMM_STAGE_RENDERING; a cancel returns
+ * SOGMM_E_CANCELLED with the outputs untouched). Moving model and pose
+ * together by one rigid transform renders the same images (up to rounding).
+ * Errors (the image size before the output pointers): width or height 0 or
+ * > INT32_MAX ->
+ * SOGMM_E_INVALID_ARG; model, depth_out or gray_out NULL ->
+ * SOGMM_E_NULL_ARG; bad intrinsics, a pose that is not rigid,
+ * DEPTH_MIN >= DEPTH_MAX -> SOGMM_E_INVALID_ARG; more than
+ * SOGMM_MAX_RENDER_PIXELS pixels -> SOGMM_E_LIMIT. */
+SOGMM_API sogmm_status sogmm_model_render_f32(const sogmm_model* model, uint32_t width, uint32_t height, double fx,
+                                              double fy, double cx, double cy, const double* camera_to_world,
+                                              const sogmm_options* options, float* depth_out, float* gray_out,
+                                              float* variance_out);
+
 /* ---- .sogmm files and memory ------------------------------------------ */
 /* Writes `model` to `path` atomically (a temporary file in the same
  * directory renamed into place: on failure the previous file, if any, is
@@ -741,6 +777,15 @@ SOGMM_API sogmm_status sogmm_map_regress_gray_f32(const sogmm_map* map, const fl
  * as sogmm_model_sample_f32: same seed, same samples. */
 SOGMM_API sogmm_status sogmm_map_sample_f32(const sogmm_map* map, size_t n, uint64_t seed, int32_t dims,
                                             const sogmm_options* options, float* out);
+
+/* Renders the map from a camera-to-world pose (world frame; NULL =
+ * identity), exactly (bitwise) as sogmm_model_render_f32 on
+ * sogmm_map_export(map, NULL). Arguments and errors as that function; a map
+ * without components -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_render_f32(const sogmm_map* map, uint32_t width, uint32_t height, double fx,
+                                            double fy, double cx, double cy, const double* camera_to_world,
+                                            const sogmm_options* options, float* depth_out, float* gray_out,
+                                            float* variance_out);
 
 /* Writes the map as a world-frame .sogmm file, atomically as
  * sogmm_model_save (write keys of `options` apply), with the provenance keys

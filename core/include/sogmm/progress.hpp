@@ -22,6 +22,7 @@ enum class Stage : std::int32_t {
   Sampling = 5,   ///< sampling; step = points drawn, total = points requested
   Scoring = 6,    ///< log-likelihood of points (map queries); step = points scored, total = points
   Regression = 7, ///< gray regression (map queries); step = points done, total = points
+  Rendering = 8,  ///< rendering an image (sogmm/render.hpp); step = rows done, total = image height
 };
 
 /// One report. `total` is 0 when unknown; `log_likelihood` is the mean

@@ -322,6 +322,15 @@ class Map:
                                                                                     mean, var))
         return mean, var
 
+    def render(self, camera: Camera, pose=None, *, depth_min: float = 0.1, depth_trunc: float = 3.0,
+               n_threads: int = 0, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The map seen from ``camera`` at the camera-to-world ``pose``: bitwise
+        ``self.export().render(...)`` (see GMM.render). An empty map: InvalidDataError."""
+        from .render import render_images
+
+        return render_images(lib.sogmm_map_render_f32, self._h(), camera, pose, depth_min, depth_trunc, n_threads,
+                             progress)
+
     def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
                spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
         """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""

@@ -410,6 +410,20 @@ class GMM:
                                lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
+    def render(self, camera: Camera, pose=None, *, depth_min: float = 0.1, depth_trunc: float = 3.0,
+               n_threads: int = 0, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What the model shows from ``camera`` placed at ``pose`` (4 x 4 camera-to-world rigid
+        transform; None = identity, the model in the camera's frame): per pixel the first surface
+        along its ray (the nearest mode of the model's density along the ray at depth in
+        (depth_min, depth_trunc]), the gray regressed there and its variance. Returns three float32
+        (height, width) arrays: depth (camera z, metres), gray, variance; NaN where the model shows
+        nothing. Bitwise the same for any ``n_threads``; ``progress`` as in :meth:`SOGMM.fit`
+        (stage STAGE_RENDERING, rows done). Bad camera or pose: InvalidArgumentError."""
+        from .render import render_images
+
+        return render_images(lib.sogmm_model_render_f32, self._h(), camera, pose, depth_min, depth_trunc,
+                             n_threads, progress)
+
     def merge(self, other: "GMM") -> "GMM":
         """A new model with the components of both, weighted by support size.
 

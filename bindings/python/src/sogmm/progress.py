@@ -39,6 +39,7 @@ STAGE_RUN = 4
 STAGE_SAMPLING = 5
 STAGE_SCORING = 6
 STAGE_REGRESSION = 7
+STAGE_RENDERING = 8
 STAGE_NAMES = {
     STAGE_MODE_COUNT: "mode count",
     STAGE_SEEDING: "seeding",
@@ -47,6 +48,7 @@ STAGE_NAMES = {
     STAGE_SAMPLING: "sampling",
     STAGE_SCORING: "scoring",
     STAGE_REGRESSION: "gray regression",
+    STAGE_RENDERING: "rendering",
 }
 
 #: progress= accepts None, True (a tqdm bar) or callable(stage, step, total, log_likelihood) -> truthy cancels.

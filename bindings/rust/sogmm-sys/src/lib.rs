@@ -119,6 +119,10 @@ pub const SOGMM_STAGE_RUN: i32 = 4;
 pub const SOGMM_STAGE_SAMPLING: i32 = 5;
 pub const SOGMM_STAGE_SCORING: i32 = 6;
 pub const SOGMM_STAGE_REGRESSION: i32 = 7;
+pub const SOGMM_STAGE_RENDERING: i32 = 8;
+
+/// The largest width * height a render takes.
+pub const SOGMM_MAX_RENDER_PIXELS: usize = 1 << 26;
 
 // ---- color formats --------------------------------------------------------
 pub const SOGMM_COLOR_GRAY8: i32 = 1;
@@ -407,6 +411,34 @@ extern "C" {
         dims: i32,
         options: *const sogmm_options,
         out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_model_render_f32(
+        model: *const sogmm_model,
+        width: u32,
+        height: u32,
+        fx: f64,
+        fy: f64,
+        cx: f64,
+        cy: f64,
+        camera_to_world: *const f64,
+        options: *const sogmm_options,
+        depth_out: *mut f32,
+        gray_out: *mut f32,
+        variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_map_render_f32(
+        map: *const sogmm_map,
+        width: u32,
+        height: u32,
+        fx: f64,
+        fy: f64,
+        cx: f64,
+        cy: f64,
+        camera_to_world: *const f64,
+        options: *const sogmm_options,
+        depth_out: *mut f32,
+        gray_out: *mut f32,
+        variance_out: *mut f32,
     ) -> sogmm_status;
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)

@@ -27,6 +27,7 @@ pub mod metrics;
 pub mod model;
 pub mod options;
 pub mod progress;
+pub mod render;
 
 use std::ffi::CStr;
 use std::sync::OnceLock;
@@ -37,6 +38,7 @@ pub use metrics::{psnr_images, Psnr};
 pub use model::{Color, Frame, Model};
 pub use options::{FusionMethod, ModeCounter, Options, OptionsBuilder};
 pub use progress::{Progress, Stage};
+pub use render::{Camera, Rendered};
 pub use sogmm_sys as sys;
 
 /// "MAJOR.MINOR.PATCH" of the loaded library.

@@ -11,6 +11,7 @@ use crate::error::{check, Result};
 use crate::model::{c_path, dims_ok, len_of, regress_with, rows, score_with, Frame, Model};
 use crate::options::{opt_ptr, Options};
 use crate::progress::{with_map_progress, with_progress, Progress};
+use crate::render::{render_into, Camera, Rendered};
 
 /// A row-major 4 x 4 rigid camera-to-world transform [R t; 0 0 0 1].
 pub type Pose = [f64; 16];
@@ -293,6 +294,27 @@ impl Map {
         regress_with(xyz, |n, mean, var| unsafe {
             sys::sogmm_map_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
         })
+    }
+
+    /// The map seen from `camera` at the camera-to-world `pose`: the same
+    /// bits as `self.export()?.render(...)` (see `Model::render`).
+    pub fn render(&self, camera: &Camera, pose: Option<&Pose>, options: Option<&Options>) -> Result<Rendered> {
+        self.render_raw(camera, pose, opt_ptr(options))
+    }
+
+    /// As `render`, reporting `Stage::Rendering` and cancellable.
+    pub fn render_with_progress(
+        &self,
+        camera: &Camera,
+        pose: Option<&Pose>,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Rendered> {
+        with_progress(options, on_progress, |o| self.render_raw(camera, pose, o))
+    }
+
+    fn render_raw(&self, camera: &Camera, pose: Option<&Pose>, o: *const sys::sogmm_options) -> Result<Rendered> {
+        render_into(sys::sogmm_map_render_f32, self.raw(), camera, pose, o)
     }
 
     /// Draws n world points (rows of `dims` floats, grouped by component);

@@ -6,8 +6,10 @@ use std::ptr::{self, NonNull};
 use sogmm_sys as sys;
 
 use crate::error::{check, Error, Result, Status};
+use crate::map::Pose;
 use crate::options::{opt_ptr, Options};
 use crate::progress::{with_progress, Progress};
+use crate::render::{render_into, Camera, Rendered};
 use std::ops::ControlFlow;
 
 /// A fitted 4-D GMM (x, y, z, gray) with its metadata. Arrays come out as
@@ -542,6 +544,31 @@ impl Model {
     pub fn merge(&self, other: &Model) -> Result<Model> {
         // SAFETY: both handles valid; const use only.
         Model::make(|out| unsafe { sys::sogmm_model_merge(out, self.raw(), other.raw()) })
+    }
+
+    /// What the model shows from `camera` at `pose` (camera-to-world; None =
+    /// identity, the model in the camera's frame): per pixel the first
+    /// surface along its ray, its depth, the gray regressed there and its
+    /// variance (NaN where nothing shows). `options`: SOGMM_OPT_DEPTH_MIN /
+    /// _MAX (the depths that count as surfaces) and SOGMM_OPT_THREADS (the
+    /// images are the same bits for any count).
+    pub fn render(&self, camera: &Camera, pose: Option<&Pose>, options: Option<&Options>) -> Result<Rendered> {
+        self.render_raw(camera, pose, opt_ptr(options))
+    }
+
+    /// As `render`, reporting `Stage::Rendering` (rows done) and cancellable.
+    pub fn render_with_progress(
+        &self,
+        camera: &Camera,
+        pose: Option<&Pose>,
+        options: Option<&Options>,
+        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
+    ) -> Result<Rendered> {
+        with_progress(options, on_progress, |o| self.render_raw(camera, pose, o))
+    }
+
+    fn render_raw(&self, camera: &Camera, pose: Option<&Pose>, o: *const sys::sogmm_options) -> Result<Rendered> {
+        render_into(sys::sogmm_model_render_f32, self.raw(), camera, pose, o)
     }
 
     /// A new model moved by a rigid 4 x 4 row-major transform.

@@ -35,6 +35,8 @@ pub enum Stage {
     Scoring,
     /// Gray regression on a map; step/total: points done / requested.
     Regression,
+    /// Rendering an image; step/total: rows done / height.
+    Rendering,
     Unknown(i32),
 }
 
@@ -48,6 +50,7 @@ impl Stage {
             sys::SOGMM_STAGE_SAMPLING => Stage::Sampling,
             sys::SOGMM_STAGE_SCORING => Stage::Scoring,
             sys::SOGMM_STAGE_REGRESSION => Stage::Regression,
+            sys::SOGMM_STAGE_RENDERING => Stage::Rendering,
             other => Stage::Unknown(other),
         }
     }

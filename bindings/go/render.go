@@ -1,0 +1,88 @@
+package sogmm
+
+// #include "sogmm/sogmm.h"
+import "C"
+
+import (
+	"context"
+	"fmt"
+)
+
+// Camera holds the pinhole intrinsics of a rendered image: pixel (u, v)
+// looks along ((u - Cx) / Fx, (v - Cy) / Fy, 1) in the camera's frame.
+type Camera struct {
+	Width, Height  uint32
+	Fx, Fy, Cx, Cy float64
+}
+
+// Rendered holds rendered images, row-major Width x Height: the first
+// surface's depth (camera z, metres), the gray regressed there and its
+// variance; NaN where the model shows nothing.
+type Rendered struct {
+	Width, Height         uint32
+	Depth, Gray, Variance []float32
+}
+
+// renderInto allocates the three images (after the pixel limit of sogmm.h,
+// so that no huge buffer is allocated for a call that must fail) and runs
+// call with them.
+func renderInto(cam Camera, call func(depth, gray, variance *C.float) error) (*Rendered, error) {
+	pixels := uint64(cam.Width) * uint64(cam.Height)
+	if pixels > C.SOGMM_MAX_RENDER_PIXELS {
+		return nil, &Error{Status: ErrLimit,
+			Message: fmt.Sprintf("render: %d x %d pixels exceed %d", cam.Width, cam.Height, C.SOGMM_MAX_RENDER_PIXELS)}
+	}
+	r := &Rendered{Width: cam.Width, Height: cam.Height, Depth: make([]float32, pixels),
+		Gray: make([]float32, pixels), Variance: make([]float32, pixels)}
+	if pixels == 0 { // the C call names the empty size
+		return nil, call(nil, nil, nil)
+	}
+	if err := call(floats(r.Depth), floats(r.Gray), floats(r.Variance)); err != nil {
+		return nil, err
+	}
+	return r, nil
+}
+
+func posePtr(pose *[16]float64) *C.double {
+	if pose == nil {
+		return nil
+	}
+	return (*C.double)(&pose[0])
+}
+
+// Render is what the model shows from cam at pose (camera-to-world; nil =
+// identity, the model in the camera's frame): per pixel the first surface
+// along its ray, its depth, the gray regressed there and its variance. o
+// (may be nil) gives DepthMin / DepthMax (the depths that count as surfaces)
+// and Threads (the same bits for any count).
+func (m *Model) Render(cam Camera, pose *[16]float64, o *Options) (*Rendered, error) {
+	return renderInto(cam, func(depth, gray, variance *C.float) error {
+		return m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_model_render_f32(p, C.uint32_t(cam.Width), C.uint32_t(cam.Height), C.double(cam.Fx),
+				C.double(cam.Fy), C.double(cam.Cx), C.double(cam.Cy), posePtr(pose), op, depth, gray, variance)
+		})
+	})
+}
+
+// RenderContext is Render with cancellation and progress (StageRendering:
+// rows done) as FitContext.
+func (m *Model) RenderContext(ctx context.Context, cam Camera, pose *[16]float64, o *Options, fn ProgressFunc) (*Rendered, error) {
+	return withProgress(ctx, o, fn, func(p *Options) (*Rendered, error) { return m.Render(cam, pose, p) })
+}
+
+// Render is the map seen from cam at the camera-to-world pose: the same bits
+// as m.Export(nil) rendered (see Model.Render). A map without components
+// gives ErrInvalidData.
+func (m *Map) Render(cam Camera, pose *[16]float64, o *Options) (*Rendered, error) {
+	return renderInto(cam, func(depth, gray, variance *C.float) error {
+		return m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_map_render_f32(p, C.uint32_t(cam.Width), C.uint32_t(cam.Height), C.double(cam.Fx),
+				C.double(cam.Fy), C.double(cam.Cx), C.double(cam.Cy), posePtr(pose), op, depth, gray, variance)
+		})
+	})
+}
+
+// RenderContext is Render with cancellation and progress as Model.RenderContext.
+func (m *Map) RenderContext(ctx context.Context, cam Camera, pose *[16]float64, o *Options, fn ProgressFunc) (*Rendered, error) {
+	return withProgress(ctx, o, fn, func(p *Options) (*Rendered, error) { return m.Render(cam, pose, p) })
+}

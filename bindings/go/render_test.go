@@ -1,0 +1,139 @@
+package sogmm
+
+import (
+	"context"
+	"errors"
+	"math"
+	"slices"
+	"testing"
+)
+
+var renderCam = Camera{Width: 9, Height: 7, Fx: 10, Fy: 12, Cx: 4, Cy: 3}
+
+const renderCentre = 3*9 + 4
+
+// onAxis is one component at (0, 0, 1.5), gray 0.4, gray correlated with x
+// (cov 0.002): along the central ray its density peaks at t = 1.5, where
+// gray = 0.4 and Var = 0.01 - 0.002^2 / 0.05^2.
+func onAxis(t *testing.T) *Model {
+	t.Helper()
+	cov := []float32{0.0025, 0, 0, 0.002, 0, 0.0016, 0, 0, 0, 0, 0.0001, 0, 0.002, 0, 0, 0.01}
+	m, err := FromArrays([]float32{1}, []float32{0, 0, 1.5, 0.4}, cov, 100)
+	if err != nil {
+		t.Fatal(err)
+	}
+	return m
+}
+
+func TestRenderSingleComponentClosedForm(t *testing.T) {
+	m := onAxis(t)
+	defer m.Close()
+	r, err := m.Render(renderCam, nil, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	if len(r.Depth) != 63 || r.Width != 9 || r.Height != 7 {
+		t.Fatalf("size %d x %d, %d pixels", r.Width, r.Height, len(r.Depth))
+	}
+	wantVar := 0.01 - 0.002*0.002/0.0025
+	if math.Abs(float64(r.Depth[renderCentre])-1.5) > 1e-5 || math.Abs(float64(r.Gray[renderCentre])-0.4) > 1e-5 ||
+		math.Abs(float64(r.Variance[renderCentre])-wantVar) > 1e-6 {
+		t.Fatalf("centre: depth %v gray %v variance %v", r.Depth[renderCentre], r.Gray[renderCentre], r.Variance[renderCentre])
+	}
+	if !math.IsNaN(float64(r.Depth[0])) || !math.IsNaN(float64(r.Gray[0])) {
+		t.Fatalf("corner shows %v", r.Depth[0])
+	}
+	// Model and pose moved together by a yaw and a shift: the same images.
+	pose := yawPose(35, 1, -2, 0.5)
+	moved, err := m.Transform(pose)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer moved.Close()
+	b, err := moved.Render(renderCam, &pose, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	for i := range r.Depth {
+		if math.IsNaN(float64(r.Depth[i])) != math.IsNaN(float64(b.Depth[i])) {
+			t.Fatalf("pixel %d: %v vs %v", i, r.Depth[i], b.Depth[i])
+		}
+		if !math.IsNaN(float64(r.Depth[i])) && (math.Abs(float64(r.Depth[i]-b.Depth[i])) > 1e-5 ||
+			math.Abs(float64(r.Gray[i]-b.Gray[i])) > 1e-5) {
+			t.Fatalf("pixel %d: depth %v vs %v, gray %v vs %v", i, r.Depth[i], b.Depth[i], r.Gray[i], b.Gray[i])
+		}
+	}
+	// Bad input.
+	scaled := [16]float64{2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}
+	if _, err := m.Render(renderCam, &scaled, nil); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("scaled pose: %v", err)
+	}
+	if _, err := m.Render(Camera{Width: 0, Height: 7, Fx: 10, Fy: 10}, nil, nil); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("width 0: %v", err)
+	}
+	if _, err := m.Render(Camera{Width: 20000, Height: 20000, Fx: 1, Fy: 1}, nil, nil); !errors.Is(err, ErrLimit) {
+		t.Fatalf("2^28 pixels: %v", err)
+	}
+	o, err := NewOptions(DepthRange(0.1, 1.4))
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	near, err := m.Render(renderCam, nil, o)
+	if err != nil || !math.IsNaN(float64(near.Depth[renderCentre])) {
+		t.Fatalf("depth max 1.4: %v (err %v)", near.Depth[renderCentre], err)
+	}
+}
+
+// A map renders bitwise as its export; progress reports rows; a cancel is ErrCancelled.
+func TestMapRenderEqualsTheExport(t *testing.T) {
+	m := twoFrameMap(t)
+	defer m.Close()
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer model.Close()
+	cam := Camera{Width: 40, Height: 30, Fx: 30, Fy: 30, Cx: 19.5, Cy: 14.5}
+	a, err := m.Render(cam, nil, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	var last Progress
+	b, err := model.RenderContext(context.Background(), cam, nil, nil, func(p Progress) error { last = p; return nil })
+	if err != nil {
+		t.Fatal(err)
+	}
+	bits := func(v []float32) []uint32 {
+		out := make([]uint32, len(v))
+		for i, x := range v {
+			out[i] = math.Float32bits(x)
+		}
+		return out
+	}
+	if !slices.Equal(bits(a.Depth), bits(b.Depth)) || !slices.Equal(bits(a.Gray), bits(b.Gray)) {
+		t.Fatal("map render differs from its export's")
+	}
+	shown := 0
+	for _, d := range a.Depth {
+		if !math.IsNaN(float64(d)) {
+			shown++
+		}
+	}
+	if shown == 0 || last.Stage != StageRendering || last.Step != 30 || last.Total != 30 {
+		t.Fatalf("%d pixels shown, last report %+v", shown, last)
+	}
+	ctx, cancel := context.WithCancel(context.Background())
+	cancel()
+	if _, err := m.RenderContext(ctx, cam, nil, nil, nil); !errors.Is(err, ErrCancelled) {
+		t.Fatalf("cancelled render: %v", err)
+	}
+	empty, err := NewMap(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer empty.Close()
+	if _, err := empty.Render(cam, nil, nil); !errors.Is(err, ErrInvalidData) {
+		t.Fatalf("empty map: %v", err)
+	}
+}
