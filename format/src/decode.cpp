@@ -174,8 +174,10 @@ void decode_frame(ZSTD_DCtx* dctx, StoredBytes& in, ZSTD_outBuffer& ob, int fram
 
 // The structure of the zstd frames that section 5.4 has every reader check
 // itself, before decoding: zstd versions differ on some of it (1.5.7
-// rejects set reserved bits of Symbol_Compression_Modes that 1.5.4 ignores),
-// and a file must have one verdict. RFC 8878 names the fields.
+// rejects set reserved bits of Symbol_Compression_Modes that 1.5.4 ignores,
+// blocks larger than the window that 1.5.4 decodes, and reads a 2-byte
+// Number_of_Sequences of 0 differently), and a file must have one verdict.
+// RFC 8878 names the fields.
 class FrameWalker {
  public:
   explicit FrameWalker(StoredBytes& in) : in_(in) {}
@@ -183,19 +185,30 @@ class FrameWalker {
   void walk() {
     for (frame_ = 0; in_.left() > 0; ++frame_) {
       if (le(4) != ZSTD_MAGICNUMBER) bad(where() + "does not start with the zstd magic number");
+      // Bit 4 (Unused_Bit) is not read: RFC 8878 says a decoder ignores it.
       const std::uint8_t fhd = byte();
       if (fhd & 0x08) bad(where() + "reserved bit of the frame header descriptor is set");
       const bool single = (fhd >> 5) & 1;
       const int fcs_flag = fhd >> 6;
       if (fcs_flag == 0 && !single) bad(where() + "does not declare its content size");
+      std::uint64_t window = 0;
+      if (!single) {
+        const std::uint8_t wd = byte();  // Exponent (bits 3-7), Mantissa (bits 0-2)
+        const std::uint64_t base = std::uint64_t{1} << (10 + (wd >> 3));
+        window = base + base / 8 * (wd & 7);
+      }
       static constexpr int kDictionaryIdBytes[4] = {0, 1, 2, 4}, kContentSizeBytes[4] = {1, 2, 4, 8};
-      skip((single ? 0 : 1) + kDictionaryIdBytes[fhd & 3] + kContentSizeBytes[fcs_flag]);
+      skip(kDictionaryIdBytes[fhd & 3]);
+      const std::uint64_t content_size = le(kContentSizeBytes[fcs_flag]) + (fcs_flag == 1 ? 256 : 0);
+      if (single) window = content_size;
+      if (window > kMaxWindow) bad(where() + "window of " + std::to_string(window) + " bytes, above 2^31");
+      block_max_ = std::min<std::uint64_t>(window, 128u << 10);  // Block_Maximum_Size
       for (bool last = false; !last;) {
         const std::uint32_t h = static_cast<std::uint32_t>(le(3));
         last = h & 1;
         const std::uint32_t type = (h >> 1) & 3, size = h >> 3;
         if (type == 3) bad(where() + "block of the reserved type 3");
-        if (size > (128u << 10)) bad(where() + "block larger than 128 KiB");
+        if (size > block_max_) bad(where() + "block of " + std::to_string(size) + " bytes, above " + max_text());
         if (type == 2) {
           compressed_block(size);
         } else {
@@ -207,33 +220,47 @@ class FrameWalker {
   }
 
  private:
+  // ZSTD_WINDOWLOG_MAX of a 64-bit libzstd: larger windows are refused there.
+  static constexpr std::uint64_t kMaxWindow = std::uint64_t{1} << 31;
+
+  std::string max_text() const {
+    return "the frame's Block_Maximum_Size of " + std::to_string(block_max_) + " bytes";
+  }
+
   void compressed_block(std::uint32_t size) {
     const std::uint8_t b0 = byte();
     const int type = b0 & 3, format = (b0 >> 2) & 3;
-    std::uint64_t header = 0, content = 0;
+    std::uint64_t header = 0, content = 0, regenerated = 0;
     if (type < 2) {  // raw or RLE literals: Regenerated_Size only
       header = format == 1 ? 2 : format == 3 ? 3 : 1;
       const std::uint64_t rest = le(static_cast<int>(header) - 1);
-      const std::uint64_t regenerated = header == 1 ? b0 >> 3 : (b0 >> 4) + (rest << 4);
+      regenerated = header == 1 ? b0 >> 3 : (b0 >> 4) + (rest << 4);
       content = type == 0 ? regenerated : 1;
     } else {  // compressed or treeless: Regenerated_Size and Compressed_Size
       header = format < 2 ? 3 : format == 2 ? 4 : 5;
       const std::uint64_t v = (b0 + (le(static_cast<int>(header) - 1) << 8)) >> 4;
       const int bits = header == 3 ? 10 : header == 4 ? 14 : 18;
       content = v >> bits;
+      regenerated = v & ((std::uint64_t{1} << bits) - 1);
+    }
+    if (regenerated > block_max_) {
+      bad(where() + "literals regenerate " + std::to_string(regenerated) + " bytes, above " + max_text());
     }
     if (header + content >= size) bad(where() + "literals leave no room for the sequences section");
     skip(content);
     std::uint64_t left = size - header - content;
     const std::uint8_t n0 = byte();
     --left;
+    const std::uint64_t count_bytes = n0 < 128 ? 0 : n0 < 255 ? 1 : 2;
+    if (left < count_bytes) bad(where() + "sequences section header beyond the block");
+    // Only the 2-byte form 80 00 can also spell 0; the 3-byte form is at least 0x7F00.
+    if (n0 == 128 && byte() == 0) bad(where() + "Number_of_Sequences of 0 in its 2-byte form");
     if (n0 == 0) {
       if (left != 0) bad(where() + "bytes after an empty sequences section");
       return;
     }
-    const std::uint64_t count_bytes = n0 < 128 ? 0 : n0 < 255 ? 1 : 2;
     if (left < count_bytes + 1) bad(where() + "sequences section header beyond the block");
-    skip(count_bytes);
+    skip(n0 == 128 ? 0 : count_bytes);
     if (byte() & 3) bad(where() + "reserved bits of Symbol_Compression_Modes are set");
     skip(left - count_bytes - 1);
   }
@@ -263,6 +290,7 @@ class FrameWalker {
 
   StoredBytes& in_;
   int frame_ = 0;
+  std::uint64_t block_max_ = 0;
 };
 
 void decode_zstd(StoredBytes& in, Scatter& scatter, std::uint8_t* out, std::uint64_t expected) {

@@ -302,11 +302,16 @@ def _check_pose(p):
         _fail("invalid_data", "bad_pose", "rotation is a reflection")
 
 
+MAX_WINDOW = 1 << 31  # section 5.4: larger windows are rejected
+
+
 def _zstd_structure(st):
     """The frame structure section 5.4 has a reader check itself (RFC 8878
-    field names): header descriptor reserved bit clear, content size present,
-    no reserved block type, blocks of at most 128 KiB, and in compressed
-    blocks the literals inside the block and the reserved bits of
+    field names): header descriptor reserved bit clear (the unused bit is
+    ignored), content size present, a window of at most 2^31 bytes, no
+    reserved block type, blocks and literals of at most Block_Maximum_Size,
+    and in compressed blocks the literals inside the block, a zero sequence
+    count only as the single last byte, and the reserved bits of
     Symbol_Compression_Modes clear."""
     def need(pos, n):
         if pos + n > len(st):
@@ -324,9 +329,23 @@ def _zstd_structure(st):
         if fhd & 0x08:
             _format("decompression_failed", "reserved bit of the frame header descriptor")
         single = fhd >> 5 & 1
-        if fhd >> 6 == 0 and not single:
+        fcs_flag = fhd >> 6
+        if fcs_flag == 0 and not single:
             _format("decompression_failed", "frame without content size")
-        pos += 5 + (0 if single else 1) + (0, 1, 2, 4)[fhd & 3] + (1, 2, 4, 8)[fhd >> 6]
+        pos += 5
+        if not single:
+            wd = le(pos, 1)
+            window = (1 << (10 + (wd >> 3))) * (8 + (wd & 7)) // 8
+            pos += 1
+        pos += (0, 1, 2, 4)[fhd & 3]
+        n = (1, 2, 4, 8)[fcs_flag]
+        content_size = le(pos, n) + (256 if fcs_flag == 1 else 0)
+        pos += n
+        if single:
+            window = content_size
+        if window > MAX_WINDOW:
+            _format("decompression_failed", "window above 2^31 bytes")
+        block_max = min(window, 128 << 10)
         last = False
         while not last:
             h = le(pos, 3)
@@ -334,17 +353,17 @@ def _zstd_structure(st):
             last, kind, size = h & 1, h >> 1 & 3, h >> 3
             if kind == 3:
                 _format("decompression_failed", "reserved block type")
-            if size > 128 << 10:
-                _format("decompression_failed", "block larger than 128 KiB")
+            if size > block_max:
+                _format("decompression_failed", "block larger than Block_Maximum_Size")
             if kind == 2:
-                _compressed_block(st, pos, size, le)
+                _compressed_block(st, pos, size, le, block_max)
             pos += 1 if kind == 1 else size
             need(pos, 0)
         pos += 4 if fhd >> 2 & 1 else 0
         need(pos, 0)
 
 
-def _compressed_block(st, pos, size, le):
+def _compressed_block(st, pos, size, le, block_max):
     b0 = le(pos, 1)
     kind, fmt = b0 & 3, b0 >> 2 & 3
     if kind < 2:
@@ -353,17 +372,25 @@ def _compressed_block(st, pos, size, le):
         content = regenerated if kind == 0 else 1
     else:
         header = 3 if fmt < 2 else 4 if fmt == 2 else 5
-        content = le(pos, header) >> 4 >> (10 if header == 3 else 14 if header == 4 else 18)
+        bits = 10 if header == 3 else 14 if header == 4 else 18
+        sizes = le(pos, header) >> 4
+        content, regenerated = sizes >> bits, sizes & ((1 << bits) - 1)
+    if regenerated > block_max:
+        _format("decompression_failed", "literals larger than Block_Maximum_Size")
     if header + content >= size:
         _format("decompression_failed", "literals leave no room for the sequences section")
     q = pos + header + content
     left = size - header - content - 1
     n0 = le(q, 1)
+    count_bytes = 0 if n0 < 128 else 1 if n0 < 255 else 2
+    if left < count_bytes:
+        _format("decompression_failed", "sequences section header beyond the block")
+    if n0 == 128 and le(q + 1, 1) == 0:
+        _format("decompression_failed", "Number_of_Sequences of 0 in its 2-byte form")
     if n0 == 0:
         if left:
             _format("decompression_failed", "bytes after an empty sequences section")
         return
-    count_bytes = 0 if n0 < 128 else 1 if n0 < 255 else 2
     if left < count_bytes + 1:
         _format("decompression_failed", "sequences section header beyond the block")
     if le(q + 1 + count_bytes, 1) & 3:
@@ -389,8 +416,8 @@ def _zstd_frames(stored, expected):
         if params.content_size > expected - len(out):
             _format("decompression_failed", "frame declares more than is left")
         start = len(out)
-        # Any window size: the content size bounds the output.
-        d = zstandard.ZstdDecompressor(max_window_size=1 << 31).decompressobj()
+        # Any window up to 2^31 (checked above): the content size bounds the output.
+        d = zstandard.ZstdDecompressor(max_window_size=MAX_WINDOW).decompressobj()
         consumed = None
         try:
             # Small input chunks keep every output burst bounded (bomb-safe).
