@@ -71,7 +71,11 @@ PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pi
           "PSNR: the ground truth is constant, so its actual data range is 0: give the data range");
   const double mse_all = se_all / static_cast<double>(pixels);
   // Identical images: report infinity, as PSNR is unbounded.
-  r.psnr = r.mse > 0 ? 10.0 * std::log10(r.data_range * r.data_range / r.mse) : INFINITY;
+  // Written as 20 log10(range) - 10 log10(mse): range^2 overflows to +inf for
+  // a range above ~1e154 (and underflows to 0, -inf, below ~1e-154), while
+  // each logarithm of a finite positive double is finite, so images that
+  // differ always get a finite figure.
+  r.psnr = r.mse > 0 ? 20.0 * std::log10(r.data_range) - 10.0 * std::log10(r.mse) : INFINITY;
   r.psnr_paper = mse_all > 0 ? 10.0 * std::log10(4.0 / mse_all) : INFINITY;
   return r;
 }

@@ -105,6 +105,26 @@ Gmm seed_components(const PointsView& nv, const std::vector<std::size_t>& seeds,
   return g;
 }
 
+// A lower bound on the mean log-likelihood of the model's own samples,
+// sum_k w_k (log w_k + E_k[log N_k]) with E_k[log N_k] = -(log det(2 pi
+// Sigma_k) + 4) / 2 in 4-D: p >= w_k N_k everywhere, so E_p[log p] is at
+// least this. Points that the model explains score about this much or more.
+double own_log_likelihood(const Gmm& gmm) {
+  constexpr double kLog2Pi = 1.8378770664093453;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < gmm.size(); ++k) {
+    const double w = gmm.weights[k];
+    if (!(w > 0.0)) continue;
+    double a[16], l[16];
+    stored_symmetric_part(gmm.covariance(k), a);
+    if (!stored_cholesky(a, l)) continue;  // validate() passed: cannot happen
+    double log_det = 0.0;
+    for (int i = 0; i < 4; ++i) log_det += 2.0 * std::log(l[5 * i]);
+    sum += w * (std::log(w) - 0.5 * (4.0 * kLog2Pi + log_det + 4.0));
+  }
+  return sum;
+}
+
 }  // namespace
 
 FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOptions& options,
@@ -146,17 +166,27 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
     auto t = std::chrono::steady_clock::now();
     // Pass 1: every point's log-likelihood, which decides the novel points.
     const std::vector<double> ll = detail::score_points(points, initial, threads).log_likelihood;
-    const double cut = median(ll) - warm.novelty_nats;
+    const double typical = median(ll);
+    const double cut = typical - warm.novelty_nats;
     std::vector<char> explained(points.size);
     for (std::size_t i = 0; i < points.size; ++i) explained[i] = ll[i] >= cut;
+    // Novelty is judged against the median point, so at least half of the
+    // points always count as explained, even by a model far from all of them
+    // (a map's last pose far away kept 1 component for 12,288 points). The
+    // explained fraction in absolute terms is below one half exactly when the
+    // median point scores more than novelty_nats below what the model's own
+    // samples score: then the start is a cold one.
+    rep.cold_fallback = typical < own_log_likelihood(initial) - warm.novelty_nats;
     // Pass 2: masses over the explained points only; a novel point far from
     // every component would otherwise lend its whole responsibility to the
     // least distant one, e.g. to a component of a surface no longer seen.
-    const std::vector<double> mass = detail::score_points(points, initial, threads, &explained).mass;
-    rep.seconds_score = seconds_since(t);
-    for (std::size_t k = 0; k < initial.size(); ++k) {
-      if (mass[k] >= warm.min_mass && start.size() < kMaxComponents) append_component(start, initial, k, mass[k]);
+    if (!rep.cold_fallback) {
+      const std::vector<double> mass = detail::score_points(points, initial, threads, &explained).mass;
+      for (std::size_t k = 0; k < initial.size(); ++k) {
+        if (mass[k] >= warm.min_mass && start.size() < kMaxComponents) append_component(start, initial, k, mass[k]);
+      }
     }
+    rep.seconds_score = seconds_since(t);
     rep.kept = start.size();
     rep.removed = initial.size() - rep.kept;
 

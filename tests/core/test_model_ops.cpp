@@ -121,6 +121,25 @@ TEST(Transform, ClosedForm) {
   EXPECT_TRUE(sogmm_test::model_is_valid(b));
 }
 
+// A moved covariance is stored exactly symmetric (bitwise), as every model
+// the library makes: an asymmetric one in memory is not what the file keeps
+// (the writer stores the symmetric part), so a map saved and loaded again
+// changed (issue 36). 200 rotations about fixed axes, no randomness.
+TEST(Transform, CovariancesAreExactlySymmetric) {
+  const sogmm::Gmm a = model_a();
+  for (int n = 0; n < 200; ++n) {
+    const Eigen::Vector3d axis(std::sin(0.37 * n), std::cos(0.91 * n), 0.3 + std::sin(1.3 * n));
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(0.031 * n + 0.1, axis.normalized()).toRotationMatrix();
+    const sogmm::Gmm b = sogmm::transform(a, pose_of(r, Eigen::Vector3d(0.5 * n, -1.0, 2.0)));
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      const float* c = b.covariance(k);
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          ASSERT_EQ(c[4 * i + j], c[4 * j + i]) << "rotation " << n << " component " << k << " entry " << i << j;
+    }
+  }
+}
+
 TEST(Transform, DensityAndRegressionInvariant) {
   // p'(T x) = p(x) (|det R| = 1) and the regressed gray moves with the point.
   const sogmm::Gmm a = model_a();

@@ -95,6 +95,55 @@ TEST(RegCovarAuto, DecadeRulesAtTheirEdges) {
   EXPECT_EQ(sogmm::auto_reg_covar(view(star(1.0, 0.5, 0.5))).gray, 1e-6);     // constant gray: 10^0
 }
 
+namespace {
+// `gray.size()` points on a 1 cm grid 100 points wide at z = 1, with the given gray.
+std::vector<float> grid_with_gray(const std::vector<float>& gray) {
+  std::vector<float> p;
+  for (std::size_t i = 0; i < gray.size(); ++i)
+    p.insert(p.end(), {0.01f * static_cast<float>(i % 100), 0.01f * static_cast<float>(i / 100), 1.f, gray[i]});
+  return p;
+}
+}  // namespace
+
+// Issue 36: one out-of-range pixel (gray 1000 in a GRAY_F32 frame of gray in
+// [0, 1], 12,288 points) set the gray floor of every component to 1 (range
+// 1000 -> 10^3); the gray scale is now the spread between the 1% and 99%
+// quantiles, so the floor stays 1e-6, the frame's own. Gray in [0, 255] with
+// one pixel of 1e5 keeps its own floor, 1, likewise.
+TEST(RegCovarAuto, OneOutOfRangePixelDoesNotSetTheGrayFloor) {
+  std::vector<float> gray(12288);
+  for (std::size_t i = 0; i < gray.size(); ++i) gray[i] = static_cast<float>((i * 37) % 256) / 255.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1e-6);
+  gray[5000] = 1000.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1e-6);
+  gray[7] = -1000.f;  // one at each end
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1e-6);
+  for (float& g : gray) g *= 255.f;
+  gray[5000] = 1e5f;
+  gray[7] = 0.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1.0);
+}
+
+// The rule at its edge, hand-computed: 1001 points, so the 1% quantile is
+// order statistic floor(0.01 x 1000) = 10 (0-based) from each end. Ten
+// points at each of 0 and 1000 around 981 in [0.5, 0.5625] leave the spread
+// 0.0625 -> 10^-1 -> 1e-8; an eleventh point at 1000 is order statistic 990,
+// the spread becomes 999.5 -> 10^3 -> 1. When more than 98% of the points
+// share one gray (spread 0), the full range decides, as for a constant gray.
+TEST(RegCovarAuto, GrayQuantileSpreadAtItsEdges) {
+  std::vector<float> gray(1001);
+  for (std::size_t i = 0; i < 981; ++i) gray[i] = 0.5f + 0.0625f * static_cast<float>(i) / 980.f;
+  for (std::size_t i = 981; i < 991; ++i) gray[i] = 0.f;
+  for (std::size_t i = 991; i < 1001; ++i) gray[i] = 1000.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1e-8);
+  gray[980] = 1000.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(gray))).gray, 1.0);
+  std::vector<float> flat(1001, 0.5f);
+  flat[3] = 0.f;
+  flat[4] = 1000.f;
+  EXPECT_EQ(sogmm::auto_reg_covar(view(grid_with_gray(flat))).gray, 1.0);
+}
+
 // Gray scaled by 1000 with the geometry unchanged gets its own floor (range
 // 1000 -> 10^3 -> 1e-6 x 100^3 = 1); the spatial floor does not move. With one
 // component per point (every point at least 0.2 m = 200 spatial or 167 gray

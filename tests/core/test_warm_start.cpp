@@ -66,6 +66,43 @@ TEST(WarmStart, RemovesVanishedAddsNewMatchesColdFit) {
   EXPECT_GE(warm.em.log_likelihood, cold.em.log_likelihood - 0.02);
 }
 
+// Issue 36: a start far from every point (a map's last pose far away) scored
+// every point equally badly, so half of them still counted as explained and
+// the nearest component took them all (1 component for a 12,288-point
+// frame). Frame B 100 m away from the model of A: the median point is
+// thousands of nats below what the model's own samples score, so the fit
+// falls back to a cold one: nothing kept, every point novel, and the
+// likelihood of a cold fit of B (within the 0.02 nats/point of the warm
+// start's own bound). The same start 0.5 mm away, a real warm start, keeps
+// its components.
+TEST(WarmStart, FarStartFallsBackToColdFit) {
+  const std::vector<float> a = frame({600, 600, 600, 0}, 1, nullptr);
+  std::vector<float> b = frame({600, 600, 0, 500}, 2, nullptr);
+  sogmm::FitOptions fixed = options();
+  fixed.n_components = 3;
+  const sogmm::Gmm initial = sogmm::fit({a.data(), a.size() / 4}, fixed).gmm;
+  std::vector<float> far = b;
+  for (std::size_t i = 0; i < far.size(); i += 4) far[i] += 100.f;
+  const sogmm::PointsView fv{far.data(), far.size() / 4};
+  sogmm::WarmStartReport rep;
+  const sogmm::FitResult warm = sogmm::fit_warm(fv, initial, options(), {}, {}, &rep);
+  EXPECT_TRUE(rep.cold_fallback);
+  EXPECT_EQ(rep.kept, 0u);
+  EXPECT_EQ(rep.removed, 3u);
+  EXPECT_EQ(rep.novel_points, fv.size);
+  EXPECT_EQ(warm.gmm.size(), rep.added);
+  EXPECT_GE(rep.added, 3u);  // B has three clusters
+  const sogmm::FitResult cold = sogmm::fit(fv, options());
+  EXPECT_GE(warm.em.log_likelihood, cold.em.log_likelihood - 0.02);
+  for (std::size_t k = 0; k < warm.gmm.size(); ++k) EXPECT_GT(warm.gmm.mean(k)[0], 99.0f) << "component " << k;
+
+  for (std::size_t i = 0; i < b.size(); i += 4) b[i] += 5e-4f;
+  sogmm::WarmStartReport near;
+  sogmm::fit_warm({b.data(), b.size() / 4}, initial, options(), {}, {}, &near);
+  EXPECT_FALSE(near.cold_fallback);
+  EXPECT_EQ(near.kept, 2u);
+}
+
 TEST(WarmStart, FixedKFromOwnOptimumStaysThere) {
   const std::vector<float> a = frame({500, 500, 500, 0}, 3, nullptr);
   sogmm::FitOptions fixed = options();
@@ -160,4 +197,17 @@ TEST(WarmStart, LivingroomNextFrameMatchesColdFit) {
   EXPECT_GT(rep.kept, moved.size() / 2);
   EXPECT_LT(rep.novel_points, b.size() / 4);
   EXPECT_GE(warm.em.log_likelihood, cold.em.log_likelihood - 0.02);
+  EXPECT_FALSE(rep.cold_fallback);
+  // The same start 50 m away explains nothing: a cold fit (issue 36: a map
+  // whose last pose is far away kept 1 component for this frame).
+  std::array<double, 16> away{};
+  for (int i = 0; i < 4; ++i) away[5 * i] = 1.0;
+  away[3] = 50.0;
+  sogmm::WarmStartReport far;
+  const sogmm::FitResult refit = sogmm::fit_warm(b.view(), sogmm::transform(moved, away), o, {}, {}, &far);
+  EXPECT_TRUE(far.cold_fallback);
+  EXPECT_EQ(far.kept, 0u);
+  EXPECT_EQ(far.novel_points, b.size());
+  EXPECT_GT(refit.gmm.size(), cold.gmm.size() / 2);
+  EXPECT_GE(refit.em.log_likelihood, cold.em.log_likelihood - 0.02);
 }

@@ -326,7 +326,11 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
  * are removed; points more than 10 nats below the median log-likelihood under
  * `initial` are novel, and the mode count (SOGMM_OPT_BANDWIDTH) and k-means++
  * (SOGMM_OPT_SEED) on the novel points only add that many new components; EM
- * then runs from kept + new. With N_COMPONENTS = K > 0, EM runs from `initial`
+ * then runs from kept + new. When `initial` explains the points badly (fewer
+ * than half of them: the median point's log-likelihood more than 10 nats
+ * below the mean log-likelihood `initial` gives its own samples, e.g. a start
+ * far from the points), it is dropped and the fit is a cold one (every point
+ * novel). With N_COMPONENTS = K > 0, EM runs from `initial`
  * as given, which must have K components. The model records the fit like
  * sogmm_fit_points_f32; `initial` is not modified and may be freed
  * afterwards. Errors as sogmm_fit_points_f32, plus: initial NULL ->
@@ -534,7 +538,10 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model
  * data, or 0 for the actual range of the valid truth pixels (max - min).
  * *psnr_paper_out (may be NULL) receives the paper-compatible figure, which
  * keeps the authors' evaluation whatever data_range is: range 2 and every
- * pixel counted, the empty ones as perfect. Identical images give +infinity.
+ * pixel counted, the empty ones as perfect. Identical images give +infinity;
+ * images that differ on a valid pixel always give a finite figure, for any
+ * finite data_range (e.g. 1e300: computed as 20 log10(data_range) -
+ * 10 log10(MSE), so data_range^2 never overflows).
  * Errors: NULL truth/estimate/psnr_out -> SOGMM_E_NULL_ARG; data_range
  * negative or not finite -> SOGMM_E_INVALID_ARG; NaN/Inf pixels, no valid
  * truth pixel, or data_range 0 on a constant truth that is not matched

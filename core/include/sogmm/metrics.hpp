@@ -36,7 +36,10 @@ PsnrResult psnr(const Gmm& gmm, const PointsView& truth, const Camera& camera, d
 /// [0, 1]; 0 = the actual range of the valid truth pixels (max - min, e.g. for
 /// normalised thermal data; a constant image then has range 0 and PSNR
 /// +infinity only if it is matched exactly, else Error(InvalidData)). Paper:
-/// data range 2, all pixels. Throws Error(InvalidArgument) for a negative or
+/// data range 2, all pixels. `psnr` is finite whenever the images differ on a
+/// valid pixel, for any finite data_range (computed as 20 log10(data_range) -
+/// 10 log10(mse), so data_range^2 never overflows); +infinity means they
+/// match exactly. Throws Error(InvalidArgument) for a negative or
 /// non-finite data_range, Error(InvalidData) without a valid pixel.
 PsnrResult psnr_images(const float* truth, const float* estimate, std::size_t pixels, double data_range = 1.0);
 

@@ -27,8 +27,13 @@ struct RegCovarFloors {
 ///   A typical size rather than the extent, so that a far outlier does not
 ///   move it.
 /// - gray = 1e-6 x 100^k, where 10^k is the smallest power of ten not below
-///   the gray range (max - min; a range up to 1e-6 above a power of ten,
-///   float rounding, counts as that power): gray's resolution follows its unit, not its
+///   the gray range (a range up to 1e-6 above a power of ten, float
+///   rounding, counts as that power). The range is the spread between the
+///   gray quantiles 1% and 99% (order statistics floor(0.01 (N - 1)) from
+///   each end; max - min below 101 points), so that out-of-range pixels, up
+///   to 1% at each end, do not set the floor of every component; when that
+///   spread is 0 (more than 98% of the points share one gray), max - min.
+///   Gray's resolution follows its unit, not its
 ///   spread (8-bit gray in [0, 1] keeps 1e-6, about its quantisation
 ///   variance (1/255)^2 / 12, also for a dark or low-contrast frame; in
 ///   [0, 255] it gets 1).

@@ -33,6 +33,9 @@ struct WarmStartReport {
   std::size_t removed = 0;  ///< initial components removed (mass < min_mass)
   std::size_t added = 0;    ///< new components seeded on poorly explained points
   std::size_t novel_points = 0;  ///< points poorly explained by the initial model
+  /// The initial model explained fewer than half of the points (see
+  /// fit_warm): the fit started cold, every point novel and kept = 0.
+  bool cold_fallback = false;
   double seconds_score = 0.0;    ///< the E-step that scores the initial model
 };
 
@@ -40,7 +43,15 @@ struct WarmStartReport {
 /// points' frame (move it with transform() by the relative pose first).
 /// Self-organizing (options.n_components == 0):
 ///  1. an exact E-step of `initial` gives every point's log-likelihood; points
-///     more than warm.novelty_nats below the median are "novel";
+///     more than warm.novelty_nats below the median are "novel". Cold
+///     fallback: when the median itself is more than warm.novelty_nats below
+///     the mean log-likelihood the model gives its own samples (bounded below
+///     by sum_k w_k (log w_k - (log det(2 pi Sigma_k) + 4) / 2), the value
+///     used), i.e. fewer than half of the points are explained in absolute
+///     terms, `initial` is dropped and the fit is a cold one (every point
+///     novel, report->cold_fallback): a start far from the points (a map's
+///     last pose far away) would otherwise keep its nearest component for
+///     all of them;
 ///  2. a second E-step sums each component's responsibility over the other
 ///     (explained) points; components with less than warm.min_mass are
 ///     removed (if all would be, the fit is a cold one: every point novel);
