@@ -207,7 +207,7 @@ def main():
     print("\nPer visible pixel, held-out grid d+1 minus d (eval's rendered first surface vs the frame; targets: "
           "PSNR loss vs own fit <= 0.5 dB, depth MAE increase <= 1 mm):")
     print("| sequence | frame | pixel PSNR dB map / own / append | depth MAE mm map / own / append "
-          "| empty %% map / own | PSNR loss dB | MAE +mm | fitting grid: PSNR map / own, MAE mm map / own |")
+          "| empty % map / own | PSNR loss dB | MAE +mm | fitting grid: PSNR map / own, MAE mm map / own |")
     print("|---|---|---|---|---|---|---|---|")
     for r in results:
         for f in r["per_frame"]:
