@@ -179,7 +179,7 @@ typedef int32_t sogmm_key;
                                         * camera-frame depth sits on discrete levels (a 16-bit depth image),
                                         * floor each component's variance along its viewing ray at the
                                         * level's bin variance, so components do not collapse onto single
-                                        * levels (every seed converges; higher held-out likelihood, lower
+                                        * levels (every seed converges; higher likelihood of held-out pixels spread in their bins; lower
                                         * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
                                         * points of sogmm_fit_rgbd, 0 for points given as arrays */
 #define SOGMM_DEQUANTISE_AUTO (-1)

@@ -64,7 +64,8 @@ struct FitOptions {
   /// measures the levels themselves, so a step that grows with range is
   /// followed), every M-step floors each component's variance along its
   /// viewing ray at the level's bin variance: every seed converges and the
-  /// likelihood of held-out pixels is higher (spec/api.md 4.3.1).
+  /// likelihood of held-out pixels, their depths spread over their bins, is
+  /// higher (README, "Depth quantisation").
   /// Auto (default): on for points back-projected from a depth image
   /// (PointsView::from_depth_image), off for points given without a camera.
   Dequantise dequantise_depth = Dequantise::Auto;

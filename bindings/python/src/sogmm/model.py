@@ -578,7 +578,8 @@ class SOGMM(GMM):
             ``fit`` of an array. True: when the camera-frame depth sits on
             discrete levels, floor each component's variance along its viewing
             ray at the level's bin variance, so components do not collapse onto
-            single levels (every seed converges; higher held-out likelihood,
+            single levels (every seed converges; held-out pixels spread in their
+            depth bins score higher;
             lower training likelihood). False: the paper's plain EM.
         n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
             the highest final mean log-likelihood is kept (as scikit-learn's
