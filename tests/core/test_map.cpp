@@ -737,6 +737,12 @@ TEST(MapTest, RevisitRefitAtTheDefaultRatioDoesNotCreepOnRepeats) {
     EXPECT_EQ(map.model().gmm.size(), after.size()) << "lap " << lap;
   }
   EXPECT_EQ(map.stats().n_refits, 1u);
+  // The refit's components are exactly symmetric, as the file stores them.
+  const sogmm::Gmm& g = map.model().gmm;
+  for (std::size_t k = 0; k < g.size(); ++k)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        ASSERT_EQ(g.covariance(k)[4 * i + j], g.covariance(k)[4 * j + i]) << "component " << k << " entry " << i << j;
 }
 
 TEST(MapTest, RevisitRefitIsOffAtRatioZeroAndBelowTheRatio) {

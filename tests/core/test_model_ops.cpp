@@ -123,8 +123,9 @@ TEST(Transform, ClosedForm) {
 
 // A moved covariance is stored exactly symmetric (bitwise), as every model
 // the library makes: an asymmetric one in memory is not what the file keeps
-// (the writer stores the symmetric part), so a map saved and loaded again
-// changed (issue 36). 200 rotations about fixed axes, no randomness.
+// (the writer stores the symmetric part), so a map built with it would change
+// when saved and loaded again (issue 36 saw that; transform was not the
+// cause, this guards it). 200 rotations about fixed axes, no randomness.
 TEST(Transform, CovariancesAreExactlySymmetric) {
   const sogmm::Gmm a = model_a();
   for (int n = 0; n < 200; ++n) {
