@@ -179,7 +179,7 @@ func farCluster(t *testing.T) *Model {
 	for k := range weights {
 		weights[k] = 0.1
 	}
-	model, err := FromArrays(weights, means, cov, 0)
+	model, err := FromArrays(weights, means, cov, 1000) // a known support: a map refuses 0 (unknown)
 	if err != nil {
 		t.Fatal(err)
 	}

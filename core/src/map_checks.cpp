@@ -19,6 +19,11 @@ PointCloud batch_cloud(const std::vector<PendingFrame>& pending, const PendingFr
   for (std::size_t g = 0; g < groups; ++g) n += group(g).xyzg.size();
   PointCloud cloud;
   cloud.xyzg.reserve(n);
+  // One RGB-D frame's points in its own camera are a depth image's: the
+  // automatic depth floor applies to them as to that frame's own fit (so
+  // append-everything is the merge of the frames' fits). Points moved in from
+  // other cameras do not sit on this camera's depth levels.
+  cloud.from_depth_image = groups == 1 && group(0).from_rgbd;
   const Pose to_last = inverse_rigid(group(groups - 1).pose);
   for (std::size_t g = 0; g < groups; ++g) {
     const PendingFrame& p = group(g);

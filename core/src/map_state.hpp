@@ -98,7 +98,8 @@ struct PendingFrame {
 };
 
 /// The points a flush fits: every pending frame (and `extra`, when given, as
-/// the latest) moved into the camera frame of the latest one, in float32.
+/// the latest) moved into the camera frame of the latest one, in float32;
+/// from_depth_image when they are one RGB-D frame's.
 PointCloud batch_cloud(const std::vector<PendingFrame>& pending, const PendingFrame* extra = nullptr);
 
 /// Error(InvalidArgument) naming the point and axis unless every world

@@ -340,7 +340,11 @@ static void test_fit_rgbd(void) {
     EXPECT_NEAR(xyzg[0], (1 - 19.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[1], (0 - 14.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[3], 40.0 / 255.0, 1e-7);
+    /* fit_rgbd floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
+     * array are floored only when asked, so ask for the same model. */
+    REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, 1));
     REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, o));
+    REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, SOGMM_DEQUANTISE_AUTO));
     EXPECT_TRUE(check_model(mp) == Mg);
     EXPECT_OK(sogmm_model_get_means_f32(mg, mu_g, 4 * Mg));
     EXPECT_OK(sogmm_model_get_means_f32(mp, mu_p, 4 * Mg));

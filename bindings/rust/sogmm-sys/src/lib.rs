@@ -121,8 +121,8 @@ pub const SOGMM_STAGE_SCORING: i32 = 6;
 pub const SOGMM_STAGE_REGRESSION: i32 = 7;
 pub const SOGMM_STAGE_RENDERING: i32 = 8;
 
-/// The largest width * height a render takes.
-pub const SOGMM_MAX_RENDER_PIXELS: usize = 1 << 26;
+/// The largest width * height a render takes (2^26).
+pub const SOGMM_MAX_RENDER_PIXELS: usize = 67108864;
 
 // ---- color formats --------------------------------------------------------
 pub const SOGMM_COLOR_GRAY8: i32 = 1;

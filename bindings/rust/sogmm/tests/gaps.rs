@@ -125,7 +125,8 @@ fn far_cluster() -> Model {
     for k in 1..M {
         means.extend_from_slice(&[4.0, 0.25 * (k - 1) as f32, 0.0, 0.75]);
     }
-    Model::from_arrays(&[0.1; M], &means, &cov, 0).unwrap()
+    // A known support size: loaded as a map, an unknown one (0) is refused.
+    Model::from_arrays(&[0.1; M], &means, &cov, 1000).unwrap()
 }
 
 const QUERY: [f32; 12] = [0.0, 0.0, 0.0, 0.25, 0.0, 0.5, 0.0, 0.5, -1.0, 0.0, 0.0, 0.25];
