@@ -45,7 +45,8 @@ if [ "${SOGMM_SKIP_HARDENING:-0}" != 1 ]; then
     -DCMAKE_C_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread >/dev/null
-  cmake --build build-tsan --parallel "$JOBS" --target sogmm_capi_test_threads sogmm_capi_test_threads_io
+  cmake --build build-tsan --parallel "$JOBS" --target sogmm_capi_test_threads sogmm_capi_test_threads_io \
+    sogmm_capi_test_map_guard
   OMP_NUM_THREADS=1 TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1" \
     ctest --test-dir build-tsan --output-on-failure --timeout 900 -R '^capi_threads'
 
