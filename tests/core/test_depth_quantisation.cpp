@@ -150,7 +150,6 @@ TEST(DepthQuantisation, FitAppliesTheFloorToDepthImagesByDefault) {
   const sogmm::FitResult on = sogmm::fit(view(stored), o);
   o.dequantise_depth = sogmm::Dequantise::Off;
   const sogmm::FitResult image_off = sogmm::fit(from_image, o);
-  o.dequantise_depth = sogmm::Dequantise::On;
   EXPECT_GE(collapsed_along_the_ray(off.gmm, off.em.reg_covar.spatial), 2);
   EXPECT_EQ(collapsed_along_the_ray(on.gmm, on.em.reg_covar.spatial), 0);
   EXPECT_EQ(image_default.gmm.covariances, on.gmm.covariances);
