@@ -6,27 +6,22 @@
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
+#include "sogmm/fit_record.hpp"
 #include "sogmm/warm_start.hpp"
 
 namespace sogmm_capi {
 
 sogmm::FitOptions fit_options(const sogmm_options& o, std::size_t k) {
-  sogmm::FitOptions f;
-  f.bandwidth = o.bandwidth;
+  sogmm::FitOptions f = o.settings.fit;
   f.n_components = k;
-  f.mode_counter = o.mode_counter == SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING
-                       ? sogmm::ModeCounter::GaussianBlurring
-                       : sogmm::ModeCounter::FlatBinned;
-  f.seed = static_cast<std::uint64_t>(o.seed);
-  f.n_init = static_cast<int>(o.n_init);
-  f.dequantise_depth = static_cast<sogmm::Dequantise>(o.dequantise_depth);
-  f.em.tol = o.tol;
-  // SOGMM_REG_COVAR_AUTO (the default) leaves it unset: floors from the data.
-  if (o.reg_covar != SOGMM_REG_COVAR_AUTO) f.em.reg_covar = o.reg_covar;
-  f.em.max_iter = static_cast<int>(o.max_iter);
-  f.em.threads = static_cast<int>(o.threads);
-  f.em.truncation_nats = o.truncation_nats;
   return f;
+}
+
+void require_depth_range(const sogmm_options& o) {
+  const sogmm::DepthOptions& d = o.settings.depth;
+  if (!(d.depth_min < d.depth_max))
+    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + sogmm::checked::exact(d.depth_min) +
+                                  " must be < SOGMM_OPT_DEPTH_MAX = " + sogmm::checked::exact(d.depth_max));
 }
 
 }  // namespace sogmm_capi
@@ -66,16 +61,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
   sogmm::Model& m = handle->model;
   m.gmm = std::move(r.gmm);
   if (m.gmm.support_size == 0) m.gmm.support_size = n;
-  m.fit.known = true;
-  m.fit.bandwidth = k > 0 ? 0.0 : o.bandwidth;
-  m.fit.n_components_requested = k;
-  m.fit.tol = o.tol;
-  sogmm::record_reg_covar(m, r.em.reg_covar);
-  m.fit.max_iter = static_cast<std::int32_t>(o.max_iter);
-  m.fit.n_iter = r.em.iterations;
-  m.fit.converged = r.em.converged;
-  m.fit.log_likelihood = r.em.log_likelihood;
-  m.fit.seed = fo.seed + static_cast<std::uint64_t>(r.run);  // the kept run's seed
+  sogmm::record_fit(m, r, fo);
   m.created_unix_ms = sogmm_capi::creation_time_now();
   handle->timings.known = true;
   handle->timings.n_points = r.n_points ? r.n_points : n;
@@ -99,7 +85,7 @@ SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* poin
     require_nonnull(out, "out");
     require_nonnull(points, "points");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = fit_to_handle(points, n, static_cast<std::size_t>(o.n_components), o);
+    *out = fit_to_handle(points, n, o.settings.fit.n_components, o);
   }
   SOGMM_CATCH
 }
@@ -124,7 +110,7 @@ SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float*
     require_nonnull(points, "points");
     require_nonnull(initial, "initial");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = fit_to_handle(points, n, static_cast<std::size_t>(o.n_components), o, &initial->model.gmm);
+    *out = fit_to_handle(points, n, o.settings.fit.n_components, o, &initial->model.gmm);
   }
   SOGMM_CATCH
 }
@@ -142,15 +128,15 @@ SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, 
       fail(SOGMM_E_INVALID_DATA, "no pixel has a depth in the valid range after decimation");
 
     std::unique_ptr<sogmm_model> handle(
-        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), static_cast<std::size_t>(o.n_components), o, nullptr,
+        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), o.settings.fit.n_components, o, nullptr,
                       r.cloud.from_depth_image));
     sogmm::CameraInfo& ci = handle->model.camera;
     ci.known = true;
     ci.camera = r.camera;
-    ci.decimation = static_cast<std::int32_t>(o.decimation);
-    ci.depth_scale = o.depth_scale;
-    ci.depth_min = o.depth_min;
-    ci.depth_max = o.depth_max;
+    ci.decimation = r.depth.decimate;
+    ci.depth_scale = r.depth.depth_scale;
+    ci.depth_min = r.depth.depth_min;
+    ci.depth_max = r.depth.depth_max;
     *out = handle.release();
   }
   SOGMM_CATCH

@@ -32,7 +32,7 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
     // With a callback, draw into a buffer (a cancel leaves `out` untouched).
     sogmm_capi::write_on_success(o.progress != nullptr, out, n * static_cast<std::size_t>(dims), [&](float* dst) {
       const sogmm::ProgressScope scope(sogmm_capi::progress_sink(o));
-      sogmm::sample(model->model.gmm, n, seed, dims, dst, o.sample_truncation);
+      sogmm::sample(model->model.gmm, n, seed, dims, dst, o.settings.sample.truncation);
     });
   }
   SOGMM_CATCH

@@ -15,53 +15,21 @@
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/model.hpp"
+#include "sogmm/options.hpp"
 #include "sogmm/point_cloud.hpp"
 #include "sogmm/progress.hpp"
 #include "sogmm/sogmm.h"
 
 // ---- handles -----------------------------------------------------------
 
+// Every setting is a field of the core's Settings, whose option registry
+// (sogmm/options.hpp) gives each key's rule and default: nothing here repeats
+// them.
 struct sogmm_options {
-  // fit
-  double bandwidth = 0.02;
-  std::int64_t n_components = 0;
-  double tol = 1e-3;
-  double reg_covar = SOGMM_REG_COVAR_AUTO;  // or a value >= 0 (SOGMM_OPT_REG_COVAR)
-  std::int64_t max_iter = 100;
-  std::int64_t seed = 0;
-  std::int64_t threads = 0;
-  std::int64_t mode_counter = SOGMM_MODE_COUNTER_FLAT_BINNED;
-  double truncation_nats = 0.0;  // SOGMM_OPT_TRUNCATION_NATS: 0 = exact E-step
-  std::int64_t n_init = 1;       // SOGMM_OPT_N_INIT: runs, the best kept
-  std::int64_t dequantise_depth = SOGMM_DEQUANTISE_AUTO;  // SOGMM_OPT_DEQUANTISE_DEPTH: -1, 0 or 1
-  // RGB-D
-  double depth_scale = 1000.0;
-  double depth_min = 0.1;
-  double depth_max = 3.0;
-  std::int64_t decimation = 1;
-  // write
-  std::int64_t zstd_level = 19;
-  std::int64_t float64 = 0;
-  std::int64_t compress = 1;
-  // read
-  std::int64_t max_decoded_bytes = 0;
-  std::int64_t verify_checksums = 1;
-  // sample
-  double sample_truncation = 2.5;
-  double query_truncation_nats = 0.0;  // SOGMM_OPT_QUERY_TRUNCATION_NATS: 0 = exact queries
+  sogmm::Settings settings;
   // progress (sogmm_options_set_progress): not a key, never stored in files
   sogmm_progress_fn progress = nullptr;
   void* progress_user_data = nullptr;
-  // incremental map (sogmm_map_*)
-  std::int64_t map_novelty = 1;
-  double map_novelty_threshold = 3.0;
-  double map_novelty_bandwidth_scale = 0.7;
-  double map_revisit_refit_ratio = 1.25;
-  std::int64_t map_batch_size = 12288;
-  std::int64_t map_fusion = 0;
-  std::int64_t map_fusion_method = SOGMM_FUSION_HELLINGER;
-  double map_fusion_threshold = 0.3;
-  std::int64_t map_warm_start = 0;
 };
 
 /// Timings of a fit run in this process (not part of the file format).
@@ -139,6 +107,11 @@ struct RgbdPoints {
 RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* color, std::int32_t color_format,
                             std::uint32_t width, std::uint32_t height, double fx, double fy, double cx, double cy,
                             const sogmm_options& options);
+
+/// SOGMM_E_INVALID_ARG "depth range: SOGMM_OPT_DEPTH_MIN = a must be <
+/// SOGMM_OPT_DEPTH_MAX = b" unless min < max (a rule across two keys, checked
+/// when the options are used).
+void require_depth_range(const sogmm_options& o);
 
 /// The fit keys of `o` as FitOptions with n_components = k (sogmm_fit_* and
 /// sogmm_map_*).

@@ -13,21 +13,8 @@ namespace {
 using sogmm_capi::fail;
 using sogmm_capi::require_nonnull;
 
-sogmm::format::WriteOptions write_options(const sogmm_options& o) {
-  sogmm::format::WriteOptions w;
-  w.zstd_level = static_cast<int>(o.zstd_level);
-  w.float64 = o.float64 != 0;
-  w.compress = o.compress != 0;
-  if (o.max_decoded_bytes > 0) w.max_decoded_bytes = static_cast<std::uint64_t>(o.max_decoded_bytes);
-  return w;
-}
-
-sogmm::format::ReadOptions read_options(const sogmm_options& o) {
-  sogmm::format::ReadOptions r;
-  if (o.max_decoded_bytes > 0) r.max_decoded_bytes = static_cast<std::uint64_t>(o.max_decoded_bytes);
-  r.verify_checksums = o.verify_checksums != 0;
-  return r;
-}
+const sogmm::format::WriteOptions& write_options(const sogmm_options& o) { return o.settings.write; }
+const sogmm::format::ReadOptions& read_options(const sogmm_options& o) { return o.settings.read; }
 
 void require_path(const char* path) {
   require_nonnull(path, "path");

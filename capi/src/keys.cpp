@@ -1,48 +1,19 @@
 // The key table behind require_key(): one row per SOGMM_OPT_* and SOGMM_INFO_*.
 #include "keys.hpp"
 
+#include <iterator>
+#include <vector>
+
 namespace sogmm_capi {
 namespace {
 
 constexpr KeyKind O = KeyKind::Option, N = KeyKind::Info;
 constexpr KeyType F = KeyType::F64, I = KeyType::I64;
 
-#define SOGMM_F64_OPTION(key, field) {key, #key, O, F, &sogmm_options::field, nullptr}
-#define SOGMM_I64_OPTION(key, field) {key, #key, O, I, nullptr, &sogmm_options::field}
-#define SOGMM_INFO(key, type) {key, #key, N, type, nullptr, nullptr}
+#define SOGMM_INFO(key, type) {key, #key, N, type, nullptr}
 
-const KeySpec kKeys[] = {
-    SOGMM_F64_OPTION(SOGMM_OPT_BANDWIDTH, bandwidth),
-    SOGMM_I64_OPTION(SOGMM_OPT_N_COMPONENTS, n_components),
-    SOGMM_F64_OPTION(SOGMM_OPT_TOL, tol),
-    SOGMM_F64_OPTION(SOGMM_OPT_REG_COVAR, reg_covar),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAX_ITER, max_iter),
-    SOGMM_I64_OPTION(SOGMM_OPT_SEED, seed),
-    SOGMM_I64_OPTION(SOGMM_OPT_THREADS, threads),
-    SOGMM_I64_OPTION(SOGMM_OPT_MODE_COUNTER, mode_counter),
-    SOGMM_F64_OPTION(SOGMM_OPT_TRUNCATION_NATS, truncation_nats),
-    SOGMM_I64_OPTION(SOGMM_OPT_N_INIT, n_init),
-    SOGMM_I64_OPTION(SOGMM_OPT_DEQUANTISE_DEPTH, dequantise_depth),
-    SOGMM_F64_OPTION(SOGMM_OPT_DEPTH_SCALE, depth_scale),
-    SOGMM_F64_OPTION(SOGMM_OPT_DEPTH_MIN, depth_min),
-    SOGMM_F64_OPTION(SOGMM_OPT_DEPTH_MAX, depth_max),
-    SOGMM_I64_OPTION(SOGMM_OPT_DECIMATION, decimation),
-    SOGMM_I64_OPTION(SOGMM_OPT_ZSTD_LEVEL, zstd_level),
-    SOGMM_I64_OPTION(SOGMM_OPT_FLOAT64, float64),
-    SOGMM_I64_OPTION(SOGMM_OPT_COMPRESS, compress),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAX_DECODED_BYTES, max_decoded_bytes),
-    SOGMM_I64_OPTION(SOGMM_OPT_VERIFY_CHECKSUMS, verify_checksums),
-    SOGMM_F64_OPTION(SOGMM_OPT_SAMPLE_TRUNCATION, sample_truncation),
-    SOGMM_F64_OPTION(SOGMM_OPT_QUERY_TRUNCATION_NATS, query_truncation_nats),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAP_NOVELTY, map_novelty),
-    SOGMM_F64_OPTION(SOGMM_OPT_MAP_NOVELTY_THRESHOLD, map_novelty_threshold),
-    SOGMM_F64_OPTION(SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE, map_novelty_bandwidth_scale),
-    SOGMM_F64_OPTION(SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, map_revisit_refit_ratio),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAP_BATCH_SIZE, map_batch_size),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAP_FUSION, map_fusion),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAP_FUSION_METHOD, map_fusion_method),
-    SOGMM_F64_OPTION(SOGMM_OPT_MAP_FUSION_THRESHOLD, map_fusion_threshold),
-    SOGMM_I64_OPTION(SOGMM_OPT_MAP_WARM_START, map_warm_start),
+// The info keys (SOGMM_INFO_*): a model's information, not settings.
+const KeySpec kInfoKeys[] = {
     SOGMM_INFO(SOGMM_INFO_SUPPORT_SIZE, I),
     SOGMM_INFO(SOGMM_INFO_CREATED_UNIX_MS, I),
     SOGMM_INFO(SOGMM_INFO_FIT_ITERATIONS, I),
@@ -73,12 +44,22 @@ const KeySpec kKeys[] = {
     SOGMM_INFO(SOGMM_INFO_CAMERA_DEPTH_MAX, F),
 };
 
-#undef SOGMM_F64_OPTION
-#undef SOGMM_I64_OPTION
 #undef SOGMM_INFO
 
+// Every key: the registry's options, then the info keys.
+const std::vector<KeySpec>& all_keys() {
+  static const std::vector<KeySpec> keys = [] {
+    std::vector<KeySpec> k;
+    for (const sogmm::OptionSpec& o : sogmm::option_specs())
+      k.push_back({static_cast<sogmm_key>(o.key), o.name, O, o.type == sogmm::OptionType::F64 ? F : I, &o});
+    k.insert(k.end(), std::begin(kInfoKeys), std::end(kInfoKeys));
+    return k;
+  }();
+  return keys;
+}
+
 const KeySpec* find_key(sogmm_key key) {
-  for (const KeySpec& k : kKeys) {
+  for (const KeySpec& k : all_keys()) {
     if (k.key == key) return &k;
   }
   return nullptr;

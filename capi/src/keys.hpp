@@ -6,6 +6,7 @@
 #include <string>
 
 #include "internal.hpp"
+#include "sogmm/options.hpp"
 
 namespace sogmm_capi {
 
@@ -16,13 +17,15 @@ enum class KeyKind { Option, Info };
 /// The value type of a key.
 enum class KeyType { F64, I64 };
 
+/// A key of either kind. Option keys come from the core's option registry
+/// (sogmm/options.hpp), whose row (`option`) holds their rule, default and
+/// storage; info keys are listed in keys.cpp.
 struct KeySpec {
   sogmm_key key;
   const char* name;  ///< the macro, e.g. "SOGMM_OPT_BANDWIDTH"
   KeyKind kind;
   KeyType type;
-  double sogmm_options::*f64;        ///< the option's storage (F64 options only)
-  std::int64_t sogmm_options::*i64;  ///< the option's storage (I64 options only)
+  const sogmm::OptionSpec* option;  ///< the registry row (option keys only)
 };
 
 /// The spec of `key` of `kind` and `type`. Otherwise SOGMM_E_INVALID_ARG with

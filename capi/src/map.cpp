@@ -13,25 +13,8 @@ using sogmm_capi::fail;
 using sogmm_capi::require_nonnull;
 
 sogmm::MapOptions map_options(const sogmm_options& o) {
-  sogmm::MapOptions m;
-  m.novelty = o.map_novelty != 0;
-  m.novelty_threshold = o.map_novelty_threshold;
-  m.novelty_bandwidth_scale = o.map_novelty_bandwidth_scale;
-  m.revisit_refit_ratio = o.map_revisit_refit_ratio;
-  m.batch_size = static_cast<std::size_t>(o.map_batch_size);
-  m.fusion = o.map_fusion != 0;
-  m.fusion_method = o.map_fusion_method == SOGMM_FUSION_KL ? sogmm::FusionMethod::KL : sogmm::FusionMethod::Hellinger;
-  m.fusion_threshold = o.map_fusion_threshold;
-  m.warm_start = o.map_warm_start != 0;
-  m.fit = sogmm_capi::fit_options(o, static_cast<std::size_t>(o.n_components));
-  m.depth.depth_scale = o.depth_scale;
-  m.depth.depth_min = o.depth_min;
-  m.depth.depth_max = o.depth_max;
-  m.depth.decimate = static_cast<int>(o.decimation);
-  if (!(o.depth_min < o.depth_max))
-    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + std::to_string(o.depth_min) +
-                                  " must be < SOGMM_OPT_DEPTH_MAX = " + std::to_string(o.depth_max));
-  return m;
+  sogmm_capi::require_depth_range(o);
+  return sogmm::map_options(o.settings);
 }
 
 sogmm::Pose pose_of(const double* pose) { return sogmm_capi::require_rigid(pose, "pose"); }

@@ -65,7 +65,7 @@ SOGMM_API sogmm_status sogmm_map_sample_f32(const sogmm_map* map, size_t n, uint
     const std::size_t count = sogmm::checked::mul<std::size_t>(n, static_cast<std::size_t>(dims), "samples");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
     sogmm_capi::write_on_success(o.progress != nullptr, out, count, [&](float* dst) {
-      sogmm::sample(map->map, n, seed, dims, dst, o.sample_truncation, sogmm_capi::progress_sink(o));
+      sogmm::sample(map->map, n, seed, dims, dst, o.settings.sample.truncation, sogmm_capi::progress_sink(o));
     });
   }
   SOGMM_CATCH

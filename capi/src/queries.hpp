@@ -29,12 +29,7 @@ inline void require_query_input(const float* in, std::size_t n, std::size_t widt
 }
 
 /// The query keys of `o`: SOGMM_OPT_THREADS, SOGMM_OPT_QUERY_TRUNCATION_NATS.
-inline sogmm::QueryOptions query_options(const sogmm_options& o) {
-  sogmm::QueryOptions q;
-  q.threads = static_cast<int>(o.threads);
-  q.truncation_nats = o.query_truncation_nats;
-  return q;
-}
+inline const sogmm::QueryOptions& query_options(const sogmm_options& o) { return o.settings.query; }
 
 /// Runs write(dst) for an output of `count` values: straight into `out`, or,
 /// when `progress` is set, into a temporary copied to `out` only on success,

@@ -37,9 +37,9 @@ void render_into(const sogmm::Gmm& gmm, std::uint32_t width, std::uint32_t heigh
   if (camera_to_world != nullptr) pose = sogmm_capi::require_rigid(camera_to_world, "camera_to_world");
   const sogmm_options& o = sogmm_capi::opts_or_default(options);
   sogmm::RenderOptions ro;
-  ro.depth_min = o.depth_min;
-  ro.depth_max = o.depth_max;
-  ro.threads = static_cast<int>(o.threads);
+  ro.depth_min = o.settings.depth.depth_min;
+  ro.depth_max = o.settings.depth.depth_max;
+  ro.threads = o.settings.query.threads;
   const sogmm::RenderedImages r = sogmm::render(gmm, camera, pose, ro, sogmm_capi::progress_sink(o));
   std::copy(r.depth.begin(), r.depth.end(), depth_out);
   std::copy(r.gray.begin(), r.gray.end(), gray_out);

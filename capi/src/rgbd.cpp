@@ -59,15 +59,11 @@ RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* colo
   r.camera.fy = fy;
   r.camera.cx = cx;
   r.camera.cy = cy;
-  r.depth.depth_scale = o.depth_scale;
-  r.depth.depth_min = o.depth_min;
-  r.depth.depth_max = o.depth_max;
-  r.depth.decimate = static_cast<int>(o.decimation);
-  if (!(o.depth_min < o.depth_max))
-    fail(SOGMM_E_INVALID_ARG, "depth range: SOGMM_OPT_DEPTH_MIN = " + sogmm::checked::exact(o.depth_min) +
-                                  " must be < SOGMM_OPT_DEPTH_MAX = " + sogmm::checked::exact(o.depth_max));
-  if (o.decimation > static_cast<std::int64_t>(width) || o.decimation > static_cast<std::int64_t>(height))
-    fail(SOGMM_E_INVALID_ARG, "decimation " + std::to_string(o.decimation) + " leaves no pixel of a " +
+  r.depth = o.settings.depth;
+  require_depth_range(o);
+  const std::int64_t decimation = r.depth.decimate;
+  if (decimation > static_cast<std::int64_t>(width) || decimation > static_cast<std::int64_t>(height))
+    fail(SOGMM_E_INVALID_ARG, "decimation " + std::to_string(decimation) + " leaves no pixel of a " +
                                   std::to_string(width) + " x " + std::to_string(height) + " image");
   // Before the color image is converted: the size limit and the finiteness of
   // the back-projection depend on the image size and parameters only.

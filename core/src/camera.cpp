@@ -9,6 +9,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
+#include "sogmm/options.hpp"
 
 namespace sogmm {
 
@@ -22,14 +23,14 @@ void validate(const Camera& c) {
 }
 
 void validate(const DepthOptions& o) {
-  require(std::isfinite(o.depth_scale) && o.depth_scale > 0, ErrorCode::InvalidArgument,
-          "depth scale must be positive, got " + checked::exact(o.depth_scale));
+  require_option(OptionKey::DEPTH_SCALE, o.depth_scale, "depth scale");
+  require_option(OptionKey::DEPTH_MIN, o.depth_min, "depth_min");
+  require_option(OptionKey::DEPTH_MAX, o.depth_max, "depth_max");
   require(std::isfinite(o.depth_min) && std::isfinite(o.depth_max) && o.depth_min >= 0 && o.depth_min < o.depth_max,
           ErrorCode::InvalidArgument,
           "depth range must satisfy 0 <= min < max, got (" + checked::exact(o.depth_min) + ", " +
               checked::exact(o.depth_max) + "]");
-  require(o.decimate >= 1, ErrorCode::InvalidArgument,
-          "decimation factor must be >= 1, got " + std::to_string(o.decimate));
+  require_option(OptionKey::DECIMATION, std::int64_t{o.decimate}, "decimation factor");
 }
 
 namespace {

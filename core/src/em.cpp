@@ -12,6 +12,7 @@
 
 #include "covariance_storage.hpp"
 #include "em_kernel.hpp"
+#include "sogmm/options.hpp"
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
@@ -38,12 +39,10 @@ using RegDiagonal = std::array<double, 4>;
 RegDiagonal diagonal(const RegCovarFloors& f) { return {f.spatial, f.spatial, f.spatial, f.gray}; }
 
 void check_options(const EmOptions& o) {
-  require(std::isfinite(o.tol) && o.tol >= 0, ErrorCode::InvalidArgument,
-          "EM tol must be finite and >= 0, got " + checked::exact(o.tol));
-  require(o.max_iter >= 1, ErrorCode::InvalidArgument, "EM max_iter must be >= 1, got " + std::to_string(o.max_iter));
-  require(o.threads >= 0, ErrorCode::InvalidArgument, "EM threads must be >= 0, got " + std::to_string(o.threads));
-  require(std::isfinite(o.truncation_nats) && o.truncation_nats >= 0, ErrorCode::InvalidArgument,
-          "EM truncation_nats must be finite and >= 0 (0 = exact), got " + checked::exact(o.truncation_nats));
+  require_option(OptionKey::TOL, o.tol, "EM tol");
+  require_option(OptionKey::MAX_ITER, std::int64_t{o.max_iter}, "EM max_iter");
+  require_option(OptionKey::THREADS, std::int64_t{o.threads}, "EM threads");
+  require_option(OptionKey::TRUNCATION_NATS, o.truncation_nats, "EM truncation_nats");
 }
 
 // The frame the fit works in: the midpoint of the data's bounding box per

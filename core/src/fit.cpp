@@ -13,6 +13,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/kmeanspp.hpp"
+#include "sogmm/options.hpp"
 
 namespace sogmm {
 namespace {
@@ -51,10 +52,8 @@ FitResult fit(const PointsView& points, const FitOptions& options, const Progres
             "K = " + std::to_string(options.n_components) + " components exceeds the limit of " +
                 std::to_string(kMaxComponents) + " components per fit");
   }
-  require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
-  require(options.n_init >= 1 && options.n_init <= kMaxRuns, ErrorCode::InvalidArgument,
-          "n_init (number of runs) must be in [1, " + std::to_string(kMaxRuns) + "], got " +
-              std::to_string(options.n_init));
+  require_option(OptionKey::THREADS, std::int64_t{options.em.threads}, "threads");
+  require_option(OptionKey::N_INIT, std::int64_t{options.n_init}, "n_init (number of runs)");
   // Every parallel loop of the fit (mode count, seeding, EM) uses this many.
   const int threads = detail::team_size(options.em.threads);
   const detail::ScopedOmpThreads scoped_threads(threads);

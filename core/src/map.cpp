@@ -16,6 +16,8 @@
 #include "sogmm/warm_start.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/mean_shift.hpp"
+#include "sogmm/fit_record.hpp"
+#include "sogmm/options.hpp"
 
 namespace sogmm {
 namespace {
@@ -49,23 +51,14 @@ bool same_camera(const Camera& a, const Camera& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy;
 }
 
-// A fit made in the camera frame of `pose` as a world-frame model with its
-// fit record, as the CLI's make_model() builds it (the seed recorded is the
-// options' seed).
+// A fit made in the camera frame of `pose` with `bandwidth` as a world-frame
+// model with its fit record (record_fit, as every front end writes it).
 Model world_model(const Map::State& s, const FitResult& r, const Pose& pose, double bandwidth, bool from_rgbd) {
   Model batch;
   batch.gmm = transform(r.gmm, pose);
-  batch.fit.known = true;
-  const FitOptions& fo = s.options.fit;
-  batch.fit.bandwidth = bandwidth;
-  batch.fit.n_components_requested = fo.n_components;
-  batch.fit.tol = fo.em.tol;
-  record_reg_covar(batch, r.em.reg_covar);
-  batch.fit.max_iter = fo.em.max_iter;
-  batch.fit.n_iter = r.em.iterations;
-  batch.fit.converged = r.em.converged;
-  batch.fit.log_likelihood = r.em.log_likelihood;
-  batch.fit.seed = fo.seed;
+  FitOptions fo = s.options.fit;
+  fo.bandwidth = bandwidth;
+  record_fit(batch, r, fo);
   if (from_rgbd && s.camera) {
     batch.camera.known = true;
     batch.camera.camera = *s.camera;
@@ -103,17 +96,14 @@ Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, co
 }  // namespace
 
 void validate(const MapOptions& o) {
-  require(std::isfinite(o.novelty_threshold), ErrorCode::InvalidArgument,
-          "map: novelty_threshold " + checked::exact(o.novelty_threshold) + " is not finite");
-  require(o.batch_size >= 1 && o.batch_size <= kMaxPoints, ErrorCode::InvalidArgument,
-          "map: batch_size " + std::to_string(o.batch_size) + " is not in [1, " + std::to_string(kMaxPoints) + "]");
-  require(o.novelty_bandwidth_scale > 0 && o.novelty_bandwidth_scale <= 1, ErrorCode::InvalidArgument,
-          "map: novelty_bandwidth_scale " + checked::exact(o.novelty_bandwidth_scale) + " is not in (0, 1]");
-  require(std::isfinite(o.fusion_threshold) && o.fusion_threshold > 0, ErrorCode::InvalidArgument,
-          "map: fusion_threshold " + checked::exact(o.fusion_threshold) + " is not finite and > 0");
-  require(o.revisit_refit_ratio == 0 || (std::isfinite(o.revisit_refit_ratio) && o.revisit_refit_ratio >= 1),
-          ErrorCode::InvalidArgument,
-          "map: revisit_refit_ratio " + checked::exact(o.revisit_refit_ratio) + " is neither 0 (off) nor finite and >= 1");
+  require_option(OptionKey::MAP_NOVELTY_THRESHOLD, o.novelty_threshold, "map: novelty_threshold");
+  // batch_size is a size_t: a value above the int64 range is out of range too.
+  require_option(OptionKey::MAP_BATCH_SIZE,
+                 static_cast<std::int64_t>(std::min<std::size_t>(o.batch_size, std::size_t{1} << 62)),
+                 "map: batch_size");
+  require_option(OptionKey::MAP_NOVELTY_BANDWIDTH_SCALE, o.novelty_bandwidth_scale, "map: novelty_bandwidth_scale");
+  require_option(OptionKey::MAP_FUSION_THRESHOLD, o.fusion_threshold, "map: fusion_threshold");
+  require_option(OptionKey::MAP_REVISIT_REFIT_RATIO, o.revisit_refit_ratio, "map: revisit_refit_ratio");
   require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
           "map: index_sigmas " + checked::exact(o.index_sigmas) + " is not in (0, 100]");
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
@@ -365,7 +355,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   const double ms_fit = ms_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
 
-  Model batch = world_model(s, r, last, s.options.fit.n_components > 0 ? 0.0 : batch_options.bandwidth, from_rgbd);
+  Model batch = world_model(s, r, last, batch_options.bandwidth, from_rgbd);
   const std::size_t first = s.model.gmm.size();
   Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);
   std::vector<std::size_t> changed;

@@ -81,9 +81,56 @@ static void test_options(void) {
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_COMPRESS, &i));
   EXPECT_TRUE(i == 1);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_MAX_DECODED_BYTES, &i));
-  EXPECT_TRUE(i == 0);
+  EXPECT_TRUE(i == ((int64_t)1 << 30));
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_VERIFY_CHECKSUMS, &i));
   EXPECT_TRUE(i == 1);
+  /* the registry (sogmm_option_get_info) reports what a fresh handle holds */
+  {
+    size_t count = 0, n = 0;
+    sogmm_key keys[64];
+    EXPECT_OK(sogmm_option_keys(NULL, 0, &count));
+    EXPECT_TRUE(count >= 31 && count <= 64);
+    EXPECT_OK(sogmm_option_keys(keys, 64, &n));
+    EXPECT_TRUE(n == count);
+    for (size_t k = 0; k < n && k < 64; ++k) {
+      sogmm_option_info info;
+      memset(&info, 0, sizeof info);
+      info.struct_size = sizeof info;
+      EXPECT_OK(sogmm_option_get_info(keys[k], &info));
+      EXPECT_TRUE(info.key == keys[k]);
+      EXPECT_TRUE(k == 0 || keys[k] > keys[k - 1]);
+      EXPECT_TRUE(info.name != NULL && strncmp(info.name, "SOGMM_OPT_", 10) == 0);
+      EXPECT_TRUE(info.range != NULL && info.unit != NULL && info.doc != NULL);
+      if (info.type == SOGMM_TYPE_F64) {
+        double v = 0;
+        EXPECT_OK(sogmm_options_get_f64(o, keys[k], &v));
+        EXPECT_TRUE(v == info.default_f64);
+        EXPECT_TRUE(info.lower_f64 <= v && v <= info.upper_f64);
+      } else {
+        int64_t v = 0;
+        EXPECT_TRUE(info.type == SOGMM_TYPE_I64);
+        EXPECT_OK(sogmm_options_get_i64(o, keys[k], &v));
+        EXPECT_TRUE(v == info.default_i64);
+        EXPECT_TRUE(info.lower_i64 <= v && v <= info.upper_i64);
+        /* the bounds are accepted, one past them refused */
+        EXPECT_OK(sogmm_options_set_i64(o, keys[k], info.upper_i64));
+        if (info.lower_i64 > INT64_MIN)
+          EXPECT_STATUS(sogmm_options_set_i64(o, keys[k], info.lower_i64 - 1), SOGMM_E_INVALID_ARG);
+        EXPECT_OK(sogmm_options_set_i64(o, keys[k], v));
+      }
+    }
+    sogmm_option_info info;
+    memset(&info, 0, sizeof info);
+    info.struct_size = sizeof info;
+    EXPECT_STATUS(sogmm_option_get_info(99, &info), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_option_get_info(SOGMM_INFO_FIT_TOL, &info), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_option_get_info(SOGMM_OPT_TOL, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_option_keys(NULL, 0, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_option_keys(NULL, 3, &n), SOGMM_E_NULL_ARG);
+    info.struct_size = sizeof(size_t);
+    EXPECT_STATUS(sogmm_option_get_info(SOGMM_OPT_TOL, &info), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(strstr(sogmm_last_error(), "struct_size") != NULL);
+  }
   /* set / get round trip, clone is deep */
   EXPECT_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
   EXPECT_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, -1)); /* = UINT64_MAX */

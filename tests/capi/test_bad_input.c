@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
   ROW("O8", sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, inf_), SOGMM_E_INVALID_ARG);
   ROW("O9", sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.0), SOGMM_E_INVALID_ARG);
   ROW("O10", sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, -0.01), SOGMM_E_INVALID_ARG);
-  ROW("O11", sogmm_options_set_f64(o, SOGMM_OPT_TOL, 0.0), SOGMM_E_INVALID_ARG);
+  ROW("O11", sogmm_options_set_f64(o, SOGMM_OPT_TOL, -1e-9), SOGMM_E_INVALID_ARG);
   ROW("O12", sogmm_options_set_f64(o, SOGMM_OPT_REG_COVAR, -1e-9), SOGMM_E_INVALID_ARG);
   ROW("O13", sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_SCALE, 0.0), SOGMM_E_INVALID_ARG);
   ROW("O14", sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_MIN, -0.1), SOGMM_E_INVALID_ARG);

@@ -91,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                         finite_nonzero(1.0 / (2.0 * bw * bw));
   FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, bw) == (bw_valid ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   if (flags & 8) {
-    const bool ok = std::isfinite(tol) && tol > 0;
+    const bool ok = std::isfinite(tol) && tol >= 0;  // 0: EM runs max_iter iterations
     FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_TOL, tol) == (ok ? SOGMM_OK : SOGMM_E_INVALID_ARG));
   }
   if (flags & 16) {

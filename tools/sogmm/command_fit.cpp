@@ -111,23 +111,19 @@ int run_single(const FitState& s) {
   FitResult r = fit(cloud.view(), s.fit, progress.fit_callback("fit " + base_name(s.src.depth)));
   progress.em_done("fit " + base_name(s.src.depth), r);
   progress.finish();
-  // The file records the kept run's seed: refitting with it and one run
-  // reproduces the model.
-  FitOptions kept = s.fit;
-  kept.seed += static_cast<std::uint64_t>(r.run);
   // File names need not be UTF-8; metadata strings must be (spec/format.md 4.4).
   std::vector<std::pair<std::string, std::string>> key_values{{"source_depth", to_metadata_string(s.src.depth)},
                                                               {"source_color", to_metadata_string(s.src.color)},
                                                               {"coordinate_frame", "camera"}};
   if (s.fit.n_init > 1) key_values.emplace_back("n_init", std::to_string(s.fit.n_init));
   if (dequantises(s.fit.dequantise_depth, cloud.view())) key_values.emplace_back("dequantise_depth", "1");
-  const Model model = make_model(std::move(r.gmm), kept, r.em, camera, s.depth_options, std::move(key_values));
+  const Model model = make_model(r, s.fit, camera, s.depth_options, std::move(key_values));
   const std::uint64_t bytes = save_model(s.output, model);
   Totals t;
   t.add(r);
   const Camera dc = decimated(camera, s.depth_options.decimate);
   const std::string runs = s.fit.n_init > 1 ? "; best of " + std::to_string(s.fit.n_init) + " runs, seed " +
-                                                    std::to_string(kept.seed)
+                                                    std::to_string(model.fit.seed)
                                               : "";
   char what[640];
   std::snprintf(what, sizeof what,

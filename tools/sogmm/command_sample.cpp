@@ -19,7 +19,7 @@ Command add_sample_command(CLI::App& root) {
     std::string model, output, ellipsoids;
     long long n = -1;
     std::uint64_t seed = 0;
-    double truncation = 2.5, sigmas = 2.0;
+    double truncation = sogmm::kDefaultSampleTruncation, sigmas = 2.0;
     int subdivisions = 1;
   };
   auto s = std::make_shared<State>();

@@ -2,6 +2,7 @@
 
 #include "file_util.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/fit_record.hpp"
 #include "sogmm/format.hpp"
 
 namespace sogmm::tools {
@@ -31,19 +32,12 @@ std::uint64_t save_model(const std::string& path, const Model& model) {
   return file_size_or_zero(path);
 }
 
-Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const Camera& camera,
-                 const DepthOptions& depth, std::vector<std::pair<std::string, std::string>> key_values) {
+Model make_model(const FitResult& result, const FitOptions& options, const Camera& camera, const DepthOptions& depth,
+                 std::vector<std::pair<std::string, std::string>> key_values) {
   Model m;
-  m.gmm = std::move(gmm);
-  m.fit.known = true;
-  m.fit.bandwidth = options.n_components > 0 ? 0.0 : options.bandwidth;
-  m.fit.n_components_requested = options.n_components;
-  m.fit.tol = options.em.tol;
-  m.fit.max_iter = options.em.max_iter;
-  m.fit.n_iter = em.iterations;
-  m.fit.converged = em.converged;
-  m.fit.log_likelihood = em.log_likelihood;
-  m.fit.seed = options.seed;
+  m.key_values = std::move(key_values);
+  record_fit(m, result, options);  // appends the floors' keys
+  m.gmm = result.gmm;
   m.camera.known = true;
   m.camera.camera = camera;
   m.camera.decimation = depth.decimate;
@@ -53,8 +47,6 @@ Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const C
   m.producer_name = "sogmm";
   m.producer_version = version_string();
   m.created_unix_ms = unix_ms_now();
-  m.key_values = std::move(key_values);
-  record_reg_covar(m, em.reg_covar);
   return m;
 }
 

@@ -17,12 +17,12 @@ Model load_model(const std::string& path);
 /// Saves atomically (format::save); returns the file size in bytes.
 std::uint64_t save_model(const std::string& path, const Model& model);
 
-/// A Model around a fit: FitInfo from the options and the EM report,
-/// CameraInfo (full-resolution intrinsics, decimation, depth scale and
-/// range), producer "sogmm" + library version, creation time now, and the
-/// given key/value pairs (e.g. source files).
-Model make_model(Gmm gmm, const FitOptions& options, const EmReport& em, const Camera& camera,
-                 const DepthOptions& depth, std::vector<std::pair<std::string, std::string>> key_values);
+/// A Model around a fit: its fit record (record_fit), CameraInfo
+/// (full-resolution intrinsics, decimation, depth scale and range), producer
+/// "sogmm" + library version, creation time now, and the given key/value
+/// pairs (e.g. source files).
+Model make_model(const FitResult& result, const FitOptions& options, const Camera& camera, const DepthOptions& depth,
+                 std::vector<std::pair<std::string, std::string>> key_values);
 
 /// The value of a key in the model's key_values ("" when absent).
 std::string key_value(const Model& model, const std::string& key);

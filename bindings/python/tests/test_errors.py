@@ -49,7 +49,7 @@ def test_empty_points():
     (dict(bandwidth=4e-314), "bandwidth"),  # 1 / (2 bw^2) overflows
     (dict(bandwidth=1e154), "bandwidth"),  # 2 bw^2 overflows
     (dict(reg_covar=1e39), "reg"),  # not finite in float32
-    (dict(tol=0.0), "tol"),
+    (dict(tol=-1e-9), "tol"),
     (dict(reg_covar=-1.0), "reg"),
     (dict(max_iter=0), "iter"),
     (dict(n_threads=-1), "thread"),

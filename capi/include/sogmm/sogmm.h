@@ -150,7 +150,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero
                                     * (about 5.3e-155 to 4.4e153); default 0.02: mean-shift bandwidth */
 #define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
-#define SOGMM_OPT_TOL 102          /* f64, > 0, finite; default 1e-3: EM stop tolerance */
+#define SOGMM_OPT_TOL 102          /* f64, >= 0, finite; default 1e-3: EM stop tolerance (0: run max_iter iterations) */
 #define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32),
                                     * or SOGMM_REG_COVAR_AUTO; default SOGMM_REG_COVAR_AUTO. A value:
                                     * added to all four covariance diagonals in each M-step, as before.
@@ -168,14 +168,14 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
 #define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores; a request is capped at
                                     * 4 x the cores (libgomp aborts when it cannot start a thread) */
-#define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default FLAT_BINNED */
+#define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default SOGMM_MODE_COUNTER_FLAT_BINNED */
 #define SOGMM_OPT_TRUNCATION_NATS 108 /* f64, >= 0, finite; default 0 = exact E-step. > 0: truncated E-step
                                        * that skips components provably more than this many nats below
                                        * every point's best in a block (25: each skipped term < 1.4e-11) */
 #define SOGMM_OPT_N_INIT 109       /* i64, [1, 1000]; default 1: runs of k-means++ + EM. Run r (from 0)
                                     * is seeded with SEED + r; the run with the highest final mean
                                     * log-likelihood is kept (ties: the earliest). Cost grows linearly. */
-#define SOGMM_OPT_DEQUANTISE_DEPTH 110 /* i64, SOGMM_DEQUANTISE_AUTO (-1, default), 0 or 1. 1: when the
+#define SOGMM_OPT_DEQUANTISE_DEPTH 110 /* i64, SOGMM_DEQUANTISE_AUTO (-1), 0 or 1; default SOGMM_DEQUANTISE_AUTO. 1: when the
                                         * camera-frame depth sits on discrete levels (a 16-bit depth image),
                                         * floor each component's variance along its viewing ray at the
                                         * level's bin variance, so components do not collapse onto single
@@ -198,7 +198,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_COMPRESS 302   /* i64, 0 or 1; default 1: zstd-compress the arrays */
 
 /* Reading .sogmm (load, load_from_memory); MAX_DECODED_BYTES also for writing (save, save_to_memory). */
-#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 0 = the format library's default cap (1 GiB)
+#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 1073741824 (1 GiB, the format library's cap); 0 sets that default again. The cap
                                          * on the arrays' decoded bytes: load refuses a file above it and
                                          * save a model above it (what a default reader would refuse) */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
@@ -232,7 +232,7 @@ typedef int32_t sogmm_key;
                                                * A refit counts as a fit (flushed, n_flushes) */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
-#define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default HELLINGER */
+#define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default SOGMM_FUSION_HELLINGER */
 #define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
 #define SOGMM_OPT_MAP_WARM_START 606        /* i64, 0 or 1; default 0. 1: each batch's fit starts from the
                                              * previous batch's model moved into its camera (as
@@ -252,6 +252,41 @@ SOGMM_API sogmm_status sogmm_options_set_f64(sogmm_options* options, sogmm_key k
 SOGMM_API sogmm_status sogmm_options_set_i64(sogmm_options* options, sogmm_key key, int64_t value);
 SOGMM_API sogmm_status sogmm_options_get_f64(const sogmm_options* options, sogmm_key key, double* out);
 SOGMM_API sogmm_status sogmm_options_get_i64(const sogmm_options* options, sogmm_key key, int64_t* out);
+
+/* ---- option introspection --------------------------------------------- */
+/* The library's option registry, which every binding and tool reads its
+ * defaults and ranges from (as zstd's ZSTD_cParam_getBounds). */
+#define SOGMM_TYPE_F64 0 /* set/get with sogmm_options_*_f64 */
+#define SOGMM_TYPE_I64 1 /* set/get with sogmm_options_*_i64 */
+
+/* What the library knows of one option key. The caller sets struct_size to
+ * sizeof(sogmm_option_info) before the call; later versions only append
+ * fields, and write only the first struct_size bytes. Strings are static
+ * (never freed, valid for the process's lifetime). */
+typedef struct sogmm_option_info {
+  size_t struct_size;  /* in: sizeof(sogmm_option_info) as the caller knows it */
+  sogmm_key key;       /* the key asked for */
+  int32_t type;        /* SOGMM_TYPE_F64 or SOGMM_TYPE_I64 */
+  const char* name;    /* the macro's name, e.g. "SOGMM_OPT_BANDWIDTH" */
+  double default_f64;  /* the default (for an I64 key: the default as a double) */
+  double lower_f64;    /* smallest accepted value (closed; may be -inf); for I64 keys the I64 bound as a double */
+  double upper_f64;    /* largest accepted value (closed; may be +inf) */
+  int64_t default_i64; /* I64 keys: the default; F64 keys: 0 */
+  int64_t lower_i64;   /* I64 keys: smallest accepted value; F64 keys: 0 */
+  int64_t upper_i64;   /* I64 keys: largest accepted value; F64 keys: 0 */
+  const char* range;   /* the whole rule in words, e.g. "> 0, finite" (the bounds are its hull:
+                        * a value inside them may still be refused, as a sentinel outside them accepted) */
+  const char* unit;    /* e.g. "m", "nats"; "" when dimensionless */
+  const char* doc;     /* one sentence: what the option does */
+} sogmm_option_info;
+
+/* Fills `*out` for `key`. SOGMM_E_INVALID_ARG for an unknown key (info keys
+ * included) or a struct_size below this version's first struct. */
+SOGMM_API sogmm_status sogmm_option_get_info(sogmm_key key, sogmm_option_info* out);
+/* Every option key, in increasing order: writes min(capacity, count) keys
+ * to `keys` (may be NULL when capacity is 0) and the number of keys to
+ * `*count`. */
+SOGMM_API sogmm_status sogmm_option_keys(sogmm_key* keys, size_t capacity, size_t* count);
 
 /* ---- progress and cancel ---------------------------------------------- */
 /* Stages reported to a progress callback. New stages are only appended:

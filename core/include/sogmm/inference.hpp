@@ -41,17 +41,21 @@ void score_samples(const Gmm& gmm, const float* points, std::size_t n, int dims,
 /// Mean of score_samples (the average log-likelihood, scikit-learn's score).
 double mean_log_likelihood(const Gmm& gmm, const float* points, std::size_t n, int dims);
 
+/// The truncation of sample's standard-normal draws unless one is given:
+/// 2.5, the authors' choice (SOGMM_OPT_SAMPLE_TRUNCATION's default).
+inline constexpr double kDefaultSampleTruncation = 2.5;
+
 /// Draws `n` points from the model: per-component counts are multinomial in
 /// the weights; each draw is mu + L z with L the Cholesky factor of the
 /// covariance and each coordinate of z drawn independently from the standard
-/// normal truncated to (-`truncation`, `truncation`) (2.5, the authors'
-/// choice; infinity = untruncated). The truncated draws invert the CDF
+/// normal truncated to (-`truncation`, `truncation`) (infinity =
+/// untruncated). The truncated draws invert the CDF
 /// exactly, so the cost does not depend on `truncation`.
 /// Rows of 4 floats (x, y, z, gray) are written to `out` grouped by component.
 /// The same seed gives the same samples. `dims` = 3 writes only (x, y, z),
 /// which is the 3-D marginal sampled the same way.
 void sample(const Gmm& gmm, std::size_t n, std::uint64_t seed, int dims, float* out,
-            double truncation = 2.5);
+            double truncation = kDefaultSampleTruncation);
 
 /// Expected gray at 3-D points, the mixture of the per-component conditionals
 /// g | xyz (the paper's regression) plus one background term for points off

@@ -38,7 +38,7 @@ void regress_gray(const Map& map, const float* xyz, std::size_t n, float* mean, 
 /// `dims` floats grouped by component; the same seed gives the same points.
 /// Errors: empty map -> Error(InvalidData); then as sample. `progress`
 /// receives Stage::Sampling reports and may cancel.
-void sample(const Map& map, std::size_t n, std::uint64_t seed, int dims, float* out, double truncation = 2.5,
+void sample(const Map& map, std::size_t n, std::uint64_t seed, int dims, float* out, double truncation = kDefaultSampleTruncation,
             const ProgressSink& progress = {});
 
 }  // namespace sogmm

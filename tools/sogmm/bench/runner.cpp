@@ -12,6 +12,7 @@
 #include "octomap_adapter.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
+#include "sogmm/fit_record.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/metrics.hpp"
 
@@ -60,16 +61,7 @@ long long sogmm_file_bytes(const FitResult& f, const FitOptions& o, const BenchC
 #ifdef SOGMM_BENCH_HAVE_FORMAT
   Model model;
   model.gmm = f.gmm;
-  model.fit.known = true;
-  model.fit.bandwidth = o.n_components > 0 ? 0.0 : o.bandwidth;
-  model.fit.n_components_requested = o.n_components;
-  model.fit.tol = o.em.tol;
-  record_reg_covar(model, f.em.reg_covar);
-  model.fit.max_iter = o.em.max_iter;
-  model.fit.n_iter = f.em.iterations;
-  model.fit.converged = f.em.converged;
-  model.fit.log_likelihood = f.em.log_likelihood;
-  model.fit.seed = o.seed;
+  record_fit(model, f, o);
   model.camera = config.camera_info;
   return static_cast<long long>(format::to_bytes(model).size());
 #else

@@ -18,6 +18,7 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
+import types
 from ctypes import POINTER, c_char_p, c_double, c_int32, c_int64, c_size_t, c_uint8, c_uint32, c_uint64, c_void_p
 from pathlib import Path
 
@@ -155,6 +156,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_options_get_f64": (STATUS, [HANDLE, KEY, POINTER(c_double)]),
     "sogmm_options_get_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
     "sogmm_options_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
+    "sogmm_option_get_info": (STATUS, [KEY, ctypes.c_void_p]),
+    "sogmm_option_keys": (STATUS, [POINTER(KEY), c_size_t, POINTER(c_size_t)]),
     "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
     "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
     "sogmm_fit_points_warm_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE, HANDLE]),
@@ -352,6 +355,53 @@ def check(status: int) -> None:
         if not message:
             message = lib.sogmm_status_string(status).decode("utf-8", "replace")
         raise error_for_status(int(status), message)
+
+
+class OptionInfo(ctypes.Structure):
+    """sogmm_option_info: what the library's option registry says of a key."""
+
+    _fields_ = [
+        ("struct_size", c_size_t),
+        ("key", ctypes.c_int32),
+        ("type", ctypes.c_int32),
+        ("name", ctypes.c_char_p),
+        ("default_f64", c_double),
+        ("lower_f64", c_double),
+        ("upper_f64", c_double),
+        ("default_i64", c_int64),
+        ("lower_i64", c_int64),
+        ("upper_i64", c_int64),
+        ("range", ctypes.c_char_p),
+        ("unit", ctypes.c_char_p),
+        ("doc", ctypes.c_char_p),
+    ]
+
+
+def option_info(key: int) -> OptionInfo:
+    """The registry's row of an option key (sogmm_option_get_info)."""
+    info = OptionInfo(struct_size=ctypes.sizeof(OptionInfo))
+    check(lib.sogmm_option_get_info(key, ctypes.byref(info)))
+    return info
+
+
+def option_default(key: int):
+    """The library's default of an option key: a float for f64 keys, an int for i64 keys."""
+    info = option_info(key)
+    return info.default_f64 if info.type == 0 else info.default_i64
+
+
+def _option_defaults() -> types.SimpleNamespace:
+    """Every option's library default, by its C name without SOGMM_OPT_, lower case
+    (DEFAULTS.bandwidth, DEFAULTS.map_batch_size, ...): the package's keyword defaults."""
+    count = c_size_t()
+    check(lib.sogmm_option_keys(None, 0, ctypes.byref(count)))
+    keys = (KEY * count.value)()
+    check(lib.sogmm_option_keys(keys, count.value, ctypes.byref(count)))
+    return types.SimpleNamespace(**{
+        option_info(k).name.decode()[len("SOGMM_OPT_"):].lower(): option_default(k) for k in keys})
+
+
+DEFAULTS = _option_defaults()
 
 
 # Python-side names of the option keys (the C message names the C macro).

@@ -21,6 +21,9 @@ from . import _ffi
 from ._input_file import read_input_file
 from .errors import FormatError, InvalidArgumentError
 
+# The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
+_D = _ffi.DEFAULTS
+
 __all__ = ["Camera", "rgbd_to_points"]
 
 
@@ -169,10 +172,10 @@ def rgbd_to_points(
     depth,
     color,
     camera: Camera,
-    depth_scale: float = 1000.0,
-    depth_min: float = 0.1,
-    depth_trunc: float = 3.0,
-    decimate: int = 1,
+    depth_scale: float = _D.depth_scale,
+    depth_min: float = _D.depth_min,
+    depth_trunc: float = _D.depth_max,
+    decimate: int = _D.decimation,
 ) -> np.ndarray:
     """Back-projects the valid pixels of an RGB-D frame to (N, 4) float32 rows (x, y, z, gray).
 

@@ -24,6 +24,9 @@ from .errors import InvalidArgumentError, MapBusyError
 from .model import GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args, _write_options
 from .progress import ProgressArg, call_with_progress
 
+# The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
+_D = _ffi.DEFAULTS
+
 __all__ = ["Map"]
 
 _FUSION = {None: None, "off": None, "hellinger": _ffi.FUSION_HELLINGER, "kl": _ffi.FUSION_KL}
@@ -130,10 +133,14 @@ class Map:
     threads at once.
     """
 
-    def __init__(self, *, novelty: bool = True, novelty_threshold: float = 3.0, batch_size: int = 12288,
-                 fusion: str | None = None, fusion_threshold: float = 0.3, warm_start: bool = False,
-                 novelty_bandwidth_scale: float = 0.7, revisit_refit_ratio: float = 1.25,
-                 depth_scale: float = 1000.0, depth_min: float = 0.1, depth_trunc: float = 3.0, decimate: int = 1,
+    def __init__(self, *, novelty: bool = bool(_D.map_novelty),
+                 novelty_threshold: float = _D.map_novelty_threshold, batch_size: int = _D.map_batch_size,
+                 fusion: str | None = None, fusion_threshold: float = _D.map_fusion_threshold,
+                 warm_start: bool = bool(_D.map_warm_start),
+                 novelty_bandwidth_scale: float = _D.map_novelty_bandwidth_scale,
+                 revisit_refit_ratio: float = _D.map_revisit_refit_ratio,
+                 depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
+                 depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
                  **fit_params):
         self._ptr = None
         self._finalizer = None
@@ -301,8 +308,8 @@ class Map:
     # components (nothing flushed yet) raises InvalidDataError. ``progress``
     # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING);
     # ``truncation_nats`` and ``n_threads`` as in GMM.score_samples.
-    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
-                      n_threads: int = 0) -> np.ndarray:
+    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
+                      n_threads: int = _D.threads) -> np.ndarray:
         """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
         x = _rows(X, (3, 4), "X")
         out = np.empty(x.shape[0], dtype=np.float64)
@@ -311,8 +318,8 @@ class Map:
                                                                                      x.shape[1], o.ptr, out))
         return out
 
-    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
-                     n_threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
+                     n_threads: int = _D.threads) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
         x = _rows(xyz, (3,), "xyz")
         mean = np.empty(x.shape[0], dtype=np.float32)
@@ -322,8 +329,8 @@ class Map:
                                                                                     mean, var))
         return mean, var
 
-    def render(self, camera: Camera, pose=None, *, depth_min: float = 0.1, depth_trunc: float = 3.0,
-               n_threads: int = 0, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
+               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The map seen from ``camera`` at the camera-to-world ``pose``: bitwise
         ``self.export().render(...)`` (see GMM.render). An empty map: InvalidDataError."""
         from .render import render_images
@@ -331,7 +338,7 @@ class Map:
         return render_images(lib.sogmm_map_render_f32, self._h(), camera, pose, depth_min, depth_trunc, n_threads,
                              progress)
 
-    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
+    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
                spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
         """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""
         n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
@@ -340,15 +347,16 @@ class Map:
         return out
 
     # ---- files -------------------------------------------------------------------
-    def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,
-             zstd_level: int = 19) -> None:
+    def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
+             zstd_level: int = _D.zstd_level) -> None:
         """Writes the map as a world-frame .sogmm file with its frame provenance
         (atomically). Pending points must be flushed first (InvalidArgumentError)."""
         with _write_options(float64, compress, zstd_level) as o, self._guard.reading("save"):
             check(lib.sogmm_map_save(self._h(), os.fsencode(path), o.ptr))
 
     @classmethod
-    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = True, max_decoded_bytes: int = 0,
+    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = bool(_D.verify_checksums),
+             max_decoded_bytes: int = _D.max_decoded_bytes,
              **options) -> "Map":
         """Reads a map file (or any world-frame model). ``options`` (as the
         constructor's) govern later inserts."""
@@ -358,8 +366,11 @@ class Map:
         obj._guard = _UseGuard()
         obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
                       options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
-        map_keys = dict(novelty=True, novelty_threshold=3.0, batch_size=12288, fusion=None, fusion_threshold=0.3,
-                        warm_start=False, novelty_bandwidth_scale=0.7, revisit_refit_ratio=1.25)
+        d = _D
+        map_keys = dict(novelty=bool(d.map_novelty), novelty_threshold=d.map_novelty_threshold,
+                        batch_size=d.map_batch_size, fusion=None, fusion_threshold=d.map_fusion_threshold,
+                        warm_start=bool(d.map_warm_start), novelty_bandwidth_scale=d.map_novelty_bandwidth_scale,
+                        revisit_refit_ratio=d.map_revisit_refit_ratio)
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

@@ -21,6 +21,9 @@ from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, NotFittedError, NotFoundError
 from .progress import ProgressArg, call_with_progress
 
+# The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
+_D = _ffi.DEFAULTS
+
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
 
 
@@ -68,7 +71,7 @@ def _sample_args(n_samples, seed, spatial_only: bool) -> tuple[int, int, int, np
     return n, int(seed) & 0xFFFFFFFFFFFFFFFF, dims, np.empty((n, dims), dtype=np.float32)
 
 
-def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = 0) -> _ffi.Options:
+def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = _D.max_decoded_bytes) -> _ffi.Options:
     return _ffi.Options(
         i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level,
              _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
@@ -361,8 +364,8 @@ class GMM:
         check(lib.sogmm_model_set_value(self._h(), k, v))
 
     # ---- inference -------------------------------------------------------
-    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
-                      n_threads: int = 0) -> np.ndarray:
+    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
+                      n_threads: int = _D.threads) -> np.ndarray:
         """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
         (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,).
 
@@ -384,7 +387,7 @@ class GMM:
         """Mean log-density of the rows of X (see score_samples)."""
         return float(np.mean(self.score_samples(X)))
 
-    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = 2.5,
+    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
                spatial_only: bool = False) -> np.ndarray:
         """Draws n_samples points, (n, 4) float32 rows (x, y, z, gray), grouped by
         component (or (n, 3) with spatial_only). The same seed gives the same
@@ -396,8 +399,8 @@ class GMM:
             check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
         return out
 
-    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = 0.0,
-                     n_threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
+                     n_threads: int = _D.threads) -> tuple[np.ndarray, np.ndarray]:
         """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays.
         ``truncation_nats`` and ``n_threads`` as for score_samples; ``progress``
         as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
@@ -410,8 +413,8 @@ class GMM:
                                lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
-    def render(self, camera: Camera, pose=None, *, depth_min: float = 0.1, depth_trunc: float = 3.0,
-               n_threads: int = 0, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
+               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What the model shows from ``camera`` placed at ``pose`` (4 x 4 camera-to-world rigid
         transform; None = identity, the model in the camera's frame): per pixel the first surface
         along its ray (the nearest mode of the model's density along the ray at depth in
@@ -448,8 +451,8 @@ class GMM:
         return GMM._wrap(out)
 
     # ---- files and bytes ---------------------------------------------------
-    def save(self, path: str | os.PathLike, *, float64: bool = False, compress: bool = True,
-             zstd_level: int = 19, max_decoded_bytes: int = 0) -> None:
+    def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
+             zstd_level: int = _D.zstd_level, max_decoded_bytes: int = _D.max_decoded_bytes) -> None:
         """Writes a .sogmm file atomically (temporary file + rename).
 
         Arrays decoding to more than ``max_decoded_bytes`` (0 = the 1 GiB that
@@ -460,8 +463,8 @@ class GMM:
         with _write_options(float64, compress, zstd_level, max_decoded_bytes) as o:
             check(lib.sogmm_model_save(h, p, o.ptr))
 
-    def to_bytes(self, *, float64: bool = False, compress: bool = True, zstd_level: int = 19,
-                 max_decoded_bytes: int = 0) -> bytes:
+    def to_bytes(self, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress), zstd_level: int = _D.zstd_level,
+                 max_decoded_bytes: int = _D.max_decoded_bytes) -> bytes:
         """The bytes of a .sogmm file (``max_decoded_bytes`` as in :meth:`save`)."""
         h = self._h()
         buf = c_void_p()
@@ -473,7 +476,8 @@ class GMM:
             lib.sogmm_buffer_free(buf)
 
     @classmethod
-    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = True, max_decoded_bytes: int = 0) -> "GMM":
+    def load(cls, path: str | os.PathLike, *, verify_checksums: bool = bool(_D.verify_checksums),
+             max_decoded_bytes: int = _D.max_decoded_bytes) -> "GMM":
         """Reads a .sogmm file (SogmmIOError if it cannot be read, FormatError if invalid)."""
         p = os.fsencode(os.fspath(path))
         out = c_void_p()
@@ -482,7 +486,8 @@ class GMM:
         return GMM._wrap(out)
 
     @classmethod
-    def from_bytes(cls, data, *, verify_checksums: bool = True, max_decoded_bytes: int = 0) -> "GMM":
+    def from_bytes(cls, data, *, verify_checksums: bool = bool(_D.verify_checksums),
+             max_decoded_bytes: int = _D.max_decoded_bytes) -> "GMM":
         """Reads a model from the bytes of a .sogmm file (bytes, bytearray, memoryview)."""
         if isinstance(data, str):
             raise InvalidArgumentError("from_bytes needs a bytes-like object, got str")
@@ -588,9 +593,10 @@ class SOGMM(GMM):
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
 
-    def __init__(self, bandwidth: float = 0.02, seed: int = 0, tol: float = 1e-3, reg_covar: float | str = "auto",
-                 max_iter: int = 100, n_components: int | None = None, n_threads: int = 0,
-                 mode_counter: str = "flat_binned", truncation_nats: float = 0.0, n_init: int = 1,
+    def __init__(self, bandwidth: float = _D.bandwidth, seed: int = _D.seed, tol: float = _D.tol,
+                 reg_covar: float | str = "auto", max_iter: int = _D.max_iter, n_components: int | None = None, n_threads: int = _D.threads,
+                 mode_counter: str = "flat_binned", truncation_nats: float = _D.truncation_nats,
+                 n_init: int = _D.n_init,
                  dequantise_depth: bool | None = None):
         self.bandwidth = bandwidth
         self.seed = seed
@@ -692,8 +698,8 @@ class SOGMM(GMM):
                                    keep=lambda: self._attach(out))
         return self
 
-    def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = 1000.0, depth_min: float = 0.1,
-                 depth_trunc: float = 3.0, decimate: int = 1, progress: ProgressArg = None) -> "SOGMM":
+    def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = _D.depth_scale,
+                 depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max, decimate: int = _D.decimation, progress: ProgressArg = None) -> "SOGMM":
         """Fits the model to one RGB-D frame (arguments as :func:`sogmm.rgbd_to_points`).
 
         The C library back-projects the frame (uint8 gray, uint8 RGB or float

@@ -159,6 +159,30 @@ pub const SOGMM_INFO_CAMERA_DEPTH_SCALE: sogmm_key = 10207;
 pub const SOGMM_INFO_CAMERA_DEPTH_MIN: sogmm_key = 10208;
 pub const SOGMM_INFO_CAMERA_DEPTH_MAX: sogmm_key = 10209;
 
+/// SOGMM_TYPE_F64 / SOGMM_TYPE_I64 (sogmm_option_info.type).
+pub const SOGMM_TYPE_F64: i32 = 0;
+pub const SOGMM_TYPE_I64: i32 = 1;
+
+/// What the library's option registry says of one key (sogmm_option_get_info).
+/// Set `struct_size` to `size_of::<sogmm_option_info>()` before the call.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct sogmm_option_info {
+    pub struct_size: usize,
+    pub key: sogmm_key,
+    pub type_: i32,
+    pub name: *const c_char,
+    pub default_f64: f64,
+    pub lower_f64: f64,
+    pub upper_f64: f64,
+    pub default_i64: i64,
+    pub lower_i64: i64,
+    pub upper_i64: i64,
+    pub range: *const c_char,
+    pub unit: *const c_char,
+    pub doc: *const c_char,
+}
+
 /// Totals of a map (sogmm_map_get_stats).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
@@ -196,6 +220,8 @@ extern "C" {
     pub fn sogmm_options_set_i64(options: *mut sogmm_options, key: sogmm_key, value: i64) -> sogmm_status;
     pub fn sogmm_options_get_f64(options: *const sogmm_options, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_options_get_i64(options: *const sogmm_options, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_option_get_info(key: sogmm_key, out: *mut sogmm_option_info) -> sogmm_status;
+    pub fn sogmm_option_keys(keys: *mut sogmm_key, capacity: usize, count: *mut usize) -> sogmm_status;
     pub fn sogmm_options_set_progress(
         options: *mut sogmm_options,
         fn_: sogmm_progress_fn,

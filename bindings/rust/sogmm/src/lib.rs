@@ -36,7 +36,9 @@ pub use error::{Error, Result, Status};
 pub use map::{Map, MapFrameStats, MapStats, Pose};
 pub use metrics::{psnr_images, Psnr};
 pub use model::{Color, Frame, Model};
-pub use options::{FusionMethod, ModeCounter, Options, OptionsBuilder};
+pub use options::{
+    option_info, option_keys, FusionMethod, ModeCounter, OptionInfo, OptionValues, Options, OptionsBuilder,
+};
 pub use progress::{Progress, Stage};
 pub use render::{Camera, Rendered};
 pub use sogmm_sys as sys;

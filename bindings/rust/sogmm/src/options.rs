@@ -255,3 +255,89 @@ impl OptionsBuilder {
         Ok(o)
     }
 }
+
+/// The value type and accepted values of an option key.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OptionValues {
+    /// An f64 key: its default and the closed hull of its accepted values.
+    F64 { default: f64, lower: f64, upper: f64 },
+    /// An i64 key: its default and its accepted range.
+    I64 { default: i64, lower: i64, upper: i64 },
+}
+
+/// What the library's option registry says of one key (sogmm_option_get_info):
+/// the single source of every option's default and range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OptionInfo {
+    /// The key.
+    pub key: i32,
+    /// The C macro's name, e.g. "SOGMM_OPT_BANDWIDTH".
+    pub name: &'static str,
+    /// Type, default and bounds.
+    pub values: OptionValues,
+    /// The whole rule in words (the bounds are its hull).
+    pub range: &'static str,
+    /// Unit ("" when dimensionless).
+    pub unit: &'static str,
+    /// What the option does.
+    pub doc: &'static str,
+}
+
+fn static_str(p: *const sys::c_char) -> &'static str {
+    // SAFETY: the library's strings are static, NUL-terminated ASCII.
+    unsafe { std::ffi::CStr::from_ptr(p) }.to_str().unwrap_or("")
+}
+
+/// The registry's row of `key`; `Status::InvalidArg` for an unknown key.
+pub fn option_info(key: i32) -> Result<OptionInfo> {
+    let mut raw = sys::sogmm_option_info {
+        struct_size: std::mem::size_of::<sys::sogmm_option_info>(),
+        key: 0,
+        type_: 0,
+        name: ptr::null(),
+        default_f64: 0.0,
+        lower_f64: 0.0,
+        upper_f64: 0.0,
+        default_i64: 0,
+        lower_i64: 0,
+        upper_i64: 0,
+        range: ptr::null(),
+        unit: ptr::null(),
+        doc: ptr::null(),
+    };
+    // SAFETY: `raw` is a valid, writable sogmm_option_info with its size set.
+    check(unsafe { sys::sogmm_option_get_info(key, &mut raw) })?;
+    let values = if raw.type_ == sys::SOGMM_TYPE_F64 {
+        OptionValues::F64 {
+            default: raw.default_f64,
+            lower: raw.lower_f64,
+            upper: raw.upper_f64,
+        }
+    } else {
+        OptionValues::I64 {
+            default: raw.default_i64,
+            lower: raw.lower_i64,
+            upper: raw.upper_i64,
+        }
+    };
+    Ok(OptionInfo {
+        key,
+        name: static_str(raw.name),
+        values,
+        range: static_str(raw.range),
+        unit: static_str(raw.unit),
+        doc: static_str(raw.doc),
+    })
+}
+
+/// Every option key of the library, in increasing order.
+pub fn option_keys() -> Result<Vec<i32>> {
+    let mut count = 0usize;
+    // SAFETY: capacity 0 with a null array only asks for the count.
+    check(unsafe { sys::sogmm_option_keys(ptr::null_mut(), 0, &mut count) })?;
+    let mut keys = vec![0i32; count];
+    // SAFETY: `keys` holds `count` writable keys.
+    check(unsafe { sys::sogmm_option_keys(keys.as_mut_ptr(), keys.len(), &mut count) })?;
+    keys.truncate(count);
+    Ok(keys)
+}

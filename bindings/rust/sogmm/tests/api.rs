@@ -300,3 +300,30 @@ fn the_depth_floor_is_the_default_for_frames() {
     assert_eq!(default, on);
     assert_ne!(default, off, "the floor changed nothing: the test would be vacuous");
 }
+
+/// The registry's defaults are what a fresh Options holds, for every key.
+#[test]
+fn option_info_reports_every_default_a_fresh_handle_holds() {
+    let o = sogmm::Options::new().unwrap();
+    let keys = sogmm::option_keys().unwrap();
+    assert!(keys.len() >= 31);
+    assert!(keys.windows(2).all(|w| w[0] < w[1]));
+    for key in keys {
+        let info = sogmm::option_info(key).unwrap();
+        assert!(info.name.starts_with("SOGMM_OPT_"), "{}", info.name);
+        assert!(!info.range.is_empty() && !info.doc.is_empty());
+        match info.values {
+            sogmm::OptionValues::F64 { default, lower, upper } => {
+                assert_eq!(o.get_f64(key).unwrap(), default, "{}", info.name);
+                assert!(lower <= default && default <= upper, "{}", info.name);
+            }
+            sogmm::OptionValues::I64 { default, lower, upper } => {
+                assert_eq!(o.get_i64(key).unwrap(), default, "{}", info.name);
+                assert!(lower <= default && default <= upper, "{}", info.name);
+            }
+        }
+    }
+    let tol = sogmm::option_info(sogmm::sys::SOGMM_OPT_TOL).unwrap();
+    assert_eq!(tol.name, "SOGMM_OPT_TOL");
+    assert_eq!(sogmm::option_info(99).unwrap_err().status(), sogmm::Status::InvalidArg);
+}
