@@ -29,7 +29,7 @@ def python_blocks(text: str) -> list[str]:
 def test_the_readme_has_one_example_that_reads_fits_saves_and_maps():
     blocks = python_blocks(README.read_text())
     assert len(blocks) == 1
-    for call in ("Image.open", "fit_rgbd", ".save(", "sogmm.Map(", "insert_rgbd", "trajectory.log"):
+    for call in ("read_frame(", "fit_rgbd", ".save(", "sogmm.Map(", "insert_rgbd", "trajectory.log"):
         assert call in blocks[0], call
 
 

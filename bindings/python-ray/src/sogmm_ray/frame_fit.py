@@ -43,7 +43,7 @@ class FitSettings:
 
 
 def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
-    from PIL import Image  # the `ray` extra installs Pillow
+    from PIL import Image  # a dependency of sogmm-ray
 
     with Image.open(frame.depth) as im:
         depth = np.array(im)
