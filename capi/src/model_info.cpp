@@ -1,6 +1,6 @@
 // sogmm_model_set_info_f64 / _i64: the information keys a .sogmm file stores
 // (the fit record and the camera), so that a model rebuilt from arrays (e.g.
-// sogmm.distributed's canonical map) carries the provenance of its fits as the
+// sogmm_ray's canonical map) carries the provenance of its fits as the
 // fit and map tools write it, not as free-form key/values.
 #include <cmath>
 #include <cstdint>

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Benchmark of sogmm.distributed (issue 19): throughput of 1 and 2 Ray workers,
+"""Benchmark of sogmm_ray (issue 19): throughput of 1 and 2 Ray workers,
 Ray's overhead per frame against the fit time (with the default chunking of
 several frames per task, and with one frame per task as before), bytes moved
 per frame, the map-building reduce, and the per-frame fit and per-component
-merge costs that the paper estimate in bindings/python/README.md is computed
+merge costs that the paper estimate in bindings/python-ray/README.md is computed
 from.
 
-    SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
+    SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src:bindings/python-ray/src \\
       python3 tools/sogmm-perf/ray_bench.py --sogmm build/tools/sogmm/sogmm [--frames 200] [--repeats 1]
 
 The sequence is the first --frames frames of the 300-frame synthetic room loop
@@ -36,10 +36,10 @@ from pathlib import Path
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import sogmm  # noqa: E402
-from sogmm.distributed import (FitSettings, MapSettings, build_map, fit_frame, load_frames,  # noqa: E402
-                               reduce_partials, sequential_build)
-from sogmm.distributed.frame_fit import camera_dict  # noqa: E402
-from sogmm.distributed.partial import finalize  # noqa: E402
+from sogmm_ray import (FitSettings, MapSettings, build_map, fit_frame, load_frames,  # noqa: E402
+                       reduce_partials, sequential_build)
+from sogmm_ray.frame_fit import camera_dict  # noqa: E402
+from sogmm_ray.partial import finalize  # noqa: E402
 
 
 LOOP_FRAMES = 300  # `sogmm demo --loop`'s default length

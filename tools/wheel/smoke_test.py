@@ -1,5 +1,6 @@
-"""Run by test_fresh_venv.sh inside the fresh venv: the installed wheel fits,
-saves, loads and samples, and its library loads the wheel's own libgomp.
+"""Run by test_fresh_venv.sh inside the fresh venv: the installed wheel fits
+(with the progress bar of its extra `progress`), saves, loads and samples, its
+extra `examples` is installed, and its library loads the wheel's own libgomp.
 
 Usage: python -I smoke_test.py VENV CHECKOUT
 """
@@ -46,11 +47,18 @@ check(not any(n.startswith("libzstd") for n in deps), f"libzstd linked dynamical
 rng = np.random.default_rng(7)
 centres = np.array([[0.0, 0.0, 1.0, 0.2], [1.0, 0.5, 2.0, 0.8]])
 X = np.concatenate([c + 0.02 * rng.standard_normal((2000, 4)) for c in centres]).astype(np.float32)
-model = sogmm.SOGMM(n_components=2, seed=0).fit(X)
+# progress=True: the extra `progress` (tqdm) was installed with the wheel.
+model = sogmm.SOGMM(n_components=2, seed=0).fit(X, progress=True)
 check(model.n_components_ == 2, f"n_components_ = {model.n_components_}")
 order = np.argsort(model.means_[:, 0])
 check(np.allclose(model.means_[order], centres, atol=0.01), f"means {model.means_[order]} != {centres}")
 check(np.allclose(model.weights_[order], [0.5, 0.5], atol=0.01), f"weights {model.weights_}")
+
+# The extra `examples` (Pillow), with which the README's example reads frames.
+try:
+    from PIL import Image  # noqa: F401
+except ImportError:
+    sys.exit("smoke_test: FAIL: Pillow (extra `examples`) not installed with the wheel")
 
 # Save (zstd-compressed), load: the arrays come back bitwise.
 model.save("m.sogmm")

@@ -78,6 +78,15 @@ def test_progress_true_draws_a_tqdm_bar(capsys):
     assert "EM" in capsys.readouterr().err
 
 
+def test_progress_true_without_tqdm_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)  # import tqdm.auto now fails, as when not installed
+    est = fixed_k()
+    with pytest.raises(ImportError, match=r"pip install 'sogmm\[progress\]'"):
+        est.fit(cube(), progress=True)
+    with pytest.raises(sogmm.NotFittedError):
+        est.means_
+
+
 def test_progress_must_be_none_true_or_callable():
     with pytest.raises(TypeError, match="progress"):
         fixed_k().fit(cube(), progress="yes")

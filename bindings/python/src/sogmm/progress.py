@@ -61,8 +61,8 @@ class _TqdmSink:
     def __init__(self):
         try:
             from tqdm.auto import tqdm
-        except ImportError as e:  # pragma: no cover - tqdm is pinned for the tests
-            raise ImportError("progress=True needs tqdm (pip install tqdm)") from e
+        except ImportError as e:
+            raise ImportError("progress=True needs tqdm, the extra `progress`: pip install 'sogmm[progress]'") from e
         self._tqdm = tqdm
         self._bar = None
         self._stage = None

@@ -1,9 +1,9 @@
-"""Partial maps: what the merge tree of :mod:`sogmm.distributed` passes around.
+"""Partial maps: what the merge tree of :mod:`sogmm_ray` passes around.
 
 A partial map is a dict of plain bytes, ints, strings and lists (Ray moves it
 without pickling any sogmm object). Its unit is a *row*: one fitted frame
 (the plain merge) or one tile's map (``sogmm.Map``, see
-:mod:`sogmm.distributed.map_tile`):
+:mod:`sogmm_ray.map_tile`):
 
 - ``model``: a world-frame ``.sogmm`` file (uncompressed: zstd level 19 costs
   more than the bytes it saves between tasks) holding the components of its
@@ -42,8 +42,7 @@ import math
 
 import numpy as np
 
-from ..errors import InvalidDataError
-from ..model import GMM
+from sogmm import GMM, InvalidDataError
 
 #: Per-frame provenance row of a partial map.
 TABLE = np.dtype([("frame", "<i8"), ("support", "<u8"), ("n", "<i8"), ("log_likelihood", "<f8"),

@@ -12,9 +12,8 @@ import time
 
 import numpy as np
 
-from ..camera import Camera
-from ..errors import SogmmError
-from ..model import SOGMM
+from sogmm import Camera, SOGMM, SogmmError
+
 from .partial import leaf, reduce_partials, size_bytes
 from .sequence import Frame
 
@@ -44,7 +43,7 @@ class FitSettings:
 
 
 def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
-    from PIL import Image  # the `ray` extra installs Pillow
+    from PIL import Image  # a dependency of sogmm-ray
 
     with Image.open(frame.depth) as im:
         depth = np.array(im)
@@ -57,7 +56,7 @@ def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_hold(frame: int) -> None:
-    """Test hook (tests_ray kills a worker mid-task): with SOGMM_DISTRIBUTED_PID_DIR
+    """Test hook (tests/test_distributed.py kills a worker mid-task): with SOGMM_DISTRIBUTED_PID_DIR
     set, a frame listed in the file PID_DIR/hold (comma-separated ids) writes its
     worker's pid to PID_DIR/<frame>.pid on its first attempt and then waits up to
     60 s to be killed; a retry finds the pid file and runs normally."""

@@ -1,10 +1,10 @@
-"""The map-building reduce of :mod:`sogmm.distributed`: one ``sogmm.Map`` per tile.
+"""The map-building reduce of :mod:`sogmm_ray`: one ``sogmm.Map`` per tile.
 
 An incremental map (issue 18; novelty test, batched fits, optional fusion) is
 sequential by nature: whether a point of frame t is new depends on the map
 after frames < t. So the map cannot be split below the unit it is built over;
 here that unit is the spatial tile of the merge tree (camera positions in a
-cube of ``tile_size`` metres, :func:`sogmm.distributed.runner.tile_of`). The
+cube of ``tile_size`` metres, :func:`sogmm_ray.runner.tile_of`). The
 order is defined, not scheduled:
 
 - inside a tile, frames are inserted in frame-id order into one ``sogmm.Map``
@@ -12,12 +12,12 @@ order is defined, not scheduled:
   it over those frames), flushed at the end;
 - tiles are independent maps: novelty and fusion act inside a tile, and the
   tiles' maps are combined by the plain world-frame union of the tree
-  (:func:`sogmm.distributed.partial.reduce_partials`), whose canonical
+  (:func:`sogmm_ray.partial.reduce_partials`), whose canonical
   finalize orders them by their first frame id.
 
 The result is a pure function of (frames, settings, tile_size): independent of
 worker count, fan-in and completion order, and bitwise equal to
-:func:`sogmm.distributed.sequential_build` with the same ``tile_size``; with
+:func:`sogmm_ray.sequential_build` with the same ``tile_size``; with
 ``tile_size = 0`` (one tile) it is the ``sogmm map`` of the whole sequence.
 Only the public ``sogmm.Map`` API is used.
 """
@@ -31,10 +31,8 @@ import time
 
 import numpy as np
 
-from ..camera import Camera
-from ..errors import SogmmError
-from ..map import Map
-from ..model import GMM
+from sogmm import Camera, GMM, Map, SogmmError
+
 from .frame_fit import FitSettings, read_images, test_hold
 from .partial import TABLE, size_bytes
 from .sequence import Frame

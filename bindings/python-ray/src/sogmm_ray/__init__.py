@@ -6,17 +6,17 @@ in worker processes that open libsogmm once; models move between tasks as
 spatial tiles (by camera position), then across them. Two reduces: the plain
 world-frame merge of every frame's fit, or (``map=MapSettings(...)``) one
 incremental ``sogmm.Map`` per tile (novelty, optional fusion; see
-:mod:`sogmm.distributed.map_tile`) united across tiles. The final model is
+:mod:`sogmm_ray.map_tile`) united across tiles. The final model is
 canonical (components in (first frame, component) order, weights rounded
 once), so it is bitwise equal to the sequential build whatever the completion
-order, worker count, fan-in or chunking; see :mod:`sogmm.distributed.partial`.
+order, worker count, fan-in or chunking; see :mod:`sogmm_ray.partial`.
 
-    from sogmm.distributed import FitSettings, build_map, load_frames
+    from sogmm_ray import FitSettings, build_map, load_frames
     frames = load_frames("seq", "seq/trajectory.log")
     result = build_map(frames, FitSettings(decimate=5), sogmm.Camera.from_json("seq/intrinsics.json"), workers=8)
     result.model.save("map.sogmm")
 
-Command line: ``python -m sogmm.distributed --help``.
+Command line: ``python -m sogmm_ray --help``.
 """
 
 from .frame_fit import FitSettings, fit_chunk, fit_frame

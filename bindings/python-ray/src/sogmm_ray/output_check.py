@@ -1,4 +1,4 @@
-"""The output of ``python -m sogmm.distributed``, checked before any work (as
+"""The output of ``python -m sogmm_ray``, checked before any work (as
 the `sogmm` tools' check_outputs, tools/sogmm/file_util.hpp): a run of hours
 must not end in an unwritable folder, and the map must not replace an input.
 The save itself is the library's atomic one (written through symbolic links,
@@ -10,8 +10,8 @@ import os
 import stat
 import tempfile
 
-from .._input_file import kind_of
-from ..errors import InvalidArgumentError, SogmmIOError
+from sogmm import InvalidArgumentError, SogmmIOError
+from sogmm._input_file import kind_of
 
 
 def _final_target(path: str) -> str:

@@ -1,4 +1,4 @@
-"""sogmm.distributed: the map of a Ray job equals the sequential build bit for
+"""sogmm_ray: the map of a Ray job equals the sequential build bit for
 bit (after the canonical order), whatever the worker count, fan-in, tiling or
 completion order, with a worker killed mid-task, and with a bad frame skipped;
 the "fail" policy names the bad frame."""
@@ -16,11 +16,14 @@ import numpy as np
 import pytest
 
 import sogmm
-from sogmm.distributed import (FitSettings, FrameError, MapSettings, build_map, finalize, fit_frame, load_frames,
-                               map_tile, merge_tree, reduce_partials, sequential_build, tiles_of)
-from sogmm.distributed.frame_fit import camera_dict
+from sogmm_ray import (FitSettings, FrameError, MapSettings, build_map, finalize, fit_frame, load_frames,
+                       map_tile, merge_tree, reduce_partials, sequential_build, tiles_of)
+from sogmm_ray.frame_fit import camera_dict
+from sogmm_ray.sequence import read_trajectory
 
-from conftest import BAD_FRAME, N_FRAMES
+from conftest import BAD_FRAME, N_FRAMES, NO_RAY
+
+pytest.importorskip("ray", reason=NO_RAY)
 
 SETTINGS = FitSettings(bandwidth=0.05, decimate=2, seed=3)
 # A batch below one frame's 1728 points: every insert fits, later frames are
@@ -144,7 +147,7 @@ def test_skip_policy_reports_the_bad_frame(local_ray, sequence):
 def test_command_line_on_an_existing_cluster(local_ray, sequence, reference, tmp_path):
     out = tmp_path / "map.sogmm"
     address = local_ray.get_runtime_context().gcs_address
-    cmd = [sys.executable, "-m", "sogmm.distributed", "--address", address, "--sequence", str(sequence),
+    cmd = [sys.executable, "-m", "sogmm_ray", "--address", address, "--sequence", str(sequence),
            "--trajectory", str(sequence / "trajectory.log"), "-o", str(out), "--bandwidth", "0.05", "--decimate", "2",
            "--seed", "3", "--fan-in", "3"]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
@@ -159,21 +162,21 @@ def test_command_line_on_an_existing_cluster(local_ray, sequence, reference, tmp
 
 
 def test_command_line_bad_input_is_one_line(tmp_path):
-    p = subprocess.run([sys.executable, "-m", "sogmm.distributed", "--sequence", str(tmp_path / "none"),
+    p = subprocess.run([sys.executable, "-m", "sogmm_ray", "--sequence", str(tmp_path / "none"),
                         "--trajectory", str(tmp_path / "t.log"), "--intrinsics", str(tmp_path / "none.json"), "-o",
                         str(tmp_path / "m.sogmm")], capture_output=True, text=True, timeout=120)
     assert p.returncode == 1
-    assert p.stderr.count("\n") == 1 and "sogmm.distributed:" in p.stderr
+    assert p.stderr.count("\n") == 1 and "sogmm_ray:" in p.stderr
 
 
 def test_trajectory_errors_name_the_line(tmp_path):
     bad = tmp_path / "t.log"
     bad.write_text("0 1 1\n1 0 0 0\n0 2 0 0\n0 0 1 0\n0 0 0 1\n")
     with pytest.raises(sogmm.InvalidDataError, match=r"t.log:5: pose 0 is not a rigid transform"):
-        sogmm.distributed.sequence.read_trajectory(str(bad))
+        read_trajectory(str(bad))
     bad.write_text("0 1 1\n1 0 0 0\n0 1 0 0\n")
     with pytest.raises(sogmm.InvalidDataError, match="truncated"):
-        sogmm.distributed.sequence.read_trajectory(str(bad))
+        read_trajectory(str(bad))
 
 
 def test_matches_the_cli_sequential_fit_up_to_weight_rounding(sequence, tmp_path):
@@ -279,7 +282,7 @@ def test_one_tile_map_is_the_sogmm_map_of_the_sequence(local_ray, sequence, tmp_
 def test_command_line_map_reduce(local_ray, sequence, map_reference, tmp_path):
     out = tmp_path / "map.sogmm"
     address = local_ray.get_runtime_context().gcs_address
-    cmd = [sys.executable, "-m", "sogmm.distributed", "--address", address, "--sequence", str(sequence),
+    cmd = [sys.executable, "-m", "sogmm_ray", "--address", address, "--sequence", str(sequence),
            "--trajectory", str(sequence / "trajectory.log"), "-o", str(out), "--bandwidth", "0.05", "--decimate", "2",
            "--seed", "3", "--reduce", "map", "--tile-size", str(TILE), "--batch", "1000", "--threshold", "4",
            "--fusion", "hellinger", "--fusion-threshold", "0.3", "-q", "--json"]
@@ -294,14 +297,14 @@ def test_command_line_map_reduce(local_ray, sequence, map_reference, tmp_path):
 
 
 def test_map_flags_need_the_map_reduce(tmp_path):
-    p = subprocess.run([sys.executable, "-m", "sogmm.distributed", "--sequence", str(tmp_path), "--trajectory",
+    p = subprocess.run([sys.executable, "-m", "sogmm_ray", "--sequence", str(tmp_path), "--trajectory",
                         str(tmp_path / "t.log"), "-o", str(tmp_path / "m.sogmm"), "--fusion", "kl"],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 1
-    assert p.stderr.strip() == "sogmm.distributed: --fusion is a map flag: give --reduce map"
+    assert p.stderr.strip() == "sogmm_ray: --fusion is a map flag: give --reduce map"
 
 
 def test_auto_chunking_keeps_four_tasks_per_cpu_and_at_most_eight_frames():
-    from sogmm.distributed import auto_frames_per_task
+    from sogmm_ray import auto_frames_per_task
     assert [auto_frames_per_task(n, c) for n, c in [(200, 1), (200, 2), (24, 2), (5, 2), (2870, 128), (0, 0)]] == \
         [8, 8, 3, 1, 5, 1]

@@ -17,9 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._input_file import read_input_file
-from ..errors import InvalidArgumentError, InvalidDataError, SogmmIOError
-from ..model import GMM
+from sogmm import GMM, InvalidArgumentError, InvalidDataError, SogmmIOError
+from sogmm._input_file import read_input_file
 
 @dataclass(frozen=True)
 class Frame:

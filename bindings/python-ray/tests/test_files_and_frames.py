@@ -1,7 +1,7 @@
-"""sogmm.distributed's inputs, output and failure policy (issue 36): a bad
+"""sogmm_ray's inputs, output and failure policy (issue 36): a bad
 frame is skipped by its identity, never the frame whose insert happened to
 trigger a fit; frames and poses are paired by frame number; a FIFO input is
-refused at once; the output is checked before the run; no traceback without Ray."""
+refused at once; the output is checked before the run."""
 
 from __future__ import annotations
 
@@ -13,9 +13,11 @@ from pathlib import Path
 import pytest
 
 import sogmm
-from sogmm.distributed import FitSettings, MapSettings, load_frames, sequential_build
+from sogmm_ray import FitSettings, MapSettings, load_frames, sequential_build
 
-from conftest import write_sequence
+from conftest import NO_RAY, write_sequence
+
+pytest.importorskip("ray", reason=NO_RAY)
 
 SETTINGS = FitSettings(bandwidth=0.05, decimate=2, seed=3)
 
@@ -63,7 +65,7 @@ def test_a_frame_that_cannot_be_fitted_is_skipped_by_its_identity(tmp_path, batc
 def test_the_command_line_skips_by_identity(local_ray, tmp_path):
     seq = _sequence(tmp_path / "seq", bad={0: "1e10"})
     out = tmp_path / "map.sogmm"
-    p = subprocess.run([sys.executable, "-m", "sogmm.distributed", "--address",
+    p = subprocess.run([sys.executable, "-m", "sogmm_ray", "--address",
                         local_ray.get_runtime_context().gcs_address, "--reduce", "map", "--on-error", "skip",
                         "--tile-size", "0", "--batch", "3000", "--decimate", "2", "--bandwidth", "0.05", "--sequence",
                         str(seq), "--trajectory", str(seq / "trajectory.log"), "-o", str(out), "-q"],
@@ -109,10 +111,10 @@ def test_frames_get_the_pose_of_their_number(tmp_path):
 
 
 def _one_line_run(args: list[str], env: dict | None = None, timeout: float = 60) -> subprocess.CompletedProcess:
-    p = subprocess.run([sys.executable, "-m", "sogmm.distributed"] + args, capture_output=True, text=True,
+    p = subprocess.run([sys.executable, "-m", "sogmm_ray"] + args, capture_output=True, text=True,
                        timeout=timeout, env=env)
     assert p.returncode == 1, p.stderr
-    assert p.stderr.count("\n") == 1 and p.stderr.startswith("sogmm.distributed: "), p.stderr
+    assert p.stderr.count("\n") == 1 and p.stderr.startswith("sogmm_ray: "), p.stderr
     return p
 
 
@@ -146,15 +148,3 @@ def test_the_output_is_checked_before_the_run(tmp_path):
         os.mkdir(folder, 0o555)
     p = _one_line_run(base + ["-o", os.path.join(folder, "m.sogmm")])
     assert f"cannot write in folder {folder}" in p.stderr
-
-
-def test_without_ray_one_line(tmp_path):
-    seq = write_sequence(tmp_path / "seq", 3)
-    fake = tmp_path / "noray" / "ray"
-    fake.mkdir(parents=True)
-    (fake / "__init__.py").write_text("raise ImportError(\"No module named 'ray'\")\n")
-    src = Path(sogmm.__file__).resolve().parents[1]  # the package under test
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(fake.parent), str(src), os.environ.get("PYTHONPATH", "")]))
-    p = _one_line_run(["--sequence", str(seq), "--trajectory", str(seq / "trajectory.log"), "-o",
-                       str(tmp_path / "m.sogmm")], env=env)
-    assert "Ray is not installed" in p.stderr

@@ -14,9 +14,11 @@ import numpy as np
 import pytest
 
 import sogmm
-from sogmm.distributed import FitSettings, Frame, MapSettings
-from sogmm.distributed import __main__ as cli
-from sogmm.distributed.frame_fit import camera_dict, fit_frame, read_images
+from sogmm_ray import FitSettings, Frame, MapSettings
+from sogmm_ray import __main__ as cli
+from sogmm_ray.frame_fit import camera_dict, fit_frame, read_images
+
+from conftest import NO_RAY
 
 PLAIN = FitSettings(bandwidth=0.05, decimate=2, seed=3, dequantise_depth=False)
 DEQ = dataclasses.replace(PLAIN, dequantise_depth=True)
@@ -70,6 +72,7 @@ def test_new_map_fits_with_dequantised_depth(tmp_path):
 
 
 def test_the_command_line_flag_sets_it(monkeypatch, sequence, tmp_path):
+    pytest.importorskip("ray", reason=NO_RAY)  # the command line asks for Ray first
     seen = []
 
     def fake_build_map(frames, settings, camera, **kw):

@@ -7,8 +7,8 @@ import math
 import time
 from collections import defaultdict
 
-from ..errors import InvalidArgumentError, SogmmError
-from ..model import GMM
+from sogmm import GMM, InvalidArgumentError, SogmmError
+
 from .frame_fit import FitSettings, camera_dict, fit_chunk
 from .map_tile import MapSettings, map_tile
 from .partial import finalize, reduce_partials, sequential_partial, size_bytes
@@ -85,7 +85,7 @@ def _progress(total: int, enabled: bool):
             def set_postfix_str(self, s): pass
             def close(self): pass
         return _Quiet()
-    return tqdm(total=total, unit="frame", desc="sogmm.distributed", smoothing=0.1)
+    return tqdm(total=total, unit="frame", desc="sogmm_ray", smoothing=0.1)
 
 
 def build_map(frames: list[Frame], settings: FitSettings, camera, *, workers: int | None = None,
@@ -103,13 +103,13 @@ def build_map(frames: list[Frame], settings: FitSettings, camera, *, workers: in
     world-frame merge (a task fits ``frames_per_task`` consecutive frames of a
     tile; None = :func:`auto_frames_per_task`); a :class:`MapSettings` builds
     one ``sogmm.Map`` per tile (novelty, optional fusion; one task per tile,
-    see :mod:`sogmm.distributed.map_tile`) and the tree unites the tiles' maps.
+    see :mod:`sogmm_ray.map_tile`) and the tree unites the tiles' maps.
 
     ``on_error``: "skip" (a bad frame is left out and listed in ``skipped``) or
     "fail" (FrameError naming the frame). A worker that dies is retried by Ray
     up to ``max_retries`` times. The model does not depend on worker count,
     fan-in, chunking or completion order, and with ``map`` None not on the
-    tiling either (see sogmm.distributed.partial)."""
+    tiling either (see sogmm_ray.partial)."""
     import ray
 
     if on_error not in ("skip", "fail"):

@@ -1,8 +1,8 @@
-"""python -m sogmm.distributed: `sogmm fit --sequence` or `sogmm map` on a Ray cluster.
+"""python -m sogmm_ray: `sogmm fit --sequence` or `sogmm map` on a Ray cluster.
 
-    python -m sogmm.distributed --sequence DIR --trajectory LOG --workers N -o map.sogmm [--decimate 5 ...]
-    python -m sogmm.distributed --address HEAD:6379 --sequence DIR --trajectory LOG -o map.sogmm
-    python -m sogmm.distributed --reduce map --fusion hellinger --sequence DIR --trajectory LOG -o map.sogmm
+    python -m sogmm_ray --sequence DIR --trajectory LOG --workers N -o map.sogmm [--decimate 5 ...]
+    python -m sogmm_ray --address HEAD:6379 --sequence DIR --trajectory LOG -o map.sogmm
+    python -m sogmm_ray --reduce map --fusion hellinger --sequence DIR --trajectory LOG -o map.sogmm
 
 --reduce merge (default): every frame is fitted whole and the fits are merged in
 the world frame (the model of `sogmm fit --sequence`). --reduce map: one
@@ -21,8 +21,8 @@ import os
 import sys
 from pathlib import Path
 
-from ..camera import Camera
-from ..errors import SogmmError
+from sogmm import Camera, SogmmError
+
 from .frame_fit import FitSettings
 from .map_tile import MapSettings
 from .output_check import check_output
@@ -32,7 +32,7 @@ from .sequence import load_frames
 
 def _parser() -> argparse.ArgumentParser:
     d = FitSettings()
-    ap = argparse.ArgumentParser(prog="python -m sogmm.distributed", description=__doc__,
+    ap = argparse.ArgumentParser(prog="python -m sogmm_ray", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sequence", required=True,
                     help="DIR/depth/*.png + DIR/color/*.{jpg,png} (paired with each other and with the poses by "
@@ -105,6 +105,14 @@ def _frames_per_task(text: str) -> int | None:
 
 
 def main(argv=None) -> int:
+    # Asked first (even before --help), so that a missing Ray is one line and
+    # not a traceback from inside build_map: nothing here runs without it.
+    try:
+        import ray  # noqa: F401
+    except ImportError:
+        print("sogmm_ray: Ray is not installed: pip install 'sogmm[ray]' (Ray 2.40.0: Python 3.9 to 3.12)",
+              file=sys.stderr)
+        return 1
     a = _parser().parse_args(argv)
     map_flags = [f for f, v in (("--threshold", a.threshold != MapSettings.novelty_threshold),
                                 ("--batch", a.batch != MapSettings.batch_size), ("--no-novelty", a.no_novelty),
@@ -134,20 +142,16 @@ def main(argv=None) -> int:
         check_output("-o", a.output, [("--trajectory", a.trajectory), ("--intrinsics", intrinsics)])
         camera = Camera.from_json(intrinsics)
         frames = load_frames(a.sequence, a.trajectory, a.frames, a.pair_by_order)
-        try:
-            import ray  # noqa: F401  (build_map imports it; asked here for a one-line error)
-        except ImportError:
-            raise SogmmError("Ray is not installed: pip install 'sogmm[ray]'") from None
         meta = {"sequence": a.sequence, "trajectory": a.trajectory}  # as sogmm fit --sequence and sogmm map
         r = build_map(frames, settings, camera, workers=a.workers, address=a.address, fan_in=a.fan_in,
                       tile_size=a.tile_size, on_error=a.on_error, max_retries=a.max_retries, progress=not a.quiet,
                       metadata=meta, map=map_settings, frames_per_task=frames_per_task)
         r.model.save(a.output)
     except (SogmmError, OSError) as e:
-        print(f"sogmm.distributed: {e}", file=sys.stderr)
+        print(f"sogmm_ray: {e}", file=sys.stderr)
         return 1
     for frame, message in r.skipped:
-        print(f"sogmm.distributed: skipped frame {frame}: {message}", file=sys.stderr)
+        print(f"sogmm_ray: skipped frame {frame}: {message}", file=sys.stderr)
     summary = {"output": a.output, "frames": r.n_frames, "skipped": [f for f, _ in r.skipped],
                "n_components": r.model.n_components_, "seconds_wall": r.seconds_wall, "seconds_fit": r.seconds_fit,
                "seconds_merge": r.seconds_merge, "bytes_moved_per_frame": r.bytes_moved / max(len(frames), 1),

@@ -1,5 +1,6 @@
-"""Fixtures of the sogmm.distributed tests (a local Ray with 2 CPUs, started and
-stopped here). Run as the ctest python_distributed; skipped without Ray."""
+"""Fixtures of the sogmm_ray tests (a local Ray with 2 CPUs, started and
+stopped here). Run as the ctest python_distributed. The test modules that need
+Ray skip without it (test_without_ray.py runs either way)."""
 
 from __future__ import annotations
 
@@ -10,15 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-SRC = Path(__file__).resolve().parents[1] / "src"
-try:
-    import sogmm  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(SRC))
-    import sogmm  # noqa: F401,E402
+# Without installed packages (a plain checkout): the checkout's sogmm and sogmm_ray.
+BINDINGS = Path(__file__).resolve().parents[2]
+for src in (BINDINGS / "python" / "src", BINDINGS / "python-ray" / "src"):
+    if str(src) not in sys.path:
+        sys.path.append(str(src))
+import sogmm  # noqa: E402
 
-ray = pytest.importorskip("ray", reason="Ray is not installed (pip install 'sogmm[ray]')")
-Image = pytest.importorskip("PIL.Image", reason="Pillow is not installed")
+NO_RAY = "Ray is not installed (pip install 'sogmm[ray]')"
 
 N_FRAMES = 12
 BAD_FRAME = 7  # all depth invalid: the fit has no point
@@ -55,6 +55,7 @@ def _frame(i: int, width=96, height=72):
 
 
 def write_sequence(folder: Path, n: int = N_FRAMES) -> Path:
+    Image = pytest.importorskip("PIL.Image", reason="Pillow is not installed")
     (folder / "depth").mkdir(parents=True)
     (folder / "color").mkdir()
     log = []
@@ -85,6 +86,7 @@ def pid_dir(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def local_ray(pid_dir):
     """A local Ray with 2 CPUs for the whole session, always shut down."""
+    ray = pytest.importorskip("ray", reason=NO_RAY)
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         yield ray
