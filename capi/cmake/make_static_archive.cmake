@@ -1,0 +1,40 @@
+# Builds libsogmm.a (run by static_archive.cmake with cmake -P):
+#  1. partial link (-r) of the C API objects with the whole core and format
+#     archives and the members of the other archives (zstd) they use;
+#  2. every strong global symbol except sogmm_* made local, so that the
+#     library's C++ internals and its zstd cannot clash with a program's own.
+#     Weak symbols (inline functions and templates, e.g. std::string's) stay
+#     weak: a program with the same COMDAT group keeps one copy, and a local
+#     copy would point into the group the linker discards;
+#  3. debug information stripped, as in the shipped libsogmm.so.
+# Arguments: CXX NM OBJCOPY AR OUTPUT, and OBJECTS / WHOLE_ARCHIVES joined by '|'.
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(run_output "${out}" PARENT_SCOPE)
+endfunction()
+
+string(REPLACE "|" ";" objects "${OBJECTS}")
+string(REPLACE "|" ";" whole "${WHOLE_ARCHIVES}")
+set(combined ${OUTPUT}.combined.o)
+set(localized ${OUTPUT}.o)
+run(${CXX} -r -nostdlib -o ${combined} ${objects}
+    -Wl,--whole-archive ${whole} -Wl,--no-whole-archive ${ARCHIVES})
+
+run(${NM} -g --defined-only ${combined})
+string(REPLACE "\n" ";" lines "${run_output}")
+set(hide "")
+foreach(line IN LISTS lines)
+  # "<address> <type> <name>": T/D/B/R/C are strong definitions.
+  if(line MATCHES "^[0-9a-fA-F]* [TDBRC] (.+)$" AND NOT CMAKE_MATCH_1 MATCHES "^sogmm_")
+    string(APPEND hide "${CMAKE_MATCH_1}\n")
+  endif()
+endforeach()
+file(WRITE ${OUTPUT}.localize "${hide}")
+run(${OBJCOPY} --localize-symbols=${OUTPUT}.localize --strip-debug ${combined} ${localized})
+
+file(REMOVE ${OUTPUT} ${combined} ${OUTPUT}.localize)
+run(${AR} rcs ${OUTPUT} ${localized})
+file(REMOVE ${localized})

@@ -1,0 +1,30 @@
+# Sourced by the consumer_* tests (arguments: <build-dir> <source-dir> ...).
+# Gives a scratch folder outside the repository, removed on exit, and `clean`,
+# which runs a command as from a fresh login shell: no variables but PATH and
+# HOME (cargo and go keep their toolchains and caches under HOME), so no
+# LD_LIBRARY_PATH, CGO_LDFLAGS or SOGMM_LIB_DIR.
+set -euo pipefail
+BUILD=$(cd "$1" && pwd)
+SRC=$(cd "$2" && pwd)
+work=$(mktemp -d "${TMPDIR:-/tmp}/sogmm-consumer-XXXXXX")
+trap 'rm -rf "$work"' EXIT
+case "$work/" in
+  "$SRC"/*) echo "scratch folder $work is inside the repository: set TMPDIR elsewhere" >&2; exit 1 ;;
+esac
+
+clean() { env -i PATH=/usr/bin:/bin HOME="${HOME:?}" "$@"; }
+
+# check_runs <program> <libsogmm folder or 'static'>: runs the program on the
+# scratch folder in a clean environment and checks which libsogmm it loaded
+# (so a stray copy elsewhere on the system cannot make the test pass).
+check_runs() {
+  local program=$1 expected=$2 loaded
+  loaded=$(clean ldd "$program" | awk '$1 ~ /^libsogmm\.so/ {print $3}')
+  if [ "$expected" = static ]; then
+    [ -z "$loaded" ] || { echo "FAIL: $program links $loaded, expected libsogmm.a" >&2; exit 1; }
+  else
+    [ "$loaded" -ef "$expected/libsogmm.so.1" ] ||
+      { echo "FAIL: $program loads '$loaded', expected $expected/libsogmm.so.1" >&2; exit 1; }
+  fi
+  clean "$program" "$work"
+}
