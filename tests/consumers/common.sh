@@ -1,8 +1,11 @@
 # Sourced by the consumer_* tests (arguments: <build-dir> <source-dir> ...).
-# Gives a scratch folder outside the repository, removed on exit, and `clean`,
-# which runs a command as from a fresh login shell: no variables but PATH and
-# HOME (cargo and go keep their toolchains and caches under HOME), so no
-# LD_LIBRARY_PATH, CGO_LDFLAGS or SOGMM_LIB_DIR.
+# Gives a scratch folder outside the repository, removed on exit, and two
+# clean environments, neither with LD_LIBRARY_PATH, CGO_LDFLAGS or SOGMM_LIB_DIR:
+# - `clean` runs a command as from a fresh login shell: PATH and HOME only.
+#   Programs are run (and checked) this way.
+# - `tools` is `clean` plus the places where cargo, rustup and go keep their
+#   toolchains and caches, when the caller's environment moved them away from
+#   HOME, so that the builds reuse what the binding tests already compiled.
 set -euo pipefail
 BUILD=$(cd "$1" && pwd)
 SRC=$(cd "$2" && pwd)
@@ -13,6 +16,13 @@ case "$work/" in
 esac
 
 clean() { env -i PATH=/usr/bin:/bin HOME="${HOME:?}" "$@"; }
+tools() {
+  local v kept=()
+  for v in CARGO_HOME RUSTUP_HOME GOCACHE GOMODCACHE GOPATH; do
+    if [ -n "${!v:-}" ]; then kept+=("$v=${!v}"); fi
+  done
+  clean "${kept[@]}" "$@"
+}
 
 # check_runs <program> <libsogmm folder or 'static'>: runs the program on the
 # scratch folder in a clean environment and checks which libsogmm it loaded

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # ctest consumer_c: a C program in a folder outside the repository, built
-# against this build four ways, each run with no environment variables:
-# installed prefix via pkg-config and via find_package (the program itself
-# installed too, which drops CMake's build rpath), and the build tree via
-# pkg-config and via -Dsogmm_DIR. Usage: consumer_c.sh <build> <source> <cmake> <generator>
+# against this build five ways, each run with no environment variables:
+# the installed prefix via pkg-config, via find_package (the program itself
+# installed too, which drops CMake's build rpath) and via libsogmm.a (whose
+# only strong globals must be sogmm_*), and the build tree via pkg-config and
+# via -Dsogmm_DIR. Usage: consumer_c.sh <build> <source> <cmake> <generator>
 . "$(dirname "$0")/common.sh"
 cmake=$3 generator=$4
 cp -r "$SRC/tests/consumers/c" "$work/src"
@@ -38,3 +39,12 @@ check_runs "$work/pc-build" "$BUILD/capi"
 echo "== build tree, find_package"
 configure "$work/cmake-build" -Dsogmm_DIR="$BUILD/capi"
 check_runs "$work/cmake-build/consumer" "$BUILD/capi"
+
+echo "== installed, static archive"
+leaked=$(nm -g --defined-only "$libdir/libsogmm.a" | awk '$2 ~ /^[TDBRC]$/ && $3 !~ /^sogmm_/ {print $3}')
+if [ -n "$leaked" ]; then
+  echo "FAIL: libsogmm.a exports more than sogmm_*: $(echo "$leaked" | head -5)" >&2; exit 1
+fi
+clean cc -std=c99 -Wall -Wextra -pedantic -Werror "$work/src/consumer.c" -I"$work/prefix/include" \
+  "$libdir/libsogmm.a" -lstdc++ -lgomp -lm -o "$work/static-installed"
+check_runs "$work/static-installed" static

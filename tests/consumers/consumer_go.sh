@@ -12,10 +12,10 @@ if [ ! -x "$go" ]; then
 fi
 cp -r "$SRC/tests/consumers/go" "$work/src"
 cd "$work/src"
-clean "$go" mod edit -replace "sogmm=$SRC/bindings/go"
+tools "$go" mod edit -replace "sogmm=$SRC/bindings/go"
 flags=()
 if [ ! "$BUILD/capi" -ef "$SRC/build/capi" ]; then
   flags=(CGO_LDFLAGS="-L$BUILD/capi -Wl,-rpath,$BUILD/capi")
 fi
-clean "${flags[@]}" "$go" build -o "$work/consumer" .
+tools GOPROXY=off "${flags[@]}" "$go" build -o "$work/consumer" .
 check_runs "$work/consumer" "$BUILD/capi"

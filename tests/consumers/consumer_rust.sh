@@ -13,6 +13,6 @@ if [ ! -x "$cargo" ]; then
 fi
 cp -r "$SRC/tests/consumers/rust" "$work/src"
 sed -i "s|\"../../../bindings/rust/sogmm\"|\"$SRC/bindings/rust/sogmm\"|" "$work/src/Cargo.toml"
-clean "$cargo" build --offline --quiet --manifest-path "$work/src/Cargo.toml" --target-dir "$target" \
+tools "$cargo" build --offline --quiet --manifest-path "$work/src/Cargo.toml" --target-dir "$target" \
   --config "env.SOGMM_LIB_DIR='$BUILD/capi'"
 check_runs "$target/debug/sogmm-consumer" static
