@@ -8,23 +8,17 @@
 #     copy would point into the group the linker discards;
 #  3. debug information stripped, as in the shipped libsogmm.so.
 # Arguments: CXX NM OBJCOPY AR OUTPUT, and OBJECTS / WHOLE_ARCHIVES joined by '|'.
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
-  endif()
-  set(run_output "${out}" PARENT_SCOPE)
-endfunction()
-
 string(REPLACE "|" ";" objects "${OBJECTS}")
 string(REPLACE "|" ";" whole "${WHOLE_ARCHIVES}")
 set(combined ${OUTPUT}.combined.o)
 set(localized ${OUTPUT}.o)
-run(${CXX} -r -nostdlib -o ${combined} ${objects}
-    -Wl,--whole-archive ${whole} -Wl,--no-whole-archive ${ARCHIVES})
+execute_process(COMMAND ${CXX} -r -nostdlib -o ${combined} ${objects}
+    -Wl,--whole-archive ${whole} -Wl,--no-whole-archive ${ARCHIVES}
+  COMMAND_ERROR_IS_FATAL ANY)
 
-run(${NM} -g --defined-only ${combined})
-string(REPLACE "\n" ";" lines "${run_output}")
+execute_process(COMMAND ${NM} -g --defined-only ${combined} OUTPUT_VARIABLE symbols
+  COMMAND_ERROR_IS_FATAL ANY)
+string(REPLACE "\n" ";" lines "${symbols}")
 set(hide "")
 foreach(line IN LISTS lines)
   # "<address> <type> <name>": T/D/B/R/C are strong definitions. (The name
@@ -37,8 +31,9 @@ foreach(line IN LISTS lines)
   endif()
 endforeach()
 file(WRITE ${OUTPUT}.localize "${hide}")
-run(${OBJCOPY} --localize-symbols=${OUTPUT}.localize --strip-debug ${combined} ${localized})
+execute_process(COMMAND ${OBJCOPY} --localize-symbols=${OUTPUT}.localize --strip-debug
+  ${combined} ${localized} COMMAND_ERROR_IS_FATAL ANY)
 
 file(REMOVE ${OUTPUT} ${combined} ${OUTPUT}.localize)
-run(${AR} rcs ${OUTPUT} ${localized})
+execute_process(COMMAND ${AR} rcs ${OUTPUT} ${localized} COMMAND_ERROR_IS_FATAL ANY)
 file(REMOVE ${localized})

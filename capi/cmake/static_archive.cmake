@@ -21,7 +21,7 @@ add_custom_command(
     "-DARCHIVES=${_sogmm_extra}"
     -DOUTPUT=${SOGMM_STATIC_ARCHIVE}
     -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/make_static_archive.cmake
-  DEPENDS sogmm_capi_objects ${_sogmm_whole} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/make_static_archive.cmake
+  DEPENDS sogmm_capi_objects $<TARGET_OBJECTS:sogmm_capi_objects> ${_sogmm_whole} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/make_static_archive.cmake
   COMMENT "Linking the static archive libsogmm.a"
   VERBATIM)
 add_custom_target(sogmm_static ALL DEPENDS ${SOGMM_STATIC_ARCHIVE})
