@@ -2,8 +2,11 @@
 // regress Self-Organizing Gaussian Mixture Models (4-D: x, y, z, gray) of
 // RGB-D frames, over the library's C API.
 //
-// Linking: cgo links libsogmm dynamically (-lsogmm). Point the linker at the
-// library with CGO_LDFLAGS, e.g.
+// Linking: cgo links libsogmm dynamically (-lsogmm). The flags below look in
+// this checkout's build/capi (where the top-level README builds it) and set
+// an rpath to it, so a program using this package, also from another module
+// through a `replace` line, runs with no environment variables. A build or
+// install elsewhere is added with CGO_LDFLAGS, e.g.
 //
 //	CGO_LDFLAGS="-L$BUILD/capi -Wl,-rpath,$BUILD/capi" go test ./...
 //
@@ -21,7 +24,7 @@ package sogmm
 
 /*
 #cgo CFLAGS: -I${SRCDIR}/../../capi/include
-#cgo LDFLAGS: -lsogmm
+#cgo LDFLAGS: -L${SRCDIR}/../../build/capi -Wl,-rpath,${SRCDIR}/../../build/capi -lsogmm
 #include <stdlib.h>
 #include "sogmm/sogmm.h"
 #if SOGMM_ABI_VERSION != 1

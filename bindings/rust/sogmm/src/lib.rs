@@ -10,10 +10,11 @@
 //! # Ok::<(), sogmm::Error>(())
 //! ```
 //!
-//! Linking: the `sogmm-sys` crate links libsogmm dynamically (see its
-//! build.rs: `SOGMM_LIB_DIR`, else pkg-config). The first handle created
-//! checks that the loaded library's ABI version is the one these bindings
-//! were written for.
+//! Linking: the `sogmm-sys` crate links libsogmm dynamically, or statically
+//! with the `static` feature, which a program needs to run without finding
+//! libsogmm.so at load time (see its build.rs and bindings/rust/README.md).
+//! The first handle created checks that the library's ABI version is the one
+//! these bindings were written for.
 //!
 //! Threads: `Model`, `Map` and `Options` are `Send + Sync`. The C API lets any
 //! number of threads call functions taking a `const` handle at once; those
