@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from sogmm import Camera, SOGMM, SogmmError
+from sogmm import DEFAULTS, SOGMM, Camera, SogmmError
 
 from .partial import leaf, reduce_partials, size_bytes
 from .sequence import Frame
@@ -20,26 +20,27 @@ from .sequence import Frame
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
-    """The fit and depth flags of `sogmm fit --sequence` (same names and defaults),
-    except ``threads``: 1, as each Ray task holds one CPU."""
+    """The fit and depth flags of `sogmm fit --sequence` (same names; the defaults
+    are the library's, sogmm.DEFAULTS), except ``threads``: 1, as each Ray task
+    holds one CPU."""
 
-    bandwidth: float = 0.02
+    bandwidth: float = DEFAULTS.bandwidth
     n_components: int | None = None
-    seed: int = 0
-    n_init: int = 1
+    seed: int = DEFAULTS.seed
+    n_init: int = DEFAULTS.n_init
     threads: int = 1
-    tol: float = 1e-3
-    max_iter: int = 100
+    tol: float = DEFAULTS.tol
+    max_iter: int = DEFAULTS.max_iter
     reg_covar: float | str = "auto"  # as sogmm.SOGMM
-    truncate: float = 0.0
+    truncate: float = DEFAULTS.truncation_nats
     #: ``--dequantise-depth`` / ``--no-dequantise-depth``: the depth-quantisation
     #: floor (SOGMM(dequantise_depth=...)); None = the library's default (on
     #: for frames).
     dequantise_depth: bool | None = None
-    decimate: int = 1
-    depth_scale: float = 1000.0
-    depth_min: float = 0.1
-    depth_max: float = 3.0
+    decimate: int = DEFAULTS.decimation
+    depth_scale: float = DEFAULTS.depth_scale
+    depth_min: float = DEFAULTS.depth_min
+    depth_max: float = DEFAULTS.depth_max
 
 
 def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:

@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 
-from sogmm import Camera, GMM, Map, SogmmError
+from sogmm import DEFAULTS, GMM, Camera, Map, SogmmError
 
 from .frame_fit import FitSettings, read_images, test_hold
 from .partial import TABLE, size_bytes
@@ -46,13 +46,13 @@ class MapSettings:
     ``fusion_threshold`` --fusion-threshold, ``novelty_bandwidth_scale``
     --novelty-bandwidth-scale, ``revisit_refit_ratio`` --revisit-refit-ratio."""
 
-    novelty: bool = True
-    novelty_threshold: float = 3.0
-    batch_size: int = 12288
+    novelty: bool = bool(DEFAULTS.map_novelty)
+    novelty_threshold: float = DEFAULTS.map_novelty_threshold
+    batch_size: int = DEFAULTS.map_batch_size
     fusion: str = "off"
-    fusion_threshold: float = 0.3
-    novelty_bandwidth_scale: float = 0.7
-    revisit_refit_ratio: float = 1.25
+    fusion_threshold: float = DEFAULTS.map_fusion_threshold
+    novelty_bandwidth_scale: float = DEFAULTS.map_novelty_bandwidth_scale
+    revisit_refit_ratio: float = DEFAULTS.map_revisit_refit_ratio
 
     def new_map(self, fit: FitSettings) -> Map:
         """An empty ``sogmm.Map`` with these map options and the fit and depth settings."""

@@ -12,6 +12,7 @@ A pure-Python (ctypes) binding of the C library libsogmm. Quick start::
 from __future__ import annotations
 
 from . import _ffi
+from ._ffi import DEFAULTS, option_info
 from .camera import Camera, rgbd_to_points
 from .errors import (
     BufferTooSmallError,
@@ -52,6 +53,8 @@ def library_path() -> str:
 
 
 __all__ = [
+    "DEFAULTS",
+    "option_info",
     "ABI_VERSION",
     "BufferTooSmallError",
     "CancelledError",
