@@ -54,7 +54,11 @@ impl ImageFrame {
         let mut out = ptr::null_mut();
         // SAFETY: NUL-terminated paths, valid for the call; `out` receives a handle.
         check(unsafe {
-            sys::sogmm_frame_read(&mut out, depth.as_ptr(), color.as_ref().map_or(ptr::null(), |c| c.as_ptr()))
+            sys::sogmm_frame_read(
+                &mut out,
+                depth.as_ptr(),
+                color.as_ref().map_or(ptr::null(), |c| c.as_ptr()),
+            )
         })?;
         Ok(Self::copy(&Handle(out)))
     }
@@ -77,11 +81,20 @@ impl ImageFrame {
             let n = width as usize * height as usize;
             let depth = std::slice::from_raw_parts(sys::sogmm_frame_depth(h.0), n).to_vec();
             let color = match sys::sogmm_frame_color_format(h.0) {
-                sys::SOGMM_COLOR_RGB8 => ColorPixels::Rgb8(std::slice::from_raw_parts(sys::sogmm_frame_color(h.0), 3 * n).to_vec()),
-                sys::SOGMM_COLOR_GRAY8 => ColorPixels::Gray8(std::slice::from_raw_parts(sys::sogmm_frame_color(h.0), n).to_vec()),
+                sys::SOGMM_COLOR_RGB8 => {
+                    ColorPixels::Rgb8(std::slice::from_raw_parts(sys::sogmm_frame_color(h.0), 3 * n).to_vec())
+                }
+                sys::SOGMM_COLOR_GRAY8 => {
+                    ColorPixels::Gray8(std::slice::from_raw_parts(sys::sogmm_frame_color(h.0), n).to_vec())
+                }
                 _ => ColorPixels::Gray8(vec![0; n]),
             };
-            ImageFrame { width, height, depth, color }
+            ImageFrame {
+                width,
+                height,
+                depth,
+                color,
+            }
         }
     }
 
@@ -92,7 +105,16 @@ impl ImageFrame {
             ColorPixels::Gray8(c) => Color::Gray8(c),
             ColorPixels::Rgb8(c) => Color::Rgb8(c),
         };
-        Frame { depth: &self.depth, color, width: self.width, height: self.height, fx, fy, cx, cy }
+        Frame {
+            depth: &self.depth,
+            color,
+            width: self.width,
+            height: self.height,
+            fx,
+            fy,
+            cx,
+            cy,
+        }
     }
 }
 
@@ -120,7 +142,10 @@ impl Trajectory {
             let n = sys::sogmm_trajectory_size(out);
             let ids = std::slice::from_raw_parts(sys::sogmm_trajectory_ids(out), n).to_vec();
             let flat = std::slice::from_raw_parts(sys::sogmm_trajectory_poses(out), 16 * n);
-            let poses = flat.chunks_exact(16).map(|c| c.try_into().expect("16 values")).collect();
+            let poses = flat
+                .chunks_exact(16)
+                .map(|c| c.try_into().expect("16 values"))
+                .collect();
             sys::sogmm_trajectory_free(out);
             Ok(Trajectory { ids, poses })
         }

@@ -81,8 +81,27 @@ fn hostile_frames_give_the_documented_status() {
 fn trajectory_round_trip_is_bitwise() {
     let (c, s) = (0.3f64.cos(), 0.3f64.sin());
     let poses = vec![
-        [c, -s, 0.0, 1.0 / 3.0, s, c, 0.0, -2.0, 0.0, 0.0, 1.0, 1e-9, 0.0, 0.0, 0.0, 1.0],
-        [1.0, 0.0, 0.0, 4.0, 0.0, 1.0, 0.0, 5.0, 0.0, 0.0, 1.0, 6.0, 0.0, 0.0, 0.0, 1.0],
+        [
+            c,
+            -s,
+            0.0,
+            1.0 / 3.0,
+            s,
+            c,
+            0.0,
+            -2.0,
+            0.0,
+            0.0,
+            1.0,
+            1e-9,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+        ],
+        [
+            1.0, 0.0, 0.0, 4.0, 0.0, 1.0, 0.0, 5.0, 0.0, 0.0, 1.0, 6.0, 0.0, 0.0, 0.0, 1.0,
+        ],
     ];
     let dir = std::env::temp_dir().join(format!("sogmm-rs-traj-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -108,13 +127,22 @@ fn livingroom_frame_fits_as_sogmm_fit_frame() {
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../../shared/data"))
         .join("rgbd/livingroom");
     if !room.is_dir() {
-        eprintln!("SKIP: {} is absent (the real frames live in ../shared/data)", room.display());
+        eprintln!(
+            "SKIP: {} is absent (the real frames live in ../shared/data)",
+            room.display()
+        );
         return;
     }
     let (d, c) = (room.join("depth/00000.png"), room.join("color/00000.jpg"));
     let image = ImageFrame::read(&d, Some(&c)).unwrap();
     assert!(matches!(image.color, ColorPixels::Rgb8(_)));
-    let opts = Options::builder().bandwidth(0.05).seed(16).threads(1).decimation(4).build().unwrap();
+    let opts = Options::builder()
+        .bandwidth(0.05)
+        .seed(16)
+        .threads(1)
+        .decimation(4)
+        .build()
+        .unwrap();
     let a = Model::fit_rgbd(&image.frame(525.0, 525.0, 319.5, 239.5), Some(&opts)).unwrap();
 
     let dp = std::ffi::CString::new(d.to_str().unwrap()).unwrap();
