@@ -177,14 +177,16 @@ def main() -> int:
           f"C-written, C-read one (sha256 {ref[:16]}).")
     bad = [k for k, v in digest.items() if v != ref]
     room = args.data_dir / "rgbd" / "livingroom"
+    cells = len(digest)
     if room.is_dir():
         bad += [("frame", lang) for lang in frame_stage(langs, env, workdir, query, room)]
+        cells += len(langs)
     else:
         missing.append(f"the frame stage ({room} is absent)")
     if bad:
-        print(f"FAIL: {len(bad)} cells differ: {bad}", file=sys.stderr)
+        print(f"FAIL: {len(bad)} of {cells} cells differ: {bad}", file=sys.stderr)
         return 1
-    print(f"{len(digest)} passed, 0 failed")
+    print(f"{cells} passed, 0 failed")
     if missing:
         print("SKIP: matrix incomplete, left out: " + ", ".join(missing))
         return SKIP

@@ -1,6 +1,7 @@
 // Frame images: format dispatch, the size cap and the file versions of the
 // decoders (image_decoders.hpp).
 #include "sogmm/frame_image.hpp"
+#include "sogmm/input_file.hpp"
 
 #include "image_decoders.hpp"
 #include "sogmm/error.hpp"

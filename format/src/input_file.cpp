@@ -8,11 +8,11 @@
 #include <cstring>
 
 #include "sogmm/error.hpp"
-#include "sogmm/frame_image.hpp"
+#include "sogmm/input_file.hpp"
 
 namespace sogmm::format {
-namespace {
-const char* kind_of(mode_t mode) {
+
+const char* file_kind(unsigned mode) {
   if (S_ISDIR(mode)) return "a folder";
   if (S_ISFIFO(mode)) return "a FIFO";
   if (S_ISSOCK(mode)) return "a socket";
@@ -20,6 +20,7 @@ const char* kind_of(mode_t mode) {
   return "not a regular file";
 }
 
+namespace {
 // Closes the descriptor on every way out.
 struct Fd {
   int fd;
@@ -37,7 +38,7 @@ std::string read_input_file(const std::string& path, const std::string& what, st
   const bool stat_ok = ::fstat(f.fd, &st) == 0;
   if (!stat_ok || !S_ISREG(st.st_mode))
     throw Error(ErrorCode::Io, path + ": cannot read " + what + " (" +
-                                   (stat_ok ? std::string("it is ") + kind_of(st.st_mode) + ", not a regular file"
+                                   (stat_ok ? std::string("it is ") + file_kind(st.st_mode) + ", not a regular file"
                                             : std::string("cannot stat it")) +
                                    ")");
   require(static_cast<std::uint64_t>(st.st_size) <= max_bytes, ErrorCode::Limit,

@@ -8,7 +8,7 @@
 
 #include "sogmm/error.hpp"
 #include "sogmm/format.hpp"
-#include "sogmm/frame_image.hpp"
+#include "sogmm/input_file.hpp"
 #include "sogmm/model.hpp"
 
 namespace sogmm::format {

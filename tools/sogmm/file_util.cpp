@@ -10,21 +10,13 @@
 
 #include "sogmm/error.hpp"
 #include "sogmm/format.hpp"
-#include "sogmm/frame_image.hpp"
+#include "sogmm/input_file.hpp"
 
 namespace sogmm::tools {
 
 namespace fs = std::filesystem;
 
 namespace {
-const char* kind_of(mode_t mode) {
-  if (S_ISDIR(mode)) return "a folder";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  return "not a regular file";
-}
-
 // The same file as far as can be told before it exists: equal when both
 // exist and are one inode (hard links, symbolic links), else when their
 // paths resolve to the same name.
@@ -52,7 +44,7 @@ void check_output_path(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {  // through symbolic links: the file a write replaces
     require(S_ISREG(st.st_mode), ErrorCode::Io,
-            path + ": cannot write (it is " + kind_of(st.st_mode) + ", not a regular file)");
+            path + ": cannot write (it is " + format::file_kind(st.st_mode) + ", not a regular file)");
   }
   // The folder of the final target: a temporary file is created there.
   std::error_code ec;

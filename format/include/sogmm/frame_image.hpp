@@ -53,10 +53,4 @@ ColorImage decode_color_image(const void* data, std::size_t size, const std::str
 DepthImage read_depth_png(const std::string& path);
 ColorImage read_color_image(const std::string& path);
 
-/// The content of a small input file (an image, a trajectory) of at most
-/// `max_bytes` bytes. Opened without blocking and refused with Error(Io)
-/// unless it is a regular file; a larger file -> Error(Limit). `what` names it
-/// in messages ("trajectory").
-std::string read_input_file(const std::string& path, const std::string& what, std::uint64_t max_bytes);
-
 }  // namespace sogmm::format
