@@ -8,7 +8,8 @@
  *
  * Conventions (apply to every function unless its comment says otherwise)
  * ---------------------------------------------------------------------
- * - Handles (sogmm_model, sogmm_options, sogmm_buffer) are opaque. A function
+ * - Handles (sogmm_model, sogmm_options, sogmm_buffer, sogmm_map, sogmm_frame,
+ *   sogmm_trajectory) are opaque. A function
  *   that creates a handle takes its out-pointer FIRST; on failure it stores
  *   NULL there (when the out-pointer itself is not NULL). The caller owns
  *   every created handle and releases it with the matching *_free function.
