@@ -16,6 +16,7 @@ DEBIAN_PACKAGES=(
   libeigen3-dev                                   # numerical core
   libopencv-core-dev libopencv-imgcodecs-dev libopencv-imgproc-dev  # image I/O (tools only)
   libzstd-dev zstd                                # .sogmm compression
+  libpng-dev libjpeg62-turbo-dev                  # frame images: libsogmm decodes PNG/JPEG (format/)
   libflatbuffers-dev flatbuffers-compiler         # .sogmm container + flatc
   libgtest-dev googletest                         # C++ tests
   libnanoflann-dev                                # exact nearest neighbours (metrics)

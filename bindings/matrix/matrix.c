@@ -10,6 +10,11 @@
  *       2024, dims 4), gray regression mean and variance at the query's
  *       (x, y, z) rows (float32), and their 3-D log-density (float64), all
  *       little-endian, concatenated.
+ *   matrix frame <depth.png> <color image> <out.sogmm>
+ *       read the RGB-D frame with the library's reader (sogmm_frame_read),
+ *       fit it with intrinsics fx = fy = 525, cx = 319.5, cy = 239.5,
+ *       bandwidth 0.05, seed 16, 1 thread, decimation 2 (sogmm_fit_frame),
+ *       and save with default options.
  */
 #include <stdint.h>
 #include <stdio.h>
@@ -64,6 +69,28 @@ static int write_model(const char* points_path, const char* out_path) {
   return rc;
 }
 
+static int fit_frame(const char* depth_path, const char* color_path, const char* out_path) {
+  sogmm_frame* frame = NULL;
+  sogmm_options* o = NULL;
+  sogmm_model* m = NULL;
+  sogmm_status st;
+  int rc = 1;
+  if ((st = sogmm_frame_read(&frame, depth_path, color_path)) != SOGMM_OK) rc = fail("frame_read", st);
+  else if ((st = sogmm_frame_set_intrinsics(frame, 525.0, 525.0, 319.5, 239.5)) != SOGMM_OK) rc = fail("intrinsics", st);
+  else if ((st = sogmm_options_create(&o)) != SOGMM_OK) rc = fail("options", st);
+  else if ((st = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) rc = fail("bandwidth", st);
+  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) rc = fail("seed", st);
+  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) rc = fail("threads", st);
+  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2)) != SOGMM_OK) rc = fail("decimation", st);
+  else if ((st = sogmm_fit_frame(&m, frame, o)) != SOGMM_OK) rc = fail("fit_frame", st);
+  else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
+  else rc = 0;
+  sogmm_model_free(m);
+  sogmm_options_free(o);
+  sogmm_frame_free(frame);
+  return rc;
+}
+
 static int read_model(const char* model_path, const char* query_path, const char* out_path) {
   float *q = NULL, *buf = NULL;
   double* score = NULL;
@@ -115,6 +142,10 @@ int main(int argc, char** argv) {
   }
   if (argc == 4 && strcmp(argv[1], "write") == 0) return write_model(argv[2], argv[3]);
   if (argc == 5 && strcmp(argv[1], "read") == 0) return read_model(argv[2], argv[3], argv[4]);
-  fprintf(stderr, "usage: %s write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin>\n", argv[0]);
+  if (argc == 5 && strcmp(argv[1], "frame") == 0) return fit_frame(argv[2], argv[3], argv[4]);
+  fprintf(stderr,
+          "usage: %s write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin> | "
+          "frame <depth.png> <color> <out.sogmm>\n",
+          argv[0]);
   return 2;
 }

@@ -2,6 +2,7 @@
 
     python matrix.py write <points.f32> <out.sogmm>
     python matrix.py read <in.sogmm> <query.f32> <out.bin>
+    python matrix.py frame <depth.png> <color image> <out.sogmm>
 """
 import sys
 
@@ -13,6 +14,12 @@ import sogmm
 def write(points_path: str, out_path: str) -> None:
     pts = np.fromfile(points_path, dtype="<f4").reshape(-1, 4)
     sogmm.SOGMM(bandwidth=0.05, seed=16, n_threads=1).fit(pts).save(out_path)
+
+
+def frame(depth_path: str, color_path: str, out_path: str) -> None:
+    depth, color = sogmm.read_frame(depth_path, color_path)  # the library's decoder, not Pillow
+    cam = sogmm.Camera(width=depth.shape[1], height=depth.shape[0], fx=525.0, fy=525.0, cx=319.5, cy=239.5)
+    sogmm.SOGMM(bandwidth=0.05, seed=16, n_threads=1).fit_rgbd(depth, color, cam, decimate=2).save(out_path)
 
 
 def read(model_path: str, query_path: str, out_path: str) -> None:
@@ -31,5 +38,7 @@ if __name__ == "__main__":
         write(*sys.argv[2:])
     elif len(sys.argv) == 5 and sys.argv[1] == "read":
         read(*sys.argv[2:])
+    elif len(sys.argv) == 5 and sys.argv[1] == "frame":
+        frame(*sys.argv[2:])
     else:
         sys.exit(__doc__)

@@ -10,6 +10,10 @@ Protocol (each participant implements it with its own binding):
       covariances, 256 samples (seed 2024, dims 4), gray regression mean and
       variance at the query's (x, y, z) rows as float32, then the 3-D
       log-density there as float64, little-endian, concatenated.
+  frame <depth.png> <color image> <out.sogmm>: read the RGB-D frame with the
+      library's frame reader (never the language's own image decoder), fit it
+      with fx = fy = 525, cx = 319.5, cy = 239.5, bandwidth 0.05, seed 16,
+      1 thread, decimation 2; save, default options.
 Participants: bindings/matrix/matrix.c (C API directly), matrix.py
 (bindings/python), bindings/rust/sogmm/examples/matrix.rs, and
 bindings/go/cmd/sogmm-matrix.
@@ -19,6 +23,12 @@ models are the same too: all 16 dumps must be byte-identical. That covers
 "model written by X, read by Y" and "same seeds, same samples and
 regressions in every language" at once. The table marks each (writer,
 reader) cell with the check mark when its dump equals the C/C reference.
+
+The frame stage fits the livingroom frame 00000 FILES (depth PNG, colour
+JPEG) of --data-dir in every language; the C reader dumps the four models and
+the dumps must be byte-identical (the same decoded bytes, the same model).
+Without the data folder the stage is left out, with a message, and the exit
+code is 77.
 
 Languages whose toolchain (cargo, go) is missing are left out: the rest of
 the matrix still runs, and the exit code is then 77 (ctest SKIP_RETURN_CODE)
@@ -53,6 +63,26 @@ def points_and_query(workdir: Path) -> tuple[Path, Path]:
     pts.tofile(p)
     query.tofile(q)
     return p, q
+
+
+def frame_stage(langs: dict[str, list[str]], env: dict, workdir: Path, query: Path, room: Path) -> list[str]:
+    """Each language fits the frame files; returns the languages whose model
+    differs from C's (compared through the C reader's dump)."""
+    depth, color = room / "depth" / "00000.png", room / "color" / "00000.jpg"
+    dumps = {}
+    for lang, cmd in langs.items():
+        model = workdir / f"frame-by-{lang}.sogmm"
+        run(cmd + ["frame", str(depth), str(color), str(model)], env)
+        out = workdir / f"frame-{lang}-read-by-C.bin"
+        run(langs["C"] + ["read", str(model), str(query), str(out)], env)
+        dumps[lang] = out.read_bytes()
+    # The dump is K weights, 4K means, 16K covariances (float32), then a fixed tail.
+    tail = 4 * (4 * 256) + 2 * 4 * 64 + 8 * 64
+    print("\nFrame stage: livingroom frame 00000 (depth PNG + colour JPEG) read by the library in each language")
+    for lang, d in dumps.items():
+        k = (len(d) - tail) // (4 * 21)
+        print(f"  {lang:>6}: {k} components, {'same' if d == dumps['C'] else 'DIFF'} as C")
+    return [lang for lang, d in dumps.items() if d != dumps["C"]]
 
 
 def find_tool(name: str, given: str | None) -> str | None:
@@ -98,6 +128,8 @@ def main() -> int:
     ap.add_argument("--cargo", help="cargo to use; '' leaves Rust out (default: PATH, ~/.cargo/bin)")
     ap.add_argument("--go", help="go to use; '' leaves Go out (default: PATH, /usr/local/go/bin)")
     ap.add_argument("--workdir", type=Path, help="scratch folder (default <build>/bindings/matrix)")
+    ap.add_argument("--data-dir", type=Path, default=ROOT.parent / "shared" / "data",
+                    help="folder holding rgbd/livingroom (default ../shared/data beside the project)")
     ap.add_argument("--markdown", action="store_true", help="print the table as Markdown (for the README)")
     args = ap.parse_args()
     build = args.build_dir.resolve()
@@ -144,10 +176,17 @@ def main() -> int:
           f"gray regression mean and variance and 3-D log-density at 64 points) is byte-identical to the "
           f"C-written, C-read one (sha256 {ref[:16]}).")
     bad = [k for k, v in digest.items() if v != ref]
+    room = args.data_dir / "rgbd" / "livingroom"
+    cells = len(digest)
+    if room.is_dir():
+        bad += [("frame", lang) for lang in frame_stage(langs, env, workdir, query, room)]
+        cells += len(langs)
+    else:
+        missing.append(f"the frame stage ({room} is absent)")
     if bad:
-        print(f"FAIL: {len(bad)} of {len(digest)} cells differ: {bad}", file=sys.stderr)
+        print(f"FAIL: {len(bad)} of {cells} cells differ: {bad}", file=sys.stderr)
         return 1
-    print(f"{len(digest)} passed, 0 failed")
+    print(f"{cells} passed, 0 failed")
     if missing:
         print("SKIP: matrix incomplete, left out: " + ", ".join(missing))
         return SKIP

@@ -29,4 +29,23 @@ SOGMM_API sogmm_status sogmm_model_load_from_memory(sogmm_model** out, const voi
   return unavailable();
 }
 
+// Frame images and trajectories are read by the format library too.
+SOGMM_API sogmm_status sogmm_frame_read(sogmm_frame** out, const char*, const char*) {
+  sogmm_capi::reset_out(out);
+  return unavailable();
+}
+SOGMM_API sogmm_status sogmm_frame_decode(sogmm_frame** out, const void*, size_t, const void*, size_t) {
+  sogmm_capi::reset_out(out);
+  return unavailable();
+}
+SOGMM_API sogmm_status sogmm_trajectory_read(sogmm_trajectory** out, const char*) {
+  sogmm_capi::reset_out(out);
+  return unavailable();
+}
+SOGMM_API void sogmm_trajectory_free(sogmm_trajectory*) {}
+SOGMM_API size_t sogmm_trajectory_size(const sogmm_trajectory*) { return 0; }
+SOGMM_API const double* sogmm_trajectory_poses(const sogmm_trajectory*) { return nullptr; }
+SOGMM_API const int64_t* sogmm_trajectory_ids(const sogmm_trajectory*) { return nullptr; }
+SOGMM_API sogmm_status sogmm_trajectory_write(const char*, const double*, size_t) { return unavailable(); }
+
 }  // extern "C"

@@ -9,20 +9,13 @@
 #include <cstring>
 
 #include "sogmm/error.hpp"
+#include "sogmm/input_file.hpp"
 
 namespace sogmm::format::detail {
 namespace {
 
 [[noreturn]] void io_error(const std::string& what, const std::string& path, int err) {
   throw Error(ErrorCode::Io, what + " '" + path + "'" + (err != 0 ? std::string(": ") + std::strerror(err) : ""));
-}
-
-const char* kind_of(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  return "not a regular file";
 }
 
 }  // namespace
@@ -45,7 +38,7 @@ FileSource::FileSource(const std::string& path) : path_(path) {
   }
   if (!S_ISREG(st.st_mode)) {
     ::close(fd_);
-    throw Error(ErrorCode::Io, "'" + path + "' is " + kind_of(st.st_mode) + ", not a regular .sogmm file");
+    throw Error(ErrorCode::Io, "'" + path + "' is " + file_kind(st.st_mode) + ", not a regular .sogmm file");
   }
   size_ = static_cast<std::uint64_t>(st.st_size);
 }

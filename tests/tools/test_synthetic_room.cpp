@@ -56,7 +56,7 @@ TEST(SyntheticRoom, LoopClosesWithEqualSteps) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("sogmm_room_loop_" + std::to_string(::getpid()) + ".log"))
                                .string();
-  sogmm::tools::write_trajectory(path, poses);
+  sogmm::tools::write_trajectory_log(path, poses);
   const std::vector<Pose> back = sogmm::tools::read_trajectory(path);
   std::filesystem::remove(path);
   ASSERT_EQ(back.size(), poses.size());

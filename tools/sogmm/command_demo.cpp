@@ -53,7 +53,7 @@ int write_synthetic_sequence(const std::string& dir, int n, bool loop) {
   j["intrinsic_matrix"] = {cam.fx, 0, 0, 0, cam.fy, 0, cam.cx, cam.cy, 1};
   const std::string text = j.dump(2) + "\n";
   write_file_atomic((fs::path(dir) / "intrinsics.json").string(), text.data(), text.size());
-  write_trajectory((fs::path(dir) / "trajectory.log").string(), poses);
+  write_trajectory_log((fs::path(dir) / "trajectory.log").string(), poses);
   std::printf("Wrote %d synthetic frame%s (640x480, depth in mm) to %s: depth/, color/, intrinsics.json, "
               "trajectory.log\n",
               n, n == 1 ? "" : "s", dir.c_str());

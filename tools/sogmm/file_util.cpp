@@ -10,20 +10,13 @@
 
 #include "sogmm/error.hpp"
 #include "sogmm/format.hpp"
+#include "sogmm/input_file.hpp"
 
 namespace sogmm::tools {
 
 namespace fs = std::filesystem;
 
 namespace {
-const char* kind_of(mode_t mode) {
-  if (S_ISDIR(mode)) return "a folder";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  return "not a regular file";
-}
-
 // The same file as far as can be told before it exists: equal when both
 // exist and are one inode (hard links, symbolic links), else when their
 // paths resolve to the same name.
@@ -51,7 +44,7 @@ void check_output_path(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {  // through symbolic links: the file a write replaces
     require(S_ISREG(st.st_mode), ErrorCode::Io,
-            path + ": cannot write (it is " + kind_of(st.st_mode) + ", not a regular file)");
+            path + ": cannot write (it is " + format::file_kind(st.st_mode) + ", not a regular file)");
   }
   // The folder of the final target: a temporary file is created there.
   std::error_code ec;
@@ -91,33 +84,7 @@ void check_outputs(const std::vector<NamedFile>& inputs, const std::vector<Named
 }
 
 std::string read_input_file(const std::string& path, const std::string& what) {
-  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  require(fd >= 0, ErrorCode::Io, path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
-  struct stat st {};
-  const bool stat_ok = ::fstat(fd, &st) == 0;
-  if (!stat_ok || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw Error(ErrorCode::Io, path + ": cannot read " + what + " (" +
-                                   (stat_ok ? std::string("it is ") + kind_of(st.st_mode) + ", not a regular file"
-                                            : std::string("cannot stat it")) +
-                                   ")");
-  }
-  std::string text;
-  char buf[65536];
-  for (;;) {
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int err = errno;
-      ::close(fd);
-      throw Error(ErrorCode::Io, path + ": cannot read " + what + " (" + std::strerror(err) + ")");
-    }
-    if (n == 0) break;
-    text.append(buf, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  return text;
+  return format::read_input_file(path, what, kMaxInputFileBytes);
 }
 
 std::uint64_t file_size_or_zero(const std::string& path) {

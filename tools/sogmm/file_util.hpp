@@ -32,9 +32,13 @@ struct NamedFile {
 /// by name, through symbolic links or as a hard link. Called before any work.
 void check_outputs(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
 
-/// The content of a small input file (a trajectory, intrinsics). Opened
-/// without blocking and refused with Error(Io) unless it is a regular file,
-/// so a FIFO or a device fails at once instead of waiting for a writer.
+/// Largest small input file read whole (1 GiB).
+constexpr std::uint64_t kMaxInputFileBytes = std::uint64_t{1} << 30;
+
+/// The content of a small input file (intrinsics), by the library's rule
+/// (format::read_input_file): opened without blocking and refused with
+/// Error(Io) unless it is a regular file, so a FIFO or a device fails at
+/// once instead of waiting for a writer; above kMaxInputFileBytes Error(Limit).
 std::string read_input_file(const std::string& path, const std::string& what);
 
 /// Size of a file in bytes (0 when it cannot be read).

@@ -1,4 +1,5 @@
-// Reading RGB-D frames from image files (OpenCV lives here, not in the core).
+// Reading RGB-D frames from image files (decoded by the library:
+// sogmm/frame_image.hpp) and writing PNGs (OpenCV, the tools only).
 #pragma once
 
 #include <cstdint>
@@ -20,9 +21,10 @@ struct LoadedFrame {
 };
 
 /// Loads a 16-bit (or 8-bit, widened) single-channel depth PNG and a color or
-/// gray image (PNG/JPEG); color becomes gray with 0.299/0.587/0.114. Throws
-/// sogmm::Error(Io) for unreadable files and Error(InvalidData) for wrong
-/// channel counts or images of different sizes, naming the file.
+/// gray image (PNG/JPEG) with the library's reader; color becomes gray with
+/// 0.299/0.587/0.114. Throws as format::read_depth_png / read_color_image
+/// (Io, Format, InvalidData, Limit, naming the file) and Error(InvalidData)
+/// for images of different sizes.
 LoadedFrame load_frame(const std::string& depth_path, const std::string& color_path);
 
 /// Loads only a depth image (as load_frame); the gray is all zeros.

@@ -1,8 +1,6 @@
 #include "sequence.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -125,47 +123,6 @@ std::vector<std::size_t> parse_frame_range(const std::string& text, std::size_t 
   return out;
 }
 
-Trajectory read_trajectory_log(const std::string& path) {
-  std::istringstream in(read_input_file(path, "trajectory"));
-  Trajectory t;
-  std::string line;
-  int line_no = 0;
-  auto next_line = [&](std::string& out) {
-    while (std::getline(in, out)) {
-      ++line_no;
-      if (out.find_first_not_of(" \t\r") != std::string::npos) return true;
-    }
-    return false;
-  };
-  while (next_line(line)) {
-    long long id = 0;
-    {
-      std::istringstream h(line);
-      long long b = 0, c = 0;
-      require(static_cast<bool>(h >> id >> b >> c), ErrorCode::InvalidData,
-              path + ":" + std::to_string(line_no) + ": expected a header line 'i j n'");
-    }
-    Pose p{};
-    for (int r = 0; r < 4; ++r) {
-      require(next_line(line), ErrorCode::InvalidData,
-              path + ":" + std::to_string(line_no) + ": truncated 4x4 matrix");
-      std::istringstream row(line);
-      for (int c = 0; c < 4; ++c)
-        require(static_cast<bool>(row >> p[4 * r + c]) && std::isfinite(p[4 * r + c]), ErrorCode::InvalidData,
-                path + ":" + std::to_string(line_no) + ": expected 4 finite numbers");
-    }
-    // Rigid by the rule every pose in the library follows (kPoseTolerance).
-    const std::string problem = rigid_pose_error(p);
-    require(problem.empty(), ErrorCode::InvalidData,
-            path + ":" + std::to_string(line_no) + ": pose " + std::to_string(t.poses.size()) +
-                " is not a rigid transform: " + problem);
-    t.poses.push_back(p);
-    t.ids.push_back(id);
-  }
-  require(!t.poses.empty(), ErrorCode::InvalidData, path + ": no pose in the trajectory");
-  return t;
-}
-
 std::vector<Pose> read_trajectory(const std::string& path) { return read_trajectory_log(path).poses; }
 
 std::vector<Pose> poses_of_frames(const Trajectory& trajectory, const std::string& path,
@@ -190,21 +147,6 @@ std::vector<Pose> poses_of_frames(const Trajectory& trajectory, const std::strin
     out.push_back(trajectory.poses[b->second]);
   }
   return out;
-}
-
-void write_trajectory(const std::string& path, const std::vector<Pose>& poses) {
-  std::string text;
-  char buf[256];
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%zu %zu %zu\n", i, i + 1, poses.size());
-    text += buf;
-    for (int r = 0; r < 4; ++r) {
-      std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g %.17g\n", poses[i][4 * r], poses[i][4 * r + 1],
-                    poses[i][4 * r + 2], poses[i][4 * r + 3]);
-      text += buf;
-    }
-  }
-  write_file_atomic(path, text.data(), text.size());
 }
 
 }  // namespace sogmm::tools

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sogmm/model.hpp"
+#include "sogmm/trajectory_log.hpp"
 
 namespace sogmm::tools {
 
@@ -36,19 +37,9 @@ std::vector<SequenceFrame> list_sequence(const std::string& dir, bool pair_by_or
 /// be empty = start/end) or "A:B:S" (step S). Throws Error(InvalidArgument).
 std::vector<std::size_t> parse_frame_range(const std::string& text, std::size_t count);
 
-/// A Redwood .log trajectory: block k holds poses[k], and ids[k] is the
-/// first number of its header line "i j n", the frame it belongs to.
-struct Trajectory {
-  std::vector<Pose> poses;
-  std::vector<long long> ids;
-};
-
-/// Reads a Redwood .log trajectory: per frame a line "i j n" then four lines
-/// of a 4x4 camera-to-world matrix. Throws Error(Io) when the file cannot be
-/// read or is not a regular file (a FIFO is refused, never waited on) and
-/// Error(InvalidData) naming the line when it is malformed or a matrix is not
-/// a rigid transform.
-Trajectory read_trajectory_log(const std::string& path);
+/// A Redwood .log trajectory and its reader (the library's: sogmm/trajectory_log.hpp).
+using format::Trajectory;
+using format::read_trajectory_log;
 
 /// The poses of read_trajectory_log in file order (entry k = block k).
 std::vector<Pose> read_trajectory(const std::string& path);
@@ -65,7 +56,7 @@ std::vector<Pose> poses_of_frames(const Trajectory& trajectory, const std::strin
 /// Inverse of a rigid transform (the core's, sogmm/model.hpp).
 using sogmm::inverse_rigid;
 
-/// Writes a trajectory in the same format (atomically).
-void write_trajectory(const std::string& path, const std::vector<Pose>& poses);
+/// Writes a trajectory in the same format (atomically; the library's writer).
+using format::write_trajectory_log;
 
 }  // namespace sogmm::tools

@@ -8,7 +8,8 @@
  *
  * Conventions (apply to every function unless its comment says otherwise)
  * ---------------------------------------------------------------------
- * - Handles (sogmm_model, sogmm_options, sogmm_buffer) are opaque. A function
+ * - Handles (sogmm_model, sogmm_options, sogmm_buffer, sogmm_map, sogmm_frame,
+ *   sogmm_trajectory) are opaque. A function
  *   that creates a handle takes its out-pointer FIRST; on failure it stores
  *   NULL there (when the out-pointer itself is not NULL). The caller owns
  *   every created handle and releases it with the matching *_free function.
@@ -107,7 +108,8 @@ typedef int32_t sogmm_status;
 #define SOGMM_E_INVALID_DATA (-3)     /* array contents unusable: empty, NaN/Inf, broken model */
 #define SOGMM_E_NUMERIC (-4)          /* numerical failure: covariance not SPD, NaN result */
 #define SOGMM_E_IO (-5)               /* a file could not be opened, read or written */
-#define SOGMM_E_FORMAT (-6)           /* bytes are not a valid / supported .sogmm document */
+#define SOGMM_E_FORMAT (-6)           /* bytes are not a valid / supported .sogmm document (or, for
+                                       * sogmm_frame_read/decode, PNG or JPEG image: corrupt, truncated) */
 #define SOGMM_E_LIMIT (-7)            /* a size limit is exceeded (decoded size, size overflow, more than
                                        * 2^26 points or 2^16 components in a fit) */
 #define SOGMM_E_NOMEM (-8)            /* memory allocation failed */
@@ -133,6 +135,8 @@ typedef struct sogmm_model sogmm_model;     /* a fitted 4-D GMM + metadata */
 typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, save, load, sample */
 typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
 typedef struct sogmm_map sogmm_map;         /* an incremental world map (sogmm_map_*) */
+typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame read from image files (sogmm_frame_*) */
+typedef struct sogmm_trajectory sogmm_trajectory; /* camera poses read from a Redwood .log file */
 
 /* ---- options ---------------------------------------------------------- */
 /* Key of a parameter (SOGMM_OPT_*, below 10000) or of a model's information
@@ -413,6 +417,57 @@ SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, siz
                                                 const uint16_t* depth, const uint8_t* color, int32_t color_format,
                                                 uint32_t width, uint32_t height, double fx, double fy, double cx,
                                                 double cy, const sogmm_options* options);
+
+/* ---- frames from image files ------------------------------------------ */
+/* The library decodes the images itself (libpng, libjpeg-turbo with fixed
+ * settings: accurate integer IDCT, no gamma), so every language gets the
+ * same pixels, and with the same options the same model, from the same
+ * files. A frame holds the depth image, the colour image (or none) and the
+ * camera intrinsics; it replaces the scalar arguments of sogmm_fit_rgbd and
+ * sogmm_map_insert_rgbd. */
+
+/* Reads a frame from a depth PNG (one channel, 16-bit; 8-bit is widened with
+ * the same values) and a colour PNG or JPEG (8-bit gray -> SOGMM_COLOR_GRAY8,
+ * RGB or palette -> SOGMM_COLOR_RGB8; an alpha channel is dropped; 1/2/4-bit
+ * gray expanded to 8). `color_path` NULL = no colour image (gray 0 when
+ * fitted). The frame has no intrinsics yet (sogmm_frame_set_intrinsics).
+ * Errors: a path NULL -> SOGMM_E_NULL_ARG; a file that cannot be read or is
+ * not a regular file (a FIFO is refused, never waited on) -> SOGMM_E_IO; not
+ * a PNG/JPEG, truncated or corrupt (a JPEG warning counts as corrupt) ->
+ * SOGMM_E_FORMAT; a depth image with colour, alpha or another bit depth, a
+ * JPEG depth image, 16-bit or CMYK colour, images of different sizes ->
+ * SOGMM_E_INVALID_DATA; an image of more than 2^26 pixels (checked from its
+ * header, before the pixels are allocated) -> SOGMM_E_LIMIT. Messages name
+ * the file. */
+SOGMM_API sogmm_status sogmm_frame_read(sogmm_frame** out, const char* depth_path, const char* color_path);
+/* As sogmm_frame_read from the files' bytes in memory (`color_data` NULL =
+ * no colour image; messages name the images "depth" and "color"). */
+SOGMM_API sogmm_status sogmm_frame_decode(sogmm_frame** out, const void* depth_data, size_t depth_size,
+                                          const void* color_data, size_t color_size);
+/* Releases `frame`. NULL is a no-op. */
+SOGMM_API void sogmm_frame_free(sogmm_frame* frame);
+/* Width and height of the frame in pixels (0 for NULL). Never fail. */
+SOGMM_API uint32_t sogmm_frame_width(const sogmm_frame* frame);
+SOGMM_API uint32_t sogmm_frame_height(const sogmm_frame* frame);
+/* The depth pixels: width * height raw uint16 values, row-major (NULL for
+ * NULL). Owned by the frame, valid until sogmm_frame_free. Never fails. */
+SOGMM_API const uint16_t* sogmm_frame_depth(const sogmm_frame* frame);
+/* The colour bytes in the layout of sogmm_frame_color_format, row-major, as
+ * sogmm_fit_rgbd takes them; NULL without a colour image (or for NULL).
+ * Owned by the frame, valid until sogmm_frame_free. Never fails. */
+SOGMM_API const uint8_t* sogmm_frame_color(const sogmm_frame* frame);
+/* SOGMM_COLOR_GRAY8 or SOGMM_COLOR_RGB8; 0 without a colour image (or for
+ * NULL). Never fails. */
+SOGMM_API int32_t sogmm_frame_color_format(const sogmm_frame* frame);
+/* Sets the intrinsics of the full-size images (pixels). They are checked
+ * where the frame is used (sogmm_fit_frame, sogmm_map_insert_frame: fx, fy >
+ * 0, all finite). Errors: frame NULL -> SOGMM_E_NULL_ARG. */
+SOGMM_API sogmm_status sogmm_frame_set_intrinsics(sogmm_frame* frame, double fx, double fy, double cx, double cy);
+/* Fits a model to `frame` exactly as sogmm_fit_rgbd does with its pixels
+ * and intrinsics (bitwise the same model); options as there (NULL =
+ * defaults). Errors: frame or out NULL -> SOGMM_E_NULL_ARG; no intrinsics
+ * set -> SOGMM_E_INVALID_ARG; else as sogmm_fit_rgbd. */
+SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options);
 
 /* ---- models from arrays, copies, release ------------------------------ */
 /* Builds a model from m components: `weights` (m floats, >= 0, summing to 1
@@ -731,6 +786,11 @@ SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* 
 SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
                                              int32_t color_format, uint32_t width, uint32_t height, double fx,
                                              double fy, double cx, double cy, const double* pose);
+/* Inserts `frame` (its pixels and intrinsics, sogmm_frame_*) with its
+ * camera-to-world `pose`, exactly as sogmm_map_insert_rgbd with them. Errors:
+ * frame NULL -> SOGMM_E_NULL_ARG; no intrinsics set -> SOGMM_E_INVALID_ARG;
+ * else as sogmm_map_insert_rgbd. */
+SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose);
 /* Fits the pending points now (no-op when none are pending). A failed or
  * cancelled fit leaves the map and the pending points unchanged. */
 SOGMM_API sogmm_status sogmm_map_flush(sogmm_map* map);
@@ -843,6 +903,35 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
  * SOGMM_E_INVALID_ARG; malformed "map_frames" (a count with a sign
  * included) -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
+
+/* ---- trajectories (Redwood .log) -------------------------------------- */
+/* A .log file holds, per frame, a header line "i j n" and four lines of a
+ * row-major 4 x 4 camera-to-world matrix. Blank lines are skipped. */
+
+/* Reads a .log file. Errors: path NULL -> SOGMM_E_NULL_ARG; cannot read, or
+ * not a regular file (a FIFO is refused, never waited on) -> SOGMM_E_IO;
+ * larger than 1 GiB -> SOGMM_E_LIMIT; a header that is not three integers, a
+ * truncated matrix, a missing or non-finite number, a pose that is not rigid
+ * (the rule of sogmm_model_set_pose), no pose at all -> SOGMM_E_INVALID_DATA
+ * with the message naming the file and line. */
+SOGMM_API sogmm_status sogmm_trajectory_read(sogmm_trajectory** out, const char* path);
+/* Releases `trajectory`. NULL is a no-op. */
+SOGMM_API void sogmm_trajectory_free(sogmm_trajectory* trajectory);
+/* Number of poses (blocks), >= 1 for a read trajectory; 0 for NULL. Never fails. */
+SOGMM_API size_t sogmm_trajectory_size(const sogmm_trajectory* trajectory);
+/* The poses: size * 16 doubles, pose k at 16 k, in file order (NULL for
+ * NULL). Owned by the trajectory, valid until sogmm_trajectory_free. */
+SOGMM_API const double* sogmm_trajectory_poses(const sogmm_trajectory* trajectory);
+/* The frame ids: size values, ids[k] the first number of block k's header,
+ * the frame the pose belongs to (NULL for NULL). Owned as the poses. */
+SOGMM_API const int64_t* sogmm_trajectory_ids(const sogmm_trajectory* trajectory);
+/* Writes n poses (n * 16 doubles, row-major) as a .log file: block k with
+ * the header "k k+1 n" and 17 significant digits (read back bitwise),
+ * atomically as sogmm_model_save (on failure the previous file is
+ * untouched). Errors: path NULL, or poses NULL with n > 0 ->
+ * SOGMM_E_NULL_ARG; n == 0, a non-finite or non-rigid pose ->
+ * SOGMM_E_INVALID_ARG (nothing written); cannot write -> SOGMM_E_IO. */
+SOGMM_API sogmm_status sogmm_trajectory_write(const char* path, const double* poses, size_t n);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

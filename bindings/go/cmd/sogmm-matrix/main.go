@@ -3,6 +3,7 @@
 //
 //	sogmm-matrix write <points.f32> <out.sogmm>
 //	sogmm-matrix read <in.sogmm> <query.f32> <out.bin>
+//	sogmm-matrix frame <depth.png> <color image> <out.sogmm>
 package main
 
 import (
@@ -38,6 +39,27 @@ func write(pointsPath, outPath string) error {
 	}
 	defer o.Close()
 	m, err := sogmm.Fit(pts, o)
+	if err != nil {
+		return err
+	}
+	defer m.Close()
+	return m.Save(outPath, nil)
+}
+
+// frame fits an RGB-D frame read by the library's reader (not image/png or
+// image/jpeg) with the protocol's intrinsics and options.
+func frame(depthPath, colorPath, outPath string) error {
+	f, err := sogmm.ReadFrame(depthPath, colorPath)
+	if err != nil {
+		return err
+	}
+	f.Fx, f.Fy, f.Cx, f.Cy = 525, 525, 319.5, 239.5
+	o, err := sogmm.NewOptions(sogmm.Bandwidth(0.05), sogmm.Seed(16), sogmm.Threads(1), sogmm.Decimation(2))
+	if err != nil {
+		return err
+	}
+	defer o.Close()
+	m, err := sogmm.FitRGBD(f, o)
 	if err != nil {
 		return err
 	}
@@ -92,8 +114,10 @@ func main() {
 		err = write(os.Args[2], os.Args[3])
 	case len(os.Args) == 5 && os.Args[1] == "read":
 		err = read(os.Args[2], os.Args[3], os.Args[4])
+	case len(os.Args) == 5 && os.Args[1] == "frame":
+		err = frame(os.Args[2], os.Args[3], os.Args[4])
 	default:
-		err = fmt.Errorf("usage: sogmm-matrix write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin>")
+		err = fmt.Errorf("usage: sogmm-matrix write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin> | frame <depth.png> <color> <out.sogmm>")
 	}
 	if err != nil {
 		fmt.Fprintln(os.Stderr, "sogmm-matrix:", err)

@@ -31,6 +31,7 @@ from .errors import (
     SogmmIOError,
     SogmmMemoryError,
 )
+from .frames import decode_frame, read_frame, read_trajectory, write_trajectory
 from .map import Map
 from .metrics import PSNR, psnr_images
 from .model import GMM, SOGMM, from_bytes, load
@@ -55,6 +56,10 @@ def library_path() -> str:
 __all__ = [
     "DEFAULTS",
     "option_info",
+    "decode_frame",
+    "read_frame",
+    "read_trajectory",
+    "write_trajectory",
     "ABI_VERSION",
     "BufferTooSmallError",
     "CancelledError",

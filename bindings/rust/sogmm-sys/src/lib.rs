@@ -38,6 +38,20 @@ pub struct sogmm_map {
     _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
 }
 
+/// Opaque handle: an RGB-D frame read from image files (sogmm_frame_*).
+#[repr(C)]
+pub struct sogmm_frame {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+
+/// Opaque handle: camera poses read from a Redwood .log file (sogmm_trajectory_*).
+#[repr(C)]
+pub struct sogmm_trajectory {
+    _opaque: [u8; 0],
+    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+}
+
 pub type sogmm_status = i32;
 pub type sogmm_key = i32;
 /// Progress callback: (stage, step, total, log_likelihood, user_data) -> 0 to
@@ -403,6 +417,7 @@ extern "C" {
         cy: f64,
         pose: *const f64,
     ) -> sogmm_status;
+    pub fn sogmm_map_insert_frame(map: *mut sogmm_map, frame: *const sogmm_frame, pose: *const f64) -> sogmm_status;
     pub fn sogmm_map_flush(map: *mut sogmm_map) -> sogmm_status;
     pub fn sogmm_map_discard_pending(map: *mut sogmm_map, dropped: *mut u64) -> sogmm_status;
     pub fn sogmm_map_set_progress(map: *mut sogmm_map, fn_: sogmm_progress_fn, user_data: *mut c_void) -> sogmm_status;
@@ -469,6 +484,36 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_frame_read(
+        out: *mut *mut sogmm_frame,
+        depth_path: *const c_char,
+        color_path: *const c_char,
+    ) -> sogmm_status;
+    pub fn sogmm_frame_decode(
+        out: *mut *mut sogmm_frame,
+        depth_data: *const c_void,
+        depth_size: usize,
+        color_data: *const c_void,
+        color_size: usize,
+    ) -> sogmm_status;
+    pub fn sogmm_frame_free(frame: *mut sogmm_frame);
+    pub fn sogmm_frame_width(frame: *const sogmm_frame) -> u32;
+    pub fn sogmm_frame_height(frame: *const sogmm_frame) -> u32;
+    pub fn sogmm_frame_depth(frame: *const sogmm_frame) -> *const u16;
+    pub fn sogmm_frame_color(frame: *const sogmm_frame) -> *const u8;
+    pub fn sogmm_frame_color_format(frame: *const sogmm_frame) -> i32;
+    pub fn sogmm_frame_set_intrinsics(frame: *mut sogmm_frame, fx: f64, fy: f64, cx: f64, cy: f64) -> sogmm_status;
+    pub fn sogmm_fit_frame(
+        out: *mut *mut sogmm_model,
+        frame: *const sogmm_frame,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_trajectory_read(out: *mut *mut sogmm_trajectory, path: *const c_char) -> sogmm_status;
+    pub fn sogmm_trajectory_free(trajectory: *mut sogmm_trajectory);
+    pub fn sogmm_trajectory_size(trajectory: *const sogmm_trajectory) -> usize;
+    pub fn sogmm_trajectory_poses(trajectory: *const sogmm_trajectory) -> *const f64;
+    pub fn sogmm_trajectory_ids(trajectory: *const sogmm_trajectory) -> *const i64;
+    pub fn sogmm_trajectory_write(path: *const c_char, poses: *const f64, n: usize) -> sogmm_status;
     pub fn sogmm_buffer_data(buffer: *const sogmm_buffer) -> *const u8;
     pub fn sogmm_buffer_size(buffer: *const sogmm_buffer) -> usize;
     pub fn sogmm_buffer_free(buffer: *mut sogmm_buffer);

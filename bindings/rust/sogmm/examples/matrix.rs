@@ -2,9 +2,11 @@
 //! bindings/matrix/run_matrix.py).
 //!   matrix write <points.f32> <out.sogmm>
 //!   matrix read <in.sogmm> <query.f32> <out.bin>
+//!   matrix frame <depth.png> <color image> <out.sogmm>
 use std::io::Write;
+use std::path::Path;
 
-use sogmm::{Model, Options};
+use sogmm::{ImageFrame, Model, Options};
 
 fn floats(path: &str) -> Vec<f32> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
@@ -20,6 +22,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ["write", points, out] => {
             let opts = Options::builder().bandwidth(0.05).seed(16).threads(1).build()?;
             Model::fit(&floats(points), Some(&opts))?.save(out, None)?;
+        }
+        ["frame", depth, color, out] => {
+            // The library's decoder, not the `image` crate.
+            let image = ImageFrame::read(depth, Some(Path::new(color)))?;
+            let opts = Options::builder().bandwidth(0.05).seed(16).threads(1).decimation(2).build()?;
+            Model::fit_rgbd(&image.frame(525.0, 525.0, 319.5, 239.5), Some(&opts))?.save(out, None)?;
         }
         ["read", model, query, out] => {
             let q = floats(query);
@@ -43,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             f.flush()?;
         }
-        _ => return Err("usage: matrix write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin>".into()),
+        _ => return Err("usage: matrix write <points.f32> <out.sogmm> | read <in.sogmm> <query.f32> <out.bin> | frame <depth.png> <color> <out.sogmm>".into()),
     }
     Ok(())
 }

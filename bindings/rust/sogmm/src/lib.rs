@@ -23,6 +23,7 @@
 //! API requires. The thread-local error message is read on the calling
 //! thread right after each call.
 pub mod error;
+pub mod frames;
 pub mod map;
 pub mod metrics;
 pub mod model;
@@ -34,6 +35,7 @@ use std::ffi::CStr;
 use std::sync::OnceLock;
 
 pub use error::{Error, Result, Status};
+pub use frames::{ColorPixels, ImageFrame, Trajectory};
 pub use map::{Map, MapFrameStats, MapStats, Pose};
 pub use metrics::{psnr_images, Psnr};
 pub use model::{Color, Frame, Model};
