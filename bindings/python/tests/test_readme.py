@@ -37,7 +37,6 @@ def test_the_readme_example_runs_as_written(tmp_path, monkeypatch, capsys):
     folder = data_dir() / "rgbd" / "livingroom"
     if not (folder / "trajectory.log").is_file():
         pytest.skip(f"the livingroom sequence is not at {folder} (../shared/data is absent)")
-    pytest.importorskip("PIL", reason="Pillow (the extra `examples`) is not installed")
     pytest.importorskip("tqdm", reason="tqdm (the extra `progress`) is not installed")
     (tmp_path / "livingroom").symlink_to(folder)
     monkeypatch.chdir(tmp_path)

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+import sogmm
 from sogmm import DEFAULTS, SOGMM, Camera, SogmmError
 
 from .partial import leaf, reduce_partials, size_bytes
@@ -44,16 +45,9 @@ class FitSettings:
 
 
 def read_images(frame: Frame) -> tuple[np.ndarray, np.ndarray]:
-    from PIL import Image  # a dependency of sogmm-ray
-
-    with Image.open(frame.depth) as im:
-        depth = np.array(im)
-    with Image.open(frame.color) as im:
-        color = np.array(im if im.mode in ("L", "RGB") else im.convert("RGB"))
-    # Pillow may open a 16-bit PNG as 32-bit mode "I"; values in range are uint16.
-    if depth.dtype.kind in "iu" and depth.dtype != np.uint16 and depth.size and 0 <= depth.min() <= depth.max() < 65536:
-        depth = depth.astype(np.uint16)
-    return depth, color
+    """The frame's depth and colour, decoded by the library (sogmm.read_frame: the
+    CLI's decoder, so a worker's frame is byte for byte the CLI's)."""
+    return sogmm.read_frame(frame.depth, frame.color)
 
 
 def test_hold(frame: int) -> None:
@@ -93,7 +87,7 @@ def fit_frame(frame: Frame, settings: FitSettings, camera: dict) -> tuple[dict, 
         model.fit_rgbd(depth, color, Camera(**camera), depth_scale=settings.depth_scale, depth_min=settings.depth_min,
                        depth_trunc=settings.depth_max, decimate=settings.decimate)
         part = leaf(frame.index, model.transform(np.asarray(frame.pose).reshape(4, 4)))
-    except (SogmmError, OSError, ValueError) as e:  # PIL raises OSError / ValueError for bad images
+    except (SogmmError, OSError, ValueError) as e:
         info.update(error=f"{type(e).__name__}: {e}", seconds=time.perf_counter() - start, bytes=0)
         return info, None
     info.update(seconds=time.perf_counter() - start, bytes=size_bytes(part), n_components=model.n_components_)

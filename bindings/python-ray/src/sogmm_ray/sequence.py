@@ -11,14 +11,13 @@ reader so both front ends accept the same folders.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from sogmm import GMM, InvalidArgumentError, InvalidDataError, SogmmIOError
-from sogmm._input_file import read_input_file
+import sogmm
+from sogmm import InvalidDataError
 
 @dataclass(frozen=True)
 class Frame:
@@ -88,55 +87,16 @@ def list_sequence(directory: str, pair_by_order: bool = False) -> list[tuple[str
     return out
 
 
-def _rigid_error(pose: np.ndarray, probe: GMM) -> str:
-    """The library's one rigid-pose rule (core/src/pose.cpp), asked through a probe model."""
-    try:
-        probe.pose = pose
-    except InvalidArgumentError as e:
-        return str(e)
-    return ""
-
-
 def read_trajectory(path: str) -> list[tuple]:
     """Camera-to-world poses of a Redwood .log file (16 floats each, row-major), in file order."""
     return read_trajectory_log(path)[0]
 
 
 def read_trajectory_log(path: str) -> tuple[list[tuple], list[int]]:
-    """(poses in file order, the frame number of each: the first field of its header line "i j n")."""
-    try:
-        text = read_input_file(path, "trajectory")
-    except FileNotFoundError:
-        raise SogmmIOError(f"{path}: cannot open trajectory (no such file)") from None
-    lines = [(n + 1, s) for n, s in enumerate(text.splitlines()) if s.strip()]
-    poses, ids, i = [], [], 0
-    probe = GMM.from_arrays([1.0], np.zeros((1, 4)), np.eye(4)[None])
-    while i < len(lines):
-        line_no, header = lines[i]
-        fields = header.split()
-        if len(fields) < 3 or not all(f.lstrip("-").isdigit() for f in fields[:3]):
-            raise InvalidDataError(f"{path}:{line_no}: expected a header line 'i j n'")
-        if i + 4 >= len(lines):
-            raise InvalidDataError(f"{path}:{lines[-1][0]}: truncated 4x4 matrix")
-        rows = []
-        for line_no, text in lines[i + 1:i + 5]:
-            try:
-                row = [float(v) for v in text.split()[:4]]
-            except ValueError:
-                row = []
-            if len(row) != 4 or not all(math.isfinite(v) for v in row):
-                raise InvalidDataError(f"{path}:{line_no}: expected 4 finite numbers")
-            rows.append(row)
-        m = np.array(rows, dtype=np.float64)
-        problem = _rigid_error(m, probe)
-        if problem:
-            raise InvalidDataError(f"{path}:{line_no}: pose {len(poses)} is not a rigid transform: {problem}")
-        poses.append(tuple(m.ravel().tolist()))
-        ids.append(int(fields[0]))
-        i += 5
-    if not poses:
-        raise InvalidDataError(f"{path}: no pose in the trajectory")
-    return poses, ids
+    """(poses in file order, the frame number of each: the first field of its header line "i j n"),
+    read by the library's reader (sogmm.read_trajectory: the CLI's rules and messages)."""
+    ids, poses = sogmm.read_trajectory(path)
+    return [tuple(p.ravel().tolist()) for p in poses], [int(i) for i in ids]
 
 
 def parse_frame_range(text: str, count: int) -> list[int]:
