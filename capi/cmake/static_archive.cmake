@@ -4,7 +4,9 @@
 # API, the core, the format layer and the zstd it needs) partially linked into
 # one object; like the shared library's version script, only the sogmm_*
 # functions stay global (make_static_archive.cmake says how). A program
-# linking it adds the C++ runtime and OpenMP: -lstdc++ -lgomp -lm.
+# linking it adds the C++ runtime, OpenMP and the image decoders (shared:
+# Debian's static libpng and libjpeg are not position-independent):
+# -lstdc++ -lgomp -lpng16 -ljpeg -lm.
 set(SOGMM_STATIC_ARCHIVE ${CMAKE_CURRENT_BINARY_DIR}/libsogmm.a)
 set(_sogmm_whole $<TARGET_FILE:sogmm_core>)
 set(_sogmm_extra "")

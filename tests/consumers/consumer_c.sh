@@ -46,5 +46,5 @@ if [ -n "$leaked" ]; then
   echo "FAIL: libsogmm.a exports more than sogmm_*: $(echo "$leaked" | head -5)" >&2; exit 1
 fi
 clean cc -std=c99 -Wall -Wextra -pedantic -Werror "$work/src/consumer.c" -I"$work/prefix/include" \
-  "$libdir/libsogmm.a" -lstdc++ -lgomp -lm -o "$work/static-installed"
+  "$libdir/libsogmm.a" -lstdc++ -lgomp -lpng16 -ljpeg -lm -o "$work/static-installed"
 check_runs "$work/static-installed" static

@@ -52,6 +52,10 @@ fn main() {
         println!("cargo:rustc-link-lib=static=sogmm");
         println!("cargo:rustc-link-lib=dylib=stdc++");
         println!("cargo:rustc-link-lib=dylib=gomp");
+        // The library's image decoders (sogmm_frame_read): the system's
+        // libpng and libjpeg, shared (Debian's static ones are not PIC).
+        println!("cargo:rustc-link-lib=dylib=png16");
+        println!("cargo:rustc-link-lib=dylib=jpeg");
     } else {
         println!("cargo:rustc-link-lib=dylib=sogmm");
     }

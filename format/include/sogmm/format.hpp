@@ -67,7 +67,7 @@ void save(const std::string& path, const Model& model, const WriteOptions& optio
 /// go to a temporary file next to the final target of `path` (a symbolic link
 /// is written through, so it keeps pointing at the new file), fsync'ed and
 /// renamed over it with the replaced file's permission bits. Refuses a target
-/// that exists and is not a regular file (a device, a FIFO, a folder): it is
+/// that exists and is not a regular file (a device, a FIFO, a directory): it is
 /// never replaced. On failure the previous file is untouched and no temporary
 /// file is left; throws Error(Io) naming the file.
 void write_file(const std::string& path, const void* data, std::size_t size);

@@ -14,7 +14,7 @@ namespace sogmm::format {
 /// Error(Limit). `what` names it in messages ("trajectory").
 std::string read_input_file(const std::string& path, const std::string& what, std::uint64_t max_bytes);
 
-/// What a file that is not a regular file is, for messages: "a folder",
+/// What a file that is not a regular file is, for messages: "a directory",
 /// "a FIFO", "a socket", "a device" or "not a regular file" (`mode`: st_mode).
 const char* file_kind(unsigned mode);
 
