@@ -23,6 +23,19 @@ func newTestMap(t *testing.T, opts ...Option) *Map {
 	return m
 }
 
+// twoFrameMap and its exported model, both closed when the test ends.
+func twoFrameMapAndExport(t *testing.T) (*Map, *Model) {
+	t.Helper()
+	m := twoFrameMap(t)
+	t.Cleanup(func() { m.Close() })
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	t.Cleanup(func() { model.Close() })
+	return m, model
+}
+
 // A map of two posed copies of twoBlobs, flushed.
 func twoFrameMap(t *testing.T) *Map {
 	t.Helper()
@@ -42,13 +55,7 @@ func twoFrameMap(t *testing.T) *Map {
 // The map's queries are bitwise the exported model's, with and without a
 // progress func; a cancelled query returns ErrCancelled with its cause.
 func TestMapQueriesEqualTheExportedModel(t *testing.T) {
-	m := twoFrameMap(t)
-	defer m.Close()
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	m, model := twoFrameMapAndExport(t)
 	q4 := twoBlobs(5000)
 	for i := 0; i < len(q4); i += 20 {
 		q4[i] += 4 // every fifth point far off
@@ -211,13 +218,7 @@ func TestFitWarm(t *testing.T) {
 
 // The model's context queries give the same values and report points.
 func TestModelQueryContexts(t *testing.T) {
-	m := twoFrameMap(t)
-	defer m.Close()
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	_, model := twoFrameMapAndExport(t)
 	q := twoBlobs(5000)
 	want, _ := model.ScoreSamples(q, 4)
 	var last Progress

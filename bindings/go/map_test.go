@@ -105,15 +105,7 @@ func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
 
 // DiscardPending is the way out of a map whose pending points cannot be saved.
 func TestMapDiscardPendingUnlocksSave(t *testing.T) {
-	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapBatchSize, 100000))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
-	m, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
+	m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
 	defer m.Close()
 	pts := twoBlobs(200)
 	if err := m.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
