@@ -8,15 +8,22 @@ import (
 	"testing"
 )
 
-// newTestMap is NewMap with bandwidth 0.3, two threads and the given keys.
-func newTestMap(t *testing.T, opts ...Option) *Map {
+// testOptions are bandwidth 0.3, seed 2, two threads and then opts (a later
+// key overrides an earlier one), closed when the test ends.
+func testOptions(t *testing.T, opts ...Option) *Options {
 	t.Helper()
 	o, err := NewOptions(append([]Option{Bandwidth(0.3), Seed(2), Threads(2)}, opts...)...)
 	if err != nil {
 		t.Fatal(err)
 	}
-	defer o.Close()
-	m, err := NewMap(o)
+	t.Cleanup(func() { o.Close() })
+	return o
+}
+
+// newTestMap is NewMap with testOptions(t, opts...).
+func newTestMap(t *testing.T, opts ...Option) *Map {
+	t.Helper()
+	m, err := NewMap(testOptions(t, opts...))
 	if err != nil {
 		t.Fatal(err)
 	}

@@ -16,11 +16,7 @@ func yawPose(deg float64, tx, ty, tz float64) [16]float64 {
 // With novelty off the map is each frame's own fit moved by its pose and
 // merged, component for component (computed here with Fit/Transform/Merge).
 func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
-	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapNovelty, 0))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
 	m, err := NewMap(o)
 	if err != nil {
 		t.Fatal(err)
