@@ -8,19 +8,39 @@ import (
 	"testing"
 )
 
-// newTestMap is NewMap with bandwidth 0.3, two threads and the given keys.
-func newTestMap(t *testing.T, opts ...Option) *Map {
+// testOptions are bandwidth 0.3, seed 2, two threads and then opts (a later
+// key overrides an earlier one), closed when the test ends.
+func testOptions(t *testing.T, opts ...Option) *Options {
 	t.Helper()
 	o, err := NewOptions(append([]Option{Bandwidth(0.3), Seed(2), Threads(2)}, opts...)...)
 	if err != nil {
 		t.Fatal(err)
 	}
-	defer o.Close()
-	m, err := NewMap(o)
+	t.Cleanup(func() { o.Close() })
+	return o
+}
+
+// newTestMap is NewMap with testOptions(t, opts...).
+func newTestMap(t *testing.T, opts ...Option) *Map {
+	t.Helper()
+	m, err := NewMap(testOptions(t, opts...))
 	if err != nil {
 		t.Fatal(err)
 	}
 	return m
+}
+
+// twoFrameMap and its exported model, both closed when the test ends.
+func twoFrameMapAndExport(t *testing.T) (*Map, *Model) {
+	t.Helper()
+	m := twoFrameMap(t)
+	t.Cleanup(func() { m.Close() })
+	model, err := m.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	t.Cleanup(func() { model.Close() })
+	return m, model
 }
 
 // A map of two posed copies of twoBlobs, flushed.
@@ -42,13 +62,7 @@ func twoFrameMap(t *testing.T) *Map {
 // The map's queries are bitwise the exported model's, with and without a
 // progress func; a cancelled query returns ErrCancelled with its cause.
 func TestMapQueriesEqualTheExportedModel(t *testing.T) {
-	m := twoFrameMap(t)
-	defer m.Close()
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	m, model := twoFrameMapAndExport(t)
 	q4 := twoBlobs(5000)
 	for i := 0; i < len(q4); i += 20 {
 		q4[i] += 4 // every fifth point far off
@@ -211,13 +225,7 @@ func TestFitWarm(t *testing.T) {
 
 // The model's context queries give the same values and report points.
 func TestModelQueryContexts(t *testing.T) {
-	m := twoFrameMap(t)
-	defer m.Close()
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	_, model := twoFrameMapAndExport(t)
 	q := twoBlobs(5000)
 	want, _ := model.ScoreSamples(q, 4)
 	var last Progress

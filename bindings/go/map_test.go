@@ -16,11 +16,7 @@ func yawPose(deg float64, tx, ty, tz float64) [16]float64 {
 // With novelty off the map is each frame's own fit moved by its pose and
 // merged, component for component (computed here with Fit/Transform/Merge).
 func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
-	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapNovelty, 0))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
 	m, err := NewMap(o)
 	if err != nil {
 		t.Fatal(err)
@@ -105,15 +101,7 @@ func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
 
 // DiscardPending is the way out of a map whose pending points cannot be saved.
 func TestMapDiscardPendingUnlocksSave(t *testing.T) {
-	o, err := NewOptions(Bandwidth(0.3), Seed(2), Threads(1), I64(OptMapBatchSize, 100000))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
-	m, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
+	m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
 	defer m.Close()
 	pts := twoBlobs(200)
 	if err := m.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {

@@ -87,13 +87,7 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 
 // A map renders bitwise as its export; progress reports rows; a cancel is ErrCancelled.
 func TestMapRenderEqualsTheExport(t *testing.T) {
-	m := twoFrameMap(t)
-	defer m.Close()
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	m, model := twoFrameMapAndExport(t)
 	cam := Camera{Width: 40, Height: 30, Fx: 30, Fy: 30, Cx: 19.5, Cy: 14.5}
 	a, err := m.Render(cam, nil, nil)
 	if err != nil {

@@ -81,8 +81,7 @@ extern "C" {
 SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
                                             const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(points, "points");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
     *out = fit_to_handle(points, n, o.settings.fit.n_components, o);
@@ -93,8 +92,7 @@ SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* poin
 SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
                                                     size_t k, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(points, "points");
     if (k == 0) fail(SOGMM_E_INVALID_ARG, "k is 0: a fixed-K fit needs k >= 1");
     *out = fit_to_handle(points, n, k, sogmm_capi::opts_or_default(options));
@@ -105,8 +103,7 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
 SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
                                                  const sogmm_model* initial, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(points, "points");
     require_nonnull(initial, "initial");
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
@@ -119,8 +116,7 @@ SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, 
                                       int32_t color_format, uint32_t width, uint32_t height, double fx,
                                       double fy, double cx, double cy, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
     const sogmm_capi::RgbdPoints r =
         sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, o);

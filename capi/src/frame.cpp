@@ -63,8 +63,7 @@ SOGMM_API sogmm_status sogmm_frame_set_intrinsics(sogmm_frame* frame, double fx,
 
 SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_capi::require_nonnull(frame, "frame");
     require_intrinsics(*frame);
     const ColorArg c = color_of(*frame);

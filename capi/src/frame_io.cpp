@@ -39,8 +39,7 @@ extern "C" {
 
 SOGMM_API sogmm_status sogmm_frame_read(sogmm_frame** out, const char* depth_path, const char* color_path) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_capi::require_nonnull(depth_path, "depth_path");
     sogmm::format::DepthImage depth = sogmm::format::read_depth_png(depth_path);
     if (color_path == nullptr) {
@@ -56,8 +55,7 @@ SOGMM_API sogmm_status sogmm_frame_read(sogmm_frame** out, const char* depth_pat
 SOGMM_API sogmm_status sogmm_frame_decode(sogmm_frame** out, const void* depth_data, size_t depth_size,
                                           const void* color_data, size_t color_size) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_capi::require_nonnull(depth_data, "depth_data");
     sogmm::format::DepthImage depth = sogmm::format::decode_depth_png(depth_data, depth_size, "depth");
     if (color_data == nullptr) {

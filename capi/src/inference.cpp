@@ -50,8 +50,7 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
 
 SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(a, "a");
     require_nonnull(b, "b");
     auto handle = std::make_unique<sogmm_model>();
@@ -65,8 +64,7 @@ SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a
 SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_model* model,
                                              const double* pose) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(model, "model");
     require_nonnull(pose, "pose");
     const std::array<double, 16> t = sogmm_capi::require_rigid(pose, "pose");

@@ -123,6 +123,15 @@ inline void reset_out(T** out) noexcept {
   if (out) *out = nullptr;
 }
 
+/// The start of every call that returns a handle through `out`: stores NULL
+/// into it (so that a failed call leaves NULL), then SOGMM_E_NULL_ARG
+/// "out is NULL" if there is nowhere to store.
+template <typename T>
+inline void require_out(T** out) {
+  reset_out(out);
+  require_nonnull(out, "out");
+}
+
 }  // namespace sogmm_capi
 
 /// Body wrapper: clears the last error, runs the statements, returns

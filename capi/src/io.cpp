@@ -50,8 +50,7 @@ SOGMM_API sogmm_status sogmm_model_save(const sogmm_model* model, const char* pa
 
 SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_path(path);
     *out = wrap(sogmm::format::load(path, read_options(sogmm_capi::opts_or_default(options))));
   }
@@ -61,8 +60,7 @@ SOGMM_API sogmm_status sogmm_model_load(sogmm_model** out, const char* path, con
 SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogmm_model* model,
                                                   const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(model, "model");
     auto buffer = std::make_unique<sogmm_buffer>();
     buffer->bytes =
@@ -75,8 +73,7 @@ SOGMM_API sogmm_status sogmm_model_save_to_memory(sogmm_buffer** out, const sogm
 SOGMM_API sogmm_status sogmm_model_load_from_memory(sogmm_model** out, const void* data, size_t size,
                                                     const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(data, "data");
     if (size == 0) fail(SOGMM_E_FORMAT, "size is 0: an empty buffer is not a .sogmm document");
     *out = wrap(sogmm::format::from_bytes(data, size, read_options(sogmm_capi::opts_or_default(options))));

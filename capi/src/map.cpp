@@ -25,8 +25,7 @@ extern "C" {
 
 SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
     *out = new sogmm_map{sogmm::Map(map_options(o)), o};
   }
@@ -154,8 +153,7 @@ SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t 
 
 SOGMM_API sogmm_status sogmm_map_export(sogmm_model** out, const sogmm_map* map, const float* box) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(map, "map");
     const sogmm_capi::MapReader use(map, "sogmm_map_export");
     auto handle = std::make_unique<sogmm_model>();
@@ -194,8 +192,7 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
 
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_model* loaded = nullptr;
     const sogmm_status status = sogmm_model_load(&loaded, path, options);
     if (status != SOGMM_OK) return status;

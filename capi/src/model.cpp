@@ -128,8 +128,7 @@ SOGMM_API sogmm_status sogmm_model_from_arrays_f32(sogmm_model** out, size_t m, 
                                                    const float* means, const float* covariances,
                                                    uint64_t support_size) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(weights, "weights");
     require_nonnull(means, "means");
     require_nonnull(covariances, "covariances");
@@ -154,8 +153,7 @@ SOGMM_API sogmm_status sogmm_model_from_arrays_f32(sogmm_model** out, size_t m, 
 
 SOGMM_API sogmm_status sogmm_model_clone(sogmm_model** out, const sogmm_model* model) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     require_nonnull(model, "model");
     *out = new sogmm_model(*model);
   }

@@ -36,8 +36,7 @@ extern "C" {
 
 SOGMM_API sogmm_status sogmm_options_create(sogmm_options** out) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     *out = new sogmm_options();
   }
   SOGMM_CATCH
@@ -45,8 +44,7 @@ SOGMM_API sogmm_status sogmm_options_create(sogmm_options** out) {
 
 SOGMM_API sogmm_status sogmm_options_clone(sogmm_options** out, const sogmm_options* src) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_capi::require_nonnull(src, "src");
     *out = new sogmm_options(*src);
   }

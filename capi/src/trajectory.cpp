@@ -16,8 +16,7 @@ extern "C" {
 
 SOGMM_API sogmm_status sogmm_trajectory_read(sogmm_trajectory** out, const char* path) {
   SOGMM_TRY {
-    sogmm_capi::reset_out(out);
-    sogmm_capi::require_nonnull(out, "out");
+    sogmm_capi::require_out(out);
     sogmm_capi::require_nonnull(path, "path");
     const sogmm::format::Trajectory t = sogmm::format::read_trajectory_log(path);
     auto h = std::make_unique<sogmm_trajectory>();

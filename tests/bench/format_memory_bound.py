@@ -34,6 +34,10 @@ import tempfile
 import flatbuffers
 import zstandard
 
+GENERATOR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "spec", "conformance", "generator")
+sys.path.insert(0, GENERATOR)
+from fb_tables import array_table, string_vector  # noqa: E402  (shared with the conformance vector generators)
+
 MIB = 1 << 20
 CAP = 1 << 30  # the default cap on decoded bytes
 METADATA_LENGTH_LIMIT = (1 << 31) - 1
@@ -138,26 +142,8 @@ def metadata(m, records, offsets, key_values, share_strings=False, covariance_la
     b = flatbuffers.Builder(1024)
     make = b.CreateSharedString if share_strings else b.CreateString
 
-    def strings(items):
-        offs = [b.CreateString(s) for s in items]
-        b.StartVector(4, len(offs), 4)
-        for o in reversed(offs):
-            b.PrependUOffsetTRelative(o)
-        return b.EndVector()
-
-    arrays = []
-    for rec, off in zip(records, offsets):
-        b.StartObject(8)
-        b.PrependUint8Slot(0, rec["dtype"], 0)
-        b.PrependUint8Slot(1, rec["order"], 0)
-        b.PrependUint8Slot(2, rec["filter"], 0)
-        b.PrependUint8Slot(3, rec["codec"], 0)
-        b.PrependUint64Slot(4, off, 0)
-        b.PrependUint64Slot(5, rec["stored_length"], 0)
-        b.PrependUint64Slot(6, rec["decoded_length"], 0)
-        b.PrependUint32Slot(7, rec["crc32c"], 0)
-        arrays.append(b.EndObject())
-    labels, units = strings(["x", "y", "z", "gray"]), strings(["m", "m", "m", "1"])
+    arrays = [array_table(b, rec, off, rec["stored_length"]) for rec, off in zip(records, offsets)]
+    labels, units = string_vector(b, ["x", "y", "z", "gray"]), string_vector(b, ["m", "m", "m", "1"])
     name, version = b.CreateString("format_memory_bound"), b.CreateString("1")
     kv_vector = None
     if key_values:

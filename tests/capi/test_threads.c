@@ -2,7 +2,6 @@
  * concurrently and give the same results as serial calls; independent
  * handles are used from several threads at once; the last-error message is
  * per thread. */
-#include <pthread.h>
 
 #include "test_util.h"
 #include "worker_check.h"
@@ -70,11 +69,10 @@ static void* worker(void* p) {
 }
 
 int main(void) {
-  pthread_t threads[N_THREADS];
   worker_arg args[N_THREADS];
   float* pts = make_clusters(N_POINTS, 11);
   sogmm_model* shared = NULL;
-  int t, failures = 0;
+  int failures = 0;
   size_t i;
   memcpy(g_points, pts, sizeof g_points);
   for (i = 0; i < N_POINTS; ++i) memcpy(g_xyz + 3 * i, g_points + 4 * i, 3 * sizeof(float));
@@ -86,18 +84,8 @@ int main(void) {
   g_shared = shared;
   /* a failure on the main thread: workers must still see their own (empty) message */
   EXPECT_STATUS(sogmm_model_n_components(NULL, &i), SOGMM_E_NULL_ARG);
-  for (t = 0; t < N_THREADS; ++t) {
-    args[t].index = t;
-    args[t].failures = 0;
-    if (pthread_create(&threads[t], NULL, worker, &args[t]) != 0) {
-      fprintf(stderr, "pthread_create failed\n");
-      return 1;
-    }
-  }
-  for (t = 0; t < N_THREADS; ++t) {
-    pthread_join(threads[t], NULL);
-    failures += args[t].failures;
-  }
+  failures = run_workers(worker, args, N_THREADS);
+  if (failures < 0) return 1;
   EXPECT_TRUE(failures == 0);
   /* main thread's message survived the workers' calls */
   EXPECT_TRUE(strstr(sogmm_last_error(), "model") != NULL);

@@ -9,7 +9,6 @@
  * Usage: sogmm_capi_test_threads_io SCRATCH_DIR
  * Under TSan run with OMP_NUM_THREADS=1 (libgomp is not instrumented); the
  * fits also set SOGMM_OPT_THREADS = 1. */
-#include <pthread.h>
 #include <unistd.h>
 
 #include "test_util.h"
@@ -113,7 +112,6 @@ static void* worker(void* p) {
 }
 
 int main(int argc, char** argv) {
-  pthread_t threads[N_THREADS];
   worker_arg args[N_THREADS];
   sogmm_model* shared = NULL;
   float* pts;
@@ -135,17 +133,8 @@ int main(int argc, char** argv) {
   }
   EXPECT_TRUE(failures == 0);
   /* concurrent run */
-  for (t = 0; t < N_THREADS; ++t) {
-    args[t].failures = 0;
-    if (pthread_create(&threads[t], NULL, worker, &args[t]) != 0) {
-      fprintf(stderr, "pthread_create failed\n");
-      return 1;
-    }
-  }
-  for (t = 0; t < N_THREADS; ++t) {
-    pthread_join(threads[t], NULL);
-    failures += args[t].failures;
-  }
+  failures = run_workers(worker, args, N_THREADS);
+  if (failures < 0) return 1;
   EXPECT_TRUE(failures == 0);
   for (t = 0; t < N_THREADS; ++t) free(g_points[t]);
   unlink(g_shared_path);

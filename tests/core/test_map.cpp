@@ -11,17 +11,10 @@
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
 #include "sogmm/warm_start.hpp"
-#include "test_util.hpp"
+#include "map_test_util.hpp"
 
 namespace {
 using namespace sogmm_test;
-
-using sogmm::ErrorCode;
-using sogmm::Map;
-using sogmm::MapOptions;
-using sogmm::Pose;
-
-constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
 // Rotation about y by `angle` and translation t (a camera turning and moving).
 Pose pose_y(double angle, double tx, double ty, double tz) {

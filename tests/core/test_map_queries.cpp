@@ -11,23 +11,10 @@
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
 #include "sogmm/map_queries.hpp"
-#include "test_util.hpp"
+#include "map_test_util.hpp"
 
 namespace {
 using namespace sogmm_test;
-
-using sogmm::ErrorCode;
-using sogmm::Map;
-using sogmm::MapOptions;
-using sogmm::Pose;
-
-constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-Pose shifted(double tx) {
-  Pose p = kIdentity;
-  p[3] = tx;
-  return p;
-}
 
 // Three tight clusters in (x, y, z, gray).
 std::vector<float> clusters(std::size_t n, std::uint64_t seed) {
@@ -51,7 +38,7 @@ Map two_frame_map() {
   const std::vector<float> p = clusters(3000, 1);
   Map map(options(true));
   map.insert_points({p.data(), 3000}, kIdentity);
-  map.insert_points({p.data(), 3000}, shifted(2.0));
+  map.insert_points({p.data(), 3000}, translated(2.0));
   map.flush();
   return map;
 }
@@ -164,12 +151,12 @@ TEST(MapQueries, ACancelledInsertOrFlushLeavesTheMapAsItWas) {
     map.insert_points({p.data(), 3000}, kIdentity);
     const Snapshot before = snapshot(map);
     ASSERT_GT(before.size, 0u);
-    expect_error([&] { map.insert_points({p.data(), 3000}, shifted(3.0), cancel); }, ErrorCode::Cancelled,
+    expect_error([&] { map.insert_points({p.data(), 3000}, translated(3.0), cancel); }, ErrorCode::Cancelled,
                  {"cancelled"}, "cancelled insert");
     EXPECT_TRUE(snapshot(map) == before);
     EXPECT_EQ(map.frames().size(), 1u);
     // The same insert then succeeds and is the second frame.
-    map.insert_points({p.data(), 3000}, shifted(3.0));
+    map.insert_points({p.data(), 3000}, translated(3.0));
     EXPECT_EQ(map.frames().size(), 2u);
     EXPECT_EQ(map.frames()[1].index, 1u);
     EXPECT_GT(map.size(), before.size);

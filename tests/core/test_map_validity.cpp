@@ -9,19 +9,10 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
-#include "test_util.hpp"
+#include "map_test_util.hpp"
 
 namespace {
 using namespace sogmm_test;
-
-using sogmm::ErrorCode;
-using sogmm::Map;
-using sogmm::MapOptions;
-using sogmm::Pose;
-
-constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-Pose translated(double tx) { return {1, 0, 0, tx, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
 
 // n points on a textured wall 1.5 m in front of the camera.
 std::vector<float> wall(std::size_t n, std::uint64_t seed) {

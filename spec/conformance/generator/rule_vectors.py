@@ -28,6 +28,8 @@ import zstandard
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[3] / "tests" / "conformance" / "python_reader"))
 from sogmm_reader import crc32c  # noqa: E402  (checked against the CRC-32C check value there)
 
+from fb_tables import array_table, string_vector  # noqa: E402  (this folder; also the memory bench's)
+
 UPPER = [(0, 0), (0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3)]
 IDENTITY = [1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0]
 
@@ -109,27 +111,9 @@ def build_metadata(model, arrays, offsets, extra=None):
     b = flatbuffers.Builder(1024)
     b.ForceDefaults(True)
 
-    def strings(items):
-        offs = [b.CreateString(s) for s in items]
-        b.StartVector(4, len(offs), 4)
-        for o in reversed(offs):
-            b.PrependUOffsetTRelative(o)
-        return b.EndVector()
-
-    arr = []
-    for rec, off in zip(arrays, offsets):
-        b.StartObject(8)
-        b.PrependUint8Slot(0, rec["dtype"], 0)
-        b.PrependUint8Slot(1, rec["order"], 0)
-        b.PrependUint8Slot(2, rec["filter"], 0)
-        b.PrependUint8Slot(3, rec["codec"], 0)
-        b.PrependUint64Slot(4, off, 0)
-        b.PrependUint64Slot(5, len(rec["stored"]), 0)
-        b.PrependUint64Slot(6, rec["decoded_length"], 0)
-        b.PrependUint32Slot(7, rec["crc32c"], 0)
-        arr.append(b.EndObject())
-    labels = strings(["x", "y", "z", "gray"]) if model["axis"] else None
-    units = strings(["m", "m", "m", "1"]) if model["axis"] else None
+    arr = [array_table(b, rec, off, len(rec["stored"])) for rec, off in zip(arrays, offsets)]
+    labels = string_vector(b, ["x", "y", "z", "gray"]) if model["axis"] else None
+    units = string_vector(b, ["m", "m", "m", "1"]) if model["axis"] else None
     fit = camera = pose = kvs = None
     if model["fit"] is not None:
         f = model["fit"]

@@ -72,6 +72,31 @@ long long sogmm_file_bytes(const FitResult& f, const FitOptions& o, const BenchC
 #endif
 }
 
+/// The row of a voxel baseline (NDT, OctoMap) at `resolution` metres, named
+/// method_prefix + resolution.
+BenchRow voxel_row(const std::string& frame, const char* family, const char* method_prefix, double resolution,
+                   const PointsView& truth) {
+  BenchRow row;
+  row.frame = frame;
+  row.family = family;
+  row.method = method_prefix + fmt_param(resolution);
+  row.parameter = resolution;
+  row.n_points = truth.size;
+  return row;
+}
+
+/// Scores a built voxel baseline: the gray it predicts at every truth point
+/// (counting the nearest-occupied-cell fallbacks) and the cloud `recon` it
+/// reconstructs (x, y, z rows) against the truth.
+template <typename VoxelMap>
+void score_voxel_map(BenchRow& row, const VoxelMap& map, const std::vector<float>& recon, const PointsView& truth,
+                     const Camera& camera, const BenchConfig& config) {
+  std::vector<float> predicted(truth.size);
+  for (std::size_t i = 0; i < truth.size; ++i) predicted[i] = map.gray_at(truth[i], &row.gray_fallbacks);
+  fill_scores(row, psnr_of_predictions(truth, predicted, camera),
+              compare_clouds(recon.data(), recon.size() / 3, 3, truth, config.threshold));
+}
+
 BenchRow run_gmm(const std::string& frame, const PointsView& truth, const Camera& camera, const BenchConfig& config,
                  const std::string& family, double bandwidth, std::size_t k) {
   BenchRow row;
@@ -105,21 +130,12 @@ BenchRow run_gmm(const std::string& frame, const PointsView& truth, const Camera
 
 BenchRow run_ndt(const std::string& frame, const PointsView& truth, const Camera& camera, const BenchConfig& config,
                  double voxel) {
-  BenchRow row;
-  row.frame = frame;
-  row.family = "ndt";
-  row.method = "NDT-" + fmt_param(voxel);
-  row.parameter = voxel;
-  row.n_points = truth.size;
+  BenchRow row = voxel_row(frame, "ndt", "NDT-", voxel, truth);
   const auto t0 = Clock::now();
   NdtMap map(voxel);
   map.build(truth);
   row.build_seconds = seconds_since(t0);
-  std::vector<float> predicted(truth.size);
-  for (std::size_t i = 0; i < truth.size; ++i) predicted[i] = map.gray_at(truth[i], &row.gray_fallbacks);
-  const std::vector<float> recon = map.sample(truth.size, config.seed);
-  fill_scores(row, psnr_of_predictions(truth, predicted, camera),
-              compare_clouds(recon.data(), recon.size() / 3, 3, truth, config.threshold));
+  score_voxel_map(row, map, map.sample(truth.size, config.seed), truth, camera, config);
   row.n_elements = map.size();
   row.memory_bytes = static_cast<long long>(map.paper_bytes());
   return row;
@@ -127,22 +143,13 @@ BenchRow run_ndt(const std::string& frame, const PointsView& truth, const Camera
 
 BenchRow run_octomap(const std::string& frame, const PointsView& truth, const Camera& camera,
                      const BenchConfig& config, double resolution) {
-  BenchRow row;
-  row.frame = frame;
-  row.family = "octomap";
-  row.method = "OM-" + fmt_param(resolution);
-  row.parameter = resolution;
-  row.n_points = truth.size;
+  BenchRow row = voxel_row(frame, "octomap", "OM-", resolution, truth);
   const auto t0 = Clock::now();
   OctoMapModel map(resolution);
   map.build(truth, config.octomap_ray_cast);
   if (!config.octomap_ray_cast) row.note = "no ray casting (endpoints only)";
   row.build_seconds = seconds_since(t0);
-  std::vector<float> predicted(truth.size);
-  for (std::size_t i = 0; i < truth.size; ++i) predicted[i] = map.gray_at(truth[i], &row.gray_fallbacks);
-  const std::vector<float> recon = map.reconstruct(truth.size);
-  fill_scores(row, psnr_of_predictions(truth, predicted, camera),
-              compare_clouds(recon.data(), recon.size() / 3, 3, truth, config.threshold));
+  score_voxel_map(row, map, map.reconstruct(truth.size), truth, camera, config);
   row.n_elements = map.occupied_leaves();
   row.file_bytes = static_cast<long long>(map.file_bytes());
   row.memory_bytes = row.file_bytes;

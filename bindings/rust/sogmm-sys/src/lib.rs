@@ -12,44 +12,36 @@
 
 pub use core::ffi::{c_char, c_void};
 
-/// Opaque handle: a fitted 4-D GMM plus metadata.
-#[repr(C)]
-pub struct sogmm_model {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
-}
-/// Opaque handle: enum-keyed parameters for fit, save, load, sample.
-#[repr(C)]
-pub struct sogmm_options {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
-}
-/// Opaque handle: bytes produced by the library.
-#[repr(C)]
-pub struct sogmm_buffer {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+/// Declares the opaque handle types of the C API, each with its doc
+/// comment: zero-sized, only ever behind a pointer, and (through the
+/// PhantomData) neither Send, Sync nor Unpin, as the Rustonomicon advises
+/// for opaque FFI structs.
+macro_rules! opaque_handles {
+    ($($(#[$doc:meta])* $name:ident;)*) => {
+        $(
+            $(#[$doc])*
+            #[repr(C)]
+            pub struct $name {
+                _opaque: [u8; 0],
+                _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+            }
+        )*
+    };
 }
 
-/// Opaque handle: an incremental world map (sogmm_map_*).
-#[repr(C)]
-pub struct sogmm_map {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
-}
-
-/// Opaque handle: an RGB-D frame read from image files (sogmm_frame_*).
-#[repr(C)]
-pub struct sogmm_frame {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
-}
-
-/// Opaque handle: camera poses read from a Redwood .log file (sogmm_trajectory_*).
-#[repr(C)]
-pub struct sogmm_trajectory {
-    _opaque: [u8; 0],
-    _pin: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
+opaque_handles! {
+    /// Opaque handle: a fitted 4-D GMM plus metadata.
+    sogmm_model;
+    /// Opaque handle: enum-keyed parameters for fit, save, load, sample.
+    sogmm_options;
+    /// Opaque handle: bytes produced by the library.
+    sogmm_buffer;
+    /// Opaque handle: an incremental world map (sogmm_map_*).
+    sogmm_map;
+    /// Opaque handle: an RGB-D frame read from image files (sogmm_frame_*).
+    sogmm_frame;
+    /// Opaque handle: camera poses read from a Redwood .log file (sogmm_trajectory_*).
+    sogmm_trajectory;
 }
 
 pub type sogmm_status = i32;
