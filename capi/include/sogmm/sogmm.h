@@ -230,6 +230,14 @@ typedef int32_t sogmm_key;
                                                * not see (MapOptions::revisit_refit_ratio: details and why).
                                                * 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START 1.
                                                * A refit counts as a fit (flushed, n_flushes) */
+/* Occupancy and distance to the surface (sogmm_map_occupancy_f32,
+ * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32). */
+#define SOGMM_OPT_OCCUPANCY_SIGMA 700     /* f64, > 0, finite; default 0.01 m: standard deviation of the
+                                           * true surface along a ray about the depth the map renders */
+#define SOGMM_OPT_OCCUPANCY_THICKNESS 701 /* f64, > 0, finite; default 0.02 m: a point within this distance
+                                           * of the surface along a ray is occupied */
+#define SOGMM_OPT_SURFACE_DISC_SIGMAS 702 /* f64, (0, 10]; default 2.0: each component is the disc of its two
+                                           * largest principal axes out to this many standard deviations */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default SOGMM_FUSION_HELLINGER */

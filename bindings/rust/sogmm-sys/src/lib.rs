@@ -108,6 +108,9 @@ pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
 pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
 pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
+pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
+pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
+pub const SOGMM_OPT_SURFACE_DISC_SIGMAS: sogmm_key = 702;
 pub const SOGMM_FUSION_HELLINGER: i64 = 0;
 pub const SOGMM_FUSION_KL: i64 = 1;
 
