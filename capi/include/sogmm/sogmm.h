@@ -852,6 +852,51 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
  * included) -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
 
+/* ---- occupancy and distance to the surface (issue 31) ----------------- */
+/* States written by sogmm_map_occupancy_f32. */
+#define SOGMM_OCCUPANCY_FREE 0
+#define SOGMM_OCCUPANCY_OCCUPIED 1
+#define SOGMM_OCCUPANCY_UNKNOWN 2
+
+/* P(occupied) of n world points (`xyz`: n * 3 floats) into `probability_out`
+ * (n doubles in [0, 1]; 0.5 = unknown) and, if `state_out` is not NULL,
+ * their state (n bytes, SOGMM_OCCUPANCY_*), from what the map's own frames
+ * see: each frame whose view (the map's camera record, its depth range)
+ * holds a point renders the map there (as sogmm_map_render_f32); a point
+ * before the first rendered surface is free, one within
+ * SOGMM_OPT_OCCUPANCY_THICKNESS of it occupied, one behind it or seen by no
+ * frame unknown, with the surface uncertain by SOGMM_OPT_OCCUPANCY_SIGMA
+ * (formula: spec/api.md, "Occupancy"). A map without frames, without a
+ * camera record (points-only inserts) or without components answers
+ * unknown everywhere (it observed nothing). Keys: SOGMM_OPT_OCCUPANCY_*,
+ * SOGMM_OPT_THREADS; the progress callback sees the renders
+ * (SOGMM_STAGE_RENDERING) and then SOGMM_STAGE_SCORING over the points, and
+ * may cancel (outputs then untouched). n == 0 writes nothing. Errors: NULL
+ * map, xyz or probability_out -> SOGMM_E_NULL_ARG; NaN/Inf in xyz ->
+ * SOGMM_E_INVALID_DATA (nothing written). */
+SOGMM_API sogmm_status sogmm_map_occupancy_f32(const sogmm_map* map, const float* xyz, size_t n,
+                                               const sogmm_options* options, double* probability_out,
+                                               uint8_t* state_out);
+
+/* Unsigned distance (metres) of n points (`xyz`: n * 3 floats, the model's
+ * frame) to the model's surface into `distance_out` (n doubles) and, if
+ * `gradient_out` is not NULL, the distance's gradient (n * 3 doubles: unit
+ * vectors pointing away from the nearest surface point). The surface is the
+ * union of the components' discs (the two largest principal axes out to
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS standard deviations; why:
+ * core/include/sogmm/surface_distance.hpp); the search is exact. Keys:
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS, SOGMM_OPT_THREADS; progress as
+ * sogmm_map_occupancy_f32 (SOGMM_STAGE_SCORING). n == 0 writes nothing.
+ * Errors: NULL model, xyz or distance_out -> SOGMM_E_NULL_ARG; NaN/Inf in
+ * xyz or a model without components -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_model_surface_distance_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                        const sogmm_options* options, double* distance_out,
+                                                        double* gradient_out);
+/* The same for a map (world frame); an empty map -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_surface_distance_f32(const sogmm_map* map, const float* xyz, size_t n,
+                                                      const sogmm_options* options, double* distance_out,
+                                                      double* gradient_out);
+
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.
  * NULL buffer -> NULL / 0. These never fail and do not touch
