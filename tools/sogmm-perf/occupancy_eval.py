@@ -88,6 +88,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--surface-sigma", type=float, default=sogmm._ffi.DEFAULTS.occupancy_sigma)
     ap.add_argument("--thickness", type=float, default=sogmm._ffi.DEFAULTS.occupancy_thickness)
+    ap.add_argument("--disc-sigmas", type=float, default=sogmm._ffi.DEFAULTS.surface_disc_sigmas)
     a = ap.parse_args()
     data = Path(a.data)
     cam = sogmm.Camera.from_json(data / "intrinsics.json")
@@ -138,7 +139,7 @@ def main() -> None:
     truth, nearest = tree.query(pts)
     sel = truth <= 0.5
     q = pts[sel]
-    dist, grad = m.surface_distance(q, gradient=True, n_threads=a.threads)
+    dist, grad = m.surface_distance(q, gradient=True, disc_sigmas=a.disc_sigmas, n_threads=a.threads)
     err = np.abs(dist - truth[sel])
     print(f"distance: {sel.sum()} points within 0.5 m of the clouds: median |error| {1e3 * np.median(err):.2f} mm, "
           f"90th percentile {1e3 * np.percentile(err, 90):.1f} mm")
@@ -152,7 +153,7 @@ def main() -> None:
               f"cloud point (median angle {np.degrees(np.median(np.arccos(np.clip(cosang, -1, 1)))):.1f} deg)")
     big = np.tile(q, (10, 1))
     load = os.getloadavg()[0]
-    t, _ = timed(lambda: m.surface_distance(big, n_threads=a.threads), a.repeats)
+    t, _ = timed(lambda: m.surface_distance(big, disc_sigmas=a.disc_sigmas, n_threads=a.threads), a.repeats)
     print(f"  throughput: {len(big)} points in {t:.3f} s = {len(big) / t / 1e6:.2f} M points/s on {a.threads} threads "
           f"against {m.n_components_} components (load average {load:.2f})")
 
