@@ -2,7 +2,8 @@
  * sogmm_map_surface_distance_f32 (issue 31) through the C API: a plane at
  * z = 2 m seen by a camera at the origin (z = 1 free, z = 2 occupied, z = 3
  * and outside the frustum unknown at exactly 0.5), the distance |z - 2| and
- * its gradient, a map and its export agree, options reach the core, cancel
+ * its gradient, collision probability of spheres on and clear of the
+ * plane, a map and its export agree, options reach the core, cancel
  * leaves the outputs untouched, and a status and message for bad input. */
 #include "test_util.h"
 
@@ -75,6 +76,21 @@ static void test_distance(sogmm_map* m) {
   sogmm_model_free(exported);
 }
 
+static void test_collision(sogmm_map* m) {
+  /* Spheres of radius 0.1 m centred on the plane and 20 cm in front of it. */
+  const double centers[] = {0.1, 0.05, 2.0, 0.1, 0.05, 1.8};
+  const double sphere[] = {0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01, 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01};
+  const double bad[] = {0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01, -0.01, 0, 0, 0, -0.01, 0, 0, 0, -0.01};
+  double p[2] = {-1.0, -1.0};
+  REQUIRE_OK(sogmm_map_collision_probability(m, centers, sphere, 2, NULL, p));
+  EXPECT_TRUE(p[0] >= 0.99 && p[1] <= 0.01);
+  p[0] = -1.0;
+  EXPECT_STATUS(sogmm_map_collision_probability(m, centers, bad, 2, NULL, p), SOGMM_E_INVALID_ARG);
+  EXPECT_TRUE(message_has("robot 1") && p[0] == -1.0);
+  EXPECT_STATUS(sogmm_map_collision_probability(m, NULL, sphere, 2, NULL, p), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_model_collision_probability(NULL, centers, sphere, 2, NULL, p), SOGMM_E_NULL_ARG);
+}
+
 static void test_bad_input(sogmm_map* m) {
   const float bad[] = {0, 0, 1, 0, NAN, 1};
   double p[2] = {-1.0, -1.0};
@@ -100,6 +116,7 @@ int main(void) {
   sogmm_map* m = plane_map();
   test_occupancy(m);
   test_distance(m);
+  test_collision(m);
   test_bad_input(m);
   sogmm_map_free(m);
   return test_summary("test_surface_queries");

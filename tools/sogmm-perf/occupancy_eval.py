@@ -13,7 +13,10 @@ then the rays of frame 2 on its decimated pixel grid (every valid pixel):
   surface, against the distance to the nearest point of the full-resolution
   clouds of frames 0-2 (a k-d tree; 4 mm pixel spacing at 2 m): the median
   absolute error, and the share of gradients within 10 degrees of the
-  direction from that nearest point for points 2-30 cm from it; throughput.
+  direction from that nearest point for points 2-30 cm from it; throughput;
+- collision: spheres of radius 10 cm at the occupied points of frame 2 and
+  20 cm in front of them (Map.collision_probability): the shares >= 0.99 and
+  <= 0.01, and the time per robot and per robot-component pair tested.
 
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
       python3 tools/sogmm-perf/occupancy_eval.py [--data /work/shared/data/rgbd/livingroom]
@@ -157,6 +160,17 @@ def main() -> None:
     print(f"  throughput: {len(big)} points in {t:.3f} s = {len(big) / t / 1e6:.2f} M points/s on {a.threads} threads "
           f"against {m.n_components_} components (load average {load:.2f})")
 
+    toward_camera = (free[3] - occ) / np.linalg.norm(free[3] - occ, axis=1, keepdims=True)
+    centers = np.concatenate([occ, occ + 0.20 * toward_camera]).astype(np.float64)
+    shapes = np.broadcast_to(np.eye(3) * 0.01, (len(centers), 3, 3))
+    load = os.getloadavg()[0]
+    t, p = timed(lambda: m.collision_probability(centers, shapes, n_threads=a.threads), a.repeats)
+    k = len(occ)
+    clear = tree.query(centers[k:])[0] > 0.13  # 3 cm (several sigma) clear of every cloud point
+    print(f"collision: spheres of 10 cm on the surface: {np.mean(p[:k] >= 0.99):.3f} with P >= 0.99; 20 cm in front "
+          f"of it and more than 3 cm clear of the clouds ({clear.sum()} of {len(clear)}): "
+          f"{np.mean(p[k:][clear] <= 0.01):.3f} with P <= 0.01; {1e6 * t / len(centers):.1f} us per robot on "
+          f"{a.threads} threads against {m.n_components_} components (load average {load:.2f})")
 
 if __name__ == "__main__":
     main()

@@ -2,7 +2,8 @@
 scene: a plane at z = 2 m seen by a camera at the origin, so z = 1 is free,
 z = 2 occupied, z = 3 (hidden) and points outside the frustum unknown; the
 distance to the plane is |z - 2| and its gradient the plane's normal; a
-single disc's distance in closed form; bad input raises."""
+single disc's distance in closed form; collision probability of a sphere
+above the plane; bad input raises."""
 
 from __future__ import annotations
 
@@ -89,3 +90,18 @@ def test_bad_input_raises(plane_map):
     with pytest.raises(sogmm.InvalidDataError):
         sogmm.Map().surface_distance(np.zeros((1, 3), np.float32))
     assert plane_map.occupancy(np.zeros((0, 3), np.float32)).shape == (0,)
+
+
+def test_collision_probability(plane_map):
+    # Spheres of radius 0.1 m centred on the plane, then 2, 4, ... 20 cm in front of it.
+    z = 2.0 - 0.02 * np.arange(11)
+    centers = np.column_stack([np.full(11, 0.1), np.full(11, 0.05), z])
+    shapes = np.broadcast_to(np.eye(3) * 0.01, (11, 3, 3))
+    p = plane_map.collision_probability(centers, shapes)
+    assert p[0] >= 0.99 and p[-1] <= 0.01
+    assert np.all(np.diff(p) <= 1e-12)
+    assert np.array_equal(plane_map.export().collision_probability(centers, shapes), p)
+    with pytest.raises(sogmm.InvalidArgumentError, match="robot 1"):
+        plane_map.collision_probability(centers[:2], np.stack([np.eye(3), -np.eye(3)]))
+    with pytest.raises(sogmm.InvalidArgumentError):
+        plane_map.collision_probability(centers, shapes[:3])

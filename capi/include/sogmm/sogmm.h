@@ -896,6 +896,28 @@ SOGMM_API sogmm_status sogmm_model_surface_distance_f32(const sogmm_model* model
 SOGMM_API sogmm_status sogmm_map_surface_distance_f32(const sogmm_map* map, const float* xyz, size_t n,
                                                       const sogmm_options* options, double* distance_out,
                                                       double* gradient_out);
+/* Probability that each of n ellipsoidal robots touches the model's surface:
+ * robot i is {x : (x - c)^T S^-1 (x - c) <= 1} with centre c = centers[3i..]
+ * and shape S = shapes[9i..] (row-major, symmetric positive definite; a
+ * sphere of radius r is r^2 I). Each component's disc (as
+ * sogmm_model_surface_distance_f32) is a surface patch uncertain along its
+ * normal by the component's smallest standard deviation sigma_k; the patch
+ * touches the robot with probability Phi(-clearance / sigma_k) and the
+ * answer is the largest over the patches (formula and why:
+ * core/include/sogmm/collision.hpp): 1/2 at contact, falling with the
+ * clearance. Writes n doubles in [0, 1] to `out`. Keys:
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS, SOGMM_OPT_THREADS; progress
+ * SOGMM_STAGE_SCORING. Errors: NULL handle, centers, shapes or out ->
+ * SOGMM_E_NULL_ARG; a non-finite centre or a model without components ->
+ * SOGMM_E_INVALID_DATA; a shape that is not finite, symmetric and positive
+ * definite (e.g. a negative radius) -> SOGMM_E_INVALID_ARG naming the robot. */
+SOGMM_API sogmm_status sogmm_model_collision_probability(const sogmm_model* model, const double* centers,
+                                                         const double* shapes, size_t n,
+                                                         const sogmm_options* options, double* out);
+/* The same for a map (world frame); an empty map -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_collision_probability(const sogmm_map* map, const double* centers,
+                                                       const double* shapes, size_t n,
+                                                       const sogmm_options* options, double* out);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

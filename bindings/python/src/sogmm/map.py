@@ -21,8 +21,8 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, MapBusyError
-from .model import (GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args, _surface_distance,
-                    _write_options)
+from .model import (GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args,
+                    _surface_distance, _write_options, _collision)
 from .progress import ProgressArg, call_with_progress
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
@@ -367,6 +367,14 @@ class Map:
         with self._guard.reading("surface_distance"):
             return _surface_distance(lib.sogmm_map_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
                                      n_threads, progress)
+
+    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
+                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
+        """Collision probability of ellipsoidal robots against the map (see
+        GMM.collision_probability); an empty map: InvalidDataError."""
+        with self._guard.reading("collision_probability"):
+            return _collision(lib.sogmm_map_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
+                              progress)
 
     def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
                spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
