@@ -11,6 +11,7 @@
 
 #include "sogmm/collision.hpp"
 #include "sogmm/map.hpp"
+#include "plane_scene.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -72,14 +73,7 @@ TEST(Collision, BesideTheDiscTheRimCounts) {
 }
 
 TEST(Collision, FittedPlaneOverlapAndClearance) {
-  const sogmm::Camera cam{64, 48, 50.0, 50.0, 31.5, 23.5};
-  sogmm::MapOptions o;
-  o.novelty = false;
-  sogmm::Map map(o);
-  std::vector<std::uint16_t> depth(cam.width * cam.height, 2000);
-  std::vector<float> gray(depth.size(), 0.5f);
-  map.insert_rgbd({depth.data(), gray.data(), cam}, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1});
-  map.flush();
+  const sogmm::Map map = sogmm_test::plane_map();
   const std::vector<double> sphere = {0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01};
   std::vector<double> centers;
   for (int i = 0; i <= 10; ++i) centers.insert(centers.end(), {0.1, 0.05, 2.0 - 0.02 * i});

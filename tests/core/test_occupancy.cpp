@@ -13,28 +13,18 @@
 #include "sogmm/map.hpp"
 #include "sogmm/occupancy.hpp"
 #include "sogmm/render.hpp"
+#include "plane_scene.hpp"
 #include "test_util.hpp"
 
 namespace {
 
 using sogmm::OccupancyState;
 
-const sogmm::Camera kCam{64, 48, 50.0, 50.0, 31.5, 23.5};
-constexpr double kPlaneZ = 2.0;
+using sogmm_test::kPlaneZ;
+using sogmm_test::plane_map;
+const sogmm::Camera& kCam = sogmm_test::kPlaneCamera;
 
-sogmm::Pose identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-
-// A map of one RGB-D frame of a gray plane at z = 2 m, taken at `pose`.
-sogmm::Map plane_map(const sogmm::Pose& pose) {
-  sogmm::MapOptions o;
-  o.novelty = false;
-  sogmm::Map map(o);
-  std::vector<std::uint16_t> depth(kCam.width * kCam.height, static_cast<std::uint16_t>(kPlaneZ * 1000));
-  std::vector<float> gray(depth.size(), 0.5f);
-  map.insert_rgbd({depth.data(), gray.data(), kCam}, pose);
-  map.flush();
-  return map;
-}
+sogmm::Pose identity() { return sogmm_test::kIdentityPose; }
 
 struct Answer {
   std::vector<double> p;

@@ -13,6 +13,7 @@
 
 #include "sogmm/map.hpp"
 #include "sogmm/surface_distance.hpp"
+#include "plane_scene.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -136,14 +137,7 @@ TEST(SurfaceDistance, ExactSearchEqualsTheMinimumOverEachComponentAlone) {
 }
 
 TEST(SurfaceDistance, FittedPlaneMatchesTheClosedForm) {
-  const sogmm::Camera cam{64, 48, 50.0, 50.0, 31.5, 23.5};
-  sogmm::MapOptions o;
-  o.novelty = false;
-  sogmm::Map map(o);
-  std::vector<std::uint16_t> depth(cam.width * cam.height, 2000);
-  std::vector<float> gray(depth.size(), 0.5f);
-  map.insert_rgbd({depth.data(), gray.data(), cam}, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1});
-  map.flush();
+  const sogmm::Map map = sogmm_test::plane_map();
   // Points over the middle of the plane (|x|, |y| <= 0.5 m; the plane spans
   // 2.56 x 1.92 m), 2 cm to 50 cm on either side.
   std::vector<float> xyz;
