@@ -84,11 +84,16 @@ void surface_distance(const Gmm& gmm, const float* xyz, std::size_t n, double* d
     double best_far = std::numeric_limits<double>::infinity();
     auto& cand = scratch[static_cast<std::size_t>(thread)];
     cand.clear();
+    // Two passes: the block's best upper bound first, so that the second
+    // keeps only the components that can beat it.
+    for (const Disc& d : discs) {
+      const Eigen::Vector3d span = (d.mu - lo).cwiseAbs().cwiseMax((hi - d.mu).cwiseAbs());
+      best_far = std::min(best_far, span.squaredNorm());
+    }
+    best_far = std::sqrt(best_far);
     for (std::size_t m = 0; m < discs.size(); ++m) {
       const Eigen::Vector3d& mu = discs[m].mu;
       const Eigen::Vector3d gap = (lo - mu).cwiseMax(mu - hi).cwiseMax(0.0);
-      const Eigen::Vector3d span = (mu - lo).cwiseAbs().cwiseMax((hi - mu).cwiseAbs());
-      best_far = std::min(best_far, span.norm());
       const double near = gap.norm() - discs[m].radius;
       if (near <= best_far) cand.emplace_back(near, static_cast<std::uint32_t>(m));
     }
