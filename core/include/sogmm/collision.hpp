@@ -15,9 +15,10 @@
 // lower bound of the union's (the patches of one surface are not
 // independent, and a product over them would count one surface many times).
 // It is 1/2 at contact, above 0.99 for a robot that reaches 2.33 sigma into
-// a patch, below 0.00135 for one 3 sigma clear of every patch, and falls as
-// the robot moves away from a patch (g_k grows with the distance along any
-// ray out of E).
+// a patch, below 0.00135 for one 3 sigma clear of every patch (g_k is at
+// least the Euclidean clearance: it is the distance between a point of E's
+// boundary and a point of D_k), and falls as the robot backs away from a
+// surface along its normal (tested; not proven for every path).
 #pragma once
 
 #include <cstddef>
