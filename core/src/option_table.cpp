@@ -134,6 +134,16 @@ std::vector<OptionSpec> make_table() {
                     [](double v) { return v == 0 || (std::isfinite(v) && v >= 1); }, "0 (off) or >= 1, finite", "",
                     "a revisited surface is refitted when its points have this many times as many modes as it has "
                     "components"),
+      // ---- occupancy and distance to the surface ----
+      SOGMM_F64_ROW(OCCUPANCY_SIGMA, occupancy.surface_sigma, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
+                    "> 0, finite", "m",
+                    "standard deviation of the true surface along a ray about the depth the map renders there"),
+      SOGMM_F64_ROW(OCCUPANCY_THICKNESS, occupancy.thickness, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
+                    "> 0, finite", "m", "a point within this distance of the surface along a ray is occupied"),
+      SOGMM_F64_ROW(SURFACE_DISC_SIGMAS, surface.disc_sigmas, 0.0, 10.0, [](double v) { return v > 0; }, "in (0, 10]",
+                    "standard deviations",
+                    "distance to the surface: each component is the disc of its two largest axes out to this many "
+                    "standard deviations"),
   };
   return t;
 }

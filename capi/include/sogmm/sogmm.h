@@ -234,6 +234,14 @@ typedef int32_t sogmm_key;
                                                * not see (MapOptions::revisit_refit_ratio: details and why).
                                                * 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START 1.
                                                * A refit counts as a fit (flushed, n_flushes) */
+/* Occupancy and distance to the surface (sogmm_map_occupancy_f32,
+ * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32). */
+#define SOGMM_OPT_OCCUPANCY_SIGMA 700     /* f64, > 0, finite; default 0.01 m: standard deviation of the
+                                           * true surface along a ray about the depth the map renders */
+#define SOGMM_OPT_OCCUPANCY_THICKNESS 701 /* f64, > 0, finite; default 0.02 m: a point within this distance
+                                           * of the surface along a ray is occupied */
+#define SOGMM_OPT_SURFACE_DISC_SIGMAS 702 /* f64, (0, 10]; default 2.0: each component is the disc of its two
+                                           * largest principal axes out to this many standard deviations */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default SOGMM_FUSION_HELLINGER */
@@ -932,6 +940,72 @@ SOGMM_API const int64_t* sogmm_trajectory_ids(const sogmm_trajectory* trajectory
  * SOGMM_E_NULL_ARG; n == 0, a non-finite or non-rigid pose ->
  * SOGMM_E_INVALID_ARG (nothing written); cannot write -> SOGMM_E_IO. */
 SOGMM_API sogmm_status sogmm_trajectory_write(const char* path, const double* poses, size_t n);
+/* ---- occupancy and distance to the surface (issue 31) ----------------- */
+/* States written by sogmm_map_occupancy_f32. */
+#define SOGMM_OCCUPANCY_FREE 0
+#define SOGMM_OCCUPANCY_OCCUPIED 1
+#define SOGMM_OCCUPANCY_UNKNOWN 2
+
+/* P(occupied) of n world points (`xyz`: n * 3 floats) into `probability_out`
+ * (n doubles in [0, 1]; 0.5 = unknown) and, if `state_out` is not NULL,
+ * their state (n bytes, SOGMM_OCCUPANCY_*), from what the map's own frames
+ * see: each frame whose view (the map's camera record, its depth range)
+ * holds a point renders the map there (as sogmm_map_render_f32); a point
+ * before the first rendered surface is free, one within
+ * SOGMM_OPT_OCCUPANCY_THICKNESS of it occupied, one behind it or seen by no
+ * frame unknown, with the surface uncertain by SOGMM_OPT_OCCUPANCY_SIGMA
+ * (formula: spec/api.md, "Occupancy"). A map without frames, without a
+ * camera record (points-only inserts) or without components answers
+ * unknown everywhere (it observed nothing). Keys: SOGMM_OPT_OCCUPANCY_*,
+ * SOGMM_OPT_THREADS; the progress callback sees the renders
+ * (SOGMM_STAGE_RENDERING) and then SOGMM_STAGE_SCORING over the points, and
+ * may cancel (outputs then untouched). n == 0 writes nothing. Errors: NULL
+ * map, xyz or probability_out -> SOGMM_E_NULL_ARG; NaN/Inf in xyz ->
+ * SOGMM_E_INVALID_DATA (nothing written). */
+SOGMM_API sogmm_status sogmm_map_occupancy_f32(const sogmm_map* map, const float* xyz, size_t n,
+                                               const sogmm_options* options, double* probability_out,
+                                               uint8_t* state_out);
+
+/* Unsigned distance (metres) of n points (`xyz`: n * 3 floats, the model's
+ * frame) to the model's surface into `distance_out` (n doubles) and, if
+ * `gradient_out` is not NULL, the distance's gradient (n * 3 doubles: unit
+ * vectors pointing away from the nearest surface point). The surface is the
+ * union of the components' discs (the two largest principal axes out to
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS standard deviations; why:
+ * core/include/sogmm/surface_distance.hpp); the search is exact. Keys:
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS, SOGMM_OPT_THREADS; progress as
+ * sogmm_map_occupancy_f32 (SOGMM_STAGE_SCORING). n == 0 writes nothing.
+ * Errors: NULL model, xyz or distance_out -> SOGMM_E_NULL_ARG; NaN/Inf in
+ * xyz or a model without components -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_model_surface_distance_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                        const sogmm_options* options, double* distance_out,
+                                                        double* gradient_out);
+/* The same for a map (world frame); an empty map -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_surface_distance_f32(const sogmm_map* map, const float* xyz, size_t n,
+                                                      const sogmm_options* options, double* distance_out,
+                                                      double* gradient_out);
+/* Probability that each of n ellipsoidal robots touches the model's surface:
+ * robot i is {x : (x - c)^T S^-1 (x - c) <= 1} with centre c = centers[3i..]
+ * and shape S = shapes[9i..] (row-major, symmetric positive definite; a
+ * sphere of radius r is r^2 I). Each component's disc (as
+ * sogmm_model_surface_distance_f32) is a surface patch uncertain along its
+ * normal by the component's smallest standard deviation sigma_k; the patch
+ * touches the robot with probability Phi(-clearance / sigma_k) and the
+ * answer is the largest over the patches (formula and why:
+ * core/include/sogmm/collision.hpp): 1/2 at contact, falling with the
+ * clearance. Writes n doubles in [0, 1] to `out`. Keys:
+ * SOGMM_OPT_SURFACE_DISC_SIGMAS, SOGMM_OPT_THREADS; progress
+ * SOGMM_STAGE_SCORING. Errors: NULL handle, centers, shapes or out ->
+ * SOGMM_E_NULL_ARG; a non-finite centre or a model without components ->
+ * SOGMM_E_INVALID_DATA; a shape that is not finite, symmetric and positive
+ * definite (e.g. a negative radius) -> SOGMM_E_INVALID_ARG naming the robot. */
+SOGMM_API sogmm_status sogmm_model_collision_probability(const sogmm_model* model, const double* centers,
+                                                         const double* shapes, size_t n,
+                                                         const sogmm_options* options, double* out);
+/* The same for a map (world frame); an empty map -> SOGMM_E_INVALID_DATA. */
+SOGMM_API sogmm_status sogmm_map_collision_probability(const sogmm_map* map, const double* centers,
+                                                       const double* shapes, size_t n,
+                                                       const sogmm_options* options, double* out);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

@@ -21,6 +21,8 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/occupancy.hpp"
+#include "sogmm/surface_distance.hpp"
 
 namespace sogmm {
 
@@ -42,6 +44,8 @@ struct Settings {
   SampleOptions sample;
   QueryOptions query;
   MapOptions map;
+  OccupancyOptions occupancy;
+  SurfaceDistanceOptions surface;
 };
 
 /// The MapOptions of `s`: s.map with s.fit and s.depth. Throws as
@@ -50,7 +54,7 @@ MapOptions map_options(const Settings& s);
 
 /// The key of each setting: the numbers and (after SOGMM_OPT_) the names of
 /// sogmm.h's SOGMM_OPT_* (stable; grouped by hundreds: fit, RGB-D, write,
-/// read, sample and query, map).
+/// read, sample and query, map, occupancy and distance).
 enum class OptionKey : int {
   BANDWIDTH = 100,
   N_COMPONENTS = 101,
@@ -83,6 +87,9 @@ enum class OptionKey : int {
   MAP_WARM_START = 606,
   MAP_NOVELTY_BANDWIDTH_SCALE = 607,
   MAP_REVISIT_REFIT_RATIO = 608,
+  OCCUPANCY_SIGMA = 700,
+  OCCUPANCY_THICKNESS = 701,
+  SURFACE_DISC_SIGMAS = 702,
 };
 
 /// The value type of a setting (sogmm.h: SOGMM_TYPE_F64 = 0, SOGMM_TYPE_I64 = 1).

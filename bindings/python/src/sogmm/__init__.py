@@ -39,6 +39,11 @@ from .ply import read_ply, write_ply
 
 __version__ = "0.1.0"
 
+#: States of Map.occupancy(points, return_state=True).
+OCCUPANCY_FREE = _ffi.OCCUPANCY_FREE
+OCCUPANCY_OCCUPIED = _ffi.OCCUPANCY_OCCUPIED
+OCCUPANCY_UNKNOWN = _ffi.OCCUPANCY_UNKNOWN
+
 #: ABI version this package expects (checked against the loaded library on import).
 ABI_VERSION = _ffi.ABI_VERSION
 
@@ -75,6 +80,9 @@ __all__ = [
     "NotFittedError",
     "NotFoundError",
     "NullArgumentError",
+    "OCCUPANCY_FREE",
+    "OCCUPANCY_OCCUPIED",
+    "OCCUPANCY_UNKNOWN",
     "NumericError",
     "PSNR",
     "SOGMM",

@@ -67,6 +67,12 @@ OPT_MAP_FUSION = 603
 OPT_MAP_FUSION_METHOD = 604
 OPT_MAP_FUSION_THRESHOLD = 605
 OPT_MAP_WARM_START = 606
+OPT_OCCUPANCY_SIGMA = 700
+OPT_OCCUPANCY_THICKNESS = 701
+OPT_SURFACE_DISC_SIGMAS = 702
+OCCUPANCY_FREE = 0
+OCCUPANCY_OCCUPIED = 1
+OCCUPANCY_UNKNOWN = 2
 FUSION_HELLINGER = 0
 FUSION_KL = 1
 
@@ -228,6 +234,12 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_map_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
     "sogmm_map_sample_f32": (STATUS, [HANDLE, c_size_t, c_uint64, c_int32, HANDLE, F32_OUT]),
+    # state_out and gradient_out may be NULL: c_void_p (None or arr.ctypes.data).
+    "sogmm_map_occupancy_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F64_OUT, c_void_p]),
+    "sogmm_model_surface_distance_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F64_OUT, c_void_p]),
+    "sogmm_map_surface_distance_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F64_OUT, c_void_p]),
+    "sogmm_model_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
+    "sogmm_map_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
     "sogmm_model_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,
                                         HANDLE, F32_OUT, F32_OUT, F32_OUT]),
     "sogmm_map_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,
@@ -454,6 +466,9 @@ OPTION_NAMES = {
     OPT_MAP_FUSION_METHOD: "fusion",
     OPT_MAP_FUSION_THRESHOLD: "fusion_threshold",
     OPT_MAP_WARM_START: "warm_start",
+    OPT_OCCUPANCY_SIGMA: "surface_sigma",
+    OPT_OCCUPANCY_THICKNESS: "thickness",
+    OPT_SURFACE_DISC_SIGMAS: "disc_sigmas",
 }
 
 

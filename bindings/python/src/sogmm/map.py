@@ -21,7 +21,8 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, MapBusyError
-from .model import GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args, _write_options
+from .model import (GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args,
+                    _surface_distance, _write_options, _collision)
 from .progress import ProgressArg, call_with_progress
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
@@ -337,6 +338,43 @@ class Map:
 
         return render_images(lib.sogmm_map_render_f32, self._h(), camera, pose, depth_min, depth_trunc, n_threads,
                              progress)
+
+    def occupancy(self, points, return_state: bool = False, *, surface_sigma: float = _D.occupancy_sigma,
+                  thickness: float = _D.occupancy_thickness, n_threads: int = _D.threads,
+                  progress: ProgressArg = None):
+        """P(occupied) of (n, 3) world points from what the map's own frames see:
+        an (n,) float64 array in [0, 1], 0.5 where no frame observed the point;
+        with ``return_state`` also an (n,) uint8 array (OCCUPANCY_FREE 0,
+        OCCUPANCY_OCCUPIED 1, OCCUPANCY_UNKNOWN 2). A point in front of the
+        first surface a frame renders along its ray is free, one within
+        ``thickness`` metres of it occupied, one behind it unknown; the surface
+        is uncertain by ``surface_sigma`` metres (spec/api.md, "Occupancy"). A
+        map without frames, camera record or components: unknown everywhere."""
+        x = _rows(points, (3,), "points")
+        prob = np.empty(x.shape[0], dtype=np.float64)
+        state = np.empty(x.shape[0], dtype=np.uint8)
+        state_ptr = state.ctypes.data if state.size else None
+        f64 = {_ffi.OPT_OCCUPANCY_SIGMA: surface_sigma, _ffi.OPT_OCCUPANCY_THICKNESS: thickness}
+        with _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}) as o, self._guard.reading("occupancy"):
+            call_with_progress(o, progress, lambda: lib.sogmm_map_occupancy_f32(self._h(), x, x.shape[0], o.ptr,
+                                                                                 prob, state_ptr))
+        return (prob, state) if return_state else prob
+
+    def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
+                         n_threads: int = _D.threads, progress: ProgressArg = None):
+        """Distance of (n, 3) world points to the map's surface (see GMM.surface_distance);
+        an empty map: InvalidDataError."""
+        with self._guard.reading("surface_distance"):
+            return _surface_distance(lib.sogmm_map_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
+                                     n_threads, progress)
+
+    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
+                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
+        """Collision probability of ellipsoidal robots against the map (see
+        GMM.collision_probability); an empty map: InvalidDataError."""
+        with self._guard.reading("collision_probability"):
+            return _collision(lib.sogmm_map_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
+                              progress)
 
     def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
                spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:

@@ -78,6 +78,30 @@ def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_b
     )
 
 
+def _surface_distance(c_fn, handle, points, gradient: bool, disc_sigmas: float, n_threads: int,
+                      progress: ProgressArg):
+    """The distance query of GMM and Map (sogmm_*_surface_distance_f32)."""
+    x = _rows(points, (3,), "points")
+    dist = np.empty(x.shape[0], dtype=np.float64)
+    grad = np.empty((x.shape[0], 3), dtype=np.float64) if gradient else None
+    grad_ptr = grad.ctypes.data if grad is not None and grad.size else None
+    with _ffi.Options(f64={_ffi.OPT_SURFACE_DISC_SIGMAS: disc_sigmas}, i64={_ffi.OPT_THREADS: n_threads}) as o:
+        call_with_progress(o, progress, lambda: c_fn(handle, x, x.shape[0], o.ptr, dist, grad_ptr))
+    return (dist, grad) if gradient else dist
+
+
+def _collision(c_fn, handle, centers, shapes, disc_sigmas: float, n_threads: int, progress: ProgressArg):
+    """The collision query of GMM and Map (sogmm_*_collision_probability)."""
+    c = np.ascontiguousarray(centers, dtype=np.float64)
+    s = np.ascontiguousarray(shapes, dtype=np.float64)
+    if c.ndim != 2 or c.shape[1] != 3 or s.shape != (c.shape[0], 3, 3):
+        raise InvalidArgumentError(f"centers must be (n, 3) and shapes (n, 3, 3), got {c.shape} and {s.shape}")
+    out = np.empty(c.shape[0], dtype=np.float64)
+    with _ffi.Options(f64={_ffi.OPT_SURFACE_DISC_SIGMAS: disc_sigmas}, i64={_ffi.OPT_THREADS: n_threads}) as o:
+        call_with_progress(o, progress, lambda: c_fn(handle, c, s, c.shape[0], o.ptr, out))
+    return out
+
+
 def _query_options(truncation_nats: float, n_threads: int) -> _ffi.Options:
     return _ffi.Options(f64={_ffi.OPT_QUERY_TRUNCATION_NATS: truncation_nats}, i64={_ffi.OPT_THREADS: n_threads})
 
@@ -382,6 +406,26 @@ class GMM:
             call_with_progress(o, progress,
                                lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
+
+    def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
+                         n_threads: int = _D.threads, progress: ProgressArg = None):
+        """Unsigned distance (metres) of (n, 3) points to the model's surface: an
+        (n,) float64 array, and with ``gradient`` also the (n, 3) gradient (unit
+        vectors pointing away from the nearest surface point). The surface is
+        the union of the components' discs (their two largest principal axes
+        out to ``disc_sigmas`` standard deviations); the search is exact."""
+        return _surface_distance(lib.sogmm_model_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
+                                 n_threads, progress)
+
+    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
+                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
+        """Probability that each ellipsoidal robot touches the surface: ``centers``
+        (n, 3), ``shapes`` (n, 3, 3) symmetric positive definite S (the robot is
+        {x : (x - c)^T S^-1 (x - c) <= 1}; a sphere of radius r is r^2 I).
+        The largest over the components' discs of Phi(-clearance / sigma_k),
+        sigma_k the patch's noise along its normal: 1/2 at contact."""
+        return _collision(lib.sogmm_model_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
+                          progress)
 
     def score(self, X) -> float:
         """Mean log-density of the rows of X (see score_samples)."""

@@ -114,6 +114,9 @@ pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
 pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
 pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
+pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
+pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
+pub const SOGMM_OPT_SURFACE_DISC_SIGMAS: sogmm_key = 702;
 pub const SOGMM_FUSION_HELLINGER: i64 = 0;
 pub const SOGMM_FUSION_KL: i64 = 1;
 
@@ -126,6 +129,9 @@ pub const SOGMM_STAGE_SAMPLING: i32 = 5;
 pub const SOGMM_STAGE_SCORING: i32 = 6;
 pub const SOGMM_STAGE_REGRESSION: i32 = 7;
 pub const SOGMM_STAGE_RENDERING: i32 = 8;
+pub const SOGMM_OCCUPANCY_FREE: u8 = 0;
+pub const SOGMM_OCCUPANCY_OCCUPIED: u8 = 1;
+pub const SOGMM_OCCUPANCY_UNKNOWN: u8 = 2;
 
 /// The largest width * height a render takes (2^26).
 pub const SOGMM_MAX_RENDER_PIXELS: usize = 67108864;
@@ -458,6 +464,46 @@ extern "C" {
         depth_out: *mut f32,
         gray_out: *mut f32,
         variance_out: *mut f32,
+    ) -> sogmm_status;
+    pub fn sogmm_map_occupancy_f32(
+        map: *const sogmm_map,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+        probability_out: *mut f64,
+        state_out: *mut u8,
+    ) -> sogmm_status;
+    pub fn sogmm_model_surface_distance_f32(
+        model: *const sogmm_model,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+        distance_out: *mut f64,
+        gradient_out: *mut f64,
+    ) -> sogmm_status;
+    pub fn sogmm_map_surface_distance_f32(
+        map: *const sogmm_map,
+        xyz: *const f32,
+        n: usize,
+        options: *const sogmm_options,
+        distance_out: *mut f64,
+        gradient_out: *mut f64,
+    ) -> sogmm_status;
+    pub fn sogmm_model_collision_probability(
+        model: *const sogmm_model,
+        centers: *const f64,
+        shapes: *const f64,
+        n: usize,
+        options: *const sogmm_options,
+        out: *mut f64,
+    ) -> sogmm_status;
+    pub fn sogmm_map_collision_probability(
+        map: *const sogmm_map,
+        centers: *const f64,
+        shapes: *const f64,
+        n: usize,
+        options: *const sogmm_options,
+        out: *mut f64,
     ) -> sogmm_status;
     pub fn sogmm_map_render_f32(
         map: *const sogmm_map,

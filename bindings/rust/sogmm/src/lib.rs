@@ -30,6 +30,7 @@ pub mod model;
 pub mod options;
 pub mod progress;
 pub mod render;
+pub mod surface;
 
 use std::ffi::CStr;
 use std::sync::OnceLock;
@@ -45,6 +46,7 @@ pub use options::{
 pub use progress::{Progress, Stage};
 pub use render::{Camera, Rendered};
 pub use sogmm_sys as sys;
+pub use surface::{OCCUPANCY_FREE, OCCUPANCY_OCCUPIED, OCCUPANCY_UNKNOWN};
 
 /// "MAJOR.MINOR.PATCH" of the loaded library.
 pub fn version() -> &'static str {

@@ -90,7 +90,7 @@ impl Map {
         })
     }
 
-    fn raw(&self) -> *const sys::sogmm_map {
+    pub(crate) fn raw(&self) -> *const sys::sogmm_map {
         self.ptr.as_ptr()
     }
 

@@ -1,0 +1,106 @@
+// The frame index of occupancy (frame_index.hpp).
+#include "frame_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sogmm::detail {
+
+namespace {
+
+// A frame whose box spans more cells than this is tested for every point
+// (kept in one list), so the grid stays linear in the number of frames.
+constexpr std::int64_t kMaxCellsPerFrame = 64;
+// Cell coordinates are packed in 21 bits each.
+constexpr std::int64_t kCellBias = std::int64_t{1} << 20;
+
+}  // namespace
+
+FrameIndex::FrameIndex(const std::vector<Pose>& poses, const Camera& camera, double depth_min, double depth_max)
+    : camera_(camera), depth_min_(depth_min), depth_max_(depth_max), cell_(depth_max) {
+  std::vector<std::array<double, 6>> boxes;
+  for (const Pose& p : poses) {
+    FrameView v{};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) v.r[3 * i + j] = p[4 * j + i];
+    for (int i = 0; i < 3; ++i) v.t[i] = -(v.r[3 * i] * p[3] + v.r[3 * i + 1] * p[7] + v.r[3 * i + 2] * p[11]);
+    views_.push_back(v);
+    // The frustum's box: the camera centre and the image corners at depth_max.
+    std::array<double, 6> b{p[3], p[7], p[11], p[3], p[7], p[11]};
+    const double us[2] = {-0.5, camera.width - 0.5}, vs[2] = {-0.5, camera.height - 0.5};
+    for (double u : us)
+      for (double w : vs) {
+        const double c[3] = {(u - camera.cx) / camera.fx * depth_max, (w - camera.cy) / camera.fy * depth_max,
+                             depth_max};
+        for (int i = 0; i < 3; ++i) {
+          const double x = p[4 * i] * c[0] + p[4 * i + 1] * c[1] + p[4 * i + 2] * c[2] + p[4 * i + 3];
+          b[i] = std::min(b[i], x);
+          b[3 + i] = std::max(b[3 + i], x);
+        }
+      }
+    boxes.push_back(b);
+  }
+  if (boxes.empty()) return;
+  for (int i = 0; i < 3; ++i) {
+    origin_[i] = boxes[0][i];
+    for (const auto& b : boxes) origin_[i] = std::min(origin_[i], b[i]);
+  }
+  for (std::uint32_t f = 0; f < boxes.size(); ++f) {
+    std::int64_t lo[3], hi[3], cells = 1;
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = cell(boxes[f][i], i);
+      hi[i] = cell(boxes[f][3 + i], i);
+      cells *= hi[i] - lo[i] + 1;
+    }
+    if (cells > kMaxCellsPerFrame || hi[0] >= kCellBias || hi[1] >= kCellBias || hi[2] >= kCellBias) {
+      large_.push_back(f);
+      continue;
+    }
+    for (std::int64_t i = lo[0]; i <= hi[0]; ++i)
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t k = lo[2]; k <= hi[2]; ++k) cells_[key(i, j, k)].push_back(f);
+  }
+  // Every cell also lists the large frames, so a point reads one list.
+  if (!large_.empty())
+    for (auto& [k, list] : cells_) {
+      list.insert(list.end(), large_.begin(), large_.end());
+      std::sort(list.begin(), list.end());
+    }
+}
+
+std::int64_t FrameIndex::cell(double v, int axis) const {
+  const double c = std::floor((v - origin_[axis]) / cell_);
+  return c < 0 ? -1 : static_cast<std::int64_t>(std::min(c, static_cast<double>(kCellBias)));
+}
+
+std::uint64_t FrameIndex::key(std::int64_t i, std::int64_t j, std::int64_t k) {
+  return static_cast<std::uint64_t>(i) << 42 | static_cast<std::uint64_t>(j) << 21 | static_cast<std::uint64_t>(k);
+}
+
+const std::vector<std::uint32_t>* FrameIndex::candidates(const double x[3]) const {
+  std::int64_t c[3];
+  for (int i = 0; i < 3; ++i) {
+    c[i] = cell(x[i], i);
+    if (c[i] < 0 || c[i] >= kCellBias) return large_.empty() ? nullptr : &large_;
+  }
+  const auto it = cells_.find(key(c[0], c[1], c[2]));
+  if (it != cells_.end()) return &it->second;
+  return large_.empty() ? nullptr : &large_;
+}
+
+Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
+  const FrameView& v = views_[f];
+  double p[3];
+  for (int i = 0; i < 3; ++i) p[i] = v.r[3 * i] * x[0] + v.r[3 * i + 1] * x[1] + v.r[3 * i + 2] * x[2] + v.t[i];
+  Projection out;
+  if (!(p[2] > depth_min_ && p[2] <= depth_max_)) return out;
+  const double u = std::floor(camera_.fx * p[0] / p[2] + camera_.cx + 0.5);
+  const double w = std::floor(camera_.fy * p[1] / p[2] + camera_.cy + 0.5);
+  if (u < 0 || w < 0 || u >= camera_.width || w >= camera_.height) return out;
+  out.pixel = static_cast<int>(w) * camera_.width + static_cast<int>(u);
+  out.depth = p[2];
+  out.ray = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / p[2];
+  return out;
+}
+
+}  // namespace sogmm::detail

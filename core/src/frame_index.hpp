@@ -1,0 +1,54 @@
+// Which of a map's frames may see a point (private; occupancy.cpp): the
+// frames' view frusta, and a uniform grid over their world boxes so that a
+// point tests only the frames whose box holds it, not every frame.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "sogmm/camera.hpp"
+#include "sogmm/map.hpp"
+
+namespace sogmm::detail {
+
+/// One frame's view: world-to-camera rotation and translation.
+struct FrameView {
+  std::array<double, 9> r;  ///< R^T of the pose, row-major
+  std::array<double, 3> t;  ///< -R^T t
+};
+
+/// Where a world point falls in a frame's image.
+struct Projection {
+  int pixel = -1;     ///< row-major pixel index; -1: the frame does not see the point
+  double ray = 0.0;   ///< |p| / p_z: distance along the ray per unit of depth
+  double depth = 0.0; ///< p_z, metres
+};
+
+class FrameIndex {
+ public:
+  /// The views of `poses` through `camera` (already decimated) for depths in
+  /// (depth_min, depth_max].
+  FrameIndex(const std::vector<Pose>& poses, const Camera& camera, double depth_min, double depth_max);
+
+  std::size_t size() const { return views_.size(); }
+  /// The frames whose frustum box holds `x` (a superset of those that see it).
+  const std::vector<std::uint32_t>* candidates(const double x[3]) const;
+  /// The projection of world point `x` into frame f.
+  Projection project(std::uint32_t f, const double x[3]) const;
+
+ private:
+  std::int64_t cell(double v, int axis) const;
+  static std::uint64_t key(std::int64_t i, std::int64_t j, std::int64_t k);
+
+  Camera camera_;
+  double depth_min_, depth_max_;
+  double cell_ = 1.0;
+  std::array<double, 3> origin_{};
+  std::vector<FrameView> views_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+  std::vector<std::uint32_t> large_;  ///< frames whose box spans too many cells
+};
+
+}  // namespace sogmm::detail
