@@ -111,7 +111,7 @@ static void test_frames(void) {
   char dpath[600], gpath[600], spath[600];
   sogmm_frame *f = NULL, *g = NULL, *bad = (sogmm_frame*)1;
   sogmm_options* o = NULL;
-  sogmm_model *m1 = NULL, *m2 = NULL;
+  sogmm_model *m1 = NULL, *m2 = NULL, *bad_model = NULL;
   sogmm_map *map1 = NULL, *map2 = NULL;
   float *p1, *p2;
 
@@ -181,7 +181,8 @@ static void test_frames(void) {
   EXPECT_STATUS(sogmm_frame_decode(&bad, dpng, dn / 2, NULL, 0), SOGMM_E_FORMAT);
   EXPECT_STATUS(sogmm_frame_decode(&bad, "not an image", 12, NULL, 0), SOGMM_E_FORMAT);
   EXPECT_STATUS(sogmm_frame_decode(&bad, dpng, dn, gpng, gn - 20), SOGMM_E_FORMAT);
-  EXPECT_STATUS(sogmm_fit_frame(&m2, NULL, o), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_fit_frame(&bad_model, NULL, o), SOGMM_E_NULL_ARG);
+  EXPECT_TRUE(bad_model == NULL); /* a refused call resets the out-pointer (m2 still holds a model) */
   EXPECT_STATUS(sogmm_frame_set_intrinsics(NULL, 1, 1, 0, 0), SOGMM_E_NULL_ARG);
   EXPECT_TRUE(sogmm_frame_width(NULL) == 0 && sogmm_frame_height(NULL) == 0 && sogmm_frame_depth(NULL) == NULL &&
               sogmm_frame_color(NULL) == NULL && sogmm_frame_color_format(NULL) == 0);
