@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
 #include "parallel.hpp"
 #include "progress.hpp"
+#include "render_tiles.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
@@ -72,15 +74,21 @@ struct RayTerm {
   double t, a, log_c;
 };
 
+// Components within this squared Mahalanobis distance of a ray shape its 1-D
+// mixture: those within max_mahalanobis, and at least those within 8 sigma.
+double shaping_radius2(const RenderOptions& o) { return std::max(o.max_mahalanobis * o.max_mahalanobis, 64.0); }
+
 // The depth of the first surface along the ray t d (see render_expected_surface),
-// or NaN. `terms` and `starts` are scratch.
-float first_surface(const std::vector<RayComponent>& comps, const double d[3], const RenderOptions& o,
-                    std::vector<RayTerm>& terms, std::vector<double>& starts) {
+// or NaN, from the components `ids` (ascending; a superset of those within
+// shaping_radius2 of the ray). `terms` and `starts` are scratch.
+float first_surface(const std::vector<RayComponent>& comps, const std::vector<std::uint32_t>& ids, const double d[3],
+                    const RenderOptions& o, std::vector<RayTerm>& terms, std::vector<double>& starts) {
   const double r_show = o.max_mahalanobis * o.max_mahalanobis;
-  const double r_use = std::max(r_show, 64.0);  // components within 8 sigma shape the 1-D mixture
+  const double r_use = shaping_radius2(o);
   terms.clear();
   starts.clear();
-  for (const RayComponent& c : comps) {
+  for (std::uint32_t id : ids) {
+    const RayComponent& c = comps[id];
     const double a = c.p[0] * d[0] * d[0] + c.p[3] * d[1] * d[1] + c.p[5] * d[2] * d[2] +
                      2 * (c.p[1] * d[0] * d[1] + c.p[2] * d[0] * d[2] + c.p[4] * d[1] * d[2]);
     const double b = c.pm[0] * d[0] + c.pm[1] * d[1] + c.pm[2] * d[2];
@@ -163,6 +171,8 @@ RenderedImages render_expected_surface(const Gmm& gmm, const Camera& camera, con
   validate(options);
   const std::vector<RayComponent> comps = ray_components(gmm);
   RenderedImages r = empty_images(camera);
+  // Each pixel tests only the components its tile's rays may meet (exact: render_tiles.hpp).
+  const detail::RayTiles tiles = detail::ray_tiles(gmm, camera, shaping_radius2(options));
   const int threads = detail::team_size(options.threads);
   struct Scratch {
     std::vector<RayTerm> terms;
@@ -181,7 +191,7 @@ RenderedImages render_expected_surface(const Gmm& gmm, const Camera& camera, con
       for (int u = 0; u < camera.width; ++u) {
         const double d[3] = {(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0};
         r.depth[static_cast<std::size_t>(v) * static_cast<std::size_t>(camera.width) + static_cast<std::size_t>(u)] =
-            first_surface(comps, d, options, s.terms, s.starts);
+            first_surface(comps, tiles.at(u, v), d, options, s.terms, s.starts);
       }
     });
     detail::progress_at(static_cast<std::uint64_t>(first + rows));
