@@ -230,6 +230,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       s.marginals = std::move(next.marginals);
       ++s.n_flushes;
       ++s.n_refits;
+      ++s.revision;
       f.n_replaced = plan->replaced.size();
       f.flushed = true;  // ran a fit
       f.ms_merge += ms_since(t2);
@@ -243,6 +244,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     s.marginals = std::move(before_refit->marginals);
     --s.n_flushes;
     --s.n_refits;
+    ++s.revision;  // the components changed back: never reuse what the refit's were
   };
   // From here on any failure (a failed or cancelled flush, which itself
   // commits nothing; an allocation) undoes the whole insert.
@@ -386,6 +388,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
     s.previous_pose = last;
   }
   ++s.n_flushes;
+  ++s.revision;
   s.n_fused += fused;
   if (!s.frames.empty()) {
     FrameStats& f = s.frames.back();

@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "map_renders.hpp"
 #include "sogmm/map.hpp"
 
 namespace sogmm::detail {
@@ -136,6 +137,10 @@ struct Map::State {
   /// camera's pose (empty before the first flush).
   Gmm previous_fit;
   Pose previous_pose{};
+  /// Bumped whenever the components change (a flush, a revisit refit or its
+  /// undo): what is kept about them (renders) is valid for one revision.
+  std::uint64_t revision = 0;
+  mutable detail::FrameRenders renders;  // filled by const queries (Map::frame_depth)
   explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {}
 };
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,7 +14,6 @@
 #include "progress.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/options.hpp"
-#include "sogmm/render.hpp"
 
 namespace sogmm {
 
@@ -28,6 +28,16 @@ struct Evidence {
   double free = 0.0;      // sum_f e_f
 
   void add(double r, double surface, const OccupancyOptions& o) {
+    // Far from the surface the terms are exactly 0 or 1 in double (Phi
+    // underflows below -38.5 sigma), so they are taken without erfc: the
+    // same bits, and most query points are far in front of a surface.
+    constexpr double kExact = 40.0;
+    if ((r - surface + o.thickness) / o.surface_sigma < -kExact) {  // e = 1, b = 0, o = 0
+      unknown = 0.0;
+      free += 1.0;
+      return;
+    }
+    if ((r - surface - o.thickness) / o.surface_sigma > kExact) return;  // e = 0, b = 1, o = 0
     const double e = 1.0 - normal_cdf((r - surface + o.thickness) / o.surface_sigma);
     const double b = normal_cdf((r - surface - o.thickness) / o.surface_sigma);
     unknown *= b;
@@ -89,13 +99,9 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       if (!seen[f].load(std::memory_order_relaxed) && index.project(f, x).pixel >= 0)
         seen[f].store(true, std::memory_order_relaxed);
   });
-  RenderOptions ro;
-  ro.depth_min = info.depth_min;
-  ro.depth_max = info.depth_max;
-  ro.threads = threads;
-  std::vector<std::vector<float>> depth(poses.size());
+  std::vector<std::shared_ptr<const std::vector<float>>> depth(poses.size());
   for (std::size_t f = 0; f < poses.size(); ++f)
-    if (seen[f]) depth[f] = render(map.model().gmm, camera, poses[f], ro).depth;
+    if (seen[f]) depth[f] = map.frame_depth(f, threads);
 
   detail::progress_begin(Stage::Scoring, n);
   detail::parallel_for(n, team, 1024, [&](std::size_t i, int) {
@@ -106,7 +112,7 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       for (std::uint32_t f : *frames) {
         const detail::Projection p = index.project(f, x);
         if (p.pixel < 0) continue;
-        const float d = depth[f][static_cast<std::size_t>(p.pixel)];
+        const float d = (*depth[f])[static_cast<std::size_t>(p.pixel)];
         if (std::isnan(d)) continue;  // no surface rendered: no evidence
         ev.add(p.depth * p.ray, d * p.ray, options);
       }

@@ -113,6 +113,44 @@ TEST(Occupancy, SameAnswerForAnyThreadCount) {
   EXPECT_EQ(one.s, two.s);
 }
 
+// The renders a map keeps between calls (Map::frame_depth) are the renders
+// of its current components: the same image as render() itself, and a second
+// frame that adds components changes the answer exactly as a map loaded
+// afresh (which keeps nothing) gives it.
+TEST(Occupancy, KeptRendersFollowTheComponents) {
+  sogmm::Map map = plane_map(identity());
+  const sogmm::CameraInfo& info = map.model().camera;
+  sogmm::RenderOptions ro;
+  ro.depth_min = info.depth_min;
+  ro.depth_max = info.depth_max;
+  const std::vector<float> direct =
+      sogmm::render(map.model().gmm, sogmm::decimated(info.camera, info.decimation), identity(), ro).depth;
+  const auto kept = map.frame_depth(0);
+  ASSERT_EQ(kept->size(), direct.size());
+  for (std::size_t i = 0; i < direct.size(); ++i)
+    ASSERT_TRUE((std::isnan(direct[i]) && std::isnan((*kept)[i])) || direct[i] == (*kept)[i]) << i;
+  EXPECT_EQ(map.frame_depth(0).get(), kept.get());  // kept, not rendered again
+
+  // A box in front of the plane, seen by a second frame: the point at
+  // z = 1.5 m was free and becomes occupied.
+  const std::vector<float> xyz = {0, 0, 1.5f, 0, 0, 1.0f, 0.3f, 0.2f, 1.5f};
+  const Answer before = ask(map, xyz);
+  EXPECT_EQ(before.s[0], static_cast<int>(OccupancyState::Free));
+  const sogmm::Camera& cam = kCam;
+  std::vector<std::uint16_t> depth(static_cast<std::size_t>(cam.width * cam.height), 2000);
+  for (int v = 18; v < 30; ++v)
+    for (int u = 26; u < 38; ++u) depth[static_cast<std::size_t>(v * cam.width + u)] = 1500;
+  std::vector<float> gray(depth.size(), 0.5f);
+  map.insert_rgbd({depth.data(), gray.data(), cam}, identity());
+  map.flush();
+  EXPECT_NE(map.frame_depth(0).get(), kept.get());
+  const Answer after = ask(map, xyz);
+  EXPECT_EQ(after.s[0], static_cast<int>(OccupancyState::Occupied));
+  const Answer fresh = ask(sogmm::Map::from_model(map.to_model(), map.options()), xyz);
+  EXPECT_EQ(after.p, fresh.p);
+  EXPECT_EQ(after.s, fresh.s);
+}
+
 TEST(Occupancy, MapsThatObservedNothingAnswerUnknown) {
   const std::vector<float> xyz = {0, 0, 1, 0, 0, 2};
   const sogmm::Map empty;

@@ -266,6 +266,17 @@ class Map {
   /// the point. Uses fit.em.threads threads.
   void local_log_likelihood(const double* xyz, std::size_t n, double* out) const;
 
+  /// The depth image (row-major, z in metres, NaN where nothing shows) of
+  /// the map rendered from frame `frame`'s pose with the map's decimated
+  /// camera and its depth range (render() of sogmm/render.hpp), as
+  /// occupancy() reads it. Kept until the components change, so that
+  /// repeated queries between two inserts render each frame once; the image
+  /// is the same whether kept or not, for any `threads`
+  /// (RenderOptions::threads). Errors: no camera record (points-only
+  /// inserts) -> Error(InvalidData); frame >= frames().size() ->
+  /// Error(InvalidArgument); as model() and render().
+  std::shared_ptr<const std::vector<float>> frame_depth(std::size_t frame, int threads = 0) const;
+
   /// model() with the provenance keys kMapFramesKey and kMapOptionsKey added
   /// (what a map file stores). Throws Error(InvalidArgument) when points are
   /// pending (flush first: a file holds components only) and as model().

@@ -25,9 +25,11 @@
 //
 // Cost: a frame index (a uniform grid over the frames' frustum boxes) gives
 // each point the frames whose frustum box holds it, and only frames that see
-// at least one query point are rendered, once per call. So a call costs
-// O(frames seen x pixels x components near a ray) for the renders plus
-// O(n x frames whose box holds a point) for the lookups.
+// at least one query point are rendered, once until the components change
+// (Map::frame_depth keeps the renders between calls). So the first call
+// after an insert costs O(frames seen x pixels x components near a ray) for
+// the renders, and every call O(n x frames whose box holds a point) for the
+// lookups.
 #pragma once
 
 #include <cstddef>
