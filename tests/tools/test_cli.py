@@ -454,6 +454,7 @@ def mode_map(tmp):
         check(r["psnr"] > a["psnr"] - 2.0 and r["fscore"] > 0.6 * a["fscore"],
               "eval --sequence frame %d: map PSNR %.2f F %.3f, append-everything PSNR %.2f F %.3f" %
               (r["frame"], r["psnr"], r["fscore"], a["psnr"], a["fscore"]))
+    query_map(tmp, d, out, lines)
     no_temp_files(tmp)
 
     def err(args, code, names):
@@ -489,6 +490,63 @@ def mode_map(tmp):
     err(["map", bad, "--trajectory", traj] + badargs, 3, "color")  # 3 depth images, 2 color
     check(not os.path.exists(m), "a failed map run wrote %s" % m)
     no_temp_files(tmp)
+
+
+def query_map(tmp, d, map_path, traj_lines):
+    """sogmm query on the loop map against what the frames show: frame 0's
+    observed surface (back-projected with its pose) is occupied and within
+    2 cm of the surface, points halfway along the same rays are free and
+    farther, points 1 km away are unknown (exactly 0.5), 1 km from the
+    surface and collision-free; CSV and .npy give the same numbers; bad
+    input gets one line and the documented exit code."""
+    depth = read_png(os.path.join(d, "depth", "00000.png")).astype(float) / 1000.0
+    intr = json.load(open(os.path.join(d, "intrinsics.json")))
+    k = intr["intrinsic_matrix"]
+    fx, fy, cx, cy = k[0], k[4], k[6], k[7]
+    pose = np.array(" ".join(traj_lines[1:5]).split(), dtype=float).reshape(4, 4)
+    v, u = np.mgrid[40:440:40, 40:600:40]
+    z = depth[v, u]
+    ok = (z > 0.2) & (z < 2.9)
+    u, v, z = u[ok], v[ok], z[ok]
+    cam = np.stack([(u - cx) / fx * z, (v - cy) / fy * z, z, np.ones_like(z)])
+    surface = (pose @ cam)[:3].T
+    half = (pose @ np.vstack([cam[:3] * 0.5, np.ones_like(z)]))[:3].T
+    far = surface + np.array([1000.0, 0, 0])
+    pts = np.vstack([surface, half, far]).astype(np.float32)  # what the tool reads, from both files
+    n = len(surface)
+    check(n > 50, "query: only %d valid pixels on the sampling grid" % n)
+    csv_in = os.path.join(tmp, "probes.csv")
+    with open(csv_in, "w") as f:
+        f.write("x,y,z\n# frame 0: surface, halfway, 1 km away\n")
+        for x in pts:
+            f.write("%.9g, %.9g\t%.9g\n" % tuple(x))
+    npy_in = os.path.join(tmp, "probes.npy")
+    np.save(npy_in, np.asfortranarray(pts))  # column-major, as NumPy often writes
+    args = ["--occupancy", "--gradient", "--robot-radius", 0.05]
+    p = run(["query", map_path, "--points", csv_in, "-o", os.path.join(tmp, "answers.csv")] + args)
+    check("Wrote" in p.stdout and "%d points" % len(pts) in p.stdout, "query: %r" % p.stdout)
+    rows = open(os.path.join(tmp, "answers.csv")).read().strip().split("\n")
+    check(rows[0] == "x,y,z,p_occupied,state,distance,gx,gy,gz,p_collision", "query CSV header: %r" % rows[0])
+    a = np.array([r.split(",") for r in rows[1:]], dtype=float)
+    run(["query", map_path, "--points", npy_in, "-o", os.path.join(tmp, "answers.npy")] + args)
+    b = np.load(os.path.join(tmp, "answers.npy"))
+    check(a.shape == b.shape == (len(pts), 10) and np.array_equal(a, b), "query: CSV and .npy answers differ")
+    s, h, f = a[:n], a[n:2 * n], a[2 * n:]
+    check(np.mean(s[:, 4] == 1) > 0.9, "query: %.2f of frame 0's surface points occupied" % np.mean(s[:, 4] == 1))
+    check(np.median(s[:, 5]) < 0.02, "query: surface points %.4f m from the surface" % np.median(s[:, 5]))
+    check(np.mean(h[:, 4] == 0) > 0.95 and np.all(h[:, 3] < 0.5), "query: halfway points not free")
+    check(np.all(h[:, 5] > s[:, 5]), "query: a halfway point is nearer the surface than its surface point")
+    check(np.all(f[:, 3] == 0.5) and np.all(f[:, 4] == 2), "query: points 1 km away not unknown")
+    check(np.all(f[:, 5] > 990) and np.allclose(np.linalg.norm(f[:, 6:9], axis=1), 1), "query: far distance/gradient")
+    check(np.all(f[:, 9] == 0) and np.mean(s[:, 9] > 0.99) > 0.9, "query: collision at far / surface points")
+    bad = os.path.join(tmp, "bad_points.csv")
+    with open(bad, "w") as f2:
+        f2.write("0 0 1\n0 nope 1\n")
+    for q_args, code, name in ((["--points", bad, "--distance"], 3, "bad_points.csv:2"),
+                               (["--points", csv_in], 2, "--occupancy"),
+                               (["--points", os.path.join(tmp, "absent.csv"), "--distance"], 4, "absent.csv")):
+        p = run(["query", map_path, "-o", os.path.join(tmp, "q.csv")] + q_args, expect=code)
+        check(len(p.stderr.strip().splitlines()) == 1 and name in p.stderr, "query %s: %r" % (q_args, p.stderr))
 
 
 def mode_errors(tmp):

@@ -95,6 +95,7 @@ Command add_fit_command(CLI::App& root);
 Command add_map_command(CLI::App& root);
 Command add_render_command(CLI::App& root);
 Command add_sample_command(CLI::App& root);
+Command add_query_command(CLI::App& root);
 Command add_view_command(CLI::App& root);
 
 /// True when any of the named options was given on the command line.

@@ -20,10 +20,11 @@ int main(int argc, char** argv) {
       "    --decimate 5 --bandwidth 0.02 -o frame0.sogmm\n"
       "  sogmm eval frame0.sogmm --depth $D/depth/00000.png --color $D/color/00000.jpg\n"
       "  sogmm render frame0.sogmm --compare --depth $D/depth/00000.png --color $D/color/00000.jpg -o cmp.png\n"
-      "  sogmm sample frame0.sogmm -n 100000 -o samples.ply --ellipsoids ellipsoids.ply");
-  std::vector<Command> commands = {add_demo_command(app),   add_eval_command(app),   add_fit_command(app),
+      "  sogmm sample frame0.sogmm -n 100000 -o samples.ply --ellipsoids ellipsoids.ply\n"
+      "  sogmm query room.sogmm --points probes.csv --occupancy --distance -o answers.csv");
+  std::vector<Command> commands = {add_demo_command(app),   add_eval_command(app),  add_fit_command(app),
                                    add_map_command(app),    add_render_command(app), add_sample_command(app),
-                                   add_view_command(app),   add_bench_command(app)};
+                                   add_query_command(app),  add_view_command(app),  add_bench_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
