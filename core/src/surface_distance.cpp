@@ -72,6 +72,7 @@ void surface_distance(const Gmm& gmm, const float* xyz, std::size_t n, double* d
 
   detail::progress_begin(Stage::Scoring, n);
   std::vector<std::vector<std::pair<double, std::uint32_t>>> scratch(static_cast<std::size_t>(team));
+  std::vector<std::vector<double>> bounds(static_cast<std::size_t>(team));
   detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
     const std::size_t first = blk * kBlock, last = std::min(n, first + kBlock);
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -101,15 +102,37 @@ void surface_distance(const Gmm& gmm, const float* xyz, std::size_t n, double* d
     for (std::size_t j = first; j < last; ++j) {
       const std::size_t i = order[j];
       const Eigen::Vector3d x(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-      double best = std::numeric_limits<double>::infinity();
-      Eigen::Vector3d best_from = Eigen::Vector3d::Zero(), from;
-      std::uint32_t best_m = 0;
+      // A lower bound per candidate: the disc lies in its plane within
+      // `radius` of mu, so with c the offset along the normal and rho the
+      // in-plane distance from mu, distance >= sqrt(c^2 + max(0, rho -
+      // radius)^2). The candidate with the smallest bound is usually the
+      // nearest disc: measured first, its distance bounds the rest, and a
+      // candidate whose bound is not below it is skipped (it cannot be
+      // strictly nearer), so only a few rim solves run per point. The
+      // block's candidates are sorted by their block-wide bound, which ends
+      // the scan once no later one can be nearer.
+      auto& lb = bounds[static_cast<std::size_t>(thread)];
+      lb.clear();
+      std::size_t first_pick = 0;
       for (const auto& [near, m] : cand) {
-        if (near > best) break;  // sorted: no later candidate can be nearer
         const Disc& d = discs[m];
-        if ((x - d.mu).norm() - d.radius > best) continue;
-        const double dist = disc_distance(d, x, from);
-        if (dist < best) {
+        const Eigen::Vector3d r = x - d.mu;
+        const double c = r.dot(d.normal);
+        const double rim = std::max(0.0, std::sqrt(std::max(0.0, r.squaredNorm() - c * c)) - d.radius);
+        const double b = std::sqrt(c * c + rim * rim);
+        if (!lb.empty() && b < lb[first_pick]) first_pick = lb.size();
+        lb.push_back(b);
+      }
+      Eigen::Vector3d from;
+      std::uint32_t best_m = cand[first_pick].second;
+      Eigen::Vector3d best_from;
+      double best = disc_distance(discs[best_m], x, best_from);
+      for (std::size_t c = 0; c < cand.size(); ++c) {
+        if (cand[c].first > best) break;  // sorted: no later candidate can be nearer
+        if (lb[c] > best || c == first_pick) continue;
+        const std::uint32_t m = cand[c].second;
+        const double dist = disc_distance(discs[m], x, from);
+        if (dist < best || (dist == best && m < best_m)) {  // ties: the lowest id, whatever the order
           best = dist;
           best_from = from;
           best_m = m;
