@@ -539,6 +539,15 @@ def query_map(tmp, d, map_path, traj_lines):
     check(np.all(f[:, 3] == 0.5) and np.all(f[:, 4] == 2), "query: points 1 km away not unknown")
     check(np.all(f[:, 5] > 990) and np.allclose(np.linalg.norm(f[:, 6:9], axis=1), 1), "query: far distance/gradient")
     check(np.all(f[:, 9] == 0) and np.mean(s[:, 9] > 0.99) > 0.9, "query: collision at far / surface points")
+    # The picture: a slice with free, occupied and unknown cells beside the view.
+    png = os.path.join(tmp, "occupancy.png")
+    p = run(["render", map_path, "--occupancy", "-o", png])
+    img = read_png(png)
+    r, g, b = [img[..., k].astype(int) for k in range(3)]
+    for name, cells in (("free", (g > r + 40) & (g > b + 40)), ("occupied", (r > 150) & (g < 120)),
+                        ("unknown", (r == 128) & (g == 128) & (b == 128))):
+        check(cells.sum() > 20, "render --occupancy: %d %s pixels" % (cells.sum(), name))
+    check("% free" in p.stdout and "unknown" in p.stdout, "render --occupancy: %r" % p.stdout)
     bad = os.path.join(tmp, "bad_points.csv")
     with open(bad, "w") as f2:
         f2.write("0 0 1\n0 nope 1\n")

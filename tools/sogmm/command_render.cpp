@@ -12,6 +12,7 @@
 #include "cli_common.hpp"
 #include "file_util.hpp"
 #include "model_io.hpp"
+#include "occupancy_slice.hpp"
 #include "render.hpp"
 #include "sequence.hpp"
 #include "sogmm/error.hpp"
@@ -26,7 +27,8 @@ struct RenderState {
   int frame = -1;
   CameraFlags camera;
   DepthOptions depth_options;
-  bool compare = false, uncertainty = false;
+  bool compare = false, uncertainty = false, occupancy = false;
+  SliceFlags slice;
   int scale = 0;
   double error_max = 0.25, std_max = 0.0, max_mahalanobis = 3.0;
   double data_range = 1.0;  // honest PSNR's peak (--data-range, with --compare)
@@ -56,6 +58,12 @@ int run_render(const RenderState& s, const CLI::App& app) {
                  {"--intrinsics", s.camera.intrinsics}},
                 {{"-o", s.output}});
   const Model model = load_model(s.model);
+  if (s.occupancy) {
+    SliceFlags slice = s.slice;
+    slice.frame = std::max(s.frame, 0);
+    write_occupancy_picture(Map::from_model(model), slice, s.output, s.model);
+    return 0;
+  }
   Gmm gmm = model.gmm;
   std::string view_note;
   if (!s.trajectory.empty()) {
@@ -162,7 +170,8 @@ Command add_render_command(CLI::App& root) {
       "  sogmm render frame0.sogmm -o expected.png --scale 4\n"
       "  sogmm render frame0.sogmm --compare --depth ../shared/data/rgbd/livingroom/depth/00000.png \\\n"
       "    --color ../shared/data/rgbd/livingroom/color/00000.jpg -o compare.png\n"
-      "  sogmm render room.sogmm --trajectory ../shared/data/rgbd/livingroom/trajectory.log --frame 2 -o view2.png");
+      "  sogmm render room.sogmm --trajectory ../shared/data/rgbd/livingroom/trajectory.log --frame 2 -o view2.png\n"
+      "  sogmm render room-map.sogmm --occupancy -o occupancy.png");
   app->add_option("model", s->model, "saved model (.sogmm)")->required();
   app->add_option("-o,--output", s->output, "output PNG")->required();
   app->add_option("--depth", s->depth, "16-bit depth PNG: regress at its points (needed by --compare)");
@@ -171,7 +180,13 @@ Command add_render_command(CLI::App& root) {
   add_data_range_flag(*app, s->data_range);
   app->add_flag("--uncertainty", s->uncertainty, "write the conditional standard deviation of gray instead");
   app->add_option("--trajectory", s->trajectory, "Redwood .log poses: render a world-frame model from --frame");
-  app->add_option("--frame", s->frame, "pose index in --trajectory");
+  app->add_option("--frame", s->frame, "pose index in --trajectory (--occupancy: frame of the map, default 0)");
+  app->add_flag("--occupancy", s->occupancy,
+                "a map: free/occupied/unknown on a horizontal slice beside the expected surface from --frame");
+  app->add_option("--slice-axis", s->slice.axis, "--occupancy: the slice's normal, x|y|z (default: the cameras' up)");
+  app->add_option("--slice-at", s->slice.height,
+                  "--occupancy: the slice's position along --slice-axis, m (default: the cameras' mean height)");
+  app->add_option("--cell", s->slice.cell, "--occupancy: slice pixel size, m")->capture_default_str();
   add_camera_flags(*app, s->camera, s->depth_options);
   app->add_option("--scale", s->scale, "integer upscaling of the picture (default 1; --compare: panels >= 320 px)");
   app->add_option("--error-max", s->error_max, "|error| at the top of the colour bar (--compare)")->capture_default_str();
@@ -187,8 +202,12 @@ Command add_render_command(CLI::App& root) {
             if (s->compare)
               require(!s->depth.empty() && !s->color.empty(), ErrorCode::InvalidArgument,
                       "render: --compare needs --depth D and --color C");
-            require(s->trajectory.empty() == (s->frame < 0), ErrorCode::InvalidArgument,
+            require(s->occupancy || s->trajectory.empty() == (s->frame < 0), ErrorCode::InvalidArgument,
                     "render: --trajectory and --frame go together");
+            require(!s->occupancy || (!s->compare && !s->uncertainty && s->trajectory.empty() && s->depth.empty()),
+                    ErrorCode::InvalidArgument,
+                    "render: --occupancy draws a map from its own frames; it takes none of --compare, --uncertainty, "
+                    "--trajectory, --depth");
             require(s->scale >= 0 && s->scale <= 16, ErrorCode::InvalidArgument, "render: --scale must be in 1..16");
             require(s->error_max > 0 && s->std_max >= 0 && s->max_mahalanobis > 0, ErrorCode::InvalidArgument,
                     "render: --error-max and --max-mahalanobis must be > 0, --std-max >= 0");
