@@ -120,9 +120,9 @@ static int read_model(const char* model_path, const char* query_path, const char
   fwrite(buf, sizeof(float), 16 * k, out);
   if ((st = sogmm_model_sample_f32(m, N_SAMPLES, SAMPLE_SEED, 4, NULL, buf)) != SOGMM_OK) { rc = fail("sample", st); goto done; }
   fwrite(buf, sizeof(float), 4 * N_SAMPLES, out);
-  if ((st = sogmm_model_regress_gray_f32(m, q, nq, buf, buf + nq)) != SOGMM_OK) { rc = fail("regress", st); goto done; }
+  if ((st = sogmm_model_regress_gray_f32(m, q, nq, NULL, buf, buf + nq)) != SOGMM_OK) { rc = fail("regress", st); goto done; }
   fwrite(buf, sizeof(float), 2 * nq, out);
-  if ((st = sogmm_model_score_samples_f32(m, q, nq, 3, score)) != SOGMM_OK) { rc = fail("score", st); goto done; }
+  if ((st = sogmm_model_score_samples_f32(m, q, nq, 3, NULL, score)) != SOGMM_OK) { rc = fail("score", st); goto done; }
   fwrite(score, sizeof(double), nq, out);
   rc = ferror(out) ? 1 : 0;
 done:

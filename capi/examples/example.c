@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   printf("first sample: (%.3f, %.3f, %.3f, gray %.3f)\n", samples[0], samples[1], samples[2], samples[3]);
 
   /* Expected gray and its variance at two 3-D points. */
-  TRY(sogmm_model_regress_gray_f32(model, xyz, 2, g, var));
+  TRY(sogmm_model_regress_gray_f32(model, xyz, 2, NULL, g, var));
   for (i = 0; i < 2; ++i)
     printf("gray at (%.2f, %.2f, %.2f): %.3f (variance %.5f)\n", xyz[3 * i], xyz[3 * i + 1],
            xyz[3 * i + 2], g[i], var[i]);

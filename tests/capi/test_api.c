@@ -531,26 +531,26 @@ static void test_inference(void) {
   {
     float xyz[9] = {0, 0, 1, 0.5f, 0, 1, 0.05f, 0, 1};
     float g[3], var[3];
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, g, var));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, NULL, g, var));
     EXPECT_NEAR(g[0], 0.2, 0.02);
     EXPECT_NEAR(g[1], 0.8, 0.02);
     EXPECT_TRUE(g[2] > g[0]); /* gray grows with x in component 0 */
     for (i = 0; i < 3; ++i) EXPECT_TRUE(var[i] >= 0 && var[i] < 0.02);
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, g, NULL));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, NULL, g, NULL));
     EXPECT_NEAR(g[1], 0.8, 0.02);
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL, NULL));
   }
   /* score: 4-D and 3-D marginal, near > far */
   {
     float p4[8] = {0, 0, 1, 0.2f, 3, 3, 3, 0.2f};
     float p3[6] = {0, 0, 1, 3, 3, 3};
     double l4[2], l3[2];
-    EXPECT_OK(sogmm_model_score_samples_f32(m, p4, 2, 4, l4));
-    EXPECT_OK(sogmm_model_score_samples_f32(m, p3, 2, 3, l3));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, p4, 2, 4, NULL, l4));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, p3, 2, 3, NULL, l3));
     EXPECT_TRUE(isfinite(l4[0]) && isfinite(l3[0]) && l4[0] > l4[1] && l3[0] > l3[1]);
     /* marginal of the N(0, 0.01 I) x-y-z part with weight 0.25 (component 1 is 0.5 away) */
     EXPECT_NEAR(l3[0], log(0.25) - 1.5 * log(2 * 3.141592653589793 * 0.01), 0.05);
-    EXPECT_OK(sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL, NULL));
   }
   /* PSNR: honest figure at the given data range, paper figure always range 2 over all pixels */
   {

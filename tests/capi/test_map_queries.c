@@ -1,6 +1,6 @@
 /* Map queries (sogmm_map_score_samples_f32, _regress_gray_f32, _sample_f32):
  * bitwise equal to the same query on the exported map, with and without a
- * progress callback (and the model's _v2 queries, which take one); a cancel writes nothing; a status and message for every
+ * progress callback (and the model queries, which take one too); a cancel writes nothing; a status and message for every
  * bad input. Progress and cancel of inserts and flushes
  * (sogmm_map_set_progress): a cancelled insert or flush leaves the map as it
  * was. */
@@ -83,7 +83,7 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
 
   for (dims = 3; dims <= 4; ++dims) {
     const float* q = dims == 3 ? q3 : q4;
-    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, want));
+    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, NULL, want));
     REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, NULL, got));
     EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
     /* With a callback: in chunks, the same bits; reports of SCORING up to n. */
@@ -97,7 +97,7 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
   /* A far point really is far: the test covers both regimes. */
   EXPECT_TRUE(want[0] < want[1] - 50.0);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, mean_w, var_w));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
   REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, NULL, mean_g, var_g));
   EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
   memset(&rec, 0, sizeof rec);
@@ -310,9 +310,9 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   sogmm_options_free(o);
 }
 
-/* The model queries with options (_v2): the same bits as without, reports
+/* The model queries with a progress callback: the same bits as without, reports
  * of SCORING / REGRESSION up to n, a cancel leaves the outputs untouched. */
-static void model_v2(const sogmm_map* map, const float* pts, size_t n) {
+static void model_with_progress(const sogmm_map* map, const float* pts, size_t n) {
   sogmm_model* model = NULL;
   sogmm_options* po = NULL;
   Recorder rec;
@@ -328,34 +328,32 @@ static void model_v2(const sogmm_map* map, const float* pts, size_t n) {
   REQUIRE_OK(sogmm_options_create(&po));
   REQUIRE_OK(sogmm_options_set_progress(po, record, &rec));
 
-  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, want));
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, NULL, want));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got));
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, po, got));
   EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_SCORING && rec.last_step == n && rec.last_total == n);
-  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, NULL, got));
-  EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, mean_w, var_w));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, var_g));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, var_g));
   EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_REGRESSION && rec.last_step == n && !rec.decreasing);
 
   rec.cancel = 1;
   memset(got, 0x7f, n * sizeof(double));
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
   EXPECT_TRUE(((const unsigned char*)got)[8 * n - 1] == 0x7f);
   memset(mean_g, 0x7f, n * sizeof(float));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
   EXPECT_TRUE(((const unsigned char*)mean_g)[0] == 0x7f);
-  /* Bad input as without _v2. */
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
-  EXPECT_OK(sogmm_model_regress_gray_f32_v2(model, NULL, 0, po, NULL, NULL));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
+  /* Bad input, with and without options. */
+  EXPECT_STATUS(sogmm_model_score_samples_f32(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
+  EXPECT_OK(sogmm_model_regress_gray_f32(model, NULL, 0, po, NULL, NULL));
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
   q3[4] = NAN;
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
 
   sogmm_options_free(po);
   sogmm_model_free(model);
@@ -373,7 +371,7 @@ int main(void) {
   float* pts = make_clusters(n, 42);
   sogmm_map* map = make_map(pts, 3000);
   equals_exported_model(map, pts, n);
-  model_v2(map, pts, n);
+  model_with_progress(map, pts, n);
   bad_input(map, pts);
   insert_progress_and_cancel(pts, 3000);
   sogmm_map_free(map);

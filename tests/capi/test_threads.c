@@ -28,9 +28,9 @@ static void* worker(void* p) {
     int64_t support = 0;
     size_t M = 0;
     /* const queries on the shared handle */
-    WCHECK(sogmm_model_score_samples_f32(g_shared, g_points, N_POINTS, 4, score) == SOGMM_OK);
+    WCHECK(sogmm_model_score_samples_f32(g_shared, g_points, N_POINTS, 4, NULL, score) == SOGMM_OK);
     WCHECK(memcmp(score, g_ref_score, sizeof score) == 0);
-    WCHECK(sogmm_model_regress_gray_f32(g_shared, g_xyz, N_POINTS, gray, var) == SOGMM_OK);
+    WCHECK(sogmm_model_regress_gray_f32(g_shared, g_xyz, N_POINTS, NULL, gray, var) == SOGMM_OK);
     WCHECK(memcmp(gray, g_ref_gray, sizeof gray) == 0 && memcmp(var, g_ref_var, sizeof var) == 0);
     WCHECK(sogmm_model_sample_f32(g_shared, N_POINTS, 99, 4, NULL, samples) == SOGMM_OK);
     WCHECK(memcmp(samples, g_ref_samples, sizeof g_ref_samples) == 0);
@@ -78,8 +78,8 @@ int main(void) {
   for (i = 0; i < N_POINTS; ++i) memcpy(g_xyz + 3 * i, g_points + 4 * i, 3 * sizeof(float));
   REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&shared, pts, N_POINTS, 3, NULL));
   REQUIRE_OK(sogmm_model_set_value(shared, "owner", "main"));
-  REQUIRE_OK(sogmm_model_score_samples_f32(shared, g_points, N_POINTS, 4, g_ref_score));
-  REQUIRE_OK(sogmm_model_regress_gray_f32(shared, g_xyz, N_POINTS, g_ref_gray, g_ref_var));
+  REQUIRE_OK(sogmm_model_score_samples_f32(shared, g_points, N_POINTS, 4, NULL, g_ref_score));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(shared, g_xyz, N_POINTS, NULL, g_ref_gray, g_ref_var));
   REQUIRE_OK(sogmm_model_sample_f32(shared, N_POINTS, 99, 4, NULL, g_ref_samples));
   g_shared = shared;
   /* a failure on the main thread: workers must still see their own (empty) message */

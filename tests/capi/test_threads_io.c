@@ -71,8 +71,8 @@ static void work(worker_arg* arg, int record) {
     if (record) memcpy(g_ref_samples[t], samples, sizeof samples);
     else WCHECK(memcmp(samples, g_ref_samples[t], sizeof samples) == 0);
     for (i = 0; i < 64; ++i) memcpy(xyz + 3 * i, samples + 4 * i, 3 * sizeof(float));
-    WCHECK(sogmm_model_regress_gray_f32(from_mem, xyz, 64, gray, var) == SOGMM_OK);
-    WCHECK(sogmm_model_score_samples_f32(from_mem, samples, 64, 4, score) == SOGMM_OK);
+    WCHECK(sogmm_model_regress_gray_f32(from_mem, xyz, 64, NULL, gray, var) == SOGMM_OK);
+    WCHECK(sogmm_model_score_samples_f32(from_mem, samples, 64, 4, NULL, score) == SOGMM_OK);
     /* the shared const model: merge, save (own path), and the shared file: load */
     WCHECK(sogmm_model_merge(&merged, from_mem, g_shared) == SOGMM_OK);
     WCHECK(sogmm_model_save(g_shared, shared_copy, o) == SOGMM_OK);

@@ -337,7 +337,7 @@ void step_inference(State& st, sogmm_fuzz::Reader& in) {
     case 1: {
       const std::vector<float> xyz = take_points(in, n_alloc);  // 4 floats a point: room for 3
       std::vector<float> mean(n_alloc + 1), var(n_alloc + 1);
-      const sogmm_status s = sogmm_model_regress_gray_f32(m, xyz.data(), n, mean.data(), (what & 8) ? nullptr : var.data());
+      const sogmm_status s = sogmm_model_regress_gray_f32(m, xyz.data(), n, nullptr, mean.data(), (what & 8) ? nullptr : var.data());
       check_status(s);
       FUZZ_CHECK(!(huge && s == SOGMM_OK));
       if (s == SOGMM_OK)
@@ -348,7 +348,7 @@ void step_inference(State& st, sogmm_fuzz::Reader& in) {
       const int32_t dims = (what & 8) ? 3 : 4;
       const std::vector<float> pts = take_points(in, n_alloc);
       std::vector<double> out(n_alloc + 1);
-      const sogmm_status s = sogmm_model_score_samples_f32(m, pts.data(), n, dims, out.data());
+      const sogmm_status s = sogmm_model_score_samples_f32(m, pts.data(), n, dims, nullptr, out.data());
       check_status(s);
       FUZZ_CHECK(!(huge && s == SOGMM_OK));
       if (s == SOGMM_OK)

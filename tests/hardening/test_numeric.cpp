@@ -152,7 +152,7 @@ TEST(CapiHostile, FitNeverReturnsNaN) {
       EXPECT_FALSE(std::isnan(ll)) << c.name;
       // Inference on the fitted model at the data itself: no NaN.
       std::vector<double> score(cloud.size() / 4);
-      ASSERT_EQ(sogmm_model_score_samples_f32(m, cloud.data(), score.size(), 4, score.data()), SOGMM_OK);
+      ASSERT_EQ(sogmm_model_score_samples_f32(m, cloud.data(), score.size(), 4, nullptr, score.data()), SOGMM_OK);
       for (double s2 : score) EXPECT_FALSE(std::isnan(s2)) << c.name;
       sogmm_model_free(m);
       sogmm_options_free(o);

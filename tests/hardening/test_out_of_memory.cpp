@@ -201,14 +201,14 @@ TEST_F(OutOfMemory, InferenceReportsNomemForEveryFailedAllocation) {
     sweep("score, dims " + std::to_string(dims), [&] {
       std::fill(scores.begin(), scores.end(), NAN);
       return expect_filled_or_untouched(
-          sogmm_model_score_samples_f32(model_, dims == 4 ? points_.data() : xyz.data(), n, dims, scores.data()),
+          sogmm_model_score_samples_f32(model_, dims == 4 ? points_.data() : xyz.data(), n, dims, nullptr, scores.data()),
           scores);
     });
   }
   sweep("gray regression", [&] {
     std::fill(mean.begin(), mean.end(), NAN);
     std::fill(var.begin(), var.end(), NAN);
-    const sogmm_status s = sogmm_model_regress_gray_f32(model_, xyz.data(), n, mean.data(), var.data());
+    const sogmm_status s = sogmm_model_regress_gray_f32(model_, xyz.data(), n, nullptr, mean.data(), var.data());
     expect_filled_or_untouched(s, var);
     return expect_filled_or_untouched(s, mean);
   });
@@ -368,7 +368,7 @@ std::string address_space_problem(const std::string& dir) {
   std::vector<double> lp(4);
   std::vector<float> g(4), samples(16);
   sogmm_model* small = nullptr;
-  sogmm_model_score_samples_f32(model, points.data(), 4, 4, lp.data());
+  sogmm_model_score_samples_f32(model, points.data(), 4, 4, nullptr, lp.data());
   sogmm_fit_points_fixed_k_f32(&small, points.data(), 1000, 4, nullptr);
   sogmm_model_free(small);
 
@@ -378,8 +378,8 @@ std::string address_space_problem(const std::string& dir) {
   };
   const Case cases[] = {
       {"fit", [&](sogmm_model** out) { return sogmm_fit_points_fixed_k_f32(out, points.data(), m, 4, nullptr); }},
-      {"score", [&](sogmm_model**) { return sogmm_model_score_samples_f32(model, points.data(), 4, 4, lp.data()); }},
-      {"regress", [&](sogmm_model**) { return sogmm_model_regress_gray_f32(model, xyz.data(), 4, g.data(), g.data()); }},
+      {"score", [&](sogmm_model**) { return sogmm_model_score_samples_f32(model, points.data(), 4, 4, nullptr, lp.data()); }},
+      {"regress", [&](sogmm_model**) { return sogmm_model_regress_gray_f32(model, xyz.data(), 4, nullptr, g.data(), g.data()); }},
       {"sample", [&](sogmm_model**) { return sogmm_model_sample_f32(model, 4, 1, 4, nullptr, samples.data()); }},
       {"save", [&](sogmm_model**) { return sogmm_model_save(model, path.c_str(), nullptr); }},
       {"load", [&](sogmm_model** out) { return sogmm_model_load(out, path.c_str(), nullptr); }},

@@ -207,7 +207,7 @@ typedef int32_t sogmm_key;
                                          * save a model above it (what a default reader would refuse) */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
 
-/* Sampling (sogmm_model_sample_f32) and queries (the _v2 score and
+/* Sampling (sogmm_model_sample_f32) and queries (the model score and
  * regression and the map queries, which also use SOGMM_OPT_THREADS). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
 #define SOGMM_OPT_QUERY_TRUNCATION_NATS 501 /* f64, >= 0, finite; default 0 = exact queries. > 0: culled score
@@ -342,8 +342,8 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
  * is passed through and not owned. sogmm_options_clone copies the pair.
  * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
  * sogmm_fit_points_warm_f32, sogmm_fit_rgbd (from the mode count on),
- * sogmm_model_sample_f32, sogmm_model_regress_gray_f32_v2,
- * sogmm_model_score_samples_f32_v2 and the map queries sogmm_map_score_samples_f32,
+ * sogmm_model_sample_f32, sogmm_model_regress_gray_f32,
+ * sogmm_model_score_samples_f32 and the map queries sogmm_map_score_samples_f32,
  * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
  * a temporary buffer: as much memory again as their output); the map's
  * inserts and flushes use the callback of sogmm_map_set_progress. Other
@@ -597,20 +597,23 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
  * floats) and, if `variance_out` is not NULL, the conditional variance (n
  * floats). Far from every component (beyond about 6.5 standard deviations)
  * both fall back smoothly to the mixture's prior gray and total gray
- * variance (sogmm::regress_gray, core/include/sogmm/inference.hpp). n == 0 writes nothing (pointers may then be NULL). NaN/Inf input
- * -> SOGMM_E_INVALID_DATA. */
+ * variance (sogmm::regress_gray, core/include/sogmm/inference.hpp). n == 0
+ * writes nothing (pointers may then be NULL). NaN/Inf input ->
+ * SOGMM_E_INVALID_DATA. Query options below. */
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
-                                                    float* mean_out, float* variance_out);
+                                                    const sogmm_options* options, float* mean_out,
+                                                    float* variance_out);
 
 /* Log-density of n points under the model into `out` (n doubles). dims = 4:
  * rows of (x, y, z, gray), joint density; dims = 3: rows of (x, y, z), the
  * marginal over gray. n == 0 writes nothing. NaN/Inf input ->
- * SOGMM_E_INVALID_DATA. */
+ * SOGMM_E_INVALID_DATA. Query options below. */
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
-                                                     size_t n, int32_t dims, double* out);
+                                                     size_t n, int32_t dims, const sogmm_options* options,
+                                                     double* out);
 
-/* sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32 with
- * options (NULL = defaults, the same bits as the functions without _v2):
+/* The query options of sogmm_model_regress_gray_f32 and
+ * sogmm_model_score_samples_f32 (NULL = defaults):
  * - SOGMM_OPT_THREADS: worker threads; the answers are bitwise the same for
  *   any count;
  * - SOGMM_OPT_QUERY_TRUNCATION_NATS: 0 = exact (default); > 0 culls (a
@@ -619,14 +622,7 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
  * - the progress callback (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION,
  *   SOGMM_STAGE_SCORING): the same bits; a cancel returns SOGMM_E_CANCELLED
  *   with the outputs untouched (they are then written through a temporary
- *   buffer: as much memory again as the output).
- * Arguments and errors otherwise as the functions without _v2. */
-SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
-                                                       const sogmm_options* options, float* mean_out,
-                                                       float* variance_out);
-SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
-                                                        size_t n, int32_t dims, const sogmm_options* options,
-                                                        double* out);
+ *   buffer: as much memory again as the output). */
 
 /* PSNR of a gray image `estimate` against `truth` (`pixels` floats each;
  * -1 marks an empty pixel, e.g. a rendering of the model against the

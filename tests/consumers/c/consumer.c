@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   CHECK(sogmm_model_save(model, path, NULL));
   CHECK(sogmm_model_load(&loaded, path, NULL));
   CHECK(sogmm_model_n_components(loaded, &loaded_m));
-  CHECK(sogmm_model_regress_gray_f32(loaded, centres, 2, gray, variance));
+  CHECK(sogmm_model_regress_gray_f32(loaded, centres, 2, NULL, gray, variance));
   printf("libsogmm %s: %zu components fitted, %zu loaded from %s, gray %.3f and %.3f\n",
          sogmm_version_string(), fitted, loaded_m, path, gray[0], gray[1]);
 

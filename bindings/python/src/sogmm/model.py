@@ -404,7 +404,7 @@ class GMM:
         out = np.empty(x.shape[0], dtype=np.float64)
         with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
+                               lambda: lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
 
     def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
@@ -454,7 +454,7 @@ class GMM:
         var = np.empty(x.shape[0], dtype=np.float32)
         with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
+                               lambda: lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
     def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,

@@ -333,25 +333,11 @@ extern "C" {
         model: *const sogmm_model,
         xyz: *const f32,
         n: usize,
-        mean_out: *mut f32,
-        variance_out: *mut f32,
-    ) -> sogmm_status;
-    pub fn sogmm_model_score_samples_f32(
-        model: *const sogmm_model,
-        points: *const f32,
-        n: usize,
-        dims: i32,
-        out: *mut f64,
-    ) -> sogmm_status;
-    pub fn sogmm_model_regress_gray_f32_v2(
-        model: *const sogmm_model,
-        xyz: *const f32,
-        n: usize,
         options: *const sogmm_options,
         mean_out: *mut f32,
         variance_out: *mut f32,
     ) -> sogmm_status;
-    pub fn sogmm_model_score_samples_f32_v2(
+    pub fn sogmm_model_score_samples_f32(
         model: *const sogmm_model,
         points: *const f32,
         n: usize,

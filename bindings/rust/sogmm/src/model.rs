@@ -504,7 +504,7 @@ impl Model {
     fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
         // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
         regress_with(xyz, |n, mean, var| unsafe {
-            sys::sogmm_model_regress_gray_f32_v2(self.raw(), xyz.as_ptr(), n, o, mean, var)
+            sys::sogmm_model_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
         })
     }
 
@@ -536,7 +536,7 @@ impl Model {
     fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
         // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
         score_with(points, dims, |n, out| unsafe {
-            sys::sogmm_model_score_samples_f32_v2(self.raw(), points.as_ptr(), n, dims, o, out)
+            sys::sogmm_model_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
         })
     }
 
