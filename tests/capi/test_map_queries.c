@@ -202,9 +202,9 @@ static void bad_input(const sogmm_map* map, const float* pts) {
 }
 
 /* Means and stats of a map, to compare a map before and after a failed call. */
-static void snapshot(const sogmm_map* map, sogmm_map_stats* st, float* means, size_t cap) {
+static void snapshot(const sogmm_map* map, test_map_stats* st, float* means, size_t cap) {
   sogmm_model* m = NULL;
-  REQUIRE_OK(sogmm_map_get_stats(map, st));
+  REQUIRE_OK(test_map_get_stats(map, st));
   memset(means, 0, cap * sizeof(float));
   if (st->n_components == 0) return;
   REQUIRE_OK(sogmm_map_export(&m, map, NULL));
@@ -212,7 +212,7 @@ static void snapshot(const sogmm_map* map, sogmm_map_stats* st, float* means, si
   sogmm_model_free(m);
 }
 
-static int same_stats(const sogmm_map_stats* a, const sogmm_map_stats* b) {
+static int same_stats(const test_map_stats* a, const test_map_stats* b) {
   return a->n_components == b->n_components && a->n_pending == b->n_pending && a->n_frames == b->n_frames &&
          a->n_flushes == b->n_flushes && a->n_fused == b->n_fused;
 }
@@ -222,7 +222,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   static float before[kCap], after[kCap];
   sogmm_options* o = NULL;
   sogmm_map* map = NULL;
-  sogmm_map_stats s0, s1;
+  test_map_stats s0, s1;
   Recorder rec;
   double moved[16];
   memcpy(moved, k_identity, sizeof moved);
@@ -250,7 +250,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   /* ... and the next insert works: it is the second frame. */
   rec.cancel = 0;
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, n, moved));
-  REQUIRE_OK(sogmm_map_get_stats(map, &s1));
+  REQUIRE_OK(test_map_get_stats(map, &s1));
   EXPECT_TRUE(s1.n_frames == 2 && s1.n_flushes == 2 && s1.n_components > s0.n_components);
   /* NULL removes the callback. */
   REQUIRE_OK(sogmm_map_set_progress(map, NULL, NULL));
@@ -276,7 +276,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   EXPECT_TRUE(same_stats(&s0, &s1) && s1.n_pending == n && s1.n_components == 0);
   rec.cancel = 0;
   REQUIRE_OK(sogmm_map_flush(map));
-  REQUIRE_OK(sogmm_map_get_stats(map, &s1));
+  REQUIRE_OK(test_map_get_stats(map, &s1));
   EXPECT_TRUE(s1.n_pending == 0 && s1.n_components > 0 && rec.n >= 2);
   sogmm_map_free(map);
 

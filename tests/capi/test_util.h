@@ -130,4 +130,51 @@ static inline int write_file(const char* path, const void* data, size_t size) {
   return fclose(f) == 0 ? 0 : -1;
 }
 
+/* A map's totals and what one insert did, read key by key
+ * (sogmm_map_get_i64, sogmm_map_frame_get_i64/_f64/_pose) into one struct
+ * for the tests to compare; returns the first status that is not SOGMM_OK. */
+typedef struct test_map_stats {
+  uint64_t n_components, n_pending, n_frames, n_flushes, n_fused, n_refits;
+} test_map_stats;
+typedef struct test_frame_stats {
+  uint64_t n_points, n_novel, n_components, n_replaced;
+  int flushed;
+  double ms_novelty, ms_fit, ms_merge, pose[16];
+} test_frame_stats;
+
+static inline sogmm_status test_map_get_stats(const sogmm_map* map, test_map_stats* out) {
+  const sogmm_key keys[6] = {SOGMM_MAP_N_COMPONENTS, SOGMM_MAP_N_PENDING, SOGMM_MAP_N_FRAMES,
+                             SOGMM_MAP_N_FLUSHES,    SOGMM_MAP_N_FUSED,   SOGMM_MAP_N_REFITS};
+  uint64_t* fields[6] = {&out->n_components, &out->n_pending, &out->n_frames,
+                         &out->n_flushes,    &out->n_fused,   &out->n_refits};
+  int i;
+  for (i = 0; i < 6; ++i) {
+    int64_t v = -1;
+    const sogmm_status s = sogmm_map_get_i64(map, keys[i], &v);
+    if (s != SOGMM_OK) return s;
+    *fields[i] = (uint64_t)v;
+  }
+  return SOGMM_OK;
+}
+
+static inline sogmm_status test_map_get_frame_stats(const sogmm_map* map, uint64_t frame, test_frame_stats* out) {
+  const sogmm_key ikeys[5] = {SOGMM_MAP_FRAME_N_POINTS, SOGMM_MAP_FRAME_N_NOVEL, SOGMM_MAP_FRAME_N_COMPONENTS,
+                              SOGMM_MAP_FRAME_N_REPLACED, SOGMM_MAP_FRAME_FLUSHED};
+  const sogmm_key fkeys[3] = {SOGMM_MAP_FRAME_MS_NOVELTY, SOGMM_MAP_FRAME_MS_FIT, SOGMM_MAP_FRAME_MS_MERGE};
+  int64_t iv[5];
+  double* fv[3] = {&out->ms_novelty, &out->ms_fit, &out->ms_merge};
+  sogmm_status s;
+  int i;
+  for (i = 0; i < 5; ++i)
+    if ((s = sogmm_map_frame_get_i64(map, frame, ikeys[i], &iv[i])) != SOGMM_OK) return s;
+  for (i = 0; i < 3; ++i)
+    if ((s = sogmm_map_frame_get_f64(map, frame, fkeys[i], fv[i])) != SOGMM_OK) return s;
+  out->n_points = (uint64_t)iv[0];
+  out->n_novel = (uint64_t)iv[1];
+  out->n_components = (uint64_t)iv[2];
+  out->n_replaced = (uint64_t)iv[3];
+  out->flushed = (int)iv[4];
+  return sogmm_map_frame_get_pose(map, frame, out->pose);
+}
+
 #endif /* SOGMM_TEST_UTIL_H */

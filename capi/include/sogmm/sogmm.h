@@ -139,9 +139,9 @@ typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame read from image fi
 typedef struct sogmm_trajectory sogmm_trajectory; /* camera poses read from a Redwood .log file */
 
 /* ---- options ---------------------------------------------------------- */
-/* Key of a parameter (SOGMM_OPT_*, below 10000) or of a model's information
- * (SOGMM_INFO_*, 10000 and up): the two ranges are disjoint, so no number is
- * both. Each key has one type: set/get an option with the _f64 or _i64
+/* Key of a parameter (SOGMM_OPT_*, below 10000), of a model's information
+ * (SOGMM_INFO_*, 10000 to 19999) or of a map's statistics (SOGMM_MAP_*, 20000
+ * and up): the ranges are disjoint, so no number is two keys. Each key has one type: set/get an option with the _f64 or _i64
  * function named in its comment; the other one, an info key or an unknown
  * key returns SOGMM_E_INVALID_ARG with a message naming the key (and the
  * function to use). Values outside the stated range are rejected by the
@@ -813,36 +813,37 @@ SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropp
  * use of the map, like an insert. */
 SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data);
 
-/* Totals of a map. */
-typedef struct sogmm_map_stats {
-  uint64_t n_components; /* components in the map */
-  uint64_t n_pending;    /* novel points waiting for a fit */
-  uint64_t n_frames;     /* frames inserted (a loaded map counts the frames of its file) */
-  uint64_t n_flushes;    /* fits run by this handle */
-  uint64_t n_fused;      /* new components fused into existing ones instead of appended */
-} sogmm_map_stats;
-/* What one insert did (frames of a loaded map have zero times). */
-typedef struct sogmm_map_frame_stats {
-  uint64_t n_points;     /* points of the frame */
-  uint64_t n_novel;      /* of which novel */
-  uint64_t n_components; /* map components after the insert */
-  int32_t flushed;       /* 1 if the insert ran a fit */
-  double ms_novelty;     /* novelty test, milliseconds */
-  double ms_fit;         /* fit run by the insert */
-  double ms_merge;       /* transform, merge, fusion and index update run by the insert */
-  double pose[16];       /* camera-to-world pose given with the frame */
-} sogmm_map_frame_stats;
-SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out);
-/* Statistics of frame `frame` (insertion order, from 0); frame >= n_frames ->
- * SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame,
-                                                 sogmm_map_frame_stats* out);
-/* Components that the revisit refit of frame `frame` replaced
- * (SOGMM_OPT_MAP_REVISIT_REFIT_RATIO) into *out: 0 when the insert ran none
- * (and for the frames of a loaded file). The frames with a non-zero count are
- * the refits this handle ran; each is also a fit in `flushed` and
- * n_flushes. frame >= n_frames -> SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out);
+/* Statistics of a map, by key (20000 and up, disjoint from the option and
+ * info keys), so that a later version can add one without changing a type.
+ * Types as with options: the getter of the other type, a key of another kind
+ * or an unknown key -> SOGMM_E_INVALID_ARG naming the key. */
+
+/* Totals of the map (sogmm_map_get_i64). */
+#define SOGMM_MAP_N_COMPONENTS 20000 /* i64: components in the map */
+#define SOGMM_MAP_N_PENDING 20001    /* i64: novel points waiting for a fit */
+#define SOGMM_MAP_N_FRAMES 20002     /* i64: frames inserted (a loaded map counts the frames of its file) */
+#define SOGMM_MAP_N_FLUSHES 20003    /* i64: fits run by this handle (batches and revisit refits) */
+#define SOGMM_MAP_N_FUSED 20004      /* i64: new components fused into existing ones instead of appended */
+#define SOGMM_MAP_N_REFITS 20005     /* i64: revisit refits run by this handle (also in N_FLUSHES) */
+SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, int64_t* out);
+
+/* What the insert of frame `frame` did (insertion order, from 0;
+ * sogmm_map_frame_get_i64 / _f64). Frames of a loaded map have zero times
+ * and no refit. frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
+#define SOGMM_MAP_FRAME_N_POINTS 20100     /* i64: points of the frame */
+#define SOGMM_MAP_FRAME_N_NOVEL 20101      /* i64: of which novel */
+#define SOGMM_MAP_FRAME_N_COMPONENTS 20102 /* i64: map components after the insert */
+#define SOGMM_MAP_FRAME_FLUSHED 20103      /* i64: 1 if the insert ran a fit (a flush or a revisit refit), else 0 */
+#define SOGMM_MAP_FRAME_N_REPLACED 20104   /* i64: components its revisit refit replaced
+                                            * (SOGMM_OPT_MAP_REVISIT_REFIT_RATIO); 0 when none ran */
+#define SOGMM_MAP_FRAME_MS_NOVELTY 20150   /* f64: novelty test, milliseconds */
+#define SOGMM_MAP_FRAME_MS_FIT 20151       /* f64: fits run by the insert (a refit's with its check) */
+#define SOGMM_MAP_FRAME_MS_MERGE 20152     /* f64: transform, merge, fusion and index update run by the insert */
+SOGMM_API sogmm_status sogmm_map_frame_get_i64(const sogmm_map* map, uint64_t frame, sogmm_key key, int64_t* out);
+SOGMM_API sogmm_status sogmm_map_frame_get_f64(const sogmm_map* map, uint64_t frame, sogmm_key key, double* out);
+/* The camera-to-world pose given with frame `frame` into `pose_out` (16
+ * doubles, row-major). frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_map_frame_get_pose(const sogmm_map* map, uint64_t frame, double* pose_out);
 
 /* New world-frame model (key "coordinate_frame" = "world") of the whole map
  * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:
