@@ -151,14 +151,13 @@ func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
 }
 
 func (m *Map) insertRGBD(f Frame, pose [16]float64, progress *mapProgress) error {
-	color, format, err := f.colorArgs()
+	h, err := f.handle()
 	if err != nil {
 		return err
 	}
+	defer C.sogmm_frame_free(h)
 	return m.change("InsertRGBD", progress, func(p *C.sogmm_map) C.sogmm_status {
-		return C.sogmm_map_insert_rgbd(p, (*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format,
-			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy),
-			(*C.double)(&pose[0]))
+		return C.sogmm_map_insert_frame(p, h, (*C.double)(&pose[0]))
 	})
 }
 

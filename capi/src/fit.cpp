@@ -34,7 +34,7 @@ using sogmm_capi::require_nonnull;
 
 /// Runs the fit on checked points (a warm start from `initial` if not null)
 /// and wraps the result (fit report, fit parameters, timings) in a new handle.
-/// `from_depth_image`: the points are sogmm_fit_rgbd's (the automatic depth
+/// `from_depth_image`: the points are sogmm_fit_frame's (the automatic depth
 /// floor applies).
 sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o,
                            const sogmm::Gmm* initial = nullptr, bool from_depth_image = false) {
@@ -112,14 +112,11 @@ SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float*
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
-                                      int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                      double fy, double cx, double cy, const sogmm_options* options) {
+SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options) {
   SOGMM_TRY {
     sogmm_capi::require_out(out);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    const sogmm_capi::RgbdPoints r =
-        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, o);
+    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, o);
     if (r.cloud.size() == 0)
       fail(SOGMM_E_INVALID_DATA, "no pixel has a depth in the valid range after decimation");
 

@@ -60,16 +60,14 @@ SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* 
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
-                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                             double fy, double cx, double cy, const double* pose) {
+SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_rgbd");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_frame");
+    require_nonnull(frame, "frame");
     require_nonnull(pose, "pose");
     const sogmm::Pose p = pose_of(pose);
-    const sogmm_capi::RgbdPoints r =
-        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, map->options);
+    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, map->options);
     map->map.insert_backprojected(r.cloud.view(), r.camera, p, sogmm_capi::progress_sink(map->options));
   }
   SOGMM_CATCH

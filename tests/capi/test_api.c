@@ -310,7 +310,7 @@ static void test_fit_points(void) {
   }
 }
 
-static void test_fit_rgbd(void) {
+static void test_rgbd_fit(void) {
   const uint32_t w = 80, h = 60;
   uint16_t* depth;
   uint8_t *gray, *rgb;
@@ -323,8 +323,8 @@ static void test_fit_rgbd(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
-  REQUIRE_OK(sogmm_fit_rgbd(&mg, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5, 29.5, o));
-  REQUIRE_OK(sogmm_fit_rgbd(&mc, depth, rgb, SOGMM_COLOR_RGB8, w, h, 70.0, 70.0, 39.5, 29.5, o));
+  REQUIRE_OK(test_fit_rgbd(&mg, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5, 29.5, o));
+  REQUIRE_OK(test_fit_rgbd(&mc, depth, rgb, SOGMM_COLOR_RGB8, w, h, 70.0, 70.0, 39.5, 29.5, o));
   Mg = check_model(mg);
   Mc = check_model(mc);
   EXPECT_TRUE(Mg == Mc); /* gray == R == G == B gives the same gray */
@@ -364,7 +364,7 @@ static void test_fit_rgbd(void) {
     }
     free(mu);
   }
-  /* The points behind the fit: sogmm_rgbd_to_points_f32 gives N = 39 x 30,
+  /* The points behind the fit: sogmm_frame_to_points_f32 gives N = 39 x 30,
    * a hand-computed first point, and fitting them as points reproduces the
    * RGB-D model bit for bit. Float gray (GRAY_F32) equal to g / 255 gives
    * the same model as GRAY8. */
@@ -372,14 +372,14 @@ static void test_fit_rgbd(void) {
     size_t n_pts = 0, k;
     float *xyzg, *mu_g, *mu_p, *grayf;
     sogmm_model *mp = NULL, *mf = NULL;
-    REQUIRE_OK(sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5,
+    REQUIRE_OK(test_rgbd_to_points(NULL, 0, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5,
                                         29.5, o));
     EXPECT_TRUE(n_pts == 39 * 30);
     xyzg = (float*)malloc(4 * n_pts * sizeof(float));
     grayf = (float*)malloc((size_t)w * h * sizeof(float));
     mu_g = (float*)malloc(4 * Mg * sizeof(float));
     mu_p = (float*)malloc(4 * Mg * sizeof(float));
-    REQUIRE_OK(sogmm_rgbd_to_points_f32(xyzg, 4 * n_pts, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0,
+    REQUIRE_OK(test_rgbd_to_points(xyzg, 4 * n_pts, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0,
                                         39.5, 29.5, o));
     /* decimated pixel (u, v) = (1, 0) <- source (2, 0): depth 1000 + 600 * 2 / 80 = 1015 mm;
      * intrinsics / 2: fx = fy = 35, cx = 19.75, cy = 14.75; gray 40 / 255 */
@@ -387,7 +387,7 @@ static void test_fit_rgbd(void) {
     EXPECT_NEAR(xyzg[0], (1 - 19.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[1], (0 - 14.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[3], 40.0 / 255.0, 1e-7);
-    /* fit_rgbd floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
+    /* sogmm_fit_frame floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
      * array are floored only when asked, so ask for the same model. */
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, 1));
     REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, o));
@@ -397,7 +397,7 @@ static void test_fit_rgbd(void) {
     EXPECT_OK(sogmm_model_get_means_f32(mp, mu_p, 4 * Mg));
     EXPECT_TRUE(memcmp(mu_g, mu_p, 4 * Mg * sizeof(float)) == 0);
     for (k = 0; k < (size_t)w * h; ++k) grayf[k] = gray[k] / 255.0f;
-    REQUIRE_OK(sogmm_fit_rgbd(&mf, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, w, h, 70.0, 70.0, 39.5, 29.5,
+    REQUIRE_OK(test_fit_rgbd(&mf, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, w, h, 70.0, 70.0, 39.5, 29.5,
                               o));
     EXPECT_TRUE(check_model(mf) == Mg);
     EXPECT_OK(sogmm_model_get_means_f32(mf, mu_p, 4 * Mg));
@@ -732,7 +732,7 @@ int main(int argc, char** argv) {
   test_versions_and_errors();
   test_options();
   test_fit_points();
-  test_fit_rgbd();
+  test_rgbd_fit();
   test_arrays_clone_metadata();
   test_inference();
   test_save_load();

@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   sogmm_model* m = NULL;      /* valid model from a fit (fit report, no camera) */
   sogmm_model* a = NULL;      /* valid model from arrays (no fit report) */
   sogmm_model* out = NULL;
+  sogmm_frame* fr = NULL;
   sogmm_buffer* buf = NULL;
   sogmm_buffer* bout = NULL;
   float* pts;
@@ -160,16 +161,17 @@ int main(int argc, char** argv) {
 
   /* ---- fit from an RGB-D frame ---- */
 #define FRAME(dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt) \
-  sogmm_fit_rgbd(&out, dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt)
-  ROW("R1", sogmm_fit_rgbd(NULL, depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R2", out, FRAME(NULL, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R3", out, FRAME(depth, NULL, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R4", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, 0, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R5", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, 0, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R6", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, 0x80000000u, 1, 35, 35, 20, 15, NULL),
-          SOGMM_E_INVALID_ARG);
-  ROW_OUT("R7", out, FRAME(depth, gray, 0, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R8", out, FRAME(depth, gray, 4, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
+  test_fit_rgbd(&out, dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt)
+  ROW("R1", test_fit_rgbd(NULL, depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
+  /* R2-R8: the frame's arrays, refused by sogmm_frame_from_arrays. */
+#define FRAME_NEW(dep, col, fmt, w_, h_) sogmm_frame_from_arrays(&fr, w_, h_, dep, col, fmt)
+  ROW_OUT("R2", fr, FRAME_NEW(NULL, gray, SOGMM_COLOR_GRAY8, W, H), SOGMM_E_NULL_ARG);
+  ROW_OUT("R3", fr, FRAME_NEW(depth, NULL, SOGMM_COLOR_GRAY8, W, H), SOGMM_E_NULL_ARG);
+  ROW_OUT("R4", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, 0, H), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R5", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, W, 0), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R6", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, 0x80000000u, 1), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R7", fr, FRAME_NEW(depth, gray, 0, W, H), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R8", fr, FRAME_NEW(depth, gray, 4, W, H), SOGMM_E_INVALID_ARG);
   ROW_OUT("R9", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 0, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R10", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, -35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R11", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, nan_, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
@@ -200,28 +202,28 @@ int main(int argc, char** argv) {
     ROW_OUT("R19", out, FRAME(depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3, 3, 2, 2, NULL),
             SOGMM_E_INVALID_DATA);
     /* back-projection only */
-    ROW("R20", sogmm_rgbd_to_points_f32(xyzg, 64, NULL, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R20", test_rgbd_to_points(xyzg, 64, NULL, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_NULL_ARG);
-    ROW("R21", sogmm_rgbd_to_points_f32(NULL, 4, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R21", test_rgbd_to_points(NULL, 4, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_NULL_ARG);
-    ROW("R22", sogmm_rgbd_to_points_f32(xyzg, 59, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R22", test_rgbd_to_points(xyzg, 59, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_BUFFER_TOO_SMALL);
     EXPECT_TRUE(n_pts == 15); /* the size is reported with the error (pixel 0 has no depth) */
-    ROW("R23", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
+    ROW("R23", test_rgbd_to_points(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
                                         3, 2, 2, NULL),
         SOGMM_E_INVALID_DATA);
     n_pts = 99;
-    ROW("R24", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
+    ROW("R24", test_rgbd_to_points(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
         SOGMM_E_INVALID_ARG);
     EXPECT_TRUE(n_pts == 99); /* an error other than BUFFER_TOO_SMALL writes no out-parameter */
     /* no valid pixel is not an error here: N = 0 */
-    ROW("R25", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
+    ROW("R25", test_rgbd_to_points(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
                                         2, NULL),
         SOGMM_OK);
     EXPECT_TRUE(n_pts == 0);
     ROW_OUT("R26", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 1e-300, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
     n_pts = 99;
-    ROW("R27", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, NULL),
+    ROW("R27", test_rgbd_to_points(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, NULL),
         SOGMM_E_INVALID_ARG);
     EXPECT_TRUE(n_pts == 99);
   }
@@ -232,9 +234,8 @@ int main(int argc, char** argv) {
     uint8_t* big_gray = (uint8_t*)calloc((size_t)big * big, 1);
     size_t n_pts = 99;
     REQUIRE_OK(big_depth && big_gray ? SOGMM_OK : SOGMM_E_NOMEM);
-    ROW_OUT("R28", out, FRAME(big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000, 4100, 4100, NULL),
-            SOGMM_E_LIMIT);
-    ROW("R29", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000,
+    ROW_OUT("R28", fr, FRAME_NEW(big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big), SOGMM_E_LIMIT);
+    ROW("R29", test_rgbd_to_points(NULL, 0, &n_pts, big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000,
                                         4100, 4100, NULL),
         SOGMM_E_LIMIT);
     EXPECT_TRUE(n_pts == 99);

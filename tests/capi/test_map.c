@@ -195,16 +195,16 @@ static void bad_input(void) {
 
   /* RGB-D: the first frame fixes the size. */
   make_frame(64, 48, &depth, &gray, &rgb);
-  REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, rgb, SOGMM_COLOR_RGB8, 64, 48, 50, 50, 32, 24, k_identity));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 32, 48, 50, 50, 32, 24, k_identity),
+  REQUIRE_OK(test_map_insert_rgbd(map, depth, rgb, SOGMM_COLOR_RGB8, 64, 48, 50, 50, 32, 24, k_identity));
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 32, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_ARG);
   EXPECT_TRUE(message_has("differs"));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, 99, 64, 48, 50, 50, 32, 24, k_identity),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, 99, 64, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_ARG);
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, NULL),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, NULL),
                 SOGMM_E_NULL_ARG);
   memset(depth, 0, 64 * 48 * sizeof(uint16_t));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_DATA);
   EXPECT_TRUE(message_has("no valid depth"));
   REQUIRE_OK(test_map_get_stats(map, &st));
@@ -273,8 +273,8 @@ static void revisit_refit(void) {
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, W * H)); /* the first frame is one batch */
     if (r == 1) REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.0));
     REQUIRE_OK(sogmm_map_create(&map, o));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, plain, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, striped, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, plain, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, striped, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
     REQUIRE_OK(test_map_get_stats(map, &st));
     EXPECT_TRUE(st.n_frames == 2 && st.n_pending == 0);
     EXPECT_TRUE(st.n_flushes == (r == 0 ? 2u : 1u));

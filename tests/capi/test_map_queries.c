@@ -290,15 +290,15 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
     REQUIRE_OK(sogmm_map_set_progress(map, record, &rec));
     memset(&rec, 0, sizeof rec);
     rec.cancel = 1;
-    EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 60, 60, 32, 24, k_identity),
+    EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 60, 60, 32, 24, k_identity),
                   SOGMM_E_CANCELLED);
     REQUIRE_OK(sogmm_map_set_progress(map, NULL, NULL));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity));
     snapshot(map, &s0, before, kCap);
     REQUIRE_OK(sogmm_map_set_progress(map, record, &rec));
     memset(&rec, 0, sizeof rec);
     rec.cancel = 1;
-    EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, moved),
+    EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, moved),
                   SOGMM_E_CANCELLED);
     snapshot(map, &s1, after, kCap);
     EXPECT_TRUE(same_stats(&s0, &s1) && s1.n_frames == 1 && memcmp(before, after, sizeof before) == 0);

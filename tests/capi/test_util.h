@@ -177,4 +177,50 @@ static inline sogmm_status test_map_get_frame_stats(const sogmm_map* map, uint64
   return sogmm_map_frame_get_pose(map, frame, out->pose);
 }
 
+/* A frame from arrays with its intrinsics (sogmm_frame_from_arrays +
+ * sogmm_frame_set_intrinsics), for the tests that give a frame as the
+ * arrays and scalars the RGB-D calls took before the frame handle: NULL and
+ * the status in *status (when not NULL) if the frame is refused. */
+static inline sogmm_frame* test_frame(const uint16_t* depth, const void* color, int32_t color_format, uint32_t w,
+                                      uint32_t h, double fx, double fy, double cx, double cy, sogmm_status* status) {
+  sogmm_frame* f = NULL;
+  sogmm_status s = sogmm_frame_from_arrays(&f, w, h, depth, color, color_format);
+  if (s == SOGMM_OK) s = sogmm_frame_set_intrinsics(f, fx, fy, cx, cy);
+  if (status) *status = s;
+  return f;
+}
+
+/* sogmm_fit_frame, sogmm_map_insert_frame and sogmm_frame_to_points_f32 on
+ * test_frame(...): the first status that is not SOGMM_OK. */
+static inline sogmm_status test_fit_rgbd(sogmm_model** out, const uint16_t* depth, const void* color,
+                                         int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
+                                         double cx, double cy, const sogmm_options* options) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_fit_frame(out, f, options);
+  sogmm_frame_free(f);
+  return s;
+}
+
+static inline sogmm_status test_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const void* color,
+                                                int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
+                                                double cx, double cy, const double* pose) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_map_insert_frame(map, f, pose);
+  sogmm_frame_free(f);
+  return s;
+}
+
+static inline sogmm_status test_rgbd_to_points(float* out, size_t capacity, size_t* n_points, const uint16_t* depth,
+                                               const void* color, int32_t color_format, uint32_t w, uint32_t h,
+                                               double fx, double fy, double cx, double cy,
+                                               const sogmm_options* options) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_frame_to_points_f32(out, capacity, n_points, f, options);
+  sogmm_frame_free(f);
+  return s;
+}
+
 #endif /* SOGMM_TEST_UTIL_H */

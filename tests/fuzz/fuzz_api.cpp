@@ -464,12 +464,21 @@ void step_rgbd(State& st, sogmm_fuzz::Reader& in) {
   const double fx = (what & 8) ? take_double(in) : 20.0, fy = (what & 16) ? take_double(in) : 20.0;
   const double cx = (what & 32) ? take_double(in) : w / 2.0, cy = (what & 64) ? take_double(in) : h / 2.0;
   sogmm_options* o = work_options(st, what);
+  // The frame from the arrays (format 0: no colour image when `what` & 128).
+  sogmm_frame* frame = reinterpret_cast<sogmm_frame*>(1);
+  const sogmm_status made = sogmm_frame_from_arrays(&frame, w, h, depth.data(),
+                                                    (format == 0 && (what & 128)) ? nullptr : color.data(), format);
+  check_status(made);
+  if (made != SOGMM_OK) {
+    FUZZ_CHECK(frame == nullptr);
+    return;
+  }
+  FUZZ_CHECK(sogmm_frame_set_intrinsics(frame, fx, fy, cx, cy) == SOGMM_OK);
   if (what & 1) {
     std::size_t n_points = 777;
     std::vector<float> out(4 * w * h + 4, 12345.0f);
     const std::size_t capacity = (what & 2) ? out.size() : in.take<std::uint8_t>();
-    const sogmm_status s = sogmm_rgbd_to_points_f32(out.data(), capacity, &n_points, depth.data(), color.data(),
-                                                    format, w, h, fx, fy, cx, cy, o);
+    const sogmm_status s = sogmm_frame_to_points_f32(out.data(), capacity, &n_points, frame, o);
     check_status(s);
     if (s == SOGMM_OK) {
       FUZZ_CHECK(n_points <= static_cast<std::size_t>(w) * h);
@@ -480,11 +489,11 @@ void step_rgbd(State& st, sogmm_fuzz::Reader& in) {
     if (sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &bw) == SOGMM_OK && bw < 0.01)
       FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.01) == SOGMM_OK);
     sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-    const sogmm_status s =
-        sogmm_fit_rgbd(&m, depth.data(), color.data(), format, w, h, fx, fy, cx, cy, o);
+    const sogmm_status s = sogmm_fit_frame(&m, frame, o);
     check_created(s, m);
     if (s == SOGMM_OK) put(st, slot, m);
   }
+  sogmm_frame_free(frame);
 }
 
 void step_misc(State& st, sogmm_fuzz::Reader& in) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "capi_frame.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -129,12 +130,12 @@ TEST(CapiMapValidity, AnAbsurdFirstCameraIsRefusedAndFixesNothing) {
   }
   MapHandle m;
   const std::vector<double> pose = translated(0);
-  EXPECT_EQ(sogmm_map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 1e-30, 1e-30, 32, 24,
+  EXPECT_EQ(sogmm_test::map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 1e-30, 1e-30, 32, 24,
                                   pose.data()),
             SOGMM_E_LIMIT);
   EXPECT_TRUE(has(last_error(), "intrinsics")) << last_error();
   EXPECT_EQ(m.stats().n_frames, 0);
-  EXPECT_EQ(sogmm_map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 60, 60, 32, 24,
+  EXPECT_EQ(sogmm_test::map_insert_rgbd(m.map, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 60, 60, 32, 24,
                                   pose.data()),
             SOGMM_OK)
       << last_error();

@@ -34,6 +34,7 @@
 #include "child_process.hpp"
 #include "heap_hook.hpp"
 #include "sogmm/random.hpp"
+#include "capi_frame.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -185,7 +186,7 @@ TEST_F(OutOfMemory, FitsReportNomemForEveryFailedAllocation) {
   }
   sweep("RGB-D fit", [&] {
     return expect_model_or_nothing([&](sogmm_model** out) {
-      return sogmm_fit_rgbd(out, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 30, 30, 20, 15, o);
+      return sogmm_test::fit_rgbd(out, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 30, 30, 20, 15, o);
     });
   });
   sogmm_options_free(o);

@@ -17,7 +17,7 @@
  * - Fallible functions return sogmm_status: SOGMM_OK (0) or a negative
  *   SOGMM_E_* code. Out-parameters and output arrays are written only on
  *   success, with two documented exceptions: the NULL stored into a handle
- *   out-pointer on failure, and the count that sogmm_rgbd_to_points_f32
+ *   out-pointer on failure, and the count that sogmm_frame_to_points_f32
  *   reports with SOGMM_E_BUFFER_TOO_SMALL.
  * - A call whose result would not be finite (a transform moving a mean beyond
  *   float32, intrinsics that back-project to infinity) fails at that call.
@@ -135,7 +135,7 @@ typedef struct sogmm_model sogmm_model;     /* a fitted 4-D GMM + metadata */
 typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, save, load, sample */
 typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
 typedef struct sogmm_map sogmm_map;         /* an incremental world map (sogmm_map_*) */
-typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame read from image files (sogmm_frame_*) */
+typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame: pixels and intrinsics (sogmm_frame_*) */
 typedef struct sogmm_trajectory sogmm_trajectory; /* camera poses read from a Redwood .log file */
 
 /* ---- options ---------------------------------------------------------- */
@@ -185,12 +185,12 @@ typedef int32_t sogmm_key;
                                         * level's bin variance, so components do not collapse onto single
                                         * levels (every seed converges; higher likelihood of held-out pixels spread in their bins; lower
                                         * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
-                                        * points of sogmm_fit_rgbd, 0 for points given as arrays */
+                                        * points of sogmm_fit_frame, 0 for points given as arrays */
 #define SOGMM_DEQUANTISE_AUTO (-1)
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
-/* RGB-D back-projection (sogmm_fit_rgbd, sogmm_rgbd_to_points_f32). */
+/* RGB-D back-projection (sogmm_fit_frame, sogmm_map_insert_frame, sogmm_frame_to_points_f32). */
 #define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite, 1 / value finite; default 1000: raw depth units per metre */
 #define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
 #define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
@@ -218,7 +218,7 @@ typedef int32_t sogmm_key;
 
 /* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
  * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
- * and the RGB-D keys (sogmm_map_insert_rgbd). */
+ * and the RGB-D keys (sogmm_map_insert_frame). */
 #define SOGMM_OPT_MAP_NOVELTY 600           /* i64, 0 or 1; default 1. 0: every point is novel and each
                                              * insert fits its whole frame (append everything) */
 #define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601 /* f64, finite; default 3.0 nats: points whose 3-D log-likelihood
@@ -341,7 +341,7 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
 /* Sets the progress callback of `options` (fn = NULL removes it); user_data
  * is passed through and not owned. sogmm_options_clone copies the pair.
  * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
- * sogmm_fit_points_warm_f32, sogmm_fit_rgbd (from the mode count on),
+ * sogmm_fit_points_warm_f32, sogmm_fit_frame (from the mode count on),
  * sogmm_model_sample_f32, sogmm_model_regress_gray_f32,
  * sogmm_model_score_samples_f32 and the map queries sogmm_map_score_samples_f32,
  * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
@@ -386,53 +386,36 @@ SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const flo
 SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
                                                  const sogmm_model* initial, const sogmm_options* options);
 
-/* Layout of the color image given to sogmm_fit_rgbd and sogmm_rgbd_to_points_f32. */
+/* ---- RGB-D frames ---------------------------------------------------- */
+/* A frame holds the depth image, the colour image (or none) and the camera
+ * intrinsics: the one descriptor of an RGB-D image that sogmm_fit_frame,
+ * sogmm_map_insert_frame and sogmm_frame_to_points_f32 take. It is made from
+ * arrays in memory (sogmm_frame_from_arrays) or from image files, which the
+ * library decodes itself (sogmm_frame_read, sogmm_frame_decode: libpng,
+ * libjpeg-turbo with fixed settings, accurate integer IDCT, no gamma), so
+ * every language gets the same pixels, and with the same options the same
+ * model, from the same files. */
+
+/* Layout of a frame's colour image (sogmm_frame_from_arrays,
+ * sogmm_frame_color_format). */
 #define SOGMM_COLOR_GRAY8 1    /* width * height bytes, gray 0..255 */
 #define SOGMM_COLOR_RGB8 2     /* width * height * 3 bytes, interleaved R, G, B */
 #define SOGMM_COLOR_GRAY_F32 3 /* width * height native floats, gray used as given (meant to be in
-                                * [0, 1], e.g. a normalised thermal image); pass the float array
-                                * cast to const uint8_t*; any alignment. Non-finite -> INVALID_DATA */
+                                * [0, 1], e.g. a normalised thermal image); any alignment.
+                                * Non-finite -> INVALID_DATA where the frame is used */
 
-/* Fits a model to one RGB-D frame. `depth` holds width * height uint16
- * values (raw units, SOGMM_OPT_DEPTH_SCALE per metre, 0 = no reading),
- * `color` the registered image in `color_format`, both row-major.
- * Intrinsics are those of the full-size images (fx, fy > 0, all finite).
- * Decimation and the valid depth range come from `options` (NULL =
- * defaults). The model records the camera (SOGMM_INFO_CAMERA_*).
- * Errors: width/height 0 or > INT32_MAX, bad intrinsics (including fx, fy,
- * cx, cy, depth scale and range that would back-project a pixel beyond the
- * float32 range), unknown color format, bad depth range ->
- * SOGMM_E_INVALID_ARG; a decimated image of more than 2^26 pixels
- * ((width / d) * (height / d), checked before anything is allocated) ->
- * SOGMM_E_LIMIT; no valid pixel or a non-finite float gray ->
- * SOGMM_E_INVALID_DATA. */
-SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
-                                      int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                      double fy, double cx, double cy, const sogmm_options* options);
-
-/* The points sogmm_fit_rgbd fits, without fitting: the valid pixels of the
- * decimated frame, row by row, as N rows (x, y, z, gray) of float32 in the
- * camera frame (x right, y down, z forward, metres): z = depth / scale,
- * x = (u - cx/d) z / (fx/d), y = (v - cy/d) z / (fy/d) on the decimated
- * pixel grid. Arguments and errors as sogmm_fit_rgbd, except that a frame
- * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
- * receives N. `out` has room for `capacity` floats and must hold 4 N, else
- * SOGMM_E_BUFFER_TOO_SMALL, which still sets *n_points to N (the size to
- * allocate); on any other error neither *n_points nor `out` is written.
- * out = NULL with capacity 0 only queries N. At most (width / d) * (height / d)
- * points (integer division), which must be at most 2^26 as for a fit. */
-SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, size_t* n_points,
-                                                const uint16_t* depth, const uint8_t* color, int32_t color_format,
-                                                uint32_t width, uint32_t height, double fx, double fy, double cx,
-                                                double cy, const sogmm_options* options);
-
-/* ---- frames from image files ------------------------------------------ */
-/* The library decodes the images itself (libpng, libjpeg-turbo with fixed
- * settings: accurate integer IDCT, no gamma), so every language gets the
- * same pixels, and with the same options the same model, from the same
- * files. A frame holds the depth image, the colour image (or none) and the
- * camera intrinsics; it replaces the scalar arguments of sogmm_fit_rgbd and
- * sogmm_map_insert_rgbd. */
+/* Makes a frame from arrays (copied; the caller keeps them): `depth` holds
+ * width * height uint16 values (raw units, SOGMM_OPT_DEPTH_SCALE per metre,
+ * 0 = no reading), `color` the registered image in `color_format`
+ * (SOGMM_COLOR_*), both row-major and contiguous. color = NULL with
+ * color_format = 0: no colour image (gray 0 when fitted). The frame has no
+ * intrinsics yet (sogmm_frame_set_intrinsics). Errors: out or depth NULL, or
+ * color NULL with a non-zero color_format -> SOGMM_E_NULL_ARG; width/height 0
+ * or > INT32_MAX, unknown color_format -> SOGMM_E_INVALID_ARG; more than 2^26
+ * pixels (the frame reader's limit, checked before anything is copied) ->
+ * SOGMM_E_LIMIT. */
+SOGMM_API sogmm_status sogmm_frame_from_arrays(sogmm_frame** out, uint32_t width, uint32_t height,
+                                               const uint16_t* depth, const void* color, int32_t color_format);
 
 /* Reads a frame from a depth PNG (one channel, 16-bit; 8-bit is widened with
  * the same values) and a colour PNG or JPEG (8-bit gray -> SOGMM_COLOR_GRAY8,
@@ -460,22 +443,42 @@ SOGMM_API uint32_t sogmm_frame_height(const sogmm_frame* frame);
 /* The depth pixels: width * height raw uint16 values, row-major (NULL for
  * NULL). Owned by the frame, valid until sogmm_frame_free. Never fails. */
 SOGMM_API const uint16_t* sogmm_frame_depth(const sogmm_frame* frame);
-/* The colour bytes in the layout of sogmm_frame_color_format, row-major, as
- * sogmm_fit_rgbd takes them; NULL without a colour image (or for NULL).
+/* The colour bytes in the layout of sogmm_frame_color_format, row-major;
+ * NULL without a colour image (or for NULL).
  * Owned by the frame, valid until sogmm_frame_free. Never fails. */
 SOGMM_API const uint8_t* sogmm_frame_color(const sogmm_frame* frame);
-/* SOGMM_COLOR_GRAY8 or SOGMM_COLOR_RGB8; 0 without a colour image (or for
- * NULL). Never fails. */
+/* SOGMM_COLOR_GRAY8 or SOGMM_COLOR_RGB8 (from files; also
+ * SOGMM_COLOR_GRAY_F32 from arrays); 0 without a colour image (or for NULL).
+ * Never fails. */
 SOGMM_API int32_t sogmm_frame_color_format(const sogmm_frame* frame);
 /* Sets the intrinsics of the full-size images (pixels). They are checked
- * where the frame is used (sogmm_fit_frame, sogmm_map_insert_frame: fx, fy >
- * 0, all finite). Errors: frame NULL -> SOGMM_E_NULL_ARG. */
+ * where the frame is used (fx, fy > 0, all finite). Errors: frame NULL ->
+ * SOGMM_E_NULL_ARG. */
 SOGMM_API sogmm_status sogmm_frame_set_intrinsics(sogmm_frame* frame, double fx, double fy, double cx, double cy);
-/* Fits a model to `frame` exactly as sogmm_fit_rgbd does with its pixels
- * and intrinsics (bitwise the same model); options as there (NULL =
- * defaults). Errors: frame or out NULL -> SOGMM_E_NULL_ARG; no intrinsics
- * set -> SOGMM_E_INVALID_ARG; else as sogmm_fit_rgbd. */
+
+/* Fits a model to one RGB-D frame. Decimation and the valid depth range come
+ * from `options` (NULL = defaults); the fit keys as sogmm_fit_points_f32.
+ * The model records the camera (SOGMM_INFO_CAMERA_*). Errors: frame or out
+ * NULL -> SOGMM_E_NULL_ARG; no intrinsics set, bad intrinsics (including fx,
+ * fy, cx, cy, depth scale and range that would back-project a pixel beyond
+ * the float32 range), bad depth range, a decimation larger than a side ->
+ * SOGMM_E_INVALID_ARG; a decimated image of more than 2^26 pixels ->
+ * SOGMM_E_LIMIT; no valid pixel or a non-finite float gray ->
+ * SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options);
+
+/* The points sogmm_fit_frame fits, without fitting: the valid pixels of the
+ * decimated frame, row by row, as N rows (x, y, z, gray) of float32 in the
+ * camera frame (x right, y down, z forward, metres): z = depth / scale,
+ * x = (u - cx/d) z / (fx/d), y = (v - cy/d) z / (fy/d) on the decimated
+ * pixel grid. Options and errors as sogmm_fit_frame, except that a frame
+ * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
+ * receives N. `out` has room for `capacity` floats and must hold 4 N, else
+ * SOGMM_E_BUFFER_TOO_SMALL, which still sets *n_points to N (the size to
+ * allocate); on any other error neither *n_points nor `out` is written.
+ * out = NULL with capacity 0 only queries N. */
+SOGMM_API sogmm_status sogmm_frame_to_points_f32(float* out, size_t capacity, size_t* n_points,
+                                                 const sogmm_frame* frame, const sogmm_options* options);
 
 /* ---- models from arrays, copies, release ------------------------------ */
 /* Builds a model from m components: `weights` (m floats, >= 0, summing to 1
@@ -532,7 +535,7 @@ SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model,
 #define SOGMM_INFO_FIT_SECONDS_TOTAL 10154         /* f64 */
 #define SOGMM_INFO_FIT_N_INIT 10155                /* i64: runs made (SOGMM_OPT_N_INIT) */
 #define SOGMM_INFO_FIT_RUN 10156                   /* i64: which run was kept, from 0 */
-/* Camera the points came from: present for sogmm_fit_rgbd models and files that store it. */
+/* Camera the points came from: present for sogmm_fit_frame models and files that store it. */
 #define SOGMM_INFO_CAMERA_WIDTH 10200       /* i64: full-size image width, pixels */
 #define SOGMM_INFO_CAMERA_HEIGHT 10201      /* i64 */
 #define SOGMM_INFO_CAMERA_FX 10202          /* f64 */
@@ -781,19 +784,12 @@ SOGMM_API void sogmm_map_free(sogmm_map* map);
  * pending), so the call can be retried. */
 SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
                                                    const double* pose);
-/* Inserts an RGB-D frame (arguments as sogmm_fit_rgbd; decimation and depth
- * range from the options the map was created with) with its camera-to-world
+/* Inserts `frame` (its pixels and intrinsics; decimation and depth range
+ * from the options the map was created with) with its camera-to-world
  * `pose`. The first RGB-D frame fixes the camera: a frame of another size or
  * other intrinsics -> SOGMM_E_INVALID_ARG; a frame without a valid pixel ->
- * SOGMM_E_INVALID_DATA; other errors as sogmm_fit_rgbd and
- * sogmm_map_insert_points_f32. */
-SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
-                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                             double fy, double cx, double cy, const double* pose);
-/* Inserts `frame` (its pixels and intrinsics, sogmm_frame_*) with its
- * camera-to-world `pose`, exactly as sogmm_map_insert_rgbd with them. Errors:
- * frame NULL -> SOGMM_E_NULL_ARG; no intrinsics set -> SOGMM_E_INVALID_ARG;
- * else as sogmm_map_insert_rgbd. */
+ * SOGMM_E_INVALID_DATA; frame NULL -> SOGMM_E_NULL_ARG; other errors as
+ * sogmm_fit_frame and sogmm_map_insert_points_f32. */
 SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose);
 /* Fits the pending points now (no-op when none are pending). A failed or
  * cancelled fit leaves the map and the pending points unchanged. */

@@ -241,7 +241,8 @@ class Map:
         camera-to-world ``pose``; returns that frame's statistics."""
         f = prepare_frame(depth, color, camera, *self._depth)
         p = _pose(pose)
-        self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_rgbd(h, *f.frame_args(), p))
+        with f.handle() as frame:
+            self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_frame(h, frame, p))
         return self.frame_stats(-1)
 
     def flush(self, progress: ProgressArg = None) -> int:

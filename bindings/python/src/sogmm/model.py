@@ -751,8 +751,8 @@ class SOGMM(GMM):
         Ctrl-C as :meth:`fit`. Returns self."""
         f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
         out = c_void_p()
-        with self._fit_options(f.f64, f.i64) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr),
+        with self._fit_options(f.f64, f.i64) as o, f.handle() as frame:
+            call_with_progress(o, progress, lambda: lib.sogmm_fit_frame(byref(out), frame, o.ptr),
                                keep=lambda: self._attach(out))
         return self
 

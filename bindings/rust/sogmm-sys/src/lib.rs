@@ -251,34 +251,6 @@ extern "C" {
         initial: *const sogmm_model,
         options: *const sogmm_options,
     ) -> sogmm_status;
-    pub fn sogmm_fit_rgbd(
-        out: *mut *mut sogmm_model,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_rgbd_to_points_f32(
-        out: *mut f32,
-        capacity: usize,
-        n_points: *mut usize,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
     pub fn sogmm_model_from_arrays_f32(
         out: *mut *mut sogmm_model,
         m: usize,
@@ -378,19 +350,6 @@ extern "C" {
         map: *mut sogmm_map,
         points: *const f32,
         n: usize,
-        pose: *const f64,
-    ) -> sogmm_status;
-    pub fn sogmm_map_insert_rgbd(
-        map: *mut sogmm_map,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
         pose: *const f64,
     ) -> sogmm_status;
     pub fn sogmm_map_insert_frame(map: *mut sogmm_map, frame: *const sogmm_frame, pose: *const f64) -> sogmm_status;
@@ -497,6 +456,21 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_frame_from_arrays(
+        out: *mut *mut sogmm_frame,
+        width: u32,
+        height: u32,
+        depth: *const u16,
+        color: *const c_void,
+        color_format: i32,
+    ) -> sogmm_status;
+    pub fn sogmm_frame_to_points_f32(
+        out: *mut f32,
+        capacity: usize,
+        n_points: *mut usize,
+        frame: *const sogmm_frame,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_frame_read(
         out: *mut *mut sogmm_frame,
         depth_path: *const c_char,

@@ -122,23 +122,9 @@ impl Map {
     /// Inserts an RGB-D frame (decimation and depth range from the map's
     /// options) with its camera-to-world pose. The first frame fixes the camera.
     pub fn insert_frame(&mut self, frame: &Frame<'_>, pose: &Pose) -> Result<()> {
-        let (color, format) = frame.color_args()?;
-        // SAFETY: exclusive through &mut self; color_args checked the slices.
-        check(unsafe {
-            sys::sogmm_map_insert_rgbd(
-                self.ptr.as_ptr(),
-                frame.depth.as_ptr(),
-                color,
-                format,
-                frame.width,
-                frame.height,
-                frame.fx,
-                frame.fy,
-                frame.cx,
-                frame.cy,
-                pose.as_ptr(),
-            )
-        })
+        let h = frame.handle()?;
+        // SAFETY: exclusive through &mut self; a valid frame and 16 doubles.
+        check(unsafe { sys::sogmm_map_insert_frame(self.ptr.as_ptr(), h.0, pose.as_ptr()) })
     }
 
     /// Fits the pending points now (nothing when none are pending).

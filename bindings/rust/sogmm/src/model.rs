@@ -78,30 +78,36 @@ impl Frame<'_> {
         Ok((color, format))
     }
 
+    /// The frame as a C `sogmm_frame` (copied by `sogmm_frame_from_arrays`,
+    /// with the intrinsics), freed when the handle drops: what the fit, the
+    /// map insert and `to_points` hand to the library.
+    pub(crate) fn handle(&self) -> Result<crate::frames::Handle> {
+        let (color, format) = self.color_args()?;
+        let mut h = crate::frames::Handle(ptr::null_mut());
+        // SAFETY: color_args checked the slices against width x height.
+        check(unsafe {
+            sys::sogmm_frame_from_arrays(
+                &mut h.0,
+                self.width,
+                self.height,
+                self.depth.as_ptr(),
+                color.cast(),
+                format,
+            )
+        })?;
+        // SAFETY: a frame just made.
+        check(unsafe { sys::sogmm_frame_set_intrinsics(h.0, self.fx, self.fy, self.cx, self.cy) })?;
+        Ok(h)
+    }
+
     /// The points `Model::fit_rgbd` would fit, without fitting: N rows (x, y,
     /// z, gray) in the camera frame (decimation and depth range from
     /// `options`). A frame without a valid pixel gives an empty Vec.
     pub fn to_points(&self, options: Option<&Options>) -> Result<Vec<f32>> {
-        let (color, format) = self.color_args()?;
+        let frame = self.handle()?;
         let call = |out: *mut f32, capacity: usize, n: &mut usize| {
-            // SAFETY: slices checked by color_args; `out` has `capacity` floats.
-            check(unsafe {
-                sys::sogmm_rgbd_to_points_f32(
-                    out,
-                    capacity,
-                    n,
-                    self.depth.as_ptr(),
-                    color,
-                    format,
-                    self.width,
-                    self.height,
-                    self.fx,
-                    self.fy,
-                    self.cx,
-                    self.cy,
-                    opt_ptr(options),
-                )
-            })
+            // SAFETY: a valid frame; `out` has `capacity` floats.
+            check(unsafe { sys::sogmm_frame_to_points_f32(out, capacity, n, frame.0, opt_ptr(options)) })
         };
         let mut n = 0;
         call(ptr::null_mut(), 0, &mut n)?; // capacity 0: only counts
@@ -272,23 +278,9 @@ impl Model {
 
     /// fit_rgbd with a raw options pointer (NULL = defaults).
     fn fit_rgbd_raw(frame: &Frame<'_>, options: *const sys::sogmm_options) -> Result<Model> {
-        let (color, format) = frame.color_args()?;
-        // SAFETY: color_args checked the slices against width x height.
-        Model::make(|out| unsafe {
-            sys::sogmm_fit_rgbd(
-                out,
-                frame.depth.as_ptr(),
-                color,
-                format,
-                frame.width,
-                frame.height,
-                frame.fx,
-                frame.fy,
-                frame.cx,
-                frame.cy,
-                options,
-            )
-        })
+        let h = frame.handle()?;
+        // SAFETY: a valid frame.
+        Model::make(|out| unsafe { sys::sogmm_fit_frame(out, h.0, options) })
     }
 
     /// Builds a model from M weights, M x 4 means and M x 4 x 4 covariances
