@@ -87,7 +87,7 @@ extern "C" {
  * library's SONAME is libsogmm.so.<SOGMM_ABI_VERSION>. Bindings that load the
  * library dynamically must check sogmm_abi_version() == the value they were
  * written for. */
-#define SOGMM_ABI_VERSION 1
+#define SOGMM_ABI_VERSION 2
 
 /* Runtime version of the loaded library, same encoding as
  * SOGMM_VERSION_NUMBER. Never fails. */

@@ -27,7 +27,7 @@ import numpy as np
 from .errors import error_for_status
 
 #: The SOGMM_ABI_VERSION this package was written for.
-ABI_VERSION = 1
+ABI_VERSION = 2
 
 # ---- constants (mirror sogmm.h) ------------------------------------------
 OK = 0
@@ -245,8 +245,8 @@ def _library_file_names() -> list[str]:
     if sys.platform == "win32":
         return ["sogmm.dll", "libsogmm.dll"]
     if sys.platform == "darwin":
-        return ["libsogmm.dylib", "libsogmm.1.dylib"]
-    return ["libsogmm.so", "libsogmm.so.1"]
+        return ["libsogmm.dylib", f"libsogmm.{ABI_VERSION}.dylib"]
+    return ["libsogmm.so", f"libsogmm.so.{ABI_VERSION}"]
 
 
 def _is_sanitizer_build(build_dir: Path) -> bool:

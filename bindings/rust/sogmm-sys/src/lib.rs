@@ -56,7 +56,7 @@ pub const SOGMM_VERSION_MAJOR: u32 = 0;
 pub const SOGMM_VERSION_MINOR: u32 = 1;
 pub const SOGMM_VERSION_PATCH: u32 = 0;
 pub const SOGMM_VERSION_STRING: &str = "0.1.0";
-pub const SOGMM_ABI_VERSION: u32 = 1;
+pub const SOGMM_ABI_VERSION: u32 = 2;
 
 // ---- status codes ---------------------------------------------------------
 pub const SOGMM_OK: sogmm_status = 0;
