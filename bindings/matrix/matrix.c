@@ -60,7 +60,7 @@ static int write_model(const char* points_path, const char* out_path) {
   else if ((st = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) rc = fail("bandwidth", st);
   else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) rc = fail("seed", st);
   else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) rc = fail("threads", st);
-  else if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, o)) != SOGMM_OK) rc = fail("fit", st);
+  else if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, NULL, o)) != SOGMM_OK) rc = fail("fit", st);
   else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
   else rc = 0;
   sogmm_model_free(m);

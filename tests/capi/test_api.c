@@ -184,7 +184,7 @@ static sogmm_model* fit_three_clusters(size_t n) {
   sogmm_options* o = NULL;
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 7));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, n, 3, o));
+  REQUIRE_OK(test_fit_fixed_k(&m, pts, n, 3, o));
   sogmm_options_free(o);
   free(pts);
   return m;
@@ -255,7 +255,7 @@ static void test_fit_points(void) {
     size_t M = 0;
     REQUIRE_OK(sogmm_options_create(&o));
     REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.1));
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
     M = check_model(m);
     EXPECT_TRUE(M >= 3 && M <= 12);
     EXPECT_OK(sogmm_model_get_info_f64(m, SOGMM_INFO_FIT_BANDWIDTH, &f));
@@ -265,7 +265,7 @@ static void test_fit_points(void) {
     sogmm_model_free(m);
     /* fixed K through the options key: same as the _fixed_k entry point */
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 5));
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
     EXPECT_TRUE(check_model(m) == 5);
     sogmm_model_free(m);
     /* N_INIT runs: the kept run is the best, its seed is recorded, and a
@@ -276,13 +276,13 @@ static void test_fit_points(void) {
       double ll_best = 0, ll_one = 0, ll_first = 0;
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 9));
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 10));
-      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, NULL, o));
       EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_first));
       EXPECT_OK(sogmm_model_get_info_i64(one, SOGMM_INFO_FIT_N_INIT, &runs));
       EXPECT_TRUE(runs == 1);
       sogmm_model_free(one);
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 3));
-      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
       EXPECT_TRUE(check_model(m) == 9);
       EXPECT_OK(sogmm_model_get_info_i64(m, SOGMM_INFO_FIT_N_INIT, &runs));
       EXPECT_TRUE(runs == 3);
@@ -294,7 +294,7 @@ static void test_fit_points(void) {
       EXPECT_TRUE(ll_best >= ll_first);
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, seed));
-      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, NULL, o));
       EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_one));
       EXPECT_TRUE(ll_one == ll_best);
       sogmm_model_free(one);
@@ -302,7 +302,7 @@ static void test_fit_points(void) {
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 0));
     }
     /* NULL options = defaults (bandwidth 0.02) */
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, 300, NULL));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, 300, NULL, NULL));
     check_model(m);
     sogmm_model_free(m);
     sogmm_options_free(o);
@@ -390,7 +390,7 @@ static void test_rgbd_fit(void) {
     /* sogmm_fit_frame floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
      * array are floored only when asked, so ask for the same model. */
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, 1));
-    REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, NULL, o));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, SOGMM_DEQUANTISE_AUTO));
     EXPECT_TRUE(check_model(mp) == Mg);
     EXPECT_OK(sogmm_model_get_means_f32(mg, mu_g, 4 * Mg));

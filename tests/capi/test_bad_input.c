@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   pts = make_clusters(30, 1);
   memcpy(pts_bad, pts, sizeof pts_bad);
   REQUIRE_OK(sogmm_options_create(&o));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, 30, 2, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&m, pts, 30, 2, NULL));
   REQUIRE_OK(sogmm_model_from_arrays_f32(&a, 2, w, mu, cov, 10));
   make_frame(W, H, &depth, &gray, &rgb);
   memset(depth_zero, 0, sizeof depth_zero);
@@ -140,24 +140,29 @@ int main(int argc, char** argv) {
   EXPECT_TRUE(f64 == 0.02);
 
   /* ---- fit from points ---- */
-  ROW("F1", sogmm_fit_points_f32(NULL, pts, 30, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F2", out, sogmm_fit_points_f32(&out, NULL, 30, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F3", out, sogmm_fit_points_f32(&out, pts, 0, NULL), SOGMM_E_INVALID_DATA);
+  ROW("F1", sogmm_fit_points_f32(NULL, pts, 30, NULL, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F2", out, sogmm_fit_points_f32(&out, NULL, 30, NULL, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F3", out, sogmm_fit_points_f32(&out, pts, 0, NULL, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)nan_;
-  ROW_OUT("F4", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F4", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)inf_;
-  ROW_OUT("F5", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F5", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL, NULL), SOGMM_E_INVALID_DATA);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 31));
-  ROW_OUT("F6", out, sogmm_fit_points_f32(&out, pts, 30, o), SOGMM_E_INVALID_ARG);
+  ROW_OUT("F6", out, sogmm_fit_points_f32(&out, pts, 30, NULL, o), SOGMM_E_INVALID_ARG);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
-  ROW_OUT("F7", out, sogmm_fit_points_f32(&out, pts, huge, NULL), SOGMM_E_LIMIT);
-  ROW("F8", sogmm_fit_points_fixed_k_f32(NULL, pts, 30, 2, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F9", out, sogmm_fit_points_fixed_k_f32(&out, NULL, 30, 2, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F10", out, sogmm_fit_points_fixed_k_f32(&out, pts, 30, 0, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("F11", out, sogmm_fit_points_fixed_k_f32(&out, pts, 30, 31, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("F12", out, sogmm_fit_points_fixed_k_f32(&out, pts, 0, 1, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F7", out, sogmm_fit_points_f32(&out, pts, huge, NULL, NULL), SOGMM_E_LIMIT);
+  /* F8-F13: a warm start from `m` (2 components). */
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 3));
+  ROW_OUT("F8", out, sogmm_fit_points_f32(&out, pts, 30, m, o), SOGMM_E_INVALID_ARG); /* K != the initial size */
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2));
+  ROW_OUT("F9", out, sogmm_fit_points_f32(&out, pts, 30, m, o), SOGMM_E_INVALID_ARG);
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
+  ROW("F10", sogmm_fit_points_f32(NULL, pts, 30, m, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F11", out, sogmm_fit_points_f32(&out, NULL, 30, m, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F12", out, sogmm_fit_points_f32(&out, pts, 0, m, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)nan_;
-  ROW_OUT("F13", out, sogmm_fit_points_fixed_k_f32(&out, pts_bad, 2, 1, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F13", out, sogmm_fit_points_f32(&out, pts_bad, 2, m, NULL), SOGMM_E_INVALID_DATA);
 
   /* ---- fit from an RGB-D frame ---- */
 #define FRAME(dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt) \

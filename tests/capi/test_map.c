@@ -113,7 +113,7 @@ static void insert_frames_and_check(const char* dir) {
   {
     sogmm_model* cam = NULL;
     sogmm_map* bad = NULL;
-    REQUIRE_OK(sogmm_fit_points_f32(&cam, pts, 3000, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&cam, pts, 3000, NULL, o));
     snprintf(path, sizeof path, "%s/camera_frame.sogmm", dir);
     REQUIRE_OK(sogmm_model_save(cam, path, NULL));
     EXPECT_STATUS(sogmm_map_load(&bad, path, NULL), SOGMM_E_INVALID_ARG);

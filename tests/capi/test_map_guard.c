@@ -242,7 +242,7 @@ static int32_t nest_fit(int32_t stage, uint64_t step, uint64_t total, double ll,
    * regression fails the test instead of exhausting the stack. */
   if (n->depth < 3) {
     sogmm_model* inner = NULL;
-    n->nested = sogmm_fit_points_fixed_k_f32(&inner, n->points, 600, 3, NULL);
+    n->nested = test_fit_fixed_k(&inner, n->points, 600, 3, NULL);
     if (inner) sogmm_model_n_components(inner, &n->nested_k);
     sogmm_model_free(inner);
   }
@@ -260,7 +260,7 @@ static void test_nested_calls_have_no_callback(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 3));
   REQUIRE_OK(sogmm_options_set_progress(o, nest_fit, &n));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&outer, pts, 600, 3, o));
+  REQUIRE_OK(test_fit_fixed_k(&outer, pts, 600, 3, o));
   EXPECT_TRUE(n.calls > 0);
   EXPECT_TRUE(n.max_depth == 1); /* the nested fits reported to nothing */
   EXPECT_TRUE(n.nested == SOGMM_OK && n.nested_k == 3);
@@ -305,7 +305,7 @@ static void test_slow_callback_reports_per_interval(void) {
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 1));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, threads));
     REQUIRE_OK(sogmm_options_set_progress(o, slow, &c));
-    REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, 1500, k, o));
+    REQUIRE_OK(test_fit_fixed_k(&m, pts, 1500, k, o));
     printf("threads %d: %d seeding reports for %zu seeds, %d reports in all\n", threads, c.seeding_reports, k,
            c.reports);
     EXPECT_TRUE(c.seeding_reports >= 1 && c.seeding_reports <= 30);

@@ -21,7 +21,7 @@ int main(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 3));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 12));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&model, pts, n, 12, o));
+  REQUIRE_OK(test_fit_fixed_k(&model, pts, n, 12, o));
   REQUIRE_OK(sogmm_model_n_components(model, &m));
 
   /* Query keys at their defaults: the answers of NULL options, bit for bit. */

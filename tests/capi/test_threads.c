@@ -46,7 +46,7 @@ static void* worker(void* p) {
       char key[32];
       WCHECK(sogmm_options_create(&o) == SOGMM_OK);
       WCHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
-      WCHECK(sogmm_fit_points_fixed_k_f32(&own, pts, 600, 3, o) == SOGMM_OK);
+      WCHECK(test_fit_fixed_k(&own, pts, 600, 3, o) == SOGMM_OK);
       snprintf(key, sizeof key, "thread-%d", arg->index);
       WCHECK(sogmm_model_set_value(own, key, "x") == SOGMM_OK);
       WCHECK(sogmm_model_merge(&merged, own, g_shared) == SOGMM_OK);
@@ -76,7 +76,7 @@ int main(void) {
   size_t i;
   memcpy(g_points, pts, sizeof g_points);
   for (i = 0; i < N_POINTS; ++i) memcpy(g_xyz + 3 * i, g_points + 4 * i, 3 * sizeof(float));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&shared, pts, N_POINTS, 3, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&shared, pts, N_POINTS, 3, NULL));
   REQUIRE_OK(sogmm_model_set_value(shared, "owner", "main"));
   REQUIRE_OK(sogmm_model_score_samples_f32(shared, g_points, N_POINTS, 4, NULL, g_ref_score));
   REQUIRE_OK(sogmm_model_regress_gray_f32(shared, g_xyz, N_POINTS, NULL, g_ref_gray, g_ref_var));

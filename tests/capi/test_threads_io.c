@@ -51,8 +51,8 @@ static void work(worker_arg* arg, int record) {
     double score[64];
     size_t M = 0, i;
     /* fit: fixed K and self-organizing */
-    WCHECK(sogmm_fit_points_fixed_k_f32(&fit, g_points[t], N_POINTS, 4, o) == SOGMM_OK);
-    WCHECK(sogmm_fit_points_f32(&so, g_points[t], N_POINTS, o) == SOGMM_OK);
+    WCHECK(test_fit_fixed_k(&fit, g_points[t], N_POINTS, 4, o) == SOGMM_OK);
+    WCHECK(sogmm_fit_points_f32(&so, g_points[t], N_POINTS, NULL, o) == SOGMM_OK);
     WCHECK(sogmm_model_n_components(so, &M) == SOGMM_OK && M >= 1);
     if (record) g_ref_M[t] = M;
     else WCHECK(M == g_ref_M[t]);
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   int t, failures = 0;
   g_dir = argc > 1 ? argv[1] : "/tmp";
   pts = make_clusters(N_POINTS, 5);
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&shared, pts, N_POINTS, 3, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&shared, pts, N_POINTS, 3, NULL));
   snprintf(g_shared_path, sizeof g_shared_path, "%s/threads-io-shared.sogmm", g_dir);
   REQUIRE_OK(sogmm_model_save(shared, g_shared_path, NULL));
   snprintf(g_same_path, sizeof g_same_path, "%s/threads-io-same.sogmm", g_dir);

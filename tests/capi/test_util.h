@@ -223,4 +223,16 @@ static inline sogmm_status test_rgbd_to_points(float* out, size_t capacity, size
   return s;
 }
 
+/* A fixed-K fit: sogmm_fit_points_f32 with SOGMM_OPT_N_COMPONENTS = k on a
+ * copy of `options` (NULL = defaults); the first status that is not SOGMM_OK. */
+static inline sogmm_status test_fit_fixed_k(sogmm_model** out, const float* points, size_t n, size_t k,
+                                            const sogmm_options* options) {
+  sogmm_options* o = NULL;
+  sogmm_status s = options ? sogmm_options_clone(&o, options) : sogmm_options_create(&o);
+  if (s == SOGMM_OK) s = sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, (int64_t)k);
+  if (s == SOGMM_OK) s = sogmm_fit_points_f32(out, points, n, NULL, o);
+  sogmm_options_free(o);
+  return s;
+}
+
 #endif /* SOGMM_TEST_UTIL_H */

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "fuzz_model_check.hpp"
+#include "../hardening/capi_calls.hpp"
 #include "fuzz_util.hpp"
 #include "sogmm/sogmm.h"
 
@@ -220,13 +221,13 @@ void step_fit(State& st, sogmm_fuzz::Reader& in) {
   sogmm_status s;
   if (how & 1) {
     const std::size_t k = (how >> 1) % 9;
-    s = sogmm_fit_points_fixed_k_f32(&m, pts.data(), n, k, o);
+    s = sogmm_test::fit_fixed_k(&m, pts.data(), n, k, o);
   } else {
     // The mode count can find many components in a small noisy cloud: a larger bandwidth keeps steps cheap.
     double bw = 0.02;
     if (sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &bw) == SOGMM_OK && bw < 0.01)
       FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.01) == SOGMM_OK);
-    s = sogmm_fit_points_f32(&m, pts.data(), n, o);
+    s = sogmm_fit_points_f32(&m, pts.data(), n, nullptr, o);
   }
   check_created(s, m);
   if (s == SOGMM_OK) put(st, slot, m);

@@ -29,7 +29,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/format.hpp"
-#include "capi_frame.hpp"
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 

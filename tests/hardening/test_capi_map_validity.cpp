@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "capi_frame.hpp"
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -108,9 +108,9 @@ TEST(CapiMapValidity, AFarPointIsJudgedAsAFitAtTheBatchBandwidth) {
   ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
   ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02 * 0.7), SOGMM_OK);
   sogmm_model* fitted = nullptr;
-  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, o), SOGMM_E_LIMIT);
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, nullptr, o), SOGMM_E_LIMIT);
   ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02), SOGMM_OK);
-  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, o), SOGMM_OK) << last_error();
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, nullptr, o), SOGMM_OK) << last_error();
   sogmm_model_free(fitted);
   sogmm_options_free(o);
   MapHandle m;

@@ -140,7 +140,7 @@ TEST(CapiHostile, FitNeverReturnsNaN) {
       ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
       sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1);
       sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, static_cast<std::int64_t>(k));
-      const sogmm_status s = sogmm_fit_points_f32(&m, cloud.data(), cloud.size() / 4, o);
+      const sogmm_status s = sogmm_fit_points_f32(&m, cloud.data(), cloud.size() / 4, nullptr, o);
       ASSERT_EQ(s, SOGMM_OK) << c.name << " K=" << k << ": " << sogmm_last_error();
       std::size_t mm = 0;
       ASSERT_EQ(sogmm_model_n_components(m, &mm), SOGMM_OK);

@@ -248,7 +248,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
 #define SOGMM_OPT_MAP_WARM_START 606        /* i64, 0 or 1; default 0. 1: each batch's fit starts from the
                                              * previous batch's model moved into its camera (as
-                                             * sogmm_fit_points_warm_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
+                                             * a warm sogmm_fit_points_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
 #define SOGMM_FUSION_HELLINGER 0 /* Hellinger distance of the 4-D Gaussians, in [0, 1] */
 #define SOGMM_FUSION_KL 1        /* symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, nats */
 
@@ -340,8 +340,7 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
 
 /* Sets the progress callback of `options` (fn = NULL removes it); user_data
  * is passed through and not owned. sogmm_options_clone copies the pair.
- * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
- * sogmm_fit_points_warm_f32, sogmm_fit_frame (from the mode count on),
+ * Called by sogmm_fit_points_f32, sogmm_fit_frame (from the mode count on),
  * sogmm_model_sample_f32, sogmm_model_regress_gray_f32,
  * sogmm_model_score_samples_f32 and the map queries sogmm_map_score_samples_f32,
  * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
@@ -353,38 +352,31 @@ SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_
 /* ---- fitting ---------------------------------------------------------- */
 /* Fits a model to n points (x, y, z, gray): `points` holds n * 4 floats.
  * Uses the fit keys of `options` (NULL = defaults). With
- * SOGMM_OPT_N_COMPONENTS = K > 0 the mode count is skipped (fixed K).
- * The model records the fit report and the fit parameters (see
- * SOGMM_INFO_*). Errors: n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA;
- * K > n -> SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
-                                            const sogmm_options* options);
-
-/* Same as sogmm_fit_points_f32 with exactly k components (k >= 1, k <= n),
- * overriding SOGMM_OPT_N_COMPONENTS. */
-SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
-                                                    size_t k, const sogmm_options* options);
-
-/* Warm start: fits n points starting from `initial`, a model of an earlier,
- * overlapping cloud already moved into these points' frame (e.g. the previous
- * frame's model moved by the relative pose with sogmm_model_transform).
- * Self-organizing (SOGMM_OPT_N_COMPONENTS = 0): components of `initial`
- * whose responsibility mass on the well-explained points is below 2 points
- * are removed; points more than 10 nats below the median log-likelihood under
- * `initial` are novel, and the mode count (SOGMM_OPT_BANDWIDTH) and k-means++
- * (SOGMM_OPT_SEED) on the novel points only add that many new components; EM
- * then runs from kept + new. When `initial` explains the points badly (fewer
- * than half of them: the median point's log-likelihood more than 10 nats
- * below the mean log-likelihood `initial` gives its own samples, e.g. a start
- * far from the points), it is dropped and the fit is a cold one (every point
- * novel). With N_COMPONENTS = K > 0, EM runs from `initial`
- * as given, which must have K components. The model records the fit like
- * sogmm_fit_points_f32; `initial` is not modified and may be freed
- * afterwards. Errors as sogmm_fit_points_f32, plus: initial NULL ->
- * SOGMM_E_NULL_ARG; SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
+ * SOGMM_OPT_N_COMPONENTS = K > 0 the mode count is skipped and the model has
+ * exactly K components (fixed K). The model records the fit report and the
+ * fit parameters (see SOGMM_INFO_*). Errors: n == 0 or NaN/Inf ->
+ * SOGMM_E_INVALID_DATA; K > n -> SOGMM_E_INVALID_ARG.
+ *
+ * `initial` NULL: a cold fit. Otherwise a warm start: the fit starts from
+ * `initial`, a model of an earlier, overlapping cloud already moved into these
+ * points' frame (e.g. the previous frame's model moved by the relative pose
+ * with sogmm_model_transform). Self-organizing (SOGMM_OPT_N_COMPONENTS = 0):
+ * components of `initial` whose responsibility mass on the well-explained
+ * points is below 2 points are removed; points more than 10 nats below the
+ * median log-likelihood under `initial` are novel, and the mode count
+ * (SOGMM_OPT_BANDWIDTH) and k-means++ (SOGMM_OPT_SEED) on the novel points
+ * only add that many new components; EM then runs from kept + new. When
+ * `initial` explains the points badly (fewer than half of them: the median
+ * point's log-likelihood more than 10 nats below the mean log-likelihood
+ * `initial` gives its own samples, e.g. a start far from the points), it is
+ * dropped and the fit is a cold one (every point novel). With
+ * N_COMPONENTS = K > 0, EM runs from `initial` as given, which must have K
+ * components. `initial` is not modified and may be freed afterwards. Warm
+ * start errors: SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
  * SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
-                                                 const sogmm_model* initial, const sogmm_options* options);
+SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
+                                            const sogmm_model* initial, const sogmm_options* options);
+
 
 /* ---- RGB-D frames ---------------------------------------------------- */
 /* A frame holds the depth image, the colour image (or none) and the camera

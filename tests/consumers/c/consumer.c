@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   CHECK(sogmm_options_create(&options));
   CHECK(sogmm_options_set_f64(options, SOGMM_OPT_BANDWIDTH, 0.05));
   CHECK(sogmm_options_set_i64(options, SOGMM_OPT_SEED, 1));
-  CHECK(sogmm_fit_points_f32(&model, points, n, options));
+  CHECK(sogmm_fit_points_f32(&model, points, n, NULL, options));
   CHECK(sogmm_model_n_components(model, &fitted));
 
   snprintf(path, sizeof path, "%s/consumer_c.sogmm", argv[1]);

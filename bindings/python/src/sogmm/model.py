@@ -727,19 +727,16 @@ class SOGMM(GMM):
         ``init``: warm start from a model of an earlier, overlapping cloud,
         already in these points' frame (e.g. ``prev.transform(relative_pose)``);
         the rule for keeping, removing and adding components is that of
-        ``sogmm_fit_points_warm_f32`` (needs ``n_init == 1``)."""
+        ``sogmm_fit_points_f32`` with ``initial`` (needs ``n_init == 1``)."""
         x = _rows(X, (4,), "X")
         if init is not None and not isinstance(init, GMM):
             raise InvalidArgumentError(f"init must be a fitted GMM or SOGMM, got {type(init).__name__}")
         out = c_void_p()
+        initial = None if init is None else init._h()
         with self._fit_options() as o:
-            if init is None:
-                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr),
-                                   keep=lambda: self._attach(out))
-            else:
-                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_warm_f32(byref(out), x, x.shape[0],
-                                                                                       init._h(), o.ptr),
-                                   keep=lambda: self._attach(out))
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], initial, o.ptr),
+                               keep=lambda: self._attach(out))
         return self
 
     def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = _D.depth_scale,

@@ -231,26 +231,6 @@ extern "C" {
         fn_: sogmm_progress_fn,
         user_data: *mut c_void,
     ) -> sogmm_status;
-    pub fn sogmm_fit_points_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_points_fixed_k_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        k: usize,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_points_warm_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        initial: *const sogmm_model,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
     pub fn sogmm_model_from_arrays_f32(
         out: *mut *mut sogmm_model,
         m: usize,
@@ -456,6 +436,13 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_fit_points_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        initial: *const sogmm_model,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_frame_from_arrays(
         out: *mut *mut sogmm_frame,
         width: u32,

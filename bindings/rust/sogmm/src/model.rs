@@ -203,7 +203,7 @@ impl Model {
     pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
         let n = rows(points, 4, "points")?;
         // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, opt_ptr(options)) })
+        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), opt_ptr(options)) })
     }
 
     /// As `fit`, reporting progress to `on_progress` (called only on this
@@ -220,7 +220,7 @@ impl Model {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| {
             // SAFETY: as fit; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, o) })
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), o) })
         })
     }
 
@@ -245,7 +245,7 @@ impl Model {
         let n = rows(points, 4, "points")?;
         // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
         Model::make(|out| unsafe {
-            sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
+            sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
         })
     }
 
@@ -260,15 +260,23 @@ impl Model {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| {
             // SAFETY: as fit_warm; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), o) })
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), o) })
         })
     }
 
-    /// Fits exactly `k` components (1 <= k <= n).
+    /// Fits exactly `k` components (1 <= k <= n): `fit` with
+    /// SOGMM_OPT_N_COMPONENTS = k on a copy of `options`.
     pub fn fit_fixed_k(points: &[f32], k: usize, options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        // SAFETY: as fit.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_fixed_k_f32(out, points.as_ptr(), n, k, opt_ptr(options)) })
+        if k == 0 {
+            return Err(invalid("k is 0: a fixed-K fit needs k >= 1".to_string()));
+        }
+        let k = i64::try_from(k).map_err(|_| invalid(format!("k = {k} is too large")))?;
+        let mut o = match options {
+            Some(o) => o.try_clone()?,
+            None => Options::new()?,
+        };
+        o.set_i64(sys::SOGMM_OPT_N_COMPONENTS, k)?;
+        Model::fit(points, Some(&o))
     }
 
     /// Fits one RGB-D frame; decimation and depth range come from `options`.
