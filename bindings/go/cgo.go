@@ -27,8 +27,8 @@ package sogmm
 #cgo LDFLAGS: -L${SRCDIR}/../../build/capi -Wl,-rpath,${SRCDIR}/../../build/capi -lsogmm
 #include <stdlib.h>
 #include "sogmm/sogmm.h"
-#if SOGMM_ABI_VERSION != 1
-#error "these bindings are written for SOGMM_ABI_VERSION 1"
+#if SOGMM_ABI_VERSION != 2
+#error "these bindings are written for SOGMM_ABI_VERSION 2"
 #endif
 */
 import "C"

@@ -45,16 +45,41 @@ func (f *Frame) colorArgs() (unsafe.Pointer, C.int32_t, error) {
 	return color, format, nil
 }
 
-// FitRGBD fits one frame; decimation and depth range come from o.
-func FitRGBD(f Frame, o *Options) (*Model, error) {
+// handle makes the C frame (sogmm_frame_from_arrays, copying the pixels, with
+// the intrinsics) that the fit, the map insert and Points hand to the
+// library; the caller frees it with C.sogmm_frame_free.
+func (f *Frame) handle() (*C.sogmm_frame, error) {
 	color, format, err := f.colorArgs()
 	if err != nil {
 		return nil, err
 	}
+	var h *C.sogmm_frame
+	err = call(func() C.sogmm_status {
+		return C.sogmm_frame_from_arrays(&h, C.uint32_t(f.Width), C.uint32_t(f.Height),
+			(*C.uint16_t)(unsafe.SliceData(f.Depth)), color, format)
+	})
+	runtime.KeepAlive(f)
+	if err != nil {
+		return nil, err
+	}
+	if err := call(func() C.sogmm_status {
+		return C.sogmm_frame_set_intrinsics(h, C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy))
+	}); err != nil {
+		C.sogmm_frame_free(h)
+		return nil, err
+	}
+	return h, nil
+}
+
+// FitRGBD fits one frame; decimation and depth range come from o.
+func FitRGBD(f Frame, o *Options) (*Model, error) {
+	h, err := f.handle()
+	if err != nil {
+		return nil, err
+	}
+	defer C.sogmm_frame_free(h)
 	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_rgbd(out, (*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format,
-			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx),
-			C.double(f.Cy), op)
+		return C.sogmm_fit_frame(out, h, op)
 	})
 }
 
@@ -62,20 +87,19 @@ func FitRGBD(f Frame, o *Options) (*Model, error) {
 // z, gray) in the camera frame (decimation and depth range from o). A frame
 // without a valid pixel gives an empty slice.
 func (f Frame) Points(o *Options) ([]float32, error) {
-	color, format, err := f.colorArgs()
-	if err != nil {
-		return nil, err
-	}
 	op, err := o.raw()
 	if err != nil {
 		return nil, err
 	}
+	h, err := f.handle()
+	if err != nil {
+		return nil, err
+	}
+	defer C.sogmm_frame_free(h)
 	var n C.size_t
 	fill := func(out []float32) error {
 		return call(func() C.sogmm_status {
-			return C.sogmm_rgbd_to_points_f32(floats(out), C.size_t(len(out)), &n,
-				(*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format, C.uint32_t(f.Width),
-				C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy), op)
+			return C.sogmm_frame_to_points_f32(floats(out), C.size_t(len(out)), &n, h, op)
 		})
 	}
 	if err := fill(nil); err != nil { // capacity 0: only counts

@@ -49,6 +49,7 @@ type Map struct {
 // MapStats are the totals of a map.
 type MapStats struct {
 	Components, Pending, Frames, Flushes, Fused uint64
+	Refits                                      uint64 // revisit refits run (also counted in Flushes)
 }
 
 // MapFrameStats is what one insert did.
@@ -150,14 +151,13 @@ func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
 }
 
 func (m *Map) insertRGBD(f Frame, pose [16]float64, progress *mapProgress) error {
-	color, format, err := f.colorArgs()
+	h, err := f.handle()
 	if err != nil {
 		return err
 	}
+	defer C.sogmm_frame_free(h)
 	return m.change("InsertRGBD", progress, func(p *C.sogmm_map) C.sogmm_status {
-		return C.sogmm_map_insert_rgbd(p, (*C.uint16_t)(unsafe.SliceData(f.Depth)), (*C.uint8_t)(color), format,
-			C.uint32_t(f.Width), C.uint32_t(f.Height), C.double(f.Fx), C.double(f.Fy), C.double(f.Cx), C.double(f.Cy),
-			(*C.double)(&pose[0]))
+		return C.sogmm_map_insert_frame(p, h, (*C.double)(&pose[0]))
 	})
 }
 
@@ -179,33 +179,70 @@ func (m *Map) DiscardPending() (uint64, error) {
 	return uint64(dropped), err
 }
 
-// Stats returns the map's totals.
+// Stats returns the map's totals (read key by key, sogmm_map_get_i64).
 func (m *Map) Stats() (MapStats, error) {
-	var s C.sogmm_map_stats
+	var s MapStats
+	fields := []struct {
+		key C.sogmm_key
+		dst *uint64
+	}{{C.SOGMM_MAP_N_COMPONENTS, &s.Components}, {C.SOGMM_MAP_N_PENDING, &s.Pending},
+		{C.SOGMM_MAP_N_FRAMES, &s.Frames}, {C.SOGMM_MAP_N_FLUSHES, &s.Flushes}, {C.SOGMM_MAP_N_FUSED, &s.Fused},
+		{C.SOGMM_MAP_N_REFITS, &s.Refits}}
 	err := m.read("Stats", func() error {
-		return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_stats(p, &s) })
-	})
-	return MapStats{uint64(s.n_components), uint64(s.n_pending), uint64(s.n_frames), uint64(s.n_flushes),
-		uint64(s.n_fused)}, err
-}
-
-// FrameStats returns what the insert of frame i (insertion order) did.
-func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
-	var s C.sogmm_map_frame_stats
-	var replaced C.uint64_t
-	err := m.read("FrameStats", func() error {
 		return m.do(func(p *C.sogmm_map) C.sogmm_status {
-			if st := C.sogmm_map_get_frame_stats(p, C.uint64_t(i), &s); st != C.SOGMM_OK {
-				return st
+			for _, f := range fields {
+				var v C.int64_t
+				if st := C.sogmm_map_get_i64(p, f.key, &v); st != C.SOGMM_OK {
+					return st
+				}
+				*f.dst = uint64(v)
 			}
-			return C.sogmm_map_get_frame_replaced(p, C.uint64_t(i), &replaced)
+			return C.SOGMM_OK
 		})
 	})
-	out := MapFrameStats{Points: uint64(s.n_points), Novel: uint64(s.n_novel), Components: uint64(s.n_components),
-		Flushed: s.flushed != 0, MsNovelty: float64(s.ms_novelty), MsFit: float64(s.ms_fit),
-		MsMerge: float64(s.ms_merge), Replaced: uint64(replaced)}
+	return s, err
+}
+
+// FrameStats returns what the insert of frame i (insertion order) did (read
+// key by key, sogmm_map_frame_get_*).
+func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {
+	var out MapFrameStats
+	var flushed uint64
+	ints := []struct {
+		key C.sogmm_key
+		dst *uint64
+	}{{C.SOGMM_MAP_FRAME_N_POINTS, &out.Points}, {C.SOGMM_MAP_FRAME_N_NOVEL, &out.Novel},
+		{C.SOGMM_MAP_FRAME_N_COMPONENTS, &out.Components}, {C.SOGMM_MAP_FRAME_FLUSHED, &flushed},
+		{C.SOGMM_MAP_FRAME_N_REPLACED, &out.Replaced}}
+	floats := []struct {
+		key C.sogmm_key
+		dst *float64
+	}{{C.SOGMM_MAP_FRAME_MS_NOVELTY, &out.MsNovelty}, {C.SOGMM_MAP_FRAME_MS_FIT, &out.MsFit},
+		{C.SOGMM_MAP_FRAME_MS_MERGE, &out.MsMerge}}
+	var pose [16]C.double
+	err := m.read("FrameStats", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status {
+			frame := C.uint64_t(i)
+			for _, f := range ints {
+				var v C.int64_t
+				if st := C.sogmm_map_frame_get_i64(p, frame, f.key, &v); st != C.SOGMM_OK {
+					return st
+				}
+				*f.dst = uint64(v)
+			}
+			for _, f := range floats {
+				var v C.double
+				if st := C.sogmm_map_frame_get_f64(p, frame, f.key, &v); st != C.SOGMM_OK {
+					return st
+				}
+				*f.dst = float64(v)
+			}
+			return C.sogmm_map_frame_get_pose(p, frame, &pose[0])
+		})
+	})
+	out.Flushed = flushed != 0
 	for k := range out.Pose {
-		out.Pose[k] = float64(s.pose[k])
+		out.Pose[k] = float64(pose[k])
 	}
 	return out, err
 }

@@ -319,7 +319,8 @@ func TestRevisitRefitRatio(t *testing.T) {
 		if err != nil {
 			t.Fatal(err)
 		}
-		if f0.Replaced != 0 || (f1.Replaced > 0) != (st.Flushes == 2) || f1.Flushed != (st.Flushes == 2) {
+		if f0.Replaced != 0 || (f1.Replaced > 0) != (st.Flushes == 2) || f1.Flushed != (st.Flushes == 2) ||
+			st.Refits != st.Flushes-1 {
 			t.Fatalf("frame stats %+v, %+v with %d fits", f0, f1, st.Flushes)
 		}
 		return st.Flushes

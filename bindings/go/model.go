@@ -117,22 +117,31 @@ func Fit(points []float32, o *Options) (*Model, error) {
 		return nil, err
 	}
 	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), op)
+		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), nil, op)
 	})
 }
 
-// FitFixedK fits exactly k components (1 <= k <= n).
+// FitFixedK fits exactly k components (1 <= k <= n): Fit with
+// OptNComponents = k on a copy of o (o may be nil).
 func FitFixedK(points []float32, k int, o *Options) (*Model, error) {
-	n, err := rowsOf(points, 4, "points")
-	if err != nil {
-		return nil, err
-	}
 	if k < 1 {
 		return nil, invalidArg("k must be >= 1, got %d", k)
 	}
-	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_fixed_k_f32(out, floats(points), C.size_t(n), C.size_t(k), op)
-	})
+	var fixed *Options
+	var err error
+	if o != nil {
+		fixed, err = o.Clone()
+	} else {
+		fixed, err = NewOptions()
+	}
+	if err != nil {
+		return nil, err
+	}
+	defer fixed.Close()
+	if err := fixed.SetI64(OptNComponents, int64(k)); err != nil {
+		return nil, err
+	}
+	return Fit(points, fixed)
 }
 
 // FromArrays builds a model from M weights, M x 4 means and M x 4 x 4

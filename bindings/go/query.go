@@ -219,7 +219,7 @@ func (m *Model) regressGray(xyz []float32, o *Options) (mean, variance []float32
 	}
 	mean, variance = make([]float32, n), make([]float32, n)
 	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_regress_gray_f32_v2(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
+		return C.sogmm_model_regress_gray_f32(p, floats(xyz), C.size_t(n), op, floats(mean), floats(variance))
 	})
 	if err != nil {
 		return nil, nil, err
@@ -246,7 +246,7 @@ func (m *Model) scoreSamples(points []float32, dims int, o *Options) ([]float64,
 		return nil, err
 	}
 	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_model_score_samples_f32_v2(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
+		return C.sogmm_model_score_samples_f32(p, floats(points), C.size_t(n), C.int32_t(dims), op, doubles(out))
 	})
 	if err != nil {
 		return nil, err

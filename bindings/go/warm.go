@@ -25,7 +25,7 @@ func FitWarm(points []float32, initial *Model, o *Options) (*Model, error) {
 	}
 	defer runtime.KeepAlive(initial)
 	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_warm_f32(out, floats(points), C.size_t(n), initial.ptr, op)
+		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), initial.ptr, op)
 	})
 }
 

@@ -60,7 +60,7 @@ static int write_model(const char* points_path, const char* out_path) {
   else if ((st = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) rc = fail("bandwidth", st);
   else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) rc = fail("seed", st);
   else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) rc = fail("threads", st);
-  else if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, o)) != SOGMM_OK) rc = fail("fit", st);
+  else if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, NULL, o)) != SOGMM_OK) rc = fail("fit", st);
   else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
   else rc = 0;
   sogmm_model_free(m);
@@ -120,9 +120,9 @@ static int read_model(const char* model_path, const char* query_path, const char
   fwrite(buf, sizeof(float), 16 * k, out);
   if ((st = sogmm_model_sample_f32(m, N_SAMPLES, SAMPLE_SEED, 4, NULL, buf)) != SOGMM_OK) { rc = fail("sample", st); goto done; }
   fwrite(buf, sizeof(float), 4 * N_SAMPLES, out);
-  if ((st = sogmm_model_regress_gray_f32(m, q, nq, buf, buf + nq)) != SOGMM_OK) { rc = fail("regress", st); goto done; }
+  if ((st = sogmm_model_regress_gray_f32(m, q, nq, NULL, buf, buf + nq)) != SOGMM_OK) { rc = fail("regress", st); goto done; }
   fwrite(buf, sizeof(float), 2 * nq, out);
-  if ((st = sogmm_model_score_samples_f32(m, q, nq, 3, score)) != SOGMM_OK) { rc = fail("score", st); goto done; }
+  if ((st = sogmm_model_score_samples_f32(m, q, nq, 3, NULL, score)) != SOGMM_OK) { rc = fail("score", st); goto done; }
   fwrite(score, sizeof(double), nq, out);
   rc = ferror(out) ? 1 : 0;
 done:

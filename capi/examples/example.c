@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   uint8_t* gray = NULL;
   sogmm_options* options = NULL;
   sogmm_model* model = NULL;
+  sogmm_frame* frame = NULL;
   sogmm_model* loaded = NULL;
   float* samples = NULL;
   size_t m = 0, loaded_m = 0, i;
@@ -69,8 +70,10 @@ int main(int argc, char** argv) {
   TRY(sogmm_options_set_i64(options, SOGMM_OPT_DECIMATION, 4));
   TRY(sogmm_options_set_i64(options, SOGMM_OPT_SEED, 1));
 
-  TRY(sogmm_fit_rgbd(&model, depth, gray, SOGMM_COLOR_GRAY8, width, height, 140.0, 140.0, 79.5, 59.5,
-                     options));
+  /* The frame: the arrays (copied) and the camera's intrinsics. */
+  TRY(sogmm_frame_from_arrays(&frame, width, height, depth, gray, SOGMM_COLOR_GRAY8));
+  TRY(sogmm_frame_set_intrinsics(frame, 140.0, 140.0, 79.5, 59.5));
+  TRY(sogmm_fit_frame(&model, frame, options));
   TRY(sogmm_model_n_components(model, &m));
   TRY(sogmm_model_get_info_i64(model, SOGMM_INFO_FIT_ITERATIONS, &iterations));
   TRY(sogmm_model_get_info_i64(model, SOGMM_INFO_FIT_CONVERGED, &converged));
@@ -89,7 +92,7 @@ int main(int argc, char** argv) {
   printf("first sample: (%.3f, %.3f, %.3f, gray %.3f)\n", samples[0], samples[1], samples[2], samples[3]);
 
   /* Expected gray and its variance at two 3-D points. */
-  TRY(sogmm_model_regress_gray_f32(model, xyz, 2, g, var));
+  TRY(sogmm_model_regress_gray_f32(model, xyz, 2, NULL, g, var));
   for (i = 0; i < 2; ++i)
     printf("gray at (%.2f, %.2f, %.2f): %.3f (variance %.5f)\n", xyz[3 * i], xyz[3 * i + 1],
            xyz[3 * i + 2], g[i], var[i]);
@@ -108,6 +111,7 @@ done:
   /* Every free function accepts NULL. */
   sogmm_model_free(loaded);
   sogmm_model_free(model);
+  sogmm_frame_free(frame);
   sogmm_options_free(options);
   free(samples);
   free(depth);

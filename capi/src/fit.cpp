@@ -34,10 +34,11 @@ using sogmm_capi::require_nonnull;
 
 /// Runs the fit on checked points (a warm start from `initial` if not null)
 /// and wraps the result (fit report, fit parameters, timings) in a new handle.
-/// `from_depth_image`: the points are sogmm_fit_rgbd's (the automatic depth
+/// `from_depth_image`: the points are sogmm_fit_frame's (the automatic depth
 /// floor applies).
-sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, const sogmm_options& o,
+sogmm_model* fit_to_handle(const float* points, std::size_t n, const sogmm_options& o,
                            const sogmm::Gmm* initial = nullptr, bool from_depth_image = false) {
+  const std::size_t k = o.settings.fit.n_components;  // 0: self-organizing
   if (n == 0) fail(SOGMM_E_INVALID_DATA, "n is 0: nothing to fit");
   const std::size_t count = sogmm::checked::mul<std::size_t>(n, 4, "points");
   // The size limit first, so an oversized input is refused before it is read.
@@ -79,53 +80,26 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, std::size_t k, co
 extern "C" {
 
 SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
-                                            const sogmm_options* options) {
+                                            const sogmm_model* initial, const sogmm_options* options) {
   SOGMM_TRY {
     sogmm_capi::require_out(out);
     require_nonnull(points, "points");
-    const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = fit_to_handle(points, n, o.settings.fit.n_components, o);
+    *out = fit_to_handle(points, n, sogmm_capi::opts_or_default(options),
+                         initial != nullptr ? &initial->model.gmm : nullptr);
   }
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
-                                                    size_t k, const sogmm_options* options) {
-  SOGMM_TRY {
-    sogmm_capi::require_out(out);
-    require_nonnull(points, "points");
-    if (k == 0) fail(SOGMM_E_INVALID_ARG, "k is 0: a fixed-K fit needs k >= 1");
-    *out = fit_to_handle(points, n, k, sogmm_capi::opts_or_default(options));
-  }
-  SOGMM_CATCH
-}
-
-SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
-                                                 const sogmm_model* initial, const sogmm_options* options) {
-  SOGMM_TRY {
-    sogmm_capi::require_out(out);
-    require_nonnull(points, "points");
-    require_nonnull(initial, "initial");
-    const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = fit_to_handle(points, n, o.settings.fit.n_components, o, &initial->model.gmm);
-  }
-  SOGMM_CATCH
-}
-
-SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
-                                      int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                      double fy, double cx, double cy, const sogmm_options* options) {
+SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options) {
   SOGMM_TRY {
     sogmm_capi::require_out(out);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    const sogmm_capi::RgbdPoints r =
-        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, o);
+    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, o);
     if (r.cloud.size() == 0)
       fail(SOGMM_E_INVALID_DATA, "no pixel has a depth in the valid range after decimation");
 
     std::unique_ptr<sogmm_model> handle(
-        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), o.settings.fit.n_components, o, nullptr,
-                      r.cloud.from_depth_image));
+        fit_to_handle(r.cloud.xyzg.data(), r.cloud.size(), o, nullptr, r.cloud.from_depth_image));
     sogmm::CameraInfo& ci = handle->model.camera;
     ci.known = true;
     ci.camera = r.camera;

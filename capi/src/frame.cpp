@@ -1,41 +1,67 @@
-// sogmm_frame: accessors, intrinsics, and the fit and map insert that take a
-// frame. Both hand the frame's pixels to the RGB-D calls, so a frame gives
-// bitwise what those calls give with the same pixels.
+// sogmm_frame: made from arrays in memory, its accessors and intrinsics. The
+// fit, the map insert and the back-projection that take a frame are in fit.cpp,
+// map.cpp and rgbd.cpp; frames from image files in frame_io.cpp.
+#include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "frame_handle.hpp"
 #include "internal.hpp"
+#include "sogmm/checked.hpp"
+#include "sogmm/fit.hpp"
 
 namespace {
 
-// The colour bytes and layout the RGB-D calls take: a frame without a colour
-// image is fitted with gray 0, as the CLI's depth-only frames are.
-struct ColorArg {
-  std::vector<std::uint8_t> zeros;
-  const std::uint8_t* data;
-  std::int32_t format;
-};
+using sogmm_capi::fail;
 
-ColorArg color_of(const sogmm_frame& f) {
-  ColorArg c{{}, f.color.data(), f.color_format};
-  if (f.color_format == 0) {
-    c.zeros.assign(static_cast<std::size_t>(f.width) * f.height, 0);
-    c.data = c.zeros.data();
-    c.format = SOGMM_COLOR_GRAY8;
+// Bytes per pixel of a colour layout; SOGMM_E_INVALID_ARG for an unknown one.
+std::size_t color_pixel_bytes(std::int32_t format) {
+  switch (format) {
+    case SOGMM_COLOR_GRAY8: return 1;
+    case SOGMM_COLOR_RGB8: return 3;
+    case SOGMM_COLOR_GRAY_F32: return sizeof(float);
+    default: fail(SOGMM_E_INVALID_ARG, "unknown color_format " + std::to_string(format));
   }
-  return c;
-}
-
-void require_intrinsics(const sogmm_frame& f) {
-  if (!f.has_intrinsics)
-    sogmm_capi::fail(SOGMM_E_INVALID_ARG, "the frame has no intrinsics (call sogmm_frame_set_intrinsics first)");
 }
 
 }  // namespace
 
 extern "C" {
+
+SOGMM_API sogmm_status sogmm_frame_from_arrays(sogmm_frame** out, uint32_t width, uint32_t height,
+                                               const uint16_t* depth, const void* color, int32_t color_format) {
+  SOGMM_TRY {
+    sogmm_capi::require_out(out);
+    sogmm_capi::require_nonnull(depth, "depth");
+    if (color == nullptr && color_format != 0)
+      fail(SOGMM_E_NULL_ARG, "color is NULL but color_format is " + std::to_string(color_format) +
+                                 " (0 = no colour image)");
+    const std::size_t color_bytes = color == nullptr ? 0 : color_pixel_bytes(color_format);
+    const std::uint32_t kMax = static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max());
+    if (width == 0 || height == 0 || width > kMax || height > kMax)
+      fail(SOGMM_E_INVALID_ARG, "image size " + std::to_string(width) + " x " + std::to_string(height) +
+                                    " is invalid (each side in [1, 2^31-1])");
+    // The frame reader's limit (as many pixels as one fit takes), checked
+    // before anything is copied.
+    const std::uint64_t pixels = std::uint64_t{width} * height;
+    if (pixels > sogmm::kMaxPoints)
+      fail(SOGMM_E_LIMIT, "image of " + std::to_string(width) + " x " + std::to_string(height) + " = " +
+                              std::to_string(pixels) + " pixels exceeds the limit of " +
+                              std::to_string(sogmm::kMaxPoints));
+    auto f = std::make_unique<sogmm_frame>();
+    f->width = width;
+    f->height = height;
+    f->depth.assign(depth, depth + pixels);
+    if (color != nullptr) {
+      const auto* bytes = static_cast<const std::uint8_t*>(color);
+      f->color.assign(bytes, bytes + pixels * color_bytes);
+      f->color_format = color_format;
+    }
+    *out = f.release();
+  }
+  SOGMM_CATCH
+}
 
 SOGMM_API void sogmm_frame_free(sogmm_frame* frame) { delete frame; }
 
@@ -57,30 +83,6 @@ SOGMM_API sogmm_status sogmm_frame_set_intrinsics(sogmm_frame* frame, double fx,
     frame->cx = cx;
     frame->cy = cy;
     frame->has_intrinsics = true;
-  }
-  SOGMM_CATCH
-}
-
-SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options) {
-  SOGMM_TRY {
-    sogmm_capi::require_out(out);
-    sogmm_capi::require_nonnull(frame, "frame");
-    require_intrinsics(*frame);
-    const ColorArg c = color_of(*frame);
-    return sogmm_fit_rgbd(out, frame->depth.data(), c.data, c.format, frame->width, frame->height, frame->fx,
-                          frame->fy, frame->cx, frame->cy, options);
-  }
-  SOGMM_CATCH
-}
-
-SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose) {
-  SOGMM_TRY {
-    sogmm_capi::require_nonnull(map, "map");
-    sogmm_capi::require_nonnull(frame, "frame");
-    require_intrinsics(*frame);
-    const ColorArg c = color_of(*frame);
-    return sogmm_map_insert_rgbd(map, frame->depth.data(), c.data, c.format, frame->width, frame->height,
-                                 frame->fx, frame->fy, frame->cx, frame->cy, pose);
   }
   SOGMM_CATCH
 }

@@ -1,4 +1,4 @@
-// Inference on a model: sample, regress gray, score, merge, transform.
+// Inference on a model: sample, merge, transform (score and regress: model_queries.cpp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,16 +36,6 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
     });
   }
   SOGMM_CATCH
-}
-
-SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
-                                                    float* mean_out, float* variance_out) {
-  return sogmm_model_regress_gray_f32_v2(model, xyz, n, nullptr, mean_out, variance_out);
-}
-
-SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
-                                                     size_t n, int32_t dims, double* out) {
-  return sogmm_model_score_samples_f32_v2(model, points, n, dims, nullptr, out);
 }
 
 SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a, const sogmm_model* b) {

@@ -95,18 +95,18 @@ void require_finite(const float* values, std::size_t count, const char* what);
 /// sogmm::rigid_pose_error accepts them (the one pose rule of the library).
 std::array<double, 16> require_rigid(const double* pose, const char* what);
 
-/// An RGB-D frame checked and back-projected as sogmm_fit_rgbd and
-/// sogmm_rgbd_to_points_f32 take it.
+/// An RGB-D frame checked and back-projected as sogmm_fit_frame,
+/// sogmm_map_insert_frame and sogmm_frame_to_points_f32 take it.
 struct RgbdPoints {
   sogmm::Camera camera;             // full-size intrinsics
   sogmm::DepthOptions depth;        // scale, range, decimation from the options
   sogmm::PointCloud cloud;          // valid pixels of the decimated frame, row by row
 };
-/// Checks every argument (SOGMM_E_NULL_ARG / INVALID_ARG / INVALID_DATA for
-/// non-finite float gray) and back-projects; the cloud may be empty.
-RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* color, std::int32_t color_format,
-                            std::uint32_t width, std::uint32_t height, double fx, double fy, double cx, double cy,
-                            const sogmm_options& options);
+/// Checks the frame's intrinsics and the options (SOGMM_E_NULL_ARG /
+/// INVALID_ARG / LIMIT / INVALID_DATA for non-finite float gray) and
+/// back-projects; the cloud may be empty. A frame without a colour image has
+/// gray 0.
+RgbdPoints backproject_frame(const sogmm_frame* frame, const sogmm_options& options);
 
 /// SOGMM_E_INVALID_ARG "depth range: SOGMM_OPT_DEPTH_MIN = a must be <
 /// SOGMM_OPT_DEPTH_MAX = b" unless min < max (a rule across two keys, checked

@@ -1,4 +1,4 @@
-// The option and info keys of the C API: number, name, kind and type of each,
+// The option, info and map statistic keys of the C API: number, name, kind and type of each,
 // and the argument check every keyed function starts with. Never installed.
 #pragma once
 
@@ -10,16 +10,17 @@
 
 namespace sogmm_capi {
 
-/// Whether a key names a parameter (sogmm_options_*) or a model's information
-/// (sogmm_model_get_info_*). The numbers are disjoint: options are below
-/// 10000, info keys 10000 and up.
-enum class KeyKind { Option, Info };
+/// Whether a key names a parameter (sogmm_options_*), a model's information
+/// (sogmm_model_get_info_*), a map's totals (sogmm_map_get_i64) or what one
+/// map insert did (sogmm_map_frame_get_*). The numbers are disjoint: options
+/// are below 10000, info keys 10000 to 19999, map keys 20000 and up.
+enum class KeyKind { Option, Info, MapStat, FrameStat };
 /// The value type of a key.
 enum class KeyType { F64, I64 };
 
 /// A key of either kind. Option keys come from the core's option registry
 /// (sogmm/options.hpp), whose row (`option`) holds their rule, default and
-/// storage; info keys are listed in keys.cpp.
+/// storage; info and map keys are listed in keys.cpp.
 struct KeySpec {
   sogmm_key key;
   const char* name;  ///< the macro, e.g. "SOGMM_OPT_BANDWIDTH"

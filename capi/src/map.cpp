@@ -1,9 +1,11 @@
 // sogmm_map_*: the incremental world map (sogmm::Map) behind a handle.
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <string>
 
 #include "internal.hpp"
+#include "keys.hpp"
 #include "map_handle.hpp"
 #include "sogmm/map.hpp"
 
@@ -18,6 +20,10 @@ sogmm::MapOptions map_options(const sogmm_options& o) {
 }
 
 sogmm::Pose pose_of(const double* pose) { return sogmm_capi::require_rigid(pose, "pose"); }
+
+// A count of the map (points, frames, components) as the keyed getters'
+// int64: such counts stay far below 2^63.
+std::int64_t count(std::uint64_t v) { return static_cast<std::int64_t>(v); }
 
 }  // namespace
 
@@ -54,16 +60,14 @@ SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* 
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
-                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                             double fy, double cx, double cy, const double* pose) {
+SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_rgbd");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_insert_frame");
+    require_nonnull(frame, "frame");
     require_nonnull(pose, "pose");
     const sogmm::Pose p = pose_of(pose);
-    const sogmm_capi::RgbdPoints r =
-        sogmm_capi::backproject_rgbd(depth, color, color_format, width, height, fx, fy, cx, cy, map->options);
+    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, map->options);
     map->map.insert_backprojected(r.cloud.view(), r.camera, p, sogmm_capi::progress_sink(map->options));
   }
   SOGMM_CATCH
@@ -98,17 +102,22 @@ SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn 
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out) {
+SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, int64_t* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    const sogmm_capi::MapReader use(map, "sogmm_map_get_stats");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_i64");
     require_nonnull(out, "out");
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::MapStat, sogmm_capi::KeyType::I64, "get");
     const sogmm::MapStats s = map->map.stats();
-    out->n_components = s.n_components;
-    out->n_pending = s.n_pending;
-    out->n_frames = s.n_frames;
-    out->n_flushes = s.n_flushes;
-    out->n_fused = s.n_fused;
+    switch (key) {
+      case SOGMM_MAP_N_COMPONENTS: *out = count(s.n_components); break;
+      case SOGMM_MAP_N_PENDING: *out = count(s.n_pending); break;
+      case SOGMM_MAP_N_FRAMES: *out = count(s.n_frames); break;
+      case SOGMM_MAP_N_FLUSHES: *out = count(s.n_flushes); break;
+      case SOGMM_MAP_N_FUSED: *out = count(s.n_fused); break;
+      case SOGMM_MAP_N_REFITS: *out = count(s.n_refits); break;
+      default: fail(SOGMM_E_INTERNAL, "map key table out of sync");
+    }
   }
   SOGMM_CATCH
 }
@@ -123,30 +132,49 @@ const sogmm::FrameStats& frame_of(const sogmm_map* map, uint64_t frame) {
 }
 }  // namespace
 
-SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out) {
+SOGMM_API sogmm_status sogmm_map_frame_get_i64(const sogmm_map* map, uint64_t frame, sogmm_key key, int64_t* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    const sogmm_capi::MapReader use(map, "sogmm_map_get_frame_replaced");
+    const sogmm_capi::MapReader use(map, "sogmm_map_frame_get_i64");
     require_nonnull(out, "out");
-    *out = frame_of(map, frame).n_replaced;
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::FrameStat, sogmm_capi::KeyType::I64, "get");
+    const sogmm::FrameStats& f = frame_of(map, frame);
+    switch (key) {
+      case SOGMM_MAP_FRAME_N_POINTS: *out = count(f.n_points); break;
+      case SOGMM_MAP_FRAME_N_NOVEL: *out = count(f.n_novel); break;
+      case SOGMM_MAP_FRAME_N_COMPONENTS: *out = count(f.n_components); break;
+      case SOGMM_MAP_FRAME_FLUSHED: *out = f.flushed ? 1 : 0; break;
+      case SOGMM_MAP_FRAME_N_REPLACED: *out = count(f.n_replaced); break;
+      default: fail(SOGMM_E_INTERNAL, "map frame key table out of sync");
+    }
   }
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame, sogmm_map_frame_stats* out) {
+SOGMM_API sogmm_status sogmm_map_frame_get_f64(const sogmm_map* map, uint64_t frame, sogmm_key key, double* out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
-    const sogmm_capi::MapReader use(map, "sogmm_map_get_frame_stats");
+    const sogmm_capi::MapReader use(map, "sogmm_map_frame_get_f64");
     require_nonnull(out, "out");
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::FrameStat, sogmm_capi::KeyType::F64, "get");
     const sogmm::FrameStats& f = frame_of(map, frame);
-    out->n_points = f.n_points;
-    out->n_novel = f.n_novel;
-    out->n_components = f.n_components;
-    out->flushed = f.flushed ? 1 : 0;
-    out->ms_novelty = f.ms_novelty;
-    out->ms_fit = f.ms_fit;
-    out->ms_merge = f.ms_merge;
-    std::memcpy(out->pose, f.pose.data(), sizeof out->pose);
+    switch (key) {
+      case SOGMM_MAP_FRAME_MS_NOVELTY: *out = f.ms_novelty; break;
+      case SOGMM_MAP_FRAME_MS_FIT: *out = f.ms_fit; break;
+      case SOGMM_MAP_FRAME_MS_MERGE: *out = f.ms_merge; break;
+      default: fail(SOGMM_E_INTERNAL, "map frame key table out of sync");
+    }
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_frame_get_pose(const sogmm_map* map, uint64_t frame, double* pose_out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_frame_get_pose");
+    require_nonnull(pose_out, "pose_out");
+    const sogmm::FrameStats& f = frame_of(map, frame);
+    std::memcpy(pose_out, f.pose.data(), sizeof(double) * 16);
   }
   SOGMM_CATCH
 }

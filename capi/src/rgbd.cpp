@@ -1,10 +1,12 @@
-// RGB-D frames: argument checks and back-projection shared by sogmm_fit_rgbd
-// and sogmm_rgbd_to_points_f32, so both see exactly the same points.
+// RGB-D frames: the checks and back-projection shared by sogmm_fit_frame,
+// sogmm_map_insert_frame and sogmm_frame_to_points_f32, so all three see
+// exactly the same points.
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
 
+#include "frame_handle.hpp"
 #include "internal.hpp"
 #include "sogmm/checked.hpp"
 
@@ -34,19 +36,11 @@ sogmm::GrayImage gray_from_f32_image(const std::uint8_t* bytes, int width, int h
 
 }  // namespace
 
-RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* color, std::int32_t color_format,
-                            std::uint32_t width, std::uint32_t height, double fx, double fy, double cx, double cy,
-                            const sogmm_options& o) {
-  require_nonnull(depth, "depth");
-  require_nonnull(color, "color");
-  if (color_format != SOGMM_COLOR_GRAY8 && color_format != SOGMM_COLOR_RGB8 && color_format != SOGMM_COLOR_GRAY_F32)
-    fail(SOGMM_E_INVALID_ARG, "unknown color_format " + std::to_string(color_format));
-  const std::uint32_t kMax = static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max());
-  if (width == 0 || height == 0 || width > kMax || height > kMax)
-    fail(SOGMM_E_INVALID_ARG, "image size " + std::to_string(width) + " x " + std::to_string(height) +
-                                  " is invalid (each side in [1, 2^31-1])");
-  const std::size_t pixels = sogmm::checked::mul<std::size_t>(width, height, "image pixels");
-  sogmm::checked::bytes(pixels, sizeof(float), "color image bytes");
+RgbdPoints backproject_frame(const sogmm_frame* f, const sogmm_options& o) {
+  require_nonnull(f, "frame");
+  if (!f->has_intrinsics) fail(SOGMM_E_INVALID_ARG, "the frame has no intrinsics (call sogmm_frame_set_intrinsics first)");
+  const std::uint32_t width = f->width, height = f->height;
+  const double fx = f->fx, fy = f->fy, cx = f->cx, cy = f->cy;
   require_intrinsic(fx, true, "fx");
   require_intrinsic(fy, true, "fy");
   require_intrinsic(cx, false, "cx");
@@ -69,12 +63,21 @@ RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* colo
   // the back-projection depend on the image size and parameters only.
   sogmm::check_backprojection(r.camera, r.depth);
 
-  const sogmm::GrayImage gray =
-      color_format == SOGMM_COLOR_RGB8     ? sogmm::gray_from_rgb_image(color, r.camera.width, r.camera.height)
-      : color_format == SOGMM_COLOR_GRAY8 ? sogmm::gray_from_u8_image(color, r.camera.width, r.camera.height)
-                                          : gray_from_f32_image(color, r.camera.width, r.camera.height);
+  // A frame without a colour image is fitted with gray 0, as the CLI's
+  // depth-only frames are.
+  const std::uint8_t* color = f->color.data();
+  sogmm::GrayImage gray;
+  switch (f->color_format) {
+    case SOGMM_COLOR_RGB8: gray = sogmm::gray_from_rgb_image(color, r.camera.width, r.camera.height); break;
+    case SOGMM_COLOR_GRAY8: gray = sogmm::gray_from_u8_image(color, r.camera.width, r.camera.height); break;
+    case SOGMM_COLOR_GRAY_F32: gray = gray_from_f32_image(color, r.camera.width, r.camera.height); break;
+    default:
+      gray.width = r.camera.width;
+      gray.height = r.camera.height;
+      gray.pixels.assign(static_cast<std::size_t>(width) * height, 0.0f);
+  }
   sogmm::RgbdView frame;
-  frame.depth = depth;
+  frame.depth = f->depth.data();
   frame.gray = gray.pixels.data();
   frame.camera = r.camera;
   r.cloud = sogmm::backproject(frame, r.depth);
@@ -85,15 +88,12 @@ RgbdPoints backproject_rgbd(const std::uint16_t* depth, const std::uint8_t* colo
 
 extern "C" {
 
-SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, size_t* n_points, const uint16_t* depth,
-                                                const uint8_t* color, int32_t color_format, uint32_t width,
-                                                uint32_t height, double fx, double fy, double cx, double cy,
-                                                const sogmm_options* options) {
+SOGMM_API sogmm_status sogmm_frame_to_points_f32(float* out, size_t capacity, size_t* n_points,
+                                                 const sogmm_frame* frame, const sogmm_options* options) {
   SOGMM_TRY {
     sogmm_capi::require_nonnull(n_points, "n_points");
     if (out == nullptr && capacity != 0) sogmm_capi::fail(SOGMM_E_NULL_ARG, "out is NULL but capacity is not 0");
-    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_rgbd(
-        depth, color, color_format, width, height, fx, fy, cx, cy, sogmm_capi::opts_or_default(options));
+    const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, sogmm_capi::opts_or_default(options));
     const std::size_t n = r.cloud.size();
     if (out != nullptr && capacity < r.cloud.xyzg.size()) {
       *n_points = n;  // the documented exception: the size to allocate comes with the error

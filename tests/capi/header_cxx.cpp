@@ -11,7 +11,8 @@ static_assert(SOGMM_VERSION_NUMBER == SOGMM_VERSION_MAJOR * 10000 + SOGMM_VERSIO
                                           SOGMM_VERSION_PATCH,
               "version number");
 
-extern "C" typedef sogmm_status c_fit_fn(sogmm_model**, const float*, size_t, const sogmm_options*);
+extern "C" typedef sogmm_status c_fit_fn(sogmm_model**, const float*, size_t, const sogmm_model*,
+                                          const sogmm_options*);
 
 int main() {
   c_fit_fn* fit = &sogmm_fit_points_f32;  // C linkage function type

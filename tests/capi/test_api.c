@@ -184,7 +184,7 @@ static sogmm_model* fit_three_clusters(size_t n) {
   sogmm_options* o = NULL;
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 7));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, n, 3, o));
+  REQUIRE_OK(test_fit_fixed_k(&m, pts, n, 3, o));
   sogmm_options_free(o);
   free(pts);
   return m;
@@ -255,7 +255,7 @@ static void test_fit_points(void) {
     size_t M = 0;
     REQUIRE_OK(sogmm_options_create(&o));
     REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.1));
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
     M = check_model(m);
     EXPECT_TRUE(M >= 3 && M <= 12);
     EXPECT_OK(sogmm_model_get_info_f64(m, SOGMM_INFO_FIT_BANDWIDTH, &f));
@@ -265,7 +265,7 @@ static void test_fit_points(void) {
     sogmm_model_free(m);
     /* fixed K through the options key: same as the _fixed_k entry point */
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 5));
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
     EXPECT_TRUE(check_model(m) == 5);
     sogmm_model_free(m);
     /* N_INIT runs: the kept run is the best, its seed is recorded, and a
@@ -276,13 +276,13 @@ static void test_fit_points(void) {
       double ll_best = 0, ll_one = 0, ll_first = 0;
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 9));
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 10));
-      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, NULL, o));
       EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_first));
       EXPECT_OK(sogmm_model_get_info_i64(one, SOGMM_INFO_FIT_N_INIT, &runs));
       EXPECT_TRUE(runs == 1);
       sogmm_model_free(one);
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 3));
-      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
       EXPECT_TRUE(check_model(m) == 9);
       EXPECT_OK(sogmm_model_get_info_i64(m, SOGMM_INFO_FIT_N_INIT, &runs));
       EXPECT_TRUE(runs == 3);
@@ -294,7 +294,7 @@ static void test_fit_points(void) {
       EXPECT_TRUE(ll_best >= ll_first);
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, seed));
-      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, o));
+      REQUIRE_OK(sogmm_fit_points_f32(&one, pts, n, NULL, o));
       EXPECT_OK(sogmm_model_get_info_f64(one, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_one));
       EXPECT_TRUE(ll_one == ll_best);
       sogmm_model_free(one);
@@ -302,7 +302,7 @@ static void test_fit_points(void) {
       REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 0));
     }
     /* NULL options = defaults (bandwidth 0.02) */
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, 300, NULL));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, 300, NULL, NULL));
     check_model(m);
     sogmm_model_free(m);
     sogmm_options_free(o);
@@ -310,7 +310,7 @@ static void test_fit_points(void) {
   }
 }
 
-static void test_fit_rgbd(void) {
+static void test_rgbd_fit(void) {
   const uint32_t w = 80, h = 60;
   uint16_t* depth;
   uint8_t *gray, *rgb;
@@ -323,8 +323,8 @@ static void test_fit_rgbd(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
-  REQUIRE_OK(sogmm_fit_rgbd(&mg, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5, 29.5, o));
-  REQUIRE_OK(sogmm_fit_rgbd(&mc, depth, rgb, SOGMM_COLOR_RGB8, w, h, 70.0, 70.0, 39.5, 29.5, o));
+  REQUIRE_OK(test_fit_rgbd(&mg, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5, 29.5, o));
+  REQUIRE_OK(test_fit_rgbd(&mc, depth, rgb, SOGMM_COLOR_RGB8, w, h, 70.0, 70.0, 39.5, 29.5, o));
   Mg = check_model(mg);
   Mc = check_model(mc);
   EXPECT_TRUE(Mg == Mc); /* gray == R == G == B gives the same gray */
@@ -364,7 +364,7 @@ static void test_fit_rgbd(void) {
     }
     free(mu);
   }
-  /* The points behind the fit: sogmm_rgbd_to_points_f32 gives N = 39 x 30,
+  /* The points behind the fit: sogmm_frame_to_points_f32 gives N = 39 x 30,
    * a hand-computed first point, and fitting them as points reproduces the
    * RGB-D model bit for bit. Float gray (GRAY_F32) equal to g / 255 gives
    * the same model as GRAY8. */
@@ -372,14 +372,14 @@ static void test_fit_rgbd(void) {
     size_t n_pts = 0, k;
     float *xyzg, *mu_g, *mu_p, *grayf;
     sogmm_model *mp = NULL, *mf = NULL;
-    REQUIRE_OK(sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5,
+    REQUIRE_OK(test_rgbd_to_points(NULL, 0, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0, 39.5,
                                         29.5, o));
     EXPECT_TRUE(n_pts == 39 * 30);
     xyzg = (float*)malloc(4 * n_pts * sizeof(float));
     grayf = (float*)malloc((size_t)w * h * sizeof(float));
     mu_g = (float*)malloc(4 * Mg * sizeof(float));
     mu_p = (float*)malloc(4 * Mg * sizeof(float));
-    REQUIRE_OK(sogmm_rgbd_to_points_f32(xyzg, 4 * n_pts, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0,
+    REQUIRE_OK(test_rgbd_to_points(xyzg, 4 * n_pts, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, w, h, 70.0, 70.0,
                                         39.5, 29.5, o));
     /* decimated pixel (u, v) = (1, 0) <- source (2, 0): depth 1000 + 600 * 2 / 80 = 1015 mm;
      * intrinsics / 2: fx = fy = 35, cx = 19.75, cy = 14.75; gray 40 / 255 */
@@ -387,17 +387,17 @@ static void test_fit_rgbd(void) {
     EXPECT_NEAR(xyzg[0], (1 - 19.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[1], (0 - 14.75) * 1.015 / 35.0, 1e-6);
     EXPECT_NEAR(xyzg[3], 40.0 / 255.0, 1e-7);
-    /* fit_rgbd floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
+    /* sogmm_fit_frame floors quantised depth by default (SOGMM_DEQUANTISE_AUTO); points given as an
      * array are floored only when asked, so ask for the same model. */
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, 1));
-    REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&mp, xyzg, n_pts, NULL, o));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DEQUANTISE_DEPTH, SOGMM_DEQUANTISE_AUTO));
     EXPECT_TRUE(check_model(mp) == Mg);
     EXPECT_OK(sogmm_model_get_means_f32(mg, mu_g, 4 * Mg));
     EXPECT_OK(sogmm_model_get_means_f32(mp, mu_p, 4 * Mg));
     EXPECT_TRUE(memcmp(mu_g, mu_p, 4 * Mg * sizeof(float)) == 0);
     for (k = 0; k < (size_t)w * h; ++k) grayf[k] = gray[k] / 255.0f;
-    REQUIRE_OK(sogmm_fit_rgbd(&mf, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, w, h, 70.0, 70.0, 39.5, 29.5,
+    REQUIRE_OK(test_fit_rgbd(&mf, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, w, h, 70.0, 70.0, 39.5, 29.5,
                               o));
     EXPECT_TRUE(check_model(mf) == Mg);
     EXPECT_OK(sogmm_model_get_means_f32(mf, mu_p, 4 * Mg));
@@ -531,26 +531,26 @@ static void test_inference(void) {
   {
     float xyz[9] = {0, 0, 1, 0.5f, 0, 1, 0.05f, 0, 1};
     float g[3], var[3];
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, g, var));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, NULL, g, var));
     EXPECT_NEAR(g[0], 0.2, 0.02);
     EXPECT_NEAR(g[1], 0.8, 0.02);
     EXPECT_TRUE(g[2] > g[0]); /* gray grows with x in component 0 */
     for (i = 0; i < 3; ++i) EXPECT_TRUE(var[i] >= 0 && var[i] < 0.02);
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, g, NULL));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, xyz, 3, NULL, g, NULL));
     EXPECT_NEAR(g[1], 0.8, 0.02);
-    EXPECT_OK(sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL));
+    EXPECT_OK(sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL, NULL));
   }
   /* score: 4-D and 3-D marginal, near > far */
   {
     float p4[8] = {0, 0, 1, 0.2f, 3, 3, 3, 0.2f};
     float p3[6] = {0, 0, 1, 3, 3, 3};
     double l4[2], l3[2];
-    EXPECT_OK(sogmm_model_score_samples_f32(m, p4, 2, 4, l4));
-    EXPECT_OK(sogmm_model_score_samples_f32(m, p3, 2, 3, l3));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, p4, 2, 4, NULL, l4));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, p3, 2, 3, NULL, l3));
     EXPECT_TRUE(isfinite(l4[0]) && isfinite(l3[0]) && l4[0] > l4[1] && l3[0] > l3[1]);
     /* marginal of the N(0, 0.01 I) x-y-z part with weight 0.25 (component 1 is 0.5 away) */
     EXPECT_NEAR(l3[0], log(0.25) - 1.5 * log(2 * 3.141592653589793 * 0.01), 0.05);
-    EXPECT_OK(sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL));
+    EXPECT_OK(sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL, NULL));
   }
   /* PSNR: honest figure at the given data range, paper figure always range 2 over all pixels */
   {
@@ -732,7 +732,7 @@ int main(int argc, char** argv) {
   test_versions_and_errors();
   test_options();
   test_fit_points();
-  test_fit_rgbd();
+  test_rgbd_fit();
   test_arrays_clone_metadata();
   test_inference();
   test_save_load();

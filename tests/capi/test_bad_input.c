@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   sogmm_model* m = NULL;      /* valid model from a fit (fit report, no camera) */
   sogmm_model* a = NULL;      /* valid model from arrays (no fit report) */
   sogmm_model* out = NULL;
+  sogmm_frame* fr = NULL;
   sogmm_buffer* buf = NULL;
   sogmm_buffer* bout = NULL;
   float* pts;
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
   pts = make_clusters(30, 1);
   memcpy(pts_bad, pts, sizeof pts_bad);
   REQUIRE_OK(sogmm_options_create(&o));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, 30, 2, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&m, pts, 30, 2, NULL));
   REQUIRE_OK(sogmm_model_from_arrays_f32(&a, 2, w, mu, cov, 10));
   make_frame(W, H, &depth, &gray, &rgb);
   memset(depth_zero, 0, sizeof depth_zero);
@@ -139,37 +140,43 @@ int main(int argc, char** argv) {
   EXPECT_TRUE(f64 == 0.02);
 
   /* ---- fit from points ---- */
-  ROW("F1", sogmm_fit_points_f32(NULL, pts, 30, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F2", out, sogmm_fit_points_f32(&out, NULL, 30, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F3", out, sogmm_fit_points_f32(&out, pts, 0, NULL), SOGMM_E_INVALID_DATA);
+  ROW("F1", sogmm_fit_points_f32(NULL, pts, 30, NULL, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F2", out, sogmm_fit_points_f32(&out, NULL, 30, NULL, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F3", out, sogmm_fit_points_f32(&out, pts, 0, NULL, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)nan_;
-  ROW_OUT("F4", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F4", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)inf_;
-  ROW_OUT("F5", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F5", out, sogmm_fit_points_f32(&out, pts_bad, 2, NULL, NULL), SOGMM_E_INVALID_DATA);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 31));
-  ROW_OUT("F6", out, sogmm_fit_points_f32(&out, pts, 30, o), SOGMM_E_INVALID_ARG);
+  ROW_OUT("F6", out, sogmm_fit_points_f32(&out, pts, 30, NULL, o), SOGMM_E_INVALID_ARG);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
-  ROW_OUT("F7", out, sogmm_fit_points_f32(&out, pts, huge, NULL), SOGMM_E_LIMIT);
-  ROW("F8", sogmm_fit_points_fixed_k_f32(NULL, pts, 30, 2, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F9", out, sogmm_fit_points_fixed_k_f32(&out, NULL, 30, 2, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("F10", out, sogmm_fit_points_fixed_k_f32(&out, pts, 30, 0, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("F11", out, sogmm_fit_points_fixed_k_f32(&out, pts, 30, 31, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("F12", out, sogmm_fit_points_fixed_k_f32(&out, pts, 0, 1, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F7", out, sogmm_fit_points_f32(&out, pts, huge, NULL, NULL), SOGMM_E_LIMIT);
+  /* F8-F13: a warm start from `m` (2 components). */
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 3));
+  ROW_OUT("F8", out, sogmm_fit_points_f32(&out, pts, 30, m, o), SOGMM_E_INVALID_ARG); /* K != the initial size */
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2));
+  ROW_OUT("F9", out, sogmm_fit_points_f32(&out, pts, 30, m, o), SOGMM_E_INVALID_ARG);
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
+  ROW("F10", sogmm_fit_points_f32(NULL, pts, 30, m, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F11", out, sogmm_fit_points_f32(&out, NULL, 30, m, NULL), SOGMM_E_NULL_ARG);
+  ROW_OUT("F12", out, sogmm_fit_points_f32(&out, pts, 0, m, NULL), SOGMM_E_INVALID_DATA);
   pts_bad[5] = (float)nan_;
-  ROW_OUT("F13", out, sogmm_fit_points_fixed_k_f32(&out, pts_bad, 2, 1, NULL), SOGMM_E_INVALID_DATA);
+  ROW_OUT("F13", out, sogmm_fit_points_f32(&out, pts_bad, 2, m, NULL), SOGMM_E_INVALID_DATA);
 
   /* ---- fit from an RGB-D frame ---- */
 #define FRAME(dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt) \
-  sogmm_fit_rgbd(&out, dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt)
-  ROW("R1", sogmm_fit_rgbd(NULL, depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R2", out, FRAME(NULL, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R3", out, FRAME(depth, NULL, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
-  ROW_OUT("R4", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, 0, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R5", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, 0, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R6", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, 0x80000000u, 1, 35, 35, 20, 15, NULL),
-          SOGMM_E_INVALID_ARG);
-  ROW_OUT("R7", out, FRAME(depth, gray, 0, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
-  ROW_OUT("R8", out, FRAME(depth, gray, 4, W, H, 35, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
+  test_fit_rgbd(&out, dep, col, fmt, w_, h_, fx_, fy_, cx_, cy_, opt)
+  ROW("R1", test_fit_rgbd(NULL, depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, 35, 20, 15, NULL), SOGMM_E_NULL_ARG);
+  /* R2-R8: the frame's arrays, refused by sogmm_frame_from_arrays. */
+#define FRAME_NEW(dep, col, fmt, w_, h_) sogmm_frame_from_arrays(&fr, w_, h_, dep, col, fmt)
+  ROW_OUT("R2", fr, FRAME_NEW(NULL, gray, SOGMM_COLOR_GRAY8, W, H), SOGMM_E_NULL_ARG);
+  ROW_OUT("R3", fr, FRAME_NEW(depth, NULL, SOGMM_COLOR_GRAY8, W, H), SOGMM_E_NULL_ARG);
+  ROW_OUT("R4", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, 0, H), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R5", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, W, 0), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R6", fr, FRAME_NEW(depth, gray, SOGMM_COLOR_GRAY8, 0x80000000u, 1), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R7", fr, FRAME_NEW(depth, gray, 0, W, H), SOGMM_E_INVALID_ARG);
+  ROW_OUT("R8", fr, FRAME_NEW(depth, gray, 4, W, H), SOGMM_E_INVALID_ARG);
   ROW_OUT("R9", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 0, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R10", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 35, -35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
   ROW_OUT("R11", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, nan_, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
@@ -200,28 +207,28 @@ int main(int argc, char** argv) {
     ROW_OUT("R19", out, FRAME(depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3, 3, 2, 2, NULL),
             SOGMM_E_INVALID_DATA);
     /* back-projection only */
-    ROW("R20", sogmm_rgbd_to_points_f32(xyzg, 64, NULL, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R20", test_rgbd_to_points(xyzg, 64, NULL, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_NULL_ARG);
-    ROW("R21", sogmm_rgbd_to_points_f32(NULL, 4, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R21", test_rgbd_to_points(NULL, 4, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_NULL_ARG);
-    ROW("R22", sogmm_rgbd_to_points_f32(xyzg, 59, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
+    ROW("R22", test_rgbd_to_points(xyzg, 59, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, NULL),
         SOGMM_E_BUFFER_TOO_SMALL);
     EXPECT_TRUE(n_pts == 15); /* the size is reported with the error (pixel 0 has no depth) */
-    ROW("R23", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
+    ROW("R23", test_rgbd_to_points(xyzg, 64, &n_pts, depth, (const uint8_t*)grayf, SOGMM_COLOR_GRAY_F32, 4, 4, 3,
                                         3, 2, 2, NULL),
         SOGMM_E_INVALID_DATA);
     n_pts = 99;
-    ROW("R24", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
+    ROW("R24", test_rgbd_to_points(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, NULL),
         SOGMM_E_INVALID_ARG);
     EXPECT_TRUE(n_pts == 99); /* an error other than BUFFER_TOO_SMALL writes no out-parameter */
     /* no valid pixel is not an error here: N = 0 */
-    ROW("R25", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
+    ROW("R25", test_rgbd_to_points(NULL, 0, &n_pts, depth_zero, gray_small, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2,
                                         2, NULL),
         SOGMM_OK);
     EXPECT_TRUE(n_pts == 0);
     ROW_OUT("R26", out, FRAME(depth, gray, SOGMM_COLOR_GRAY8, W, H, 1e-300, 35, 20, 15, NULL), SOGMM_E_INVALID_ARG);
     n_pts = 99;
-    ROW("R27", sogmm_rgbd_to_points_f32(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, NULL),
+    ROW("R27", test_rgbd_to_points(xyzg, 64, &n_pts, depth, gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, NULL),
         SOGMM_E_INVALID_ARG);
     EXPECT_TRUE(n_pts == 99);
   }
@@ -232,9 +239,8 @@ int main(int argc, char** argv) {
     uint8_t* big_gray = (uint8_t*)calloc((size_t)big * big, 1);
     size_t n_pts = 99;
     REQUIRE_OK(big_depth && big_gray ? SOGMM_OK : SOGMM_E_NOMEM);
-    ROW_OUT("R28", out, FRAME(big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000, 4100, 4100, NULL),
-            SOGMM_E_LIMIT);
-    ROW("R29", sogmm_rgbd_to_points_f32(NULL, 0, &n_pts, big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000,
+    ROW_OUT("R28", fr, FRAME_NEW(big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big), SOGMM_E_LIMIT);
+    ROW("R29", test_rgbd_to_points(NULL, 0, &n_pts, big_depth, big_gray, SOGMM_COLOR_GRAY8, big, big, 7000, 7000,
                                         4100, 4100, NULL),
         SOGMM_E_LIMIT);
     EXPECT_TRUE(n_pts == 99);
@@ -349,26 +355,26 @@ int main(int argc, char** argv) {
   ROW("I4", sogmm_model_sample_f32(m, 4, 0, 2, NULL, f1), SOGMM_E_INVALID_ARG);
   ROW("I5", sogmm_model_sample_f32(m, 4, 0, 5, NULL, f1), SOGMM_E_INVALID_ARG);
   ROW("I6", sogmm_model_sample_f32(m, huge, 0, 4, NULL, f1), SOGMM_E_LIMIT);
-  ROW("I7", sogmm_model_regress_gray_f32(NULL, mu, 2, f1, NULL), SOGMM_E_NULL_ARG);
-  ROW("I8", sogmm_model_regress_gray_f32(m, NULL, 2, f1, NULL), SOGMM_E_NULL_ARG);
-  ROW("I9", sogmm_model_regress_gray_f32(m, mu, 2, NULL, f1), SOGMM_E_NULL_ARG);
-  ROW("I10", sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL), SOGMM_OK);
+  ROW("I7", sogmm_model_regress_gray_f32(NULL, mu, 2, NULL, f1, NULL), SOGMM_E_NULL_ARG);
+  ROW("I8", sogmm_model_regress_gray_f32(m, NULL, 2, NULL, f1, NULL), SOGMM_E_NULL_ARG);
+  ROW("I9", sogmm_model_regress_gray_f32(m, mu, 2, NULL, NULL, f1), SOGMM_E_NULL_ARG);
+  ROW("I10", sogmm_model_regress_gray_f32(m, NULL, 0, NULL, NULL, NULL), SOGMM_OK);
   xyzbad[7] = (float)nan_;
-  ROW("I11", sogmm_model_regress_gray_f32(m, xyzbad, 3, f1, f1 + 8), SOGMM_E_INVALID_DATA);
+  ROW("I11", sogmm_model_regress_gray_f32(m, xyzbad, 3, NULL, f1, f1 + 8), SOGMM_E_INVALID_DATA);
   xyzbad[7] = (float)-inf_;
-  ROW("I12", sogmm_model_regress_gray_f32(m, xyzbad, 3, f1, NULL), SOGMM_E_INVALID_DATA);
-  ROW("I13", sogmm_model_regress_gray_f32(m, mu, huge, f1, NULL), SOGMM_E_LIMIT);
-  ROW("I14", sogmm_model_score_samples_f32(NULL, mu, 2, 4, d1), SOGMM_E_NULL_ARG);
-  ROW("I15", sogmm_model_score_samples_f32(m, NULL, 2, 4, d1), SOGMM_E_NULL_ARG);
-  ROW("I16", sogmm_model_score_samples_f32(m, mu, 2, 4, NULL), SOGMM_E_NULL_ARG);
-  ROW("I17", sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL), SOGMM_OK);
-  ROW("I18", sogmm_model_score_samples_f32(m, mu, 2, 0, d1), SOGMM_E_INVALID_ARG);
+  ROW("I12", sogmm_model_regress_gray_f32(m, xyzbad, 3, NULL, f1, NULL), SOGMM_E_INVALID_DATA);
+  ROW("I13", sogmm_model_regress_gray_f32(m, mu, huge, NULL, f1, NULL), SOGMM_E_LIMIT);
+  ROW("I14", sogmm_model_score_samples_f32(NULL, mu, 2, 4, NULL, d1), SOGMM_E_NULL_ARG);
+  ROW("I15", sogmm_model_score_samples_f32(m, NULL, 2, 4, NULL, d1), SOGMM_E_NULL_ARG);
+  ROW("I16", sogmm_model_score_samples_f32(m, mu, 2, 4, NULL, NULL), SOGMM_E_NULL_ARG);
+  ROW("I17", sogmm_model_score_samples_f32(m, NULL, 0, 4, NULL, NULL), SOGMM_OK);
+  ROW("I18", sogmm_model_score_samples_f32(m, mu, 2, 0, NULL, d1), SOGMM_E_INVALID_ARG);
   mubad[6] = (float)-inf_;
-  ROW("I19", sogmm_model_score_samples_f32(m, mubad, 2, 4, d1), SOGMM_E_INVALID_DATA);
+  ROW("I19", sogmm_model_score_samples_f32(m, mubad, 2, 4, NULL, d1), SOGMM_E_INVALID_DATA);
   mubad[6] = 0.0f;
   mubad[4] = (float)nan_;
-  ROW("I20", sogmm_model_score_samples_f32(m, mubad, 2, 3, d1), SOGMM_E_INVALID_DATA);
-  ROW("I21", sogmm_model_score_samples_f32(m, mu, huge, 4, d1), SOGMM_E_LIMIT);
+  ROW("I20", sogmm_model_score_samples_f32(m, mubad, 2, 3, NULL, d1), SOGMM_E_INVALID_DATA);
+  ROW("I21", sogmm_model_score_samples_f32(m, mu, huge, 4, NULL, d1), SOGMM_E_LIMIT);
   ROW("I22", sogmm_model_merge(NULL, m, a), SOGMM_E_NULL_ARG);
   ROW_OUT("I23", out, sogmm_model_merge(&out, NULL, a), SOGMM_E_NULL_ARG);
   ROW_OUT("I24", out, sogmm_model_merge(&out, m, NULL), SOGMM_E_NULL_ARG);

@@ -134,7 +134,7 @@ static void test_frames(void) {
   EXPECT_TRUE(memcmp(sogmm_frame_depth(g), depth, (size_t)w * h * 2) == 0);
   EXPECT_TRUE(sogmm_frame_color(g) == NULL && sogmm_frame_color_format(g) == 0);
 
-  /* Fit and insert: bitwise what the RGB-D calls give with the same pixels. */
+  /* Fit and insert: bitwise what a frame made from the same pixels gives. */
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 3));
@@ -142,7 +142,7 @@ static void test_frames(void) {
   EXPECT_TRUE(m1 == NULL && strstr(sogmm_last_error(), "sogmm_frame_set_intrinsics") != NULL);
   REQUIRE_OK(sogmm_frame_set_intrinsics(f, 60.0, 60.0, 31.5, 23.5));
   REQUIRE_OK(sogmm_fit_frame(&m1, f, o));
-  REQUIRE_OK(sogmm_fit_rgbd(&m2, depth, gray, SOGMM_COLOR_GRAY8, w, h, 60.0, 60.0, 31.5, 23.5, o));
+  REQUIRE_OK(test_fit_rgbd(&m2, depth, gray, SOGMM_COLOR_GRAY8, w, h, 60.0, 60.0, 31.5, 23.5, o));
   p1 = params_of(m1, &k1);
   p2 = params_of(m2, &k2);
   EXPECT_TRUE(k1 == k2 && k1 >= 2 && memcmp(p1, p2, sizeof(float) * 5 * k1) == 0);
@@ -155,7 +155,7 @@ static void test_frames(void) {
   REQUIRE_OK(sogmm_map_create(&map1, o));
   REQUIRE_OK(sogmm_map_create(&map2, o));
   REQUIRE_OK(sogmm_map_insert_frame(map1, f, pose));
-  REQUIRE_OK(sogmm_map_insert_rgbd(map2, depth, gray, SOGMM_COLOR_GRAY8, w, h, 60.0, 60.0, 31.5, 23.5, pose));
+  REQUIRE_OK(test_map_insert_rgbd(map2, depth, gray, SOGMM_COLOR_GRAY8, w, h, 60.0, 60.0, 31.5, 23.5, pose));
   REQUIRE_OK(sogmm_map_flush(map1));
   REQUIRE_OK(sogmm_map_flush(map2));
   REQUIRE_OK(sogmm_map_export(&m1, map1, NULL));
@@ -244,9 +244,64 @@ static void test_trajectories(void) {
   sogmm_trajectory_free(NULL);
 }
 
+/* Frames from arrays: the arrays are copied (the accessors give them back
+ * after the caller's copies change), a frame without a colour image fits
+ * bitwise as one with gray 0 everywhere (its documented meaning), float gray
+ * keeps its layout, and a refused frame leaves the out-pointer NULL. */
+static void test_frames_from_arrays(void) {
+  const uint32_t w = 64, h = 48;
+  uint16_t *depth = NULL;
+  uint8_t *gray = NULL, *rgb = NULL, *zeros = (uint8_t*)calloc((size_t)w * h, 1);
+  float* grayf = (float*)malloc((size_t)w * h * sizeof(float));
+  sogmm_frame *bare = NULL, *zero = NULL, *ff = NULL, *bad = (sogmm_frame*)&g_dir;
+  sogmm_model *m1 = NULL, *m2 = NULL;
+  sogmm_options* o = NULL;
+  size_t k1 = 0, k2 = 0, i;
+  float *p1, *p2;
+  make_frame(w, h, &depth, &gray, &rgb);
+  for (i = 0; i < (size_t)w * h; ++i) grayf[i] = gray[i] / 255.0f;
+  REQUIRE_OK(sogmm_frame_from_arrays(&bare, w, h, depth, NULL, 0));
+  REQUIRE_OK(sogmm_frame_from_arrays(&zero, w, h, depth, zeros, SOGMM_COLOR_GRAY8));
+  REQUIRE_OK(sogmm_frame_from_arrays(&ff, w, h, depth, grayf, SOGMM_COLOR_GRAY_F32));
+  depth[5] ^= 0x55;
+  EXPECT_TRUE(sogmm_frame_width(bare) == w && sogmm_frame_height(bare) == h);
+  EXPECT_TRUE(sogmm_frame_depth(bare)[5] == (uint16_t)(depth[5] ^ 0x55)); /* a copy */
+  depth[5] ^= 0x55;
+  EXPECT_TRUE(sogmm_frame_color(bare) == NULL && sogmm_frame_color_format(bare) == 0);
+  EXPECT_TRUE(sogmm_frame_color_format(ff) == SOGMM_COLOR_GRAY_F32);
+  EXPECT_TRUE(memcmp(sogmm_frame_color(ff), grayf, (size_t)w * h * sizeof(float)) == 0);
+  REQUIRE_OK(sogmm_options_create(&o));
+  REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 3));
+  REQUIRE_OK(sogmm_frame_set_intrinsics(bare, 60.0, 60.0, 31.5, 23.5));
+  REQUIRE_OK(sogmm_frame_set_intrinsics(zero, 60.0, 60.0, 31.5, 23.5));
+  REQUIRE_OK(sogmm_fit_frame(&m1, bare, o));
+  REQUIRE_OK(sogmm_fit_frame(&m2, zero, o));
+  p1 = params_of(m1, &k1);
+  p2 = params_of(m2, &k2);
+  EXPECT_TRUE(k1 == k2 && k1 >= 1 && memcmp(p1, p2, sizeof(float) * 5 * k1) == 0);
+  free(p1);
+  free(p2);
+  EXPECT_STATUS(sogmm_frame_from_arrays(&bad, w, h, depth, NULL, SOGMM_COLOR_GRAY8), SOGMM_E_NULL_ARG);
+  EXPECT_TRUE(bad == NULL && strstr(sogmm_last_error(), "color is NULL") != NULL);
+  EXPECT_STATUS(sogmm_frame_from_arrays(NULL, w, h, depth, gray, SOGMM_COLOR_GRAY8), SOGMM_E_NULL_ARG);
+  sogmm_model_free(m1);
+  sogmm_model_free(m2);
+  sogmm_frame_free(bare);
+  sogmm_frame_free(zero);
+  sogmm_frame_free(ff);
+  sogmm_options_free(o);
+  free(depth);
+  free(gray);
+  free(rgb);
+  free(zeros);
+  free(grayf);
+}
+
 int main(int argc, char** argv) {
   if (argc > 1) snprintf(g_dir, sizeof g_dir, "%s", argv[1]);
   test_frames();
+  test_frames_from_arrays();
   test_trajectories();
   return test_summary("capi_frame");
 }

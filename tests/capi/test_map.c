@@ -9,8 +9,8 @@ static int message_has(const char* needle) { return strstr(sogmm_last_error(), n
 static void insert_frames_and_check(const char* dir) {
   sogmm_options* o = NULL;
   sogmm_map* map = NULL;
-  sogmm_map_stats st;
-  sogmm_map_frame_stats fs;
+  test_map_stats st;
+  test_frame_stats fs;
   sogmm_model* all = NULL;
   sogmm_model* part = NULL;
   sogmm_map* loaded = NULL;
@@ -32,33 +32,33 @@ static void insert_frames_and_check(const char* dir) {
   EXPECT_TRUE(all == NULL);
 
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 3000, k_identity));
-  REQUIRE_OK(sogmm_map_get_stats(map, &st));
+  REQUIRE_OK(test_map_get_stats(map, &st));
   EXPECT_TRUE(st.n_pending == 3000 && st.n_components == 0 && st.n_frames == 1);
   snprintf(path, sizeof path, "%s/map_pending.sogmm", dir);
   EXPECT_STATUS(sogmm_map_save(map, path, NULL), SOGMM_E_INVALID_ARG);
   EXPECT_TRUE(message_has("flush"));
   REQUIRE_OK(sogmm_map_flush(map));
-  REQUIRE_OK(sogmm_map_get_stats(map, &st));
+  REQUIRE_OK(test_map_get_stats(map, &st));
   EXPECT_TRUE(st.n_pending == 0 && st.n_components >= 3 && st.n_flushes == 1);
 
   /* The same points again: (almost) nothing is novel. */
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 3000, k_identity));
-  REQUIRE_OK(sogmm_map_get_frame_stats(map, 1, &fs));
+  REQUIRE_OK(test_map_get_frame_stats(map, 1, &fs));
   EXPECT_TRUE(fs.n_points == 3000 && fs.n_novel < 150);
   EXPECT_TRUE(fs.pose[0] == 1.0 && fs.pose[15] == 1.0);
-  EXPECT_STATUS(sogmm_map_get_frame_stats(map, 2, &fs), SOGMM_E_INVALID_ARG);
+  EXPECT_STATUS(test_map_get_frame_stats(map, 2, &fs), SOGMM_E_INVALID_ARG);
   /* Moved 3 m: all novel. */
   memcpy(moved, k_identity, sizeof moved);
   moved[3] = 3.0;
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 3000, moved));
-  REQUIRE_OK(sogmm_map_get_frame_stats(map, 2, &fs));
+  REQUIRE_OK(test_map_get_frame_stats(map, 2, &fs));
   EXPECT_TRUE(fs.n_novel == 3000);
   REQUIRE_OK(sogmm_map_flush(map));
 
   /* Export all and a box. */
   REQUIRE_OK(sogmm_map_export(&all, map, NULL));
   REQUIRE_OK(sogmm_model_n_components(all, &m));
-  REQUIRE_OK(sogmm_map_get_stats(map, &st));
+  REQUIRE_OK(test_map_get_stats(map, &st));
   EXPECT_TRUE(m == st.n_components);
   REQUIRE_OK(sogmm_model_get_value(all, "coordinate_frame", &value));
   EXPECT_TRUE(strcmp(value, "world") == 0);
@@ -75,14 +75,14 @@ static void insert_frames_and_check(const char* dir) {
   REQUIRE_OK(sogmm_map_save(map, path, NULL));
   REQUIRE_OK(sogmm_map_load(&loaded, path, o));
   {
-    sogmm_map_stats ls;
-    sogmm_map_frame_stats lf;
+    test_map_stats ls;
+    test_frame_stats lf;
     sogmm_model* reloaded = NULL;
     float *w1, *w2;
     size_t m2 = 0;
-    REQUIRE_OK(sogmm_map_get_stats(loaded, &ls));
+    REQUIRE_OK(test_map_get_stats(loaded, &ls));
     EXPECT_TRUE(ls.n_components == st.n_components && ls.n_frames == 3 && ls.n_pending == 0);
-    REQUIRE_OK(sogmm_map_get_frame_stats(loaded, 2, &lf));
+    REQUIRE_OK(test_map_get_frame_stats(loaded, 2, &lf));
     EXPECT_TRUE(lf.n_points == 3000 && lf.n_novel == 3000 && lf.pose[3] == 3.0);
     REQUIRE_OK(sogmm_map_export(&reloaded, loaded, NULL));
     REQUIRE_OK(sogmm_model_n_components(reloaded, &m2));
@@ -106,14 +106,14 @@ static void insert_frames_and_check(const char* dir) {
   /* A loaded map keeps growing. */
   moved[3] = -3.0;
   REQUIRE_OK(sogmm_map_insert_points_f32(loaded, pts, 3000, moved));
-  REQUIRE_OK(sogmm_map_get_stats(loaded, &st));
+  REQUIRE_OK(test_map_get_stats(loaded, &st));
   EXPECT_TRUE(st.n_frames == 4 && st.n_pending == 3000);
 
   /* A camera-frame model is not a map. */
   {
     sogmm_model* cam = NULL;
     sogmm_map* bad = NULL;
-    REQUIRE_OK(sogmm_fit_points_f32(&cam, pts, 3000, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&cam, pts, 3000, NULL, o));
     snprintf(path, sizeof path, "%s/camera_frame.sogmm", dir);
     REQUIRE_OK(sogmm_model_save(cam, path, NULL));
     EXPECT_STATUS(sogmm_map_load(&bad, path, NULL), SOGMM_E_INVALID_ARG);
@@ -133,7 +133,7 @@ static void insert_frames_and_check(const char* dir) {
 static void bad_input(void) {
   sogmm_map* map = NULL;
   sogmm_options* o = NULL;
-  sogmm_map_stats st;
+  test_map_stats st;
   float* pts = make_clusters(300, 7);
   double pose[16];
   uint16_t* depth;
@@ -190,29 +190,55 @@ static void bad_input(void) {
   pts[5] = NAN;
   EXPECT_STATUS(sogmm_map_insert_points_f32(map, pts, 300, k_identity), SOGMM_E_INVALID_DATA);
   pts[5] = 0.0f;
-  REQUIRE_OK(sogmm_map_get_stats(map, &st));
+  REQUIRE_OK(test_map_get_stats(map, &st));
   EXPECT_TRUE(st.n_frames == 0 && st.n_pending == 0);
 
   /* RGB-D: the first frame fixes the size. */
   make_frame(64, 48, &depth, &gray, &rgb);
-  REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, rgb, SOGMM_COLOR_RGB8, 64, 48, 50, 50, 32, 24, k_identity));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 32, 48, 50, 50, 32, 24, k_identity),
+  REQUIRE_OK(test_map_insert_rgbd(map, depth, rgb, SOGMM_COLOR_RGB8, 64, 48, 50, 50, 32, 24, k_identity));
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 32, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_ARG);
   EXPECT_TRUE(message_has("differs"));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, 99, 64, 48, 50, 50, 32, 24, k_identity),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, 99, 64, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_ARG);
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, NULL),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, NULL),
                 SOGMM_E_NULL_ARG);
   memset(depth, 0, 64 * 48 * sizeof(uint16_t));
-  EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity),
+  EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity),
                 SOGMM_E_INVALID_DATA);
   EXPECT_TRUE(message_has("no valid depth"));
-  REQUIRE_OK(sogmm_map_get_stats(map, &st));
+  REQUIRE_OK(test_map_get_stats(map, &st));
   EXPECT_TRUE(st.n_frames == 1);
 
   EXPECT_STATUS(sogmm_map_flush(NULL), SOGMM_E_NULL_ARG);
-  EXPECT_STATUS(sogmm_map_get_stats(map, NULL), SOGMM_E_NULL_ARG);
-  EXPECT_STATUS(sogmm_map_get_frame_stats(NULL, 0, NULL), SOGMM_E_NULL_ARG);
+  /* The keyed statistics: each getter takes only its own keys, of its type. */
+  {
+    int64_t iv = -7;
+    double fv = -7.0, pose_out[16];
+    EXPECT_STATUS(sogmm_map_get_i64(map, SOGMM_MAP_N_FRAMES, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_get_i64(NULL, SOGMM_MAP_N_FRAMES, &iv), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_frame_get_i64(NULL, 0, SOGMM_MAP_FRAME_N_POINTS, &iv), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_frame_get_i64(map, 0, SOGMM_MAP_FRAME_N_POINTS, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_frame_get_f64(map, 0, SOGMM_MAP_FRAME_MS_FIT, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_frame_get_pose(map, 0, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_get_i64(map, SOGMM_MAP_FRAME_N_POINTS, &iv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("SOGMM_MAP_FRAME_N_POINTS") && message_has("sogmm_map_frame_get_i64"));
+    EXPECT_STATUS(sogmm_map_frame_get_i64(map, 0, SOGMM_MAP_N_FRAMES, &iv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("sogmm_map_get_i64"));
+    EXPECT_STATUS(sogmm_map_frame_get_i64(map, 0, SOGMM_MAP_FRAME_MS_FIT, &iv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("f64") && message_has("sogmm_map_frame_get_f64"));
+    EXPECT_STATUS(sogmm_map_frame_get_f64(map, 0, SOGMM_MAP_FRAME_N_POINTS, &fv), SOGMM_E_INVALID_ARG);
+    EXPECT_STATUS(sogmm_map_get_i64(map, SOGMM_INFO_SUPPORT_SIZE, &iv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("info key"));
+    EXPECT_STATUS(sogmm_map_get_i64(map, 29999, &iv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("unknown map key 29999"));
+    EXPECT_STATUS(sogmm_map_frame_get_pose(map, 1, pose_out), SOGMM_E_INVALID_ARG); /* one frame so far */
+    EXPECT_STATUS(sogmm_map_frame_get_f64(map, 1, SOGMM_MAP_FRAME_MS_FIT, &fv), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(message_has("does not exist"));
+    EXPECT_TRUE(iv == -7 && fv == -7.0); /* a refused call writes nothing */
+    REQUIRE_OK(sogmm_map_frame_get_pose(map, 0, pose_out));
+    EXPECT_TRUE(memcmp(pose_out, k_identity, sizeof pose_out) == 0);
+  }
   EXPECT_STATUS(sogmm_map_save(map, NULL, NULL), SOGMM_E_NULL_ARG);
   EXPECT_STATUS(sogmm_map_load(NULL, "x", NULL), SOGMM_E_NULL_ARG);
   sogmm_map_free(NULL);
@@ -242,28 +268,30 @@ static void revisit_refit(void) {
   for (int r = 0; r < 2; ++r) { /* r = 0: default ratio (1.25); r = 1: ratio 0 */
     sogmm_options* o = NULL;
     sogmm_map* map = NULL;
-    sogmm_map_stats st;
+    test_map_stats st;
     REQUIRE_OK(sogmm_options_create(&o));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, W * H)); /* the first frame is one batch */
     if (r == 1) REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_MAP_REVISIT_REFIT_RATIO, 0.0));
     REQUIRE_OK(sogmm_map_create(&map, o));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, plain, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, striped, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
-    REQUIRE_OK(sogmm_map_get_stats(map, &st));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, plain, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, striped, SOGMM_COLOR_GRAY8, W, H, 60, 60, 32, 24, k_identity));
+    REQUIRE_OK(test_map_get_stats(map, &st));
     EXPECT_TRUE(st.n_frames == 2 && st.n_pending == 0);
     EXPECT_TRUE(st.n_flushes == (r == 0 ? 2u : 1u));
     {
-      uint64_t replaced0 = 99, replaced1 = 99;
-      sogmm_map_frame_stats fs;
-      REQUIRE_OK(sogmm_map_get_frame_replaced(map, 0, &replaced0));
-      REQUIRE_OK(sogmm_map_get_frame_replaced(map, 1, &replaced1));
-      REQUIRE_OK(sogmm_map_get_frame_stats(map, 1, &fs));
+      int64_t replaced0 = 99, replaced1 = 99;
+      test_frame_stats fs;
+      REQUIRE_OK(sogmm_map_frame_get_i64(map, 0, SOGMM_MAP_FRAME_N_REPLACED, &replaced0));
+      REQUIRE_OK(sogmm_map_frame_get_i64(map, 1, SOGMM_MAP_FRAME_N_REPLACED, &replaced1));
+      REQUIRE_OK(test_map_get_frame_stats(map, 1, &fs));
       EXPECT_TRUE(replaced0 == 0);                         /* the first frame was a batch, not a refit */
       EXPECT_TRUE(r == 0 ? replaced1 > 0 : replaced1 == 0); /* the refit replaced the plain wall's components */
       EXPECT_TRUE(fs.flushed == (r == 0));                  /* a refit is a fit */
-      EXPECT_STATUS(sogmm_map_get_frame_replaced(map, 2, &replaced0), SOGMM_E_INVALID_ARG);
-      EXPECT_STATUS(sogmm_map_get_frame_replaced(map, 0, NULL), SOGMM_E_NULL_ARG);
-      EXPECT_STATUS(sogmm_map_get_frame_replaced(NULL, 0, &replaced0), SOGMM_E_NULL_ARG);
+      EXPECT_TRUE(fs.n_replaced == (uint64_t)replaced1);
+      EXPECT_TRUE(st.n_refits == (r == 0 ? 1u : 0u));       /* the frames with a replaced count */
+      EXPECT_STATUS(sogmm_map_frame_get_i64(map, 2, SOGMM_MAP_FRAME_N_REPLACED, &replaced0), SOGMM_E_INVALID_ARG);
+      EXPECT_STATUS(sogmm_map_frame_get_i64(map, 0, SOGMM_MAP_FRAME_N_REPLACED, NULL), SOGMM_E_NULL_ARG);
+      EXPECT_STATUS(sogmm_map_frame_get_i64(NULL, 0, SOGMM_MAP_FRAME_N_REPLACED, &replaced0), SOGMM_E_NULL_ARG);
     }
     sogmm_map_free(map);
     sogmm_options_free(o);

@@ -56,7 +56,7 @@ typedef struct {
 
 static int32_t reenter(int32_t stage, uint64_t step, uint64_t total, double ll, void* user_data) {
   Reentry* r = (Reentry*)user_data;
-  sogmm_map_stats st;
+  int64_t frames = 0;
   double score = 0.0;
   const float xyz[4] = {0.f, 0.f, 1.f, 0.5f};
   (void)stage, (void)step, (void)total, (void)ll;
@@ -69,8 +69,8 @@ static int32_t reenter(int32_t stage, uint64_t step, uint64_t total, double ll, 
   r->busy_messages += message_starts("map busy: sogmm_map_flush");
   r->set_progress = sogmm_map_set_progress(r->map, NULL, NULL);
   r->busy_messages += message_starts("map busy: sogmm_map_set_progress");
-  r->stats = sogmm_map_get_stats(r->map, &st);
-  r->busy_messages += message_starts("map busy: sogmm_map_get_stats");
+  r->stats = sogmm_map_get_i64(r->map, SOGMM_MAP_N_FRAMES, &frames);
+  r->busy_messages += message_starts("map busy: sogmm_map_get_i64");
   r->score = sogmm_map_score_samples_f32(r->map, xyz, 1, 4, NULL, &score);
   r->busy_messages += message_starts("map busy: sogmm_map_score_samples_f32");
   sogmm_map_free(r->map); /* refused: the map is in use; the outer call goes on with it */
@@ -82,7 +82,7 @@ static void test_reentry_from_callback(void) {
   float* pts = make_clusters(3000, 7);
   sogmm_map* ref = small_batch_map();
   sogmm_map* map = small_batch_map();
-  sogmm_map_stats want, got;
+  test_map_stats want, got;
   Reentry r;
   memset(&r, 0, sizeof r);
   r.map = map;
@@ -90,7 +90,7 @@ static void test_reentry_from_callback(void) {
 
   /* Reference: the same insert without a callback. */
   REQUIRE_OK(sogmm_map_insert_points_f32(ref, pts, 3000, k_identity));
-  REQUIRE_OK(sogmm_map_get_stats(ref, &want));
+  REQUIRE_OK(test_map_get_stats(ref, &want));
   EXPECT_TRUE(want.n_flushes == 1 && want.n_components > 0);
 
   /* The insert's fit calls the callback, which calls into the map. */
@@ -102,7 +102,7 @@ static void test_reentry_from_callback(void) {
   EXPECT_TRUE(r.busy_messages == 5);
   EXPECT_TRUE(r.free_refused);
   /* Nothing nested took effect: the map is the reference, frame for frame. */
-  REQUIRE_OK(sogmm_map_get_stats(map, &got));
+  REQUIRE_OK(test_map_get_stats(map, &got));
   EXPECT_TRUE(got.n_components == want.n_components && got.n_frames == 1 && got.n_pending == want.n_pending);
   EXPECT_TRUE(got.n_flushes == 1);
 
@@ -111,7 +111,7 @@ static void test_reentry_from_callback(void) {
   {
     sogmm_options* o = NULL;
     sogmm_map *a = NULL, *b = NULL;
-    sogmm_map_stats sa, sb;
+    test_map_stats sa, sb;
     REQUIRE_OK(sogmm_options_create(&o));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, 100000));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, team()));
@@ -126,8 +126,8 @@ static void test_reentry_from_callback(void) {
     REQUIRE_OK(sogmm_map_set_progress(b, reenter, &r));
     REQUIRE_OK(sogmm_map_flush(b));
     EXPECT_TRUE(r.flush == SOGMM_E_BUSY);
-    REQUIRE_OK(sogmm_map_get_stats(a, &sa));
-    REQUIRE_OK(sogmm_map_get_stats(b, &sb));
+    REQUIRE_OK(test_map_get_stats(a, &sa));
+    REQUIRE_OK(test_map_get_stats(b, &sb));
     EXPECT_TRUE(sb.n_components == sa.n_components && sb.n_flushes == 1 && sb.n_pending == 0);
     sogmm_map_free(a);
     sogmm_map_free(b);
@@ -167,7 +167,7 @@ static int32_t hold_until_tried(int32_t stage, uint64_t step, uint64_t total, do
 
 static void* thread_b(void* p) {
   Meeting* m = (Meeting*)p;
-  sogmm_map_stats st;
+  test_map_stats st;
   sogmm_model* out = NULL;
   pthread_mutex_lock(&m->mutex);
   while (!m->inside) pthread_cond_wait(&m->cond, &m->mutex);
@@ -175,7 +175,7 @@ static void* thread_b(void* p) {
   /* Thread A is inside sogmm_map_insert_points_f32 on this map. */
   m->b_insert = sogmm_map_insert_points_f32(m->map, m->points, 3000, k_identity);
   m->b_busy_messages += message_starts("map busy: ");
-  m->b_stats = sogmm_map_get_stats(m->map, &st);
+  m->b_stats = test_map_get_stats(m->map, &st);
   m->b_busy_messages += message_starts("map busy: ");
   m->b_export = sogmm_map_export(&out, m->map, NULL);
   m->b_busy_messages += message_starts("map busy: ") && out == NULL;
@@ -191,7 +191,7 @@ static void* thread_b(void* p) {
 static void test_two_threads(void) {
   float* pts = make_clusters(3000, 8);
   sogmm_map* ref = small_batch_map();
-  sogmm_map_stats want, got;
+  test_map_stats want, got;
   pthread_t b;
   Meeting m;
   memset(&m, 0, sizeof m);
@@ -200,7 +200,7 @@ static void test_two_threads(void) {
   m.map = small_batch_map();
   m.points = pts;
   REQUIRE_OK(sogmm_map_insert_points_f32(ref, pts, 3000, k_identity));
-  REQUIRE_OK(sogmm_map_get_stats(ref, &want));
+  REQUIRE_OK(test_map_get_stats(ref, &want));
 
   REQUIRE_OK(sogmm_map_set_progress(m.map, hold_until_tried, &m));
   if (pthread_create(&b, NULL, thread_b, &m) != 0) {
@@ -211,7 +211,7 @@ static void test_two_threads(void) {
   pthread_join(b, NULL);
   EXPECT_TRUE(m.b_insert == SOGMM_E_BUSY && m.b_stats == SOGMM_E_BUSY && m.b_export == SOGMM_E_BUSY);
   EXPECT_TRUE(m.b_busy_messages == 3 && m.b_free_refused);
-  REQUIRE_OK(sogmm_map_get_stats(m.map, &got));
+  REQUIRE_OK(test_map_get_stats(m.map, &got));
   EXPECT_TRUE(got.n_frames == 1 && got.n_components == want.n_components && got.n_pending == want.n_pending);
   /* After the call, thread B's calls succeed (here, on this thread). */
   REQUIRE_OK(sogmm_map_set_progress(m.map, NULL, NULL));
@@ -242,7 +242,7 @@ static int32_t nest_fit(int32_t stage, uint64_t step, uint64_t total, double ll,
    * regression fails the test instead of exhausting the stack. */
   if (n->depth < 3) {
     sogmm_model* inner = NULL;
-    n->nested = sogmm_fit_points_fixed_k_f32(&inner, n->points, 600, 3, NULL);
+    n->nested = test_fit_fixed_k(&inner, n->points, 600, 3, NULL);
     if (inner) sogmm_model_n_components(inner, &n->nested_k);
     sogmm_model_free(inner);
   }
@@ -260,7 +260,7 @@ static void test_nested_calls_have_no_callback(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 3));
   REQUIRE_OK(sogmm_options_set_progress(o, nest_fit, &n));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&outer, pts, 600, 3, o));
+  REQUIRE_OK(test_fit_fixed_k(&outer, pts, 600, 3, o));
   EXPECT_TRUE(n.calls > 0);
   EXPECT_TRUE(n.max_depth == 1); /* the nested fits reported to nothing */
   EXPECT_TRUE(n.nested == SOGMM_OK && n.nested_k == 3);
@@ -305,7 +305,7 @@ static void test_slow_callback_reports_per_interval(void) {
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 1));
     REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, threads));
     REQUIRE_OK(sogmm_options_set_progress(o, slow, &c));
-    REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&m, pts, 1500, k, o));
+    REQUIRE_OK(test_fit_fixed_k(&m, pts, 1500, k, o));
     printf("threads %d: %d seeding reports for %zu seeds, %d reports in all\n", threads, c.seeding_reports, k,
            c.reports);
     EXPECT_TRUE(c.seeding_reports >= 1 && c.seeding_reports <= 30);

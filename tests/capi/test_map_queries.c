@@ -1,6 +1,6 @@
 /* Map queries (sogmm_map_score_samples_f32, _regress_gray_f32, _sample_f32):
  * bitwise equal to the same query on the exported map, with and without a
- * progress callback (and the model's _v2 queries, which take one); a cancel writes nothing; a status and message for every
+ * progress callback (and the model queries, which take one too); a cancel writes nothing; a status and message for every
  * bad input. Progress and cancel of inserts and flushes
  * (sogmm_map_set_progress): a cancelled insert or flush leaves the map as it
  * was. */
@@ -83,7 +83,7 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
 
   for (dims = 3; dims <= 4; ++dims) {
     const float* q = dims == 3 ? q3 : q4;
-    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, want));
+    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, NULL, want));
     REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, NULL, got));
     EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
     /* With a callback: in chunks, the same bits; reports of SCORING up to n. */
@@ -97,7 +97,7 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
   /* A far point really is far: the test covers both regimes. */
   EXPECT_TRUE(want[0] < want[1] - 50.0);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, mean_w, var_w));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
   REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, NULL, mean_g, var_g));
   EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
   memset(&rec, 0, sizeof rec);
@@ -202,9 +202,9 @@ static void bad_input(const sogmm_map* map, const float* pts) {
 }
 
 /* Means and stats of a map, to compare a map before and after a failed call. */
-static void snapshot(const sogmm_map* map, sogmm_map_stats* st, float* means, size_t cap) {
+static void snapshot(const sogmm_map* map, test_map_stats* st, float* means, size_t cap) {
   sogmm_model* m = NULL;
-  REQUIRE_OK(sogmm_map_get_stats(map, st));
+  REQUIRE_OK(test_map_get_stats(map, st));
   memset(means, 0, cap * sizeof(float));
   if (st->n_components == 0) return;
   REQUIRE_OK(sogmm_map_export(&m, map, NULL));
@@ -212,7 +212,7 @@ static void snapshot(const sogmm_map* map, sogmm_map_stats* st, float* means, si
   sogmm_model_free(m);
 }
 
-static int same_stats(const sogmm_map_stats* a, const sogmm_map_stats* b) {
+static int same_stats(const test_map_stats* a, const test_map_stats* b) {
   return a->n_components == b->n_components && a->n_pending == b->n_pending && a->n_frames == b->n_frames &&
          a->n_flushes == b->n_flushes && a->n_fused == b->n_fused;
 }
@@ -222,7 +222,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   static float before[kCap], after[kCap];
   sogmm_options* o = NULL;
   sogmm_map* map = NULL;
-  sogmm_map_stats s0, s1;
+  test_map_stats s0, s1;
   Recorder rec;
   double moved[16];
   memcpy(moved, k_identity, sizeof moved);
@@ -250,7 +250,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   /* ... and the next insert works: it is the second frame. */
   rec.cancel = 0;
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, n, moved));
-  REQUIRE_OK(sogmm_map_get_stats(map, &s1));
+  REQUIRE_OK(test_map_get_stats(map, &s1));
   EXPECT_TRUE(s1.n_frames == 2 && s1.n_flushes == 2 && s1.n_components > s0.n_components);
   /* NULL removes the callback. */
   REQUIRE_OK(sogmm_map_set_progress(map, NULL, NULL));
@@ -276,7 +276,7 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   EXPECT_TRUE(same_stats(&s0, &s1) && s1.n_pending == n && s1.n_components == 0);
   rec.cancel = 0;
   REQUIRE_OK(sogmm_map_flush(map));
-  REQUIRE_OK(sogmm_map_get_stats(map, &s1));
+  REQUIRE_OK(test_map_get_stats(map, &s1));
   EXPECT_TRUE(s1.n_pending == 0 && s1.n_components > 0 && rec.n >= 2);
   sogmm_map_free(map);
 
@@ -290,15 +290,15 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
     REQUIRE_OK(sogmm_map_set_progress(map, record, &rec));
     memset(&rec, 0, sizeof rec);
     rec.cancel = 1;
-    EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 60, 60, 32, 24, k_identity),
+    EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 60, 60, 32, 24, k_identity),
                   SOGMM_E_CANCELLED);
     REQUIRE_OK(sogmm_map_set_progress(map, NULL, NULL));
-    REQUIRE_OK(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity));
+    REQUIRE_OK(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, k_identity));
     snapshot(map, &s0, before, kCap);
     REQUIRE_OK(sogmm_map_set_progress(map, record, &rec));
     memset(&rec, 0, sizeof rec);
     rec.cancel = 1;
-    EXPECT_STATUS(sogmm_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, moved),
+    EXPECT_STATUS(test_map_insert_rgbd(map, depth, gray, SOGMM_COLOR_GRAY8, 64, 48, 50, 50, 32, 24, moved),
                   SOGMM_E_CANCELLED);
     snapshot(map, &s1, after, kCap);
     EXPECT_TRUE(same_stats(&s0, &s1) && s1.n_frames == 1 && memcmp(before, after, sizeof before) == 0);
@@ -310,9 +310,9 @@ static void insert_progress_and_cancel(const float* pts, size_t n) {
   sogmm_options_free(o);
 }
 
-/* The model queries with options (_v2): the same bits as without, reports
+/* The model queries with a progress callback: the same bits as without, reports
  * of SCORING / REGRESSION up to n, a cancel leaves the outputs untouched. */
-static void model_v2(const sogmm_map* map, const float* pts, size_t n) {
+static void model_with_progress(const sogmm_map* map, const float* pts, size_t n) {
   sogmm_model* model = NULL;
   sogmm_options* po = NULL;
   Recorder rec;
@@ -328,34 +328,32 @@ static void model_v2(const sogmm_map* map, const float* pts, size_t n) {
   REQUIRE_OK(sogmm_options_create(&po));
   REQUIRE_OK(sogmm_options_set_progress(po, record, &rec));
 
-  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, want));
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, NULL, want));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got));
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, po, got));
   EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_SCORING && rec.last_step == n && rec.last_total == n);
-  REQUIRE_OK(sogmm_model_score_samples_f32_v2(model, q3, n, 3, NULL, got));
-  EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, mean_w, var_w));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, var_g));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, var_g));
   EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_REGRESSION && rec.last_step == n && !rec.decreasing);
 
   rec.cancel = 1;
   memset(got, 0x7f, n * sizeof(double));
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
   EXPECT_TRUE(((const unsigned char*)got)[8 * n - 1] == 0x7f);
   memset(mean_g, 0x7f, n * sizeof(float));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
   EXPECT_TRUE(((const unsigned char*)mean_g)[0] == 0x7f);
-  /* Bad input as without _v2. */
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
-  EXPECT_STATUS(sogmm_model_score_samples_f32_v2(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
-  EXPECT_OK(sogmm_model_regress_gray_f32_v2(model, NULL, 0, po, NULL, NULL));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
+  /* Bad input, with and without options. */
+  EXPECT_STATUS(sogmm_model_score_samples_f32(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
+  EXPECT_OK(sogmm_model_regress_gray_f32(model, NULL, 0, po, NULL, NULL));
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
   q3[4] = NAN;
-  EXPECT_STATUS(sogmm_model_regress_gray_f32_v2(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
 
   sogmm_options_free(po);
   sogmm_model_free(model);
@@ -373,7 +371,7 @@ int main(void) {
   float* pts = make_clusters(n, 42);
   sogmm_map* map = make_map(pts, 3000);
   equals_exported_model(map, pts, n);
-  model_v2(map, pts, n);
+  model_with_progress(map, pts, n);
   bad_input(map, pts);
   insert_progress_and_cancel(pts, 3000);
   sogmm_map_free(map);

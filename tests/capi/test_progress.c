@@ -64,8 +64,8 @@ int main(void) {
     rec.caller = pthread_self();
     rec.cancel_stage = -1;
     o = em_options(&rec);
-    REQUIRE_OK(sogmm_fit_points_f32(&plain, pts, n, plain_o));
-    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, o));
+    REQUIRE_OK(sogmm_fit_points_f32(&plain, pts, n, NULL, plain_o));
+    REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, o));
     get_means(plain, plain_means);
     get_means(m, means);
     EXPECT_TRUE(memcmp(plain_means, means, sizeof means) == 0);
@@ -88,7 +88,7 @@ int main(void) {
     rec.cancel_stage = SOGMM_STAGE_EM;
     rec.cancel_step = 3;
     m = (sogmm_model*)&rec; /* must become NULL */
-    EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, o), SOGMM_E_CANCELLED);
+    EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, NULL, o), SOGMM_E_CANCELLED);
     EXPECT_TRUE(m == NULL);
     EXPECT_TRUE(strstr(sogmm_last_error(), "EM iteration 3") != NULL);
     EXPECT_TRUE(rec.stage[rec.n - 1] == SOGMM_STAGE_EM && rec.step[rec.n - 1] == 3);
@@ -98,7 +98,7 @@ int main(void) {
     memset(&rec, 0, sizeof rec);
     rec.caller = pthread_self();
     rec.cancel_stage = SOGMM_STAGE_SEEDING;
-    EXPECT_STATUS(sogmm_fit_points_fixed_k_f32(&m, pts, n, 12, o), SOGMM_E_CANCELLED);
+    EXPECT_STATUS(test_fit_fixed_k(&m, pts, n, 12, o), SOGMM_E_CANCELLED);
     EXPECT_TRUE(m == NULL && rec.n == 1);
 
     /* A clone keeps the callback; NULL removes it. */
@@ -108,10 +108,10 @@ int main(void) {
       memset(&rec, 0, sizeof rec);
       rec.caller = pthread_self();
       rec.cancel_stage = SOGMM_STAGE_SEEDING;
-      EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, c), SOGMM_E_CANCELLED);
+      EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, NULL, c), SOGMM_E_CANCELLED);
       REQUIRE_OK(sogmm_options_set_progress(c, NULL, &rec));
       memset(&rec, 0, sizeof rec);
-      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, c));
+      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, c));
       EXPECT_TRUE(rec.n == 0);
       sogmm_model_free(m);
       sogmm_options_free(c);
@@ -128,7 +128,7 @@ int main(void) {
       rec.caller = pthread_self();
       rec.cancel_stage = SOGMM_STAGE_MODE_COUNT;
       rec.cancel_step = 0;
-      EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, so), SOGMM_E_CANCELLED);
+      EXPECT_STATUS(sogmm_fit_points_f32(&m, pts, n, NULL, so), SOGMM_E_CANCELLED);
       EXPECT_TRUE(m == NULL && rec.n == 1 && rec.stage[0] == SOGMM_STAGE_MODE_COUNT);
       sogmm_options_free(so);
     }
@@ -139,7 +139,7 @@ int main(void) {
       const size_t ns = 5000;
       float* out = (float*)malloc(ns * 4 * sizeof(float));
       float* ref = (float*)malloc(ns * 4 * sizeof(float));
-      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, plain_o = em_options(NULL)));
+      REQUIRE_OK(sogmm_fit_points_f32(&m, pts, n, NULL, plain_o = em_options(NULL)));
       for (i = 0; i < ns * 4; ++i) out[i] = -7.0f;
       memset(&rec, 0, sizeof rec);
       rec.caller = pthread_self();

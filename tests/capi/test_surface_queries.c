@@ -27,7 +27,7 @@ static sogmm_map* plane_map(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_NOVELTY, 0));
   REQUIRE_OK(sogmm_map_create(&m, o));
-  REQUIRE_OK(sogmm_map_insert_rgbd(m, depth, gray, SOGMM_COLOR_GRAY8, W, H, 50.0, 50.0, 31.5, 23.5, k_identity));
+  REQUIRE_OK(test_map_insert_rgbd(m, depth, gray, SOGMM_COLOR_GRAY8, W, H, 50.0, 50.0, 31.5, 23.5, k_identity));
   REQUIRE_OK(sogmm_map_flush(m));
   sogmm_options_free(o);
   return m;

@@ -28,9 +28,9 @@ static void* worker(void* p) {
     int64_t support = 0;
     size_t M = 0;
     /* const queries on the shared handle */
-    WCHECK(sogmm_model_score_samples_f32(g_shared, g_points, N_POINTS, 4, score) == SOGMM_OK);
+    WCHECK(sogmm_model_score_samples_f32(g_shared, g_points, N_POINTS, 4, NULL, score) == SOGMM_OK);
     WCHECK(memcmp(score, g_ref_score, sizeof score) == 0);
-    WCHECK(sogmm_model_regress_gray_f32(g_shared, g_xyz, N_POINTS, gray, var) == SOGMM_OK);
+    WCHECK(sogmm_model_regress_gray_f32(g_shared, g_xyz, N_POINTS, NULL, gray, var) == SOGMM_OK);
     WCHECK(memcmp(gray, g_ref_gray, sizeof gray) == 0 && memcmp(var, g_ref_var, sizeof var) == 0);
     WCHECK(sogmm_model_sample_f32(g_shared, N_POINTS, 99, 4, NULL, samples) == SOGMM_OK);
     WCHECK(memcmp(samples, g_ref_samples, sizeof g_ref_samples) == 0);
@@ -46,7 +46,7 @@ static void* worker(void* p) {
       char key[32];
       WCHECK(sogmm_options_create(&o) == SOGMM_OK);
       WCHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
-      WCHECK(sogmm_fit_points_fixed_k_f32(&own, pts, 600, 3, o) == SOGMM_OK);
+      WCHECK(test_fit_fixed_k(&own, pts, 600, 3, o) == SOGMM_OK);
       snprintf(key, sizeof key, "thread-%d", arg->index);
       WCHECK(sogmm_model_set_value(own, key, "x") == SOGMM_OK);
       WCHECK(sogmm_model_merge(&merged, own, g_shared) == SOGMM_OK);
@@ -76,10 +76,10 @@ int main(void) {
   size_t i;
   memcpy(g_points, pts, sizeof g_points);
   for (i = 0; i < N_POINTS; ++i) memcpy(g_xyz + 3 * i, g_points + 4 * i, 3 * sizeof(float));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&shared, pts, N_POINTS, 3, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&shared, pts, N_POINTS, 3, NULL));
   REQUIRE_OK(sogmm_model_set_value(shared, "owner", "main"));
-  REQUIRE_OK(sogmm_model_score_samples_f32(shared, g_points, N_POINTS, 4, g_ref_score));
-  REQUIRE_OK(sogmm_model_regress_gray_f32(shared, g_xyz, N_POINTS, g_ref_gray, g_ref_var));
+  REQUIRE_OK(sogmm_model_score_samples_f32(shared, g_points, N_POINTS, 4, NULL, g_ref_score));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(shared, g_xyz, N_POINTS, NULL, g_ref_gray, g_ref_var));
   REQUIRE_OK(sogmm_model_sample_f32(shared, N_POINTS, 99, 4, NULL, g_ref_samples));
   g_shared = shared;
   /* a failure on the main thread: workers must still see their own (empty) message */

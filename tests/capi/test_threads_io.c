@@ -51,8 +51,8 @@ static void work(worker_arg* arg, int record) {
     double score[64];
     size_t M = 0, i;
     /* fit: fixed K and self-organizing */
-    WCHECK(sogmm_fit_points_fixed_k_f32(&fit, g_points[t], N_POINTS, 4, o) == SOGMM_OK);
-    WCHECK(sogmm_fit_points_f32(&so, g_points[t], N_POINTS, o) == SOGMM_OK);
+    WCHECK(test_fit_fixed_k(&fit, g_points[t], N_POINTS, 4, o) == SOGMM_OK);
+    WCHECK(sogmm_fit_points_f32(&so, g_points[t], N_POINTS, NULL, o) == SOGMM_OK);
     WCHECK(sogmm_model_n_components(so, &M) == SOGMM_OK && M >= 1);
     if (record) g_ref_M[t] = M;
     else WCHECK(M == g_ref_M[t]);
@@ -71,8 +71,8 @@ static void work(worker_arg* arg, int record) {
     if (record) memcpy(g_ref_samples[t], samples, sizeof samples);
     else WCHECK(memcmp(samples, g_ref_samples[t], sizeof samples) == 0);
     for (i = 0; i < 64; ++i) memcpy(xyz + 3 * i, samples + 4 * i, 3 * sizeof(float));
-    WCHECK(sogmm_model_regress_gray_f32(from_mem, xyz, 64, gray, var) == SOGMM_OK);
-    WCHECK(sogmm_model_score_samples_f32(from_mem, samples, 64, 4, score) == SOGMM_OK);
+    WCHECK(sogmm_model_regress_gray_f32(from_mem, xyz, 64, NULL, gray, var) == SOGMM_OK);
+    WCHECK(sogmm_model_score_samples_f32(from_mem, samples, 64, 4, NULL, score) == SOGMM_OK);
     /* the shared const model: merge, save (own path), and the shared file: load */
     WCHECK(sogmm_model_merge(&merged, from_mem, g_shared) == SOGMM_OK);
     WCHECK(sogmm_model_save(g_shared, shared_copy, o) == SOGMM_OK);
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   int t, failures = 0;
   g_dir = argc > 1 ? argv[1] : "/tmp";
   pts = make_clusters(N_POINTS, 5);
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&shared, pts, N_POINTS, 3, NULL));
+  REQUIRE_OK(test_fit_fixed_k(&shared, pts, N_POINTS, 3, NULL));
   snprintf(g_shared_path, sizeof g_shared_path, "%s/threads-io-shared.sogmm", g_dir);
   REQUIRE_OK(sogmm_model_save(shared, g_shared_path, NULL));
   snprintf(g_same_path, sizeof g_same_path, "%s/threads-io-same.sogmm", g_dir);

@@ -130,4 +130,109 @@ static inline int write_file(const char* path, const void* data, size_t size) {
   return fclose(f) == 0 ? 0 : -1;
 }
 
+/* A map's totals and what one insert did, read key by key
+ * (sogmm_map_get_i64, sogmm_map_frame_get_i64/_f64/_pose) into one struct
+ * for the tests to compare; returns the first status that is not SOGMM_OK. */
+typedef struct test_map_stats {
+  uint64_t n_components, n_pending, n_frames, n_flushes, n_fused, n_refits;
+} test_map_stats;
+typedef struct test_frame_stats {
+  uint64_t n_points, n_novel, n_components, n_replaced;
+  int flushed;
+  double ms_novelty, ms_fit, ms_merge, pose[16];
+} test_frame_stats;
+
+static inline sogmm_status test_map_get_stats(const sogmm_map* map, test_map_stats* out) {
+  const sogmm_key keys[6] = {SOGMM_MAP_N_COMPONENTS, SOGMM_MAP_N_PENDING, SOGMM_MAP_N_FRAMES,
+                             SOGMM_MAP_N_FLUSHES,    SOGMM_MAP_N_FUSED,   SOGMM_MAP_N_REFITS};
+  uint64_t* fields[6] = {&out->n_components, &out->n_pending, &out->n_frames,
+                         &out->n_flushes,    &out->n_fused,   &out->n_refits};
+  int i;
+  for (i = 0; i < 6; ++i) {
+    int64_t v = -1;
+    const sogmm_status s = sogmm_map_get_i64(map, keys[i], &v);
+    if (s != SOGMM_OK) return s;
+    *fields[i] = (uint64_t)v;
+  }
+  return SOGMM_OK;
+}
+
+static inline sogmm_status test_map_get_frame_stats(const sogmm_map* map, uint64_t frame, test_frame_stats* out) {
+  const sogmm_key ikeys[5] = {SOGMM_MAP_FRAME_N_POINTS, SOGMM_MAP_FRAME_N_NOVEL, SOGMM_MAP_FRAME_N_COMPONENTS,
+                              SOGMM_MAP_FRAME_N_REPLACED, SOGMM_MAP_FRAME_FLUSHED};
+  const sogmm_key fkeys[3] = {SOGMM_MAP_FRAME_MS_NOVELTY, SOGMM_MAP_FRAME_MS_FIT, SOGMM_MAP_FRAME_MS_MERGE};
+  int64_t iv[5];
+  double* fv[3] = {&out->ms_novelty, &out->ms_fit, &out->ms_merge};
+  sogmm_status s;
+  int i;
+  for (i = 0; i < 5; ++i)
+    if ((s = sogmm_map_frame_get_i64(map, frame, ikeys[i], &iv[i])) != SOGMM_OK) return s;
+  for (i = 0; i < 3; ++i)
+    if ((s = sogmm_map_frame_get_f64(map, frame, fkeys[i], fv[i])) != SOGMM_OK) return s;
+  out->n_points = (uint64_t)iv[0];
+  out->n_novel = (uint64_t)iv[1];
+  out->n_components = (uint64_t)iv[2];
+  out->n_replaced = (uint64_t)iv[3];
+  out->flushed = (int)iv[4];
+  return sogmm_map_frame_get_pose(map, frame, out->pose);
+}
+
+/* A frame from arrays with its intrinsics (sogmm_frame_from_arrays +
+ * sogmm_frame_set_intrinsics), for the tests that give a frame as the
+ * arrays and scalars the RGB-D calls took before the frame handle: NULL and
+ * the status in *status (when not NULL) if the frame is refused. */
+static inline sogmm_frame* test_frame(const uint16_t* depth, const void* color, int32_t color_format, uint32_t w,
+                                      uint32_t h, double fx, double fy, double cx, double cy, sogmm_status* status) {
+  sogmm_frame* f = NULL;
+  sogmm_status s = sogmm_frame_from_arrays(&f, w, h, depth, color, color_format);
+  if (s == SOGMM_OK) s = sogmm_frame_set_intrinsics(f, fx, fy, cx, cy);
+  if (status) *status = s;
+  return f;
+}
+
+/* sogmm_fit_frame, sogmm_map_insert_frame and sogmm_frame_to_points_f32 on
+ * test_frame(...): the first status that is not SOGMM_OK. */
+static inline sogmm_status test_fit_rgbd(sogmm_model** out, const uint16_t* depth, const void* color,
+                                         int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
+                                         double cx, double cy, const sogmm_options* options) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_fit_frame(out, f, options);
+  sogmm_frame_free(f);
+  return s;
+}
+
+static inline sogmm_status test_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const void* color,
+                                                int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
+                                                double cx, double cy, const double* pose) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_map_insert_frame(map, f, pose);
+  sogmm_frame_free(f);
+  return s;
+}
+
+static inline sogmm_status test_rgbd_to_points(float* out, size_t capacity, size_t* n_points, const uint16_t* depth,
+                                               const void* color, int32_t color_format, uint32_t w, uint32_t h,
+                                               double fx, double fy, double cx, double cy,
+                                               const sogmm_options* options) {
+  sogmm_status s;
+  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
+  if (s == SOGMM_OK) s = sogmm_frame_to_points_f32(out, capacity, n_points, f, options);
+  sogmm_frame_free(f);
+  return s;
+}
+
+/* A fixed-K fit: sogmm_fit_points_f32 with SOGMM_OPT_N_COMPONENTS = k on a
+ * copy of `options` (NULL = defaults); the first status that is not SOGMM_OK. */
+static inline sogmm_status test_fit_fixed_k(sogmm_model** out, const float* points, size_t n, size_t k,
+                                            const sogmm_options* options) {
+  sogmm_options* o = NULL;
+  sogmm_status s = options ? sogmm_options_clone(&o, options) : sogmm_options_create(&o);
+  if (s == SOGMM_OK) s = sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, (int64_t)k);
+  if (s == SOGMM_OK) s = sogmm_fit_points_f32(out, points, n, NULL, o);
+  sogmm_options_free(o);
+  return s;
+}
+
 #endif /* SOGMM_TEST_UTIL_H */

@@ -16,12 +16,12 @@ int main(void) {
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_SEED, 7));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_TOL, 1e-6));
-  REQUIRE_OK(sogmm_fit_points_fixed_k_f32(&cold, pts, n, 3, o));
+  REQUIRE_OK(test_fit_fixed_k(&cold, pts, n, 3, o));
   REQUIRE_OK(sogmm_model_get_info_f64(cold, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_cold));
 
   /* Fixed K = 3 from the converged model: converged at once, same likelihood. */
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 3));
-  REQUIRE_OK(sogmm_fit_points_warm_f32(&warm, pts, n, cold, o));
+  REQUIRE_OK(sogmm_fit_points_f32(&warm, pts, n, cold, o));
   EXPECT_OK(sogmm_model_get_info_f64(warm, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_warm));
   EXPECT_OK(sogmm_model_get_info_i64(warm, SOGMM_INFO_FIT_ITERATIONS, &iters));
   EXPECT_NEAR(ll_warm, ll_cold, 1e-4);
@@ -33,7 +33,7 @@ int main(void) {
    * clusters are explained, so every component is kept. */
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 0));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
-  REQUIRE_OK(sogmm_fit_points_warm_f32(&warm, pts, n, cold, o));
+  REQUIRE_OK(sogmm_fit_points_f32(&warm, pts, n, cold, o));
   EXPECT_OK(sogmm_model_n_components(warm, &m));
   EXPECT_TRUE(m >= 3);
   EXPECT_OK(sogmm_model_get_info_f64(warm, SOGMM_INFO_FIT_LOG_LIKELIHOOD, &ll_warm));
@@ -41,16 +41,15 @@ int main(void) {
   sogmm_model_free(warm);
   warm = NULL;
 
-  /* Errors: no initial model, several runs, K not the initial model's size. */
-  EXPECT_STATUS(sogmm_fit_points_warm_f32(&warm, pts, n, NULL, o), SOGMM_E_NULL_ARG);
-  EXPECT_TRUE(warm == NULL);
+  /* Errors: several runs, K not the initial model's size (initial NULL is a
+   * cold fit, not an error). */
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2));
-  EXPECT_STATUS(sogmm_fit_points_warm_f32(&warm, pts, n, cold, o), SOGMM_E_INVALID_ARG);
+  EXPECT_STATUS(sogmm_fit_points_f32(&warm, pts, n, cold, o), SOGMM_E_INVALID_ARG);
   EXPECT_TRUE(strstr(sogmm_last_error(), "n_init") != NULL);
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 1));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, 2));
-  EXPECT_STATUS(sogmm_fit_points_warm_f32(&warm, pts, n, cold, o), SOGMM_E_INVALID_ARG);
-  EXPECT_STATUS(sogmm_fit_points_warm_f32(&warm, pts, 0, cold, o), SOGMM_E_INVALID_DATA);
+  EXPECT_STATUS(sogmm_fit_points_f32(&warm, pts, n, cold, o), SOGMM_E_INVALID_ARG);
+  EXPECT_STATUS(sogmm_fit_points_f32(&warm, pts, 0, cold, o), SOGMM_E_INVALID_DATA);
 
   sogmm_model_free(cold);
   sogmm_options_free(o);

@@ -29,13 +29,13 @@ tools() {
 # (so a stray copy elsewhere on the system cannot make the test pass).
 check_runs() {
   local program=$1 expected=$2 loaded
-  # "libsogmm.so.1 => /path/libsogmm.so.1 (0x...)" or "... => not found".
+  # "libsogmm.so.2 => /path/libsogmm.so.2 (0x...)" or "... => not found".
   loaded=$(clean ldd "$program" | awk '$1 ~ /^libsogmm\.so/ {print $3, $4}')
   if [ "$expected" = static ]; then
     [ -z "$loaded" ] || { echo "FAIL: $program needs libsogmm.so ($loaded), expected libsogmm.a" >&2; exit 1; }
   else
-    [ "${loaded%% *}" -ef "$expected/libsogmm.so.1" ] ||
-      { echo "FAIL: $program: libsogmm.so.1 => '$loaded', expected $expected/libsogmm.so.1" >&2; exit 1; }
+    [ "${loaded%% *}" -ef "$expected/libsogmm.so.2" ] ||
+      { echo "FAIL: $program: libsogmm.so.2 => '$loaded', expected $expected/libsogmm.so.2" >&2; exit 1; }
   fi
   # SOGMM_ISA (the EM/query kernel, not a way to find the library) is passed
   # on, so the result is checked under each kernel the suite runs with.

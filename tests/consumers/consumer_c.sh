@@ -10,7 +10,7 @@ cmake=$3 generator=$4
 cp -r "$SRC/tests/consumers/c" "$work/src"
 "$cmake" --install "$BUILD" --prefix "$work/prefix" --component sogmm_capi >/dev/null
 pcdir=$(dirname "$(find "$work/prefix" -name sogmm.pc)")
-libdir=$(dirname "$(find "$work/prefix" -name libsogmm.so.1)")
+libdir=$(dirname "$(find "$work/prefix" -name libsogmm.so.2)")
 
 compile_pc() { # <PKG_CONFIG_PATH> <output>
   clean PKG_CONFIG_PATH="$1" sh -c \

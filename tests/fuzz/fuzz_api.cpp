@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "fuzz_model_check.hpp"
+#include "../hardening/capi_calls.hpp"
 #include "fuzz_util.hpp"
 #include "sogmm/sogmm.h"
 
@@ -220,13 +221,13 @@ void step_fit(State& st, sogmm_fuzz::Reader& in) {
   sogmm_status s;
   if (how & 1) {
     const std::size_t k = (how >> 1) % 9;
-    s = sogmm_fit_points_fixed_k_f32(&m, pts.data(), n, k, o);
+    s = sogmm_test::fit_fixed_k(&m, pts.data(), n, k, o);
   } else {
     // The mode count can find many components in a small noisy cloud: a larger bandwidth keeps steps cheap.
     double bw = 0.02;
     if (sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &bw) == SOGMM_OK && bw < 0.01)
       FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.01) == SOGMM_OK);
-    s = sogmm_fit_points_f32(&m, pts.data(), n, o);
+    s = sogmm_fit_points_f32(&m, pts.data(), n, nullptr, o);
   }
   check_created(s, m);
   if (s == SOGMM_OK) put(st, slot, m);
@@ -337,7 +338,7 @@ void step_inference(State& st, sogmm_fuzz::Reader& in) {
     case 1: {
       const std::vector<float> xyz = take_points(in, n_alloc);  // 4 floats a point: room for 3
       std::vector<float> mean(n_alloc + 1), var(n_alloc + 1);
-      const sogmm_status s = sogmm_model_regress_gray_f32(m, xyz.data(), n, mean.data(), (what & 8) ? nullptr : var.data());
+      const sogmm_status s = sogmm_model_regress_gray_f32(m, xyz.data(), n, nullptr, mean.data(), (what & 8) ? nullptr : var.data());
       check_status(s);
       FUZZ_CHECK(!(huge && s == SOGMM_OK));
       if (s == SOGMM_OK)
@@ -348,7 +349,7 @@ void step_inference(State& st, sogmm_fuzz::Reader& in) {
       const int32_t dims = (what & 8) ? 3 : 4;
       const std::vector<float> pts = take_points(in, n_alloc);
       std::vector<double> out(n_alloc + 1);
-      const sogmm_status s = sogmm_model_score_samples_f32(m, pts.data(), n, dims, out.data());
+      const sogmm_status s = sogmm_model_score_samples_f32(m, pts.data(), n, dims, nullptr, out.data());
       check_status(s);
       FUZZ_CHECK(!(huge && s == SOGMM_OK));
       if (s == SOGMM_OK)
@@ -464,12 +465,21 @@ void step_rgbd(State& st, sogmm_fuzz::Reader& in) {
   const double fx = (what & 8) ? take_double(in) : 20.0, fy = (what & 16) ? take_double(in) : 20.0;
   const double cx = (what & 32) ? take_double(in) : w / 2.0, cy = (what & 64) ? take_double(in) : h / 2.0;
   sogmm_options* o = work_options(st, what);
+  // The frame from the arrays (format 0: no colour image when `what` & 128).
+  sogmm_frame* frame = reinterpret_cast<sogmm_frame*>(1);
+  const sogmm_status made = sogmm_frame_from_arrays(&frame, w, h, depth.data(),
+                                                    (format == 0 && (what & 128)) ? nullptr : color.data(), format);
+  check_status(made);
+  if (made != SOGMM_OK) {
+    FUZZ_CHECK(frame == nullptr);
+    return;
+  }
+  FUZZ_CHECK(sogmm_frame_set_intrinsics(frame, fx, fy, cx, cy) == SOGMM_OK);
   if (what & 1) {
     std::size_t n_points = 777;
     std::vector<float> out(4 * w * h + 4, 12345.0f);
     const std::size_t capacity = (what & 2) ? out.size() : in.take<std::uint8_t>();
-    const sogmm_status s = sogmm_rgbd_to_points_f32(out.data(), capacity, &n_points, depth.data(), color.data(),
-                                                    format, w, h, fx, fy, cx, cy, o);
+    const sogmm_status s = sogmm_frame_to_points_f32(out.data(), capacity, &n_points, frame, o);
     check_status(s);
     if (s == SOGMM_OK) {
       FUZZ_CHECK(n_points <= static_cast<std::size_t>(w) * h);
@@ -480,11 +490,11 @@ void step_rgbd(State& st, sogmm_fuzz::Reader& in) {
     if (sogmm_options_get_f64(o, SOGMM_OPT_BANDWIDTH, &bw) == SOGMM_OK && bw < 0.01)
       FUZZ_CHECK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.01) == SOGMM_OK);
     sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-    const sogmm_status s =
-        sogmm_fit_rgbd(&m, depth.data(), color.data(), format, w, h, fx, fy, cx, cy, o);
+    const sogmm_status s = sogmm_fit_frame(&m, frame, o);
     check_created(s, m);
     if (s == SOGMM_OK) put(st, slot, m);
   }
+  sogmm_frame_free(frame);
 }
 
 void step_misc(State& st, sogmm_fuzz::Reader& in) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "fuzz_model_check.hpp"
+#include "../hardening/capi_calls.hpp"
 #include "fuzz_util.hpp"
 #include "sogmm/sogmm.h"
 
@@ -46,14 +47,14 @@ void probe_huge_sizes(const float* pts, std::size_t n, const sogmm_options* o) {
   // n * 4 floats overflows size_t: refused before the buffer is read.
   for (std::size_t huge : {SIZE_MAX, SIZE_MAX / 4 + 1, SIZE_MAX / 2}) {
     sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-    FUZZ_CHECK(sogmm_fit_points_f32(&m, pts, huge, o) == SOGMM_E_LIMIT && m == nullptr);
+    FUZZ_CHECK(sogmm_fit_points_f32(&m, pts, huge, nullptr, o) == SOGMM_E_LIMIT && m == nullptr);
     m = reinterpret_cast<sogmm_model*>(1);
-    FUZZ_CHECK(sogmm_fit_points_fixed_k_f32(&m, pts, huge, 1, o) == SOGMM_E_LIMIT && m == nullptr);
+    FUZZ_CHECK(sogmm_test::fit_fixed_k(&m, pts, huge, 1, o) == SOGMM_E_LIMIT && m == nullptr);
   }
   // A huge K with a real (small) buffer: K > N.
   if (n > 0) {
     sogmm_model* m = nullptr;
-    FUZZ_CHECK(sogmm_fit_points_fixed_k_f32(&m, pts, n, SIZE_MAX, o) != SOGMM_OK && m == nullptr);
+    FUZZ_CHECK(sogmm_test::fit_fixed_k(&m, pts, n, SIZE_MAX, o) != SOGMM_OK && m == nullptr);
   }
 }
 
@@ -106,13 +107,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sogmm_model* model = reinterpret_cast<sogmm_model*>(1);
   sogmm_status s;
   if (flags & 1) {
-    const std::size_t k = k_raw % (n + 2);
-    s = sogmm_fit_points_fixed_k_f32(&model, pts.data(), n, k, o);
-    if (k == 0) FUZZ_CHECK(s == SOGMM_E_INVALID_ARG);
-    else if (n == 0 || !finite) FUZZ_CHECK(s == SOGMM_E_INVALID_DATA);
+    const std::size_t k = 1 + k_raw % (n + 1);  // K = 0 would be a self-organizing fit
+    s = sogmm_test::fit_fixed_k(&model, pts.data(), n, k, o);
+    if (n == 0 || !finite) FUZZ_CHECK(s == SOGMM_E_INVALID_DATA);
     else if (k > n) FUZZ_CHECK(s == SOGMM_E_INVALID_ARG);
   } else {
-    s = sogmm_fit_points_f32(&model, pts.data(), n, o);
+    s = sogmm_fit_points_f32(&model, pts.data(), n, nullptr, o);
     if (n == 0 || !finite) FUZZ_CHECK(s == SOGMM_E_INVALID_DATA);
   }
   if (s == SOGMM_OK) {

@@ -56,10 +56,10 @@ void exercise(const sogmm_model* model) {
   std::vector<double> score(n);
   FUZZ_CHECK(sogmm_model_sample_f32(model, n, 7, 4, nullptr, samples.data()) == SOGMM_OK);
   for (std::size_t i = 0; i < n; ++i) std::memcpy(&xyz[3 * i], &samples[4 * i], 3 * sizeof(float));
-  if (sogmm_model_regress_gray_f32(model, xyz.data(), n, gray.data(), var.data()) == SOGMM_OK) {
+  if (sogmm_model_regress_gray_f32(model, xyz.data(), n, nullptr, gray.data(), var.data()) == SOGMM_OK) {
     for (std::size_t i = 0; i < n; ++i) FUZZ_CHECK(!std::isnan(gray[i]) && !std::isnan(var[i]));
   }
-  if (sogmm_model_score_samples_f32(model, samples.data(), n, 4, score.data()) == SOGMM_OK) {
+  if (sogmm_model_score_samples_f32(model, samples.data(), n, 4, nullptr, score.data()) == SOGMM_OK) {
     for (double s : score) FUZZ_CHECK(!std::isnan(s));
   }
 

@@ -29,6 +29,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/format.hpp"
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -255,15 +256,14 @@ TEST(CapiRgbd, FrameOverThePointLimitIsRefusedFromItsSize) {
   if (f.base == MAP_FAILED) GTEST_SKIP() << "cannot map 400 MB of address space";
   const bool can_measure = sogmm::test::reset_peak();
   const long long before = sogmm::test::resident_bytes();
-  sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-  EXPECT_EQ(sogmm_fit_rgbd(&m, f.depth(), f.gray(), SOGMM_COLOR_GRAY8, 8200, 8200, 7000, 7000, 4100, 4100, nullptr),
-            SOGMM_E_LIMIT)
+  sogmm_frame* frame = reinterpret_cast<sogmm_frame*>(1);
+  EXPECT_EQ(sogmm_frame_from_arrays(&frame, 8200, 8200, f.depth(), f.gray(), SOGMM_COLOR_GRAY8), SOGMM_E_LIMIT)
       << last_error();
-  EXPECT_EQ(m, nullptr);
+  EXPECT_EQ(frame, nullptr);
   EXPECT_TRUE(has(last_error(), "67240000")) << last_error();
   std::size_t n = 12345;
   float out[4];
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(out, 4, &n, f.depth(), f.gray(), SOGMM_COLOR_GRAY8, 8200, 8200, 7000, 7000,
+  EXPECT_EQ(sogmm_test::rgbd_to_points(out, 4, &n, f.depth(), f.gray(), SOGMM_COLOR_GRAY8, 8200, 8200, 7000, 7000,
                                      4100, 4100, nullptr),
             SOGMM_E_LIMIT)
       << last_error();
@@ -271,16 +271,9 @@ TEST(CapiRgbd, FrameOverThePointLimitIsRefusedFromItsSize) {
   if (can_measure) {
     EXPECT_LE(sogmm::test::peak_bytes() - before, 32 << 20) << "bytes allocated before the refusal";
   }
-  // With decimation 2 the same frame is within the limit (4100 x 4100 pixels).
-  sogmm_options* o = nullptr;
-  ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
-  ASSERT_EQ(sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2), SOGMM_OK);
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(nullptr, 0, &n, f.depth(), f.gray(), SOGMM_COLOR_GRAY8, 8200, 8200, 7000, 7000,
-                                     4100, 4100, o),
-            SOGMM_OK)
-      << last_error();
-  EXPECT_EQ(n, 0u);  // all depths are 0: no valid pixel
-  sogmm_options_free(o);
+  // The limit is on the frame's pixels, as the frame reader's: decimation,
+  // applied where the frame is used, does not lift it (a fit of a decimated
+  // frame of that size takes a frame made from the decimated arrays).
 }
 
 TEST(CoreCamera, BackprojectionChecksTheGridAndTheRange) {
@@ -325,14 +318,14 @@ TEST(CapiRgbd, NonFiniteBackProjectionIsAnErrorAndWritesNothing) {
   std::size_t n = 12345;
   float out[64];
   for (float& v : out) v = -7.0f;
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(out, 64, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 1e-300, 3, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(out, 64, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 1e-300, 3, 2, 2, nullptr),
             SOGMM_E_INVALID_ARG)
       << last_error();
   EXPECT_TRUE(has(last_error(), "fx")) << last_error();
   EXPECT_EQ(n, 12345u);
   for (float v : out) EXPECT_EQ(v, -7.0f);
   sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-  EXPECT_EQ(sogmm_fit_rgbd(&m, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::fit_rgbd(&m, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 1e-300, 2, 2, nullptr),
             SOGMM_E_INVALID_ARG)
       << last_error();
   EXPECT_EQ(m, nullptr);
@@ -341,7 +334,7 @@ TEST(CapiRgbd, NonFiniteBackProjectionIsAnErrorAndWritesNothing) {
   ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
   ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_SCALE, 1e-300), SOGMM_OK);
   ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_DEPTH_MAX, 1e300), SOGMM_OK);
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(out, 64, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, o),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(out, 64, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, o),
             SOGMM_E_INVALID_ARG)
       << last_error();
   EXPECT_EQ(n, 12345u);
@@ -351,16 +344,16 @@ TEST(CapiRgbd, NonFiniteBackProjectionIsAnErrorAndWritesNothing) {
 TEST(CapiRgbd, ErrorsLeaveNPointsUntouched) {
   const SmallFrame f;
   std::size_t n = 12345;
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(nullptr, 0, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(nullptr, 0, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 0, 3, 3, 2, 2, nullptr),
             SOGMM_E_INVALID_ARG);
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(nullptr, 0, &n, f.depth, f.gray, 7, 4, 4, 3, 3, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(nullptr, 0, &n, f.depth, f.gray, 7, 4, 4, 3, 3, 2, 2, nullptr),
             SOGMM_E_INVALID_ARG);
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(nullptr, 0, &n, nullptr, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(nullptr, 0, &n, nullptr, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, nullptr),
             SOGMM_E_NULL_ARG);
   EXPECT_EQ(n, 12345u);
   // The documented exception: BUFFER_TOO_SMALL reports the size to allocate.
   float out[8];
-  EXPECT_EQ(sogmm_rgbd_to_points_f32(out, 8, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, nullptr),
+  EXPECT_EQ(sogmm_test::rgbd_to_points(out, 8, &n, f.depth, f.gray, SOGMM_COLOR_GRAY8, 4, 4, 3, 3, 2, 2, nullptr),
             SOGMM_E_BUFFER_TOO_SMALL);
   EXPECT_EQ(n, 16u);
 }

@@ -22,6 +22,7 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/format.hpp"
 #include "sogmm/mean_shift.hpp"
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -102,7 +103,7 @@ TEST(CapiLimits, ComponentLimitMapsToSogmmELimit) {
   const std::size_t n = sogmm::kMaxComponents + 1;
   const std::vector<float> pts = spread_points(n);
   sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-  EXPECT_EQ(sogmm_fit_points_fixed_k_f32(&m, pts.data(), n, n, nullptr), SOGMM_E_LIMIT) << sogmm_last_error();
+  EXPECT_EQ(sogmm_test::fit_fixed_k(&m, pts.data(), n, n, nullptr), SOGMM_E_LIMIT) << sogmm_last_error();
   EXPECT_EQ(m, nullptr);
   EXPECT_NE(std::string(sogmm_last_error()).find("limit"), std::string::npos) << sogmm_last_error();
 }
@@ -115,7 +116,7 @@ TEST(CapiLimits, PointLimitMapsToSogmmELimit) {
   void* region = ::mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
   if (region == MAP_FAILED) GTEST_SKIP() << "cannot reserve 1 GiB of address space";
   sogmm_model* m = reinterpret_cast<sogmm_model*>(1);
-  EXPECT_EQ(sogmm_fit_points_fixed_k_f32(&m, static_cast<const float*>(region), n, 2, nullptr), SOGMM_E_LIMIT)
+  EXPECT_EQ(sogmm_test::fit_fixed_k(&m, static_cast<const float*>(region), n, 2, nullptr), SOGMM_E_LIMIT)
       << sogmm_last_error();
   EXPECT_EQ(m, nullptr);
   ::munmap(region, bytes);

@@ -140,7 +140,7 @@ TEST(CapiHostile, FitNeverReturnsNaN) {
       ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
       sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1);
       sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, static_cast<std::int64_t>(k));
-      const sogmm_status s = sogmm_fit_points_f32(&m, cloud.data(), cloud.size() / 4, o);
+      const sogmm_status s = sogmm_fit_points_f32(&m, cloud.data(), cloud.size() / 4, nullptr, o);
       ASSERT_EQ(s, SOGMM_OK) << c.name << " K=" << k << ": " << sogmm_last_error();
       std::size_t mm = 0;
       ASSERT_EQ(sogmm_model_n_components(m, &mm), SOGMM_OK);
@@ -152,7 +152,7 @@ TEST(CapiHostile, FitNeverReturnsNaN) {
       EXPECT_FALSE(std::isnan(ll)) << c.name;
       // Inference on the fitted model at the data itself: no NaN.
       std::vector<double> score(cloud.size() / 4);
-      ASSERT_EQ(sogmm_model_score_samples_f32(m, cloud.data(), score.size(), 4, score.data()), SOGMM_OK);
+      ASSERT_EQ(sogmm_model_score_samples_f32(m, cloud.data(), score.size(), 4, nullptr, score.data()), SOGMM_OK);
       for (double s2 : score) EXPECT_FALSE(std::isnan(s2)) << c.name;
       sogmm_model_free(m);
       sogmm_options_free(o);

@@ -34,6 +34,7 @@
 #include "child_process.hpp"
 #include "heap_hook.hpp"
 #include "sogmm/random.hpp"
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 #include "test_support.hpp"
 
@@ -138,7 +139,7 @@ class OutOfMemory : public ::testing::Test {
   void SetUp() override {
     points_ = blobs(800, 3);
     sogmm_options* o = options({{SOGMM_OPT_MAX_ITER, 5}});
-    ASSERT_EQ(sogmm_fit_points_fixed_k_f32(&model_, points_.data(), 800, 6, o), SOGMM_OK) << sogmm_last_error();
+    ASSERT_EQ(sogmm_test::fit_fixed_k(&model_, points_.data(), 800, 6, o), SOGMM_OK) << sogmm_last_error();
     sogmm_options_free(o);
     ASSERT_EQ(sogmm_model_set_value(model_, "note", "a fitted model with metadata"), SOGMM_OK);
     dir_ = sogmm::test::make_scratch_dir("sogmm-oom");
@@ -167,13 +168,13 @@ TEST_F(OutOfMemory, FitsReportNomemForEveryFailedAllocation) {
   for (std::int64_t nats : {0, 20}) {
     sogmm_options* o = options({{SOGMM_OPT_THREADS, 2}, {SOGMM_OPT_MAX_ITER, 3}}, {{SOGMM_OPT_TRUNCATION_NATS, double(nats)}});
     sweep("fixed-K fit, truncation " + std::to_string(nats) + " nats", [&] {
-      return expect_model_or_nothing([&](sogmm_model** out) { return sogmm_fit_points_fixed_k_f32(out, points_.data(), n, 4, o); });
+      return expect_model_or_nothing([&](sogmm_model** out) { return sogmm_test::fit_fixed_k(out, points_.data(), n, 4, o); });
     });
     sogmm_options_free(o);
   }
   sogmm_options* o = options({{SOGMM_OPT_THREADS, 2}, {SOGMM_OPT_MAX_ITER, 3}}, {{SOGMM_OPT_BANDWIDTH, 0.1}});
   sweep("self-organizing fit", [&] {
-    return expect_model_or_nothing([&](sogmm_model** out) { return sogmm_fit_points_f32(out, points_.data(), n, o); });
+    return expect_model_or_nothing([&](sogmm_model** out) { return sogmm_fit_points_f32(out, points_.data(), n, nullptr, o); });
   });
   // A 40 x 30 frame: a tilted plane 1-1.3 m away with a gray ramp.
   const std::uint32_t w = 40, h = 30;
@@ -185,7 +186,7 @@ TEST_F(OutOfMemory, FitsReportNomemForEveryFailedAllocation) {
   }
   sweep("RGB-D fit", [&] {
     return expect_model_or_nothing([&](sogmm_model** out) {
-      return sogmm_fit_rgbd(out, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 30, 30, 20, 15, o);
+      return sogmm_test::fit_rgbd(out, depth.data(), gray.data(), SOGMM_COLOR_GRAY8, w, h, 30, 30, 20, 15, o);
     });
   });
   sogmm_options_free(o);
@@ -201,14 +202,14 @@ TEST_F(OutOfMemory, InferenceReportsNomemForEveryFailedAllocation) {
     sweep("score, dims " + std::to_string(dims), [&] {
       std::fill(scores.begin(), scores.end(), NAN);
       return expect_filled_or_untouched(
-          sogmm_model_score_samples_f32(model_, dims == 4 ? points_.data() : xyz.data(), n, dims, scores.data()),
+          sogmm_model_score_samples_f32(model_, dims == 4 ? points_.data() : xyz.data(), n, dims, nullptr, scores.data()),
           scores);
     });
   }
   sweep("gray regression", [&] {
     std::fill(mean.begin(), mean.end(), NAN);
     std::fill(var.begin(), var.end(), NAN);
-    const sogmm_status s = sogmm_model_regress_gray_f32(model_, xyz.data(), n, mean.data(), var.data());
+    const sogmm_status s = sogmm_model_regress_gray_f32(model_, xyz.data(), n, nullptr, mean.data(), var.data());
     expect_filled_or_untouched(s, var);
     return expect_filled_or_untouched(s, mean);
   });
@@ -368,8 +369,8 @@ std::string address_space_problem(const std::string& dir) {
   std::vector<double> lp(4);
   std::vector<float> g(4), samples(16);
   sogmm_model* small = nullptr;
-  sogmm_model_score_samples_f32(model, points.data(), 4, 4, lp.data());
-  sogmm_fit_points_fixed_k_f32(&small, points.data(), 1000, 4, nullptr);
+  sogmm_model_score_samples_f32(model, points.data(), 4, 4, nullptr, lp.data());
+  sogmm_test::fit_fixed_k(&small, points.data(), 1000, 4, nullptr);
   sogmm_model_free(small);
 
   struct Case {
@@ -377,9 +378,9 @@ std::string address_space_problem(const std::string& dir) {
     std::function<sogmm_status(sogmm_model**)> call;
   };
   const Case cases[] = {
-      {"fit", [&](sogmm_model** out) { return sogmm_fit_points_fixed_k_f32(out, points.data(), m, 4, nullptr); }},
-      {"score", [&](sogmm_model**) { return sogmm_model_score_samples_f32(model, points.data(), 4, 4, lp.data()); }},
-      {"regress", [&](sogmm_model**) { return sogmm_model_regress_gray_f32(model, xyz.data(), 4, g.data(), g.data()); }},
+      {"fit", [&](sogmm_model** out) { return sogmm_test::fit_fixed_k(out, points.data(), m, 4, nullptr); }},
+      {"score", [&](sogmm_model**) { return sogmm_model_score_samples_f32(model, points.data(), 4, 4, nullptr, lp.data()); }},
+      {"regress", [&](sogmm_model**) { return sogmm_model_regress_gray_f32(model, xyz.data(), 4, nullptr, g.data(), g.data()); }},
       {"sample", [&](sogmm_model**) { return sogmm_model_sample_f32(model, 4, 1, 4, nullptr, samples.data()); }},
       {"save", [&](sogmm_model**) { return sogmm_model_save(model, path.c_str(), nullptr); }},
       {"load", [&](sogmm_model** out) { return sogmm_model_load(out, path.c_str(), nullptr); }},
@@ -424,7 +425,7 @@ std::vector<float> fitted_means(const std::vector<float>& points, std::int64_t t
   sogmm_options* o = options({{SOGMM_OPT_THREADS, threads}, {SOGMM_OPT_MAX_ITER, 3}});
   sogmm_model* out = nullptr;
   std::vector<float> means(16);
-  if (sogmm_fit_points_fixed_k_f32(&out, points.data(), points.size() / 4, 4, o) != SOGMM_OK ||
+  if (sogmm_test::fit_fixed_k(&out, points.data(), points.size() / 4, 4, o) != SOGMM_OK ||
       sogmm_model_get_means_f32(out, means.data(), means.size()) != SOGMM_OK)
     means.clear();
   sogmm_model_free(out);

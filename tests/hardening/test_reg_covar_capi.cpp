@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "capi_calls.hpp"
 #include "sogmm/sogmm.h"
 
 namespace {
@@ -80,7 +81,7 @@ TEST(CapiRegCovar, FitRecordsTheFloorsItUsed) {
     SCOPED_TRACE(std::string(c.source) + " " + std::to_string(c.spatial));
     ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_REG_COVAR, c.set), SOGMM_OK);
     sogmm_model* m = nullptr;
-    ASSERT_EQ(sogmm_fit_points_fixed_k_f32(&m, c.points->data(), c.points->size() / 4, 4, o), SOGMM_OK)
+    ASSERT_EQ(sogmm_test::fit_fixed_k(&m, c.points->data(), c.points->size() / 4, 4, o), SOGMM_OK)
         << sogmm_last_error();
     sogmm_buffer* buf = nullptr;
     ASSERT_EQ(sogmm_model_save_to_memory(&buf, m, nullptr), SOGMM_OK);

@@ -100,7 +100,7 @@ def main():
     ap.add_argument("--samples", type=int, default=200000)
     a = ap.parse_args()
     sys.path.insert(0, os.path.join(root, "bindings", "python", "src"))
-    os.environ.setdefault("SOGMM_LIBRARY_PATH", os.path.join(root, "build", "capi", "libsogmm.so.1"))
+    os.environ.setdefault("SOGMM_LIBRARY_PATH", os.path.join(root, "build", "capi", "libsogmm.so.2"))
     import json
 
     import sogmm

@@ -64,7 +64,7 @@ def test_constants_match_the_header():
     defines = {m.group(1): int(m.group(2)) for m in re.finditer(r"#define\s+SOGMM_(\w+)\s+\(?(-?\d+)\)?\s", text)}
     checked = 0
     for name, value in defines.items():
-        if name.startswith(("OPT_", "INFO_", "COLOR_", "MODE_COUNTER_")):
+        if name.startswith(("OPT_", "INFO_", "MAP_", "COLOR_", "MODE_COUNTER_")):
             assert getattr(_ffi, name) == value, name
             checked += 1
     assert checked >= 40

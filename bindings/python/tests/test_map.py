@@ -216,6 +216,7 @@ def test_a_revisit_with_many_more_modes_refits_what_it_sees(ratio, fits):
         m.insert_rgbd(*_wall(True), np.eye(4))
         st = m.stats()
         assert st["n_flushes"] == fits and st["n_pending"] == 0
+        assert st["n_refits"] == fits - 1  # the refit is the second fit
         assert m.frame_stats(0)["n_replaced"] == 0
         assert (m.frame_stats(1)["n_replaced"] > 0) == (fits == 2)
         assert m.frame_stats(1)["flushed"] == (fits == 2)

@@ -151,7 +151,7 @@ def interrupt_during(monkeypatch, name, after_last_report=False):
 def test_ctrl_c_during_an_insert_that_completes_keeps_the_frame(monkeypatch):
     depth, color, cam = synthetic_rgbd()
     with sogmm.Map(**FIT) as m:  # default batch: this insert runs no fit, so no report
-        interrupt_during(monkeypatch, "sogmm_map_insert_rgbd")
+        interrupt_during(monkeypatch, "sogmm_map_insert_frame")
         with pytest.raises(KeyboardInterrupt) as e:
             m.insert_rgbd(depth, color, cam, np.eye(4), progress=lambda *a: False)
         monkeypatch.undo()

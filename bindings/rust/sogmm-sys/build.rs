@@ -1,5 +1,5 @@
 //! Finds libsogmm and links to it: dynamically by default (-lsogmm, SONAME
-//! libsogmm.so.1), statically with the `static` feature (libsogmm.a).
+//! libsogmm.so.2), statically with the `static` feature (libsogmm.a).
 //!
 //! Where the library is found, in this order:
 //! 1. `SOGMM_LIB_DIR`: a folder holding libsogmm.so and libsogmm.a (a CMake

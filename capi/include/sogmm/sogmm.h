@@ -17,7 +17,7 @@
  * - Fallible functions return sogmm_status: SOGMM_OK (0) or a negative
  *   SOGMM_E_* code. Out-parameters and output arrays are written only on
  *   success, with two documented exceptions: the NULL stored into a handle
- *   out-pointer on failure, and the count that sogmm_rgbd_to_points_f32
+ *   out-pointer on failure, and the count that sogmm_frame_to_points_f32
  *   reports with SOGMM_E_BUFFER_TOO_SMALL.
  * - A call whose result would not be finite (a transform moving a mean beyond
  *   float32, intrinsics that back-project to infinity) fails at that call.
@@ -87,7 +87,7 @@ extern "C" {
  * library's SONAME is libsogmm.so.<SOGMM_ABI_VERSION>. Bindings that load the
  * library dynamically must check sogmm_abi_version() == the value they were
  * written for. */
-#define SOGMM_ABI_VERSION 1
+#define SOGMM_ABI_VERSION 2
 
 /* Runtime version of the loaded library, same encoding as
  * SOGMM_VERSION_NUMBER. Never fails. */
@@ -135,13 +135,13 @@ typedef struct sogmm_model sogmm_model;     /* a fitted 4-D GMM + metadata */
 typedef struct sogmm_options sogmm_options; /* enum-keyed parameters for fit, save, load, sample */
 typedef struct sogmm_buffer sogmm_buffer;   /* bytes produced by the library */
 typedef struct sogmm_map sogmm_map;         /* an incremental world map (sogmm_map_*) */
-typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame read from image files (sogmm_frame_*) */
+typedef struct sogmm_frame sogmm_frame;     /* an RGB-D frame: pixels and intrinsics (sogmm_frame_*) */
 typedef struct sogmm_trajectory sogmm_trajectory; /* camera poses read from a Redwood .log file */
 
 /* ---- options ---------------------------------------------------------- */
-/* Key of a parameter (SOGMM_OPT_*, below 10000) or of a model's information
- * (SOGMM_INFO_*, 10000 and up): the two ranges are disjoint, so no number is
- * both. Each key has one type: set/get an option with the _f64 or _i64
+/* Key of a parameter (SOGMM_OPT_*, below 10000), of a model's information
+ * (SOGMM_INFO_*, 10000 to 19999) or of a map's statistics (SOGMM_MAP_*, 20000
+ * and up): the ranges are disjoint, so no number is two keys. Each key has one type: set/get an option with the _f64 or _i64
  * function named in its comment; the other one, an info key or an unknown
  * key returns SOGMM_E_INVALID_ARG with a message naming the key (and the
  * function to use). Values outside the stated range are rejected by the
@@ -185,12 +185,12 @@ typedef int32_t sogmm_key;
                                         * level's bin variance, so components do not collapse onto single
                                         * levels (every seed converges; higher likelihood of held-out pixels spread in their bins; lower
                                         * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
-                                        * points of sogmm_fit_rgbd, 0 for points given as arrays */
+                                        * points of sogmm_fit_frame, 0 for points given as arrays */
 #define SOGMM_DEQUANTISE_AUTO (-1)
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
-/* RGB-D back-projection (sogmm_fit_rgbd, sogmm_rgbd_to_points_f32). */
+/* RGB-D back-projection (sogmm_fit_frame, sogmm_map_insert_frame, sogmm_frame_to_points_f32). */
 #define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite, 1 / value finite; default 1000: raw depth units per metre */
 #define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
 #define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
@@ -207,7 +207,7 @@ typedef int32_t sogmm_key;
                                          * save a model above it (what a default reader would refuse) */
 #define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
 
-/* Sampling (sogmm_model_sample_f32) and queries (the _v2 score and
+/* Sampling (sogmm_model_sample_f32) and queries (the model score and
  * regression and the map queries, which also use SOGMM_OPT_THREADS). */
 #define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
 #define SOGMM_OPT_QUERY_TRUNCATION_NATS 501 /* f64, >= 0, finite; default 0 = exact queries. > 0: culled score
@@ -218,7 +218,7 @@ typedef int32_t sogmm_key;
 
 /* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
  * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
- * and the RGB-D keys (sogmm_map_insert_rgbd). */
+ * and the RGB-D keys (sogmm_map_insert_frame). */
 #define SOGMM_OPT_MAP_NOVELTY 600           /* i64, 0 or 1; default 1. 0: every point is novel and each
                                              * insert fits its whole frame (append everything) */
 #define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601 /* f64, finite; default 3.0 nats: points whose 3-D log-likelihood
@@ -248,7 +248,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
 #define SOGMM_OPT_MAP_WARM_START 606        /* i64, 0 or 1; default 0. 1: each batch's fit starts from the
                                              * previous batch's model moved into its camera (as
-                                             * sogmm_fit_points_warm_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
+                                             * a warm sogmm_fit_points_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
 #define SOGMM_FUSION_HELLINGER 0 /* Hellinger distance of the 4-D Gaussians, in [0, 1] */
 #define SOGMM_FUSION_KL 1        /* symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, nats */
 
@@ -340,10 +340,9 @@ typedef int32_t (*sogmm_progress_fn)(int32_t stage, uint64_t step, uint64_t tota
 
 /* Sets the progress callback of `options` (fn = NULL removes it); user_data
  * is passed through and not owned. sogmm_options_clone copies the pair.
- * Called by sogmm_fit_points_f32, sogmm_fit_points_fixed_k_f32,
- * sogmm_fit_points_warm_f32, sogmm_fit_rgbd (from the mode count on),
- * sogmm_model_sample_f32, sogmm_model_regress_gray_f32_v2,
- * sogmm_model_score_samples_f32_v2 and the map queries sogmm_map_score_samples_f32,
+ * Called by sogmm_fit_points_f32, sogmm_fit_frame (from the mode count on),
+ * sogmm_model_sample_f32, sogmm_model_regress_gray_f32,
+ * sogmm_model_score_samples_f32 and the map queries sogmm_map_score_samples_f32,
  * sogmm_map_regress_gray_f32 and sogmm_map_sample_f32 (which then write into
  * a temporary buffer: as much memory again as their output); the map's
  * inserts and flushes use the callback of sogmm_map_set_progress. Other
@@ -353,86 +352,62 @@ SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_
 /* ---- fitting ---------------------------------------------------------- */
 /* Fits a model to n points (x, y, z, gray): `points` holds n * 4 floats.
  * Uses the fit keys of `options` (NULL = defaults). With
- * SOGMM_OPT_N_COMPONENTS = K > 0 the mode count is skipped (fixed K).
- * The model records the fit report and the fit parameters (see
- * SOGMM_INFO_*). Errors: n == 0 or NaN/Inf -> SOGMM_E_INVALID_DATA;
- * K > n -> SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
-                                            const sogmm_options* options);
-
-/* Same as sogmm_fit_points_f32 with exactly k components (k >= 1, k <= n),
- * overriding SOGMM_OPT_N_COMPONENTS. */
-SOGMM_API sogmm_status sogmm_fit_points_fixed_k_f32(sogmm_model** out, const float* points, size_t n,
-                                                    size_t k, const sogmm_options* options);
-
-/* Warm start: fits n points starting from `initial`, a model of an earlier,
- * overlapping cloud already moved into these points' frame (e.g. the previous
- * frame's model moved by the relative pose with sogmm_model_transform).
- * Self-organizing (SOGMM_OPT_N_COMPONENTS = 0): components of `initial`
- * whose responsibility mass on the well-explained points is below 2 points
- * are removed; points more than 10 nats below the median log-likelihood under
- * `initial` are novel, and the mode count (SOGMM_OPT_BANDWIDTH) and k-means++
- * (SOGMM_OPT_SEED) on the novel points only add that many new components; EM
- * then runs from kept + new. When `initial` explains the points badly (fewer
- * than half of them: the median point's log-likelihood more than 10 nats
- * below the mean log-likelihood `initial` gives its own samples, e.g. a start
- * far from the points), it is dropped and the fit is a cold one (every point
- * novel). With N_COMPONENTS = K > 0, EM runs from `initial`
- * as given, which must have K components. The model records the fit like
- * sogmm_fit_points_f32; `initial` is not modified and may be freed
- * afterwards. Errors as sogmm_fit_points_f32, plus: initial NULL ->
- * SOGMM_E_NULL_ARG; SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
+ * SOGMM_OPT_N_COMPONENTS = K > 0 the mode count is skipped and the model has
+ * exactly K components (fixed K). The model records the fit report and the
+ * fit parameters (see SOGMM_INFO_*). Errors: n == 0 or NaN/Inf ->
+ * SOGMM_E_INVALID_DATA; K > n -> SOGMM_E_INVALID_ARG.
+ *
+ * `initial` NULL: a cold fit. Otherwise a warm start: the fit starts from
+ * `initial`, a model of an earlier, overlapping cloud already moved into these
+ * points' frame (e.g. the previous frame's model moved by the relative pose
+ * with sogmm_model_transform). Self-organizing (SOGMM_OPT_N_COMPONENTS = 0):
+ * components of `initial` whose responsibility mass on the well-explained
+ * points is below 2 points are removed; points more than 10 nats below the
+ * median log-likelihood under `initial` are novel, and the mode count
+ * (SOGMM_OPT_BANDWIDTH) and k-means++ (SOGMM_OPT_SEED) on the novel points
+ * only add that many new components; EM then runs from kept + new. When
+ * `initial` explains the points badly (fewer than half of them: the median
+ * point's log-likelihood more than 10 nats below the mean log-likelihood
+ * `initial` gives its own samples, e.g. a start far from the points), it is
+ * dropped and the fit is a cold one (every point novel). With
+ * N_COMPONENTS = K > 0, EM runs from `initial` as given, which must have K
+ * components. `initial` is not modified and may be freed afterwards. Warm
+ * start errors: SOGMM_OPT_N_INIT != 1 or K != the initial model's size ->
  * SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_fit_points_warm_f32(sogmm_model** out, const float* points, size_t n,
-                                                 const sogmm_model* initial, const sogmm_options* options);
+SOGMM_API sogmm_status sogmm_fit_points_f32(sogmm_model** out, const float* points, size_t n,
+                                            const sogmm_model* initial, const sogmm_options* options);
 
-/* Layout of the color image given to sogmm_fit_rgbd and sogmm_rgbd_to_points_f32. */
+
+/* ---- RGB-D frames ---------------------------------------------------- */
+/* A frame holds the depth image, the colour image (or none) and the camera
+ * intrinsics: the one descriptor of an RGB-D image that sogmm_fit_frame,
+ * sogmm_map_insert_frame and sogmm_frame_to_points_f32 take. It is made from
+ * arrays in memory (sogmm_frame_from_arrays) or from image files, which the
+ * library decodes itself (sogmm_frame_read, sogmm_frame_decode: libpng,
+ * libjpeg-turbo with fixed settings, accurate integer IDCT, no gamma), so
+ * every language gets the same pixels, and with the same options the same
+ * model, from the same files. */
+
+/* Layout of a frame's colour image (sogmm_frame_from_arrays,
+ * sogmm_frame_color_format). */
 #define SOGMM_COLOR_GRAY8 1    /* width * height bytes, gray 0..255 */
 #define SOGMM_COLOR_RGB8 2     /* width * height * 3 bytes, interleaved R, G, B */
 #define SOGMM_COLOR_GRAY_F32 3 /* width * height native floats, gray used as given (meant to be in
-                                * [0, 1], e.g. a normalised thermal image); pass the float array
-                                * cast to const uint8_t*; any alignment. Non-finite -> INVALID_DATA */
+                                * [0, 1], e.g. a normalised thermal image); any alignment.
+                                * Non-finite -> INVALID_DATA where the frame is used */
 
-/* Fits a model to one RGB-D frame. `depth` holds width * height uint16
- * values (raw units, SOGMM_OPT_DEPTH_SCALE per metre, 0 = no reading),
- * `color` the registered image in `color_format`, both row-major.
- * Intrinsics are those of the full-size images (fx, fy > 0, all finite).
- * Decimation and the valid depth range come from `options` (NULL =
- * defaults). The model records the camera (SOGMM_INFO_CAMERA_*).
- * Errors: width/height 0 or > INT32_MAX, bad intrinsics (including fx, fy,
- * cx, cy, depth scale and range that would back-project a pixel beyond the
- * float32 range), unknown color format, bad depth range ->
- * SOGMM_E_INVALID_ARG; a decimated image of more than 2^26 pixels
- * ((width / d) * (height / d), checked before anything is allocated) ->
- * SOGMM_E_LIMIT; no valid pixel or a non-finite float gray ->
- * SOGMM_E_INVALID_DATA. */
-SOGMM_API sogmm_status sogmm_fit_rgbd(sogmm_model** out, const uint16_t* depth, const uint8_t* color,
-                                      int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                      double fy, double cx, double cy, const sogmm_options* options);
-
-/* The points sogmm_fit_rgbd fits, without fitting: the valid pixels of the
- * decimated frame, row by row, as N rows (x, y, z, gray) of float32 in the
- * camera frame (x right, y down, z forward, metres): z = depth / scale,
- * x = (u - cx/d) z / (fx/d), y = (v - cy/d) z / (fy/d) on the decimated
- * pixel grid. Arguments and errors as sogmm_fit_rgbd, except that a frame
- * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
- * receives N. `out` has room for `capacity` floats and must hold 4 N, else
- * SOGMM_E_BUFFER_TOO_SMALL, which still sets *n_points to N (the size to
- * allocate); on any other error neither *n_points nor `out` is written.
- * out = NULL with capacity 0 only queries N. At most (width / d) * (height / d)
- * points (integer division), which must be at most 2^26 as for a fit. */
-SOGMM_API sogmm_status sogmm_rgbd_to_points_f32(float* out, size_t capacity, size_t* n_points,
-                                                const uint16_t* depth, const uint8_t* color, int32_t color_format,
-                                                uint32_t width, uint32_t height, double fx, double fy, double cx,
-                                                double cy, const sogmm_options* options);
-
-/* ---- frames from image files ------------------------------------------ */
-/* The library decodes the images itself (libpng, libjpeg-turbo with fixed
- * settings: accurate integer IDCT, no gamma), so every language gets the
- * same pixels, and with the same options the same model, from the same
- * files. A frame holds the depth image, the colour image (or none) and the
- * camera intrinsics; it replaces the scalar arguments of sogmm_fit_rgbd and
- * sogmm_map_insert_rgbd. */
+/* Makes a frame from arrays (copied; the caller keeps them): `depth` holds
+ * width * height uint16 values (raw units, SOGMM_OPT_DEPTH_SCALE per metre,
+ * 0 = no reading), `color` the registered image in `color_format`
+ * (SOGMM_COLOR_*), both row-major and contiguous. color = NULL with
+ * color_format = 0: no colour image (gray 0 when fitted). The frame has no
+ * intrinsics yet (sogmm_frame_set_intrinsics). Errors: out or depth NULL, or
+ * color NULL with a non-zero color_format -> SOGMM_E_NULL_ARG; width/height 0
+ * or > INT32_MAX, unknown color_format -> SOGMM_E_INVALID_ARG; more than 2^26
+ * pixels (the frame reader's limit, checked before anything is copied) ->
+ * SOGMM_E_LIMIT. */
+SOGMM_API sogmm_status sogmm_frame_from_arrays(sogmm_frame** out, uint32_t width, uint32_t height,
+                                               const uint16_t* depth, const void* color, int32_t color_format);
 
 /* Reads a frame from a depth PNG (one channel, 16-bit; 8-bit is widened with
  * the same values) and a colour PNG or JPEG (8-bit gray -> SOGMM_COLOR_GRAY8,
@@ -460,22 +435,42 @@ SOGMM_API uint32_t sogmm_frame_height(const sogmm_frame* frame);
 /* The depth pixels: width * height raw uint16 values, row-major (NULL for
  * NULL). Owned by the frame, valid until sogmm_frame_free. Never fails. */
 SOGMM_API const uint16_t* sogmm_frame_depth(const sogmm_frame* frame);
-/* The colour bytes in the layout of sogmm_frame_color_format, row-major, as
- * sogmm_fit_rgbd takes them; NULL without a colour image (or for NULL).
+/* The colour bytes in the layout of sogmm_frame_color_format, row-major;
+ * NULL without a colour image (or for NULL).
  * Owned by the frame, valid until sogmm_frame_free. Never fails. */
 SOGMM_API const uint8_t* sogmm_frame_color(const sogmm_frame* frame);
-/* SOGMM_COLOR_GRAY8 or SOGMM_COLOR_RGB8; 0 without a colour image (or for
- * NULL). Never fails. */
+/* SOGMM_COLOR_GRAY8 or SOGMM_COLOR_RGB8 (from files; also
+ * SOGMM_COLOR_GRAY_F32 from arrays); 0 without a colour image (or for NULL).
+ * Never fails. */
 SOGMM_API int32_t sogmm_frame_color_format(const sogmm_frame* frame);
 /* Sets the intrinsics of the full-size images (pixels). They are checked
- * where the frame is used (sogmm_fit_frame, sogmm_map_insert_frame: fx, fy >
- * 0, all finite). Errors: frame NULL -> SOGMM_E_NULL_ARG. */
+ * where the frame is used (fx, fy > 0, all finite). Errors: frame NULL ->
+ * SOGMM_E_NULL_ARG. */
 SOGMM_API sogmm_status sogmm_frame_set_intrinsics(sogmm_frame* frame, double fx, double fy, double cx, double cy);
-/* Fits a model to `frame` exactly as sogmm_fit_rgbd does with its pixels
- * and intrinsics (bitwise the same model); options as there (NULL =
- * defaults). Errors: frame or out NULL -> SOGMM_E_NULL_ARG; no intrinsics
- * set -> SOGMM_E_INVALID_ARG; else as sogmm_fit_rgbd. */
+
+/* Fits a model to one RGB-D frame. Decimation and the valid depth range come
+ * from `options` (NULL = defaults); the fit keys as sogmm_fit_points_f32.
+ * The model records the camera (SOGMM_INFO_CAMERA_*). Errors: frame or out
+ * NULL -> SOGMM_E_NULL_ARG; no intrinsics set, bad intrinsics (including fx,
+ * fy, cx, cy, depth scale and range that would back-project a pixel beyond
+ * the float32 range), bad depth range, a decimation larger than a side ->
+ * SOGMM_E_INVALID_ARG; a decimated image of more than 2^26 pixels ->
+ * SOGMM_E_LIMIT; no valid pixel or a non-finite float gray ->
+ * SOGMM_E_INVALID_DATA. */
 SOGMM_API sogmm_status sogmm_fit_frame(sogmm_model** out, const sogmm_frame* frame, const sogmm_options* options);
+
+/* The points sogmm_fit_frame fits, without fitting: the valid pixels of the
+ * decimated frame, row by row, as N rows (x, y, z, gray) of float32 in the
+ * camera frame (x right, y down, z forward, metres): z = depth / scale,
+ * x = (u - cx/d) z / (fx/d), y = (v - cy/d) z / (fy/d) on the decimated
+ * pixel grid. Options and errors as sogmm_fit_frame, except that a frame
+ * without a valid pixel gives N = 0 and SOGMM_OK. *n_points (required)
+ * receives N. `out` has room for `capacity` floats and must hold 4 N, else
+ * SOGMM_E_BUFFER_TOO_SMALL, which still sets *n_points to N (the size to
+ * allocate); on any other error neither *n_points nor `out` is written.
+ * out = NULL with capacity 0 only queries N. */
+SOGMM_API sogmm_status sogmm_frame_to_points_f32(float* out, size_t capacity, size_t* n_points,
+                                                 const sogmm_frame* frame, const sogmm_options* options);
 
 /* ---- models from arrays, copies, release ------------------------------ */
 /* Builds a model from m components: `weights` (m floats, >= 0, summing to 1
@@ -532,7 +527,7 @@ SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model,
 #define SOGMM_INFO_FIT_SECONDS_TOTAL 10154         /* f64 */
 #define SOGMM_INFO_FIT_N_INIT 10155                /* i64: runs made (SOGMM_OPT_N_INIT) */
 #define SOGMM_INFO_FIT_RUN 10156                   /* i64: which run was kept, from 0 */
-/* Camera the points came from: present for sogmm_fit_rgbd models and files that store it. */
+/* Camera the points came from: present for sogmm_fit_frame models and files that store it. */
 #define SOGMM_INFO_CAMERA_WIDTH 10200       /* i64: full-size image width, pixels */
 #define SOGMM_INFO_CAMERA_HEIGHT 10201      /* i64 */
 #define SOGMM_INFO_CAMERA_FX 10202          /* f64 */
@@ -597,20 +592,23 @@ SOGMM_API sogmm_status sogmm_model_sample_f32(const sogmm_model* model, size_t n
  * floats) and, if `variance_out` is not NULL, the conditional variance (n
  * floats). Far from every component (beyond about 6.5 standard deviations)
  * both fall back smoothly to the mixture's prior gray and total gray
- * variance (sogmm::regress_gray, core/include/sogmm/inference.hpp). n == 0 writes nothing (pointers may then be NULL). NaN/Inf input
- * -> SOGMM_E_INVALID_DATA. */
+ * variance (sogmm::regress_gray, core/include/sogmm/inference.hpp). n == 0
+ * writes nothing (pointers may then be NULL). NaN/Inf input ->
+ * SOGMM_E_INVALID_DATA. Query options below. */
 SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
-                                                    float* mean_out, float* variance_out);
+                                                    const sogmm_options* options, float* mean_out,
+                                                    float* variance_out);
 
 /* Log-density of n points under the model into `out` (n doubles). dims = 4:
  * rows of (x, y, z, gray), joint density; dims = 3: rows of (x, y, z), the
  * marginal over gray. n == 0 writes nothing. NaN/Inf input ->
- * SOGMM_E_INVALID_DATA. */
+ * SOGMM_E_INVALID_DATA. Query options below. */
 SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
-                                                     size_t n, int32_t dims, double* out);
+                                                     size_t n, int32_t dims, const sogmm_options* options,
+                                                     double* out);
 
-/* sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32 with
- * options (NULL = defaults, the same bits as the functions without _v2):
+/* The query options of sogmm_model_regress_gray_f32 and
+ * sogmm_model_score_samples_f32 (NULL = defaults):
  * - SOGMM_OPT_THREADS: worker threads; the answers are bitwise the same for
  *   any count;
  * - SOGMM_OPT_QUERY_TRUNCATION_NATS: 0 = exact (default); > 0 culls (a
@@ -619,14 +617,7 @@ SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, c
  * - the progress callback (sogmm_options_set_progress; SOGMM_STAGE_REGRESSION,
  *   SOGMM_STAGE_SCORING): the same bits; a cancel returns SOGMM_E_CANCELLED
  *   with the outputs untouched (they are then written through a temporary
- *   buffer: as much memory again as the output).
- * Arguments and errors otherwise as the functions without _v2. */
-SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
-                                                       const sogmm_options* options, float* mean_out,
-                                                       float* variance_out);
-SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
-                                                        size_t n, int32_t dims, const sogmm_options* options,
-                                                        double* out);
+ *   buffer: as much memory again as the output). */
 
 /* PSNR of a gray image `estimate` against `truth` (`pixels` floats each;
  * -1 marks an empty pixel, e.g. a rendering of the model against the
@@ -785,19 +776,12 @@ SOGMM_API void sogmm_map_free(sogmm_map* map);
  * pending), so the call can be retried. */
 SOGMM_API sogmm_status sogmm_map_insert_points_f32(sogmm_map* map, const float* points, size_t n,
                                                    const double* pose);
-/* Inserts an RGB-D frame (arguments as sogmm_fit_rgbd; decimation and depth
- * range from the options the map was created with) with its camera-to-world
+/* Inserts `frame` (its pixels and intrinsics; decimation and depth range
+ * from the options the map was created with) with its camera-to-world
  * `pose`. The first RGB-D frame fixes the camera: a frame of another size or
  * other intrinsics -> SOGMM_E_INVALID_ARG; a frame without a valid pixel ->
- * SOGMM_E_INVALID_DATA; other errors as sogmm_fit_rgbd and
- * sogmm_map_insert_points_f32. */
-SOGMM_API sogmm_status sogmm_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const uint8_t* color,
-                                             int32_t color_format, uint32_t width, uint32_t height, double fx,
-                                             double fy, double cx, double cy, const double* pose);
-/* Inserts `frame` (its pixels and intrinsics, sogmm_frame_*) with its
- * camera-to-world `pose`, exactly as sogmm_map_insert_rgbd with them. Errors:
- * frame NULL -> SOGMM_E_NULL_ARG; no intrinsics set -> SOGMM_E_INVALID_ARG;
- * else as sogmm_map_insert_rgbd. */
+ * SOGMM_E_INVALID_DATA; frame NULL -> SOGMM_E_NULL_ARG; other errors as
+ * sogmm_fit_frame and sogmm_map_insert_points_f32. */
 SOGMM_API sogmm_status sogmm_map_insert_frame(sogmm_map* map, const sogmm_frame* frame, const double* pose);
 /* Fits the pending points now (no-op when none are pending). A failed or
  * cancelled fit leaves the map and the pending points unchanged. */
@@ -817,36 +801,37 @@ SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropp
  * use of the map, like an insert. */
 SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data);
 
-/* Totals of a map. */
-typedef struct sogmm_map_stats {
-  uint64_t n_components; /* components in the map */
-  uint64_t n_pending;    /* novel points waiting for a fit */
-  uint64_t n_frames;     /* frames inserted (a loaded map counts the frames of its file) */
-  uint64_t n_flushes;    /* fits run by this handle */
-  uint64_t n_fused;      /* new components fused into existing ones instead of appended */
-} sogmm_map_stats;
-/* What one insert did (frames of a loaded map have zero times). */
-typedef struct sogmm_map_frame_stats {
-  uint64_t n_points;     /* points of the frame */
-  uint64_t n_novel;      /* of which novel */
-  uint64_t n_components; /* map components after the insert */
-  int32_t flushed;       /* 1 if the insert ran a fit */
-  double ms_novelty;     /* novelty test, milliseconds */
-  double ms_fit;         /* fit run by the insert */
-  double ms_merge;       /* transform, merge, fusion and index update run by the insert */
-  double pose[16];       /* camera-to-world pose given with the frame */
-} sogmm_map_frame_stats;
-SOGMM_API sogmm_status sogmm_map_get_stats(const sogmm_map* map, sogmm_map_stats* out);
-/* Statistics of frame `frame` (insertion order, from 0); frame >= n_frames ->
- * SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_map_get_frame_stats(const sogmm_map* map, uint64_t frame,
-                                                 sogmm_map_frame_stats* out);
-/* Components that the revisit refit of frame `frame` replaced
- * (SOGMM_OPT_MAP_REVISIT_REFIT_RATIO) into *out: 0 when the insert ran none
- * (and for the frames of a loaded file). The frames with a non-zero count are
- * the refits this handle ran; each is also a fit in `flushed` and
- * n_flushes. frame >= n_frames -> SOGMM_E_INVALID_ARG. */
-SOGMM_API sogmm_status sogmm_map_get_frame_replaced(const sogmm_map* map, uint64_t frame, uint64_t* out);
+/* Statistics of a map, by key (20000 and up, disjoint from the option and
+ * info keys), so that a later version can add one without changing a type.
+ * Types as with options: the getter of the other type, a key of another kind
+ * or an unknown key -> SOGMM_E_INVALID_ARG naming the key. */
+
+/* Totals of the map (sogmm_map_get_i64). */
+#define SOGMM_MAP_N_COMPONENTS 20000 /* i64: components in the map */
+#define SOGMM_MAP_N_PENDING 20001    /* i64: novel points waiting for a fit */
+#define SOGMM_MAP_N_FRAMES 20002     /* i64: frames inserted (a loaded map counts the frames of its file) */
+#define SOGMM_MAP_N_FLUSHES 20003    /* i64: fits run by this handle (batches and revisit refits) */
+#define SOGMM_MAP_N_FUSED 20004      /* i64: new components fused into existing ones instead of appended */
+#define SOGMM_MAP_N_REFITS 20005     /* i64: revisit refits run by this handle (also in N_FLUSHES) */
+SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, int64_t* out);
+
+/* What the insert of frame `frame` did (insertion order, from 0;
+ * sogmm_map_frame_get_i64 / _f64). Frames of a loaded map have zero times
+ * and no refit. frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
+#define SOGMM_MAP_FRAME_N_POINTS 20100     /* i64: points of the frame */
+#define SOGMM_MAP_FRAME_N_NOVEL 20101      /* i64: of which novel */
+#define SOGMM_MAP_FRAME_N_COMPONENTS 20102 /* i64: map components after the insert */
+#define SOGMM_MAP_FRAME_FLUSHED 20103      /* i64: 1 if the insert ran a fit (a flush or a revisit refit), else 0 */
+#define SOGMM_MAP_FRAME_N_REPLACED 20104   /* i64: components its revisit refit replaced
+                                            * (SOGMM_OPT_MAP_REVISIT_REFIT_RATIO); 0 when none ran */
+#define SOGMM_MAP_FRAME_MS_NOVELTY 20150   /* f64: novelty test, milliseconds */
+#define SOGMM_MAP_FRAME_MS_FIT 20151       /* f64: fits run by the insert (a refit's with its check) */
+#define SOGMM_MAP_FRAME_MS_MERGE 20152     /* f64: transform, merge, fusion and index update run by the insert */
+SOGMM_API sogmm_status sogmm_map_frame_get_i64(const sogmm_map* map, uint64_t frame, sogmm_key key, int64_t* out);
+SOGMM_API sogmm_status sogmm_map_frame_get_f64(const sogmm_map* map, uint64_t frame, sogmm_key key, double* out);
+/* The camera-to-world pose given with frame `frame` into `pose_out` (16
+ * doubles, row-major). frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
+SOGMM_API sogmm_status sogmm_map_frame_get_pose(const sogmm_map* map, uint64_t frame, double* pose_out);
 
 /* New world-frame model (key "coordinate_frame" = "world") of the whole map
  * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:

@@ -162,7 +162,7 @@ struct FrameStats {
   double ms_merge = 0.0;            ///< transform + merge + fusion (+ index) of that flush (and refit)
   /// Map components a revisit refit of this frame replaced (0: none ran;
   /// MapOptions::revisit_refit_ratio). Its fit time is in ms_fit. (C API:
-  /// sogmm_map_get_frame_replaced, beside the fixed frame-stats struct.)
+  /// key SOGMM_MAP_FRAME_N_REPLACED.)
   std::size_t n_replaced = 0;
 };
 

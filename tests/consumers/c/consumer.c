@@ -48,14 +48,14 @@ int main(int argc, char** argv) {
   CHECK(sogmm_options_create(&options));
   CHECK(sogmm_options_set_f64(options, SOGMM_OPT_BANDWIDTH, 0.05));
   CHECK(sogmm_options_set_i64(options, SOGMM_OPT_SEED, 1));
-  CHECK(sogmm_fit_points_f32(&model, points, n, options));
+  CHECK(sogmm_fit_points_f32(&model, points, n, NULL, options));
   CHECK(sogmm_model_n_components(model, &fitted));
 
   snprintf(path, sizeof path, "%s/consumer_c.sogmm", argv[1]);
   CHECK(sogmm_model_save(model, path, NULL));
   CHECK(sogmm_model_load(&loaded, path, NULL));
   CHECK(sogmm_model_n_components(loaded, &loaded_m));
-  CHECK(sogmm_model_regress_gray_f32(loaded, centres, 2, gray, variance));
+  CHECK(sogmm_model_regress_gray_f32(loaded, centres, 2, NULL, gray, variance));
   printf("libsogmm %s: %zu components fitted, %zu loaded from %s, gray %.3f and %.3f\n",
          sogmm_version_string(), fitted, loaded_m, path, gray[0], gray[1]);
 

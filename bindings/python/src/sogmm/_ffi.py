@@ -1,7 +1,7 @@
 """ctypes layer over libsogmm (the C API of capi/include/sogmm/sogmm.h).
 
-Only handles, scalars, pointers and the map's two statistics structs
-(MapStats, MapFrameStats) cross the boundary. Every exported function is
+Only handles, scalars, pointers and the option-info struct cross the
+boundary. Every exported function is
 declared in ``_DECLARATIONS`` below; a test parses the C header and checks
 that the names and arities match.
 
@@ -27,7 +27,7 @@ import numpy as np
 from .errors import error_for_status
 
 #: The SOGMM_ABI_VERSION this package was written for.
-ABI_VERSION = 1
+ABI_VERSION = 2
 
 # ---- constants (mirror sogmm.h) ------------------------------------------
 OK = 0
@@ -110,6 +110,22 @@ INFO_CAMERA_DEPTH_SCALE = 10207
 INFO_CAMERA_DEPTH_MIN = 10208
 INFO_CAMERA_DEPTH_MAX = 10209
 
+# Map statistic keys (SOGMM_MAP_*): totals, then what one insert did.
+MAP_N_COMPONENTS = 20000
+MAP_N_PENDING = 20001
+MAP_N_FRAMES = 20002
+MAP_N_FLUSHES = 20003
+MAP_N_FUSED = 20004
+MAP_N_REFITS = 20005
+MAP_FRAME_N_POINTS = 20100
+MAP_FRAME_N_NOVEL = 20101
+MAP_FRAME_N_COMPONENTS = 20102
+MAP_FRAME_FLUSHED = 20103
+MAP_FRAME_N_REPLACED = 20104
+MAP_FRAME_MS_NOVELTY = 20150
+MAP_FRAME_MS_FIT = 20151
+MAP_FRAME_MS_MERGE = 20152
+
 # ---- argument types ------------------------------------------------------
 _C = "C_CONTIGUOUS"
 F32_IN = np.ctypeslib.ndpointer(dtype=np.float32, flags=_C)
@@ -126,26 +142,6 @@ KEY = c_int32
 
 # sogmm_progress_fn: (stage, step, total, log_likelihood, user_data) -> 0 / non-zero = cancel.
 PROGRESS_FN = ctypes.CFUNCTYPE(c_int32, c_int32, c_uint64, c_uint64, c_double, c_void_p)
-
-class MapStats(ctypes.Structure):
-    """sogmm_map_stats (sogmm.h)."""
-
-    _fields_ = [(name, c_uint64) for name in ("n_components", "n_pending", "n_frames", "n_flushes", "n_fused")]
-
-
-class MapFrameStats(ctypes.Structure):
-    """sogmm_map_frame_stats (sogmm.h)."""
-
-    _fields_ = [
-        ("n_points", c_uint64),
-        ("n_novel", c_uint64),
-        ("n_components", c_uint64),
-        ("flushed", c_int32),
-        ("ms_novelty", c_double),
-        ("ms_fit", c_double),
-        ("ms_merge", c_double),
-        ("pose", c_double * 16),
-    ]
 
 # name -> (restype, argtypes). Keep in the order of sogmm.h.
 _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
@@ -164,18 +160,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_options_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
     "sogmm_option_get_info": (STATUS, [KEY, ctypes.c_void_p]),
     "sogmm_option_keys": (STATUS, [POINTER(KEY), c_size_t, POINTER(c_size_t)]),
-    "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE]),
-    "sogmm_fit_points_fixed_k_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, c_size_t, HANDLE]),
-    "sogmm_fit_points_warm_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE, HANDLE]),
-    "sogmm_fit_rgbd": (
-        STATUS,
-        [HANDLE_OUT, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, HANDLE],
-    ),
-    "sogmm_rgbd_to_points_f32": (
-        STATUS,
-        [F32_OUT, c_size_t, POINTER(c_size_t), U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double,
-         c_double, c_double, HANDLE],
-    ),
+    "sogmm_fit_points_f32": (STATUS, [HANDLE_OUT, F32_IN, c_size_t, HANDLE, HANDLE]),
+    "sogmm_frame_from_arrays": (STATUS, [HANDLE_OUT, c_uint32, c_uint32, U16_IN, c_void_p, c_int32]),
     "sogmm_frame_read": (STATUS, [HANDLE_OUT, c_char_p, c_char_p]),
     "sogmm_frame_decode": (STATUS, [HANDLE_OUT, c_void_p, c_size_t, c_void_p, c_size_t]),
     "sogmm_frame_free": (None, [HANDLE]),
@@ -186,6 +172,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_frame_color_format": (c_int32, [HANDLE]),
     "sogmm_frame_set_intrinsics": (STATUS, [HANDLE, c_double, c_double, c_double, c_double]),
     "sogmm_fit_frame": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
+    "sogmm_frame_to_points_f32": (STATUS, [F32_OUT, c_size_t, POINTER(c_size_t), HANDLE, HANDLE]),
     "sogmm_model_from_arrays_f32": (STATUS, [HANDLE_OUT, c_size_t, F32_IN, F32_IN, F32_IN, c_uint64]),
     "sogmm_model_clone": (STATUS, [HANDLE_OUT, HANDLE]),
     "sogmm_model_free": (None, [HANDLE]),
@@ -205,10 +192,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_value_count": (STATUS, [HANDLE, POINTER(c_size_t)]),
     "sogmm_model_value_at": (STATUS, [HANDLE, c_size_t, POINTER(c_char_p), POINTER(c_char_p)]),
     "sogmm_model_sample_f32": (STATUS, [HANDLE, c_size_t, c_uint64, c_int32, HANDLE, F32_OUT]),
-    "sogmm_model_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F32_OUT, F32_OUT]),
-    "sogmm_model_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, F64_OUT]),
-    "sogmm_model_regress_gray_f32_v2": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
-    "sogmm_model_score_samples_f32_v2": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
+    "sogmm_model_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
+    "sogmm_model_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_psnr_images_f32": (STATUS, [F32_IN, F32_IN, c_size_t, c_double, F64_OUT, F64_OUT]),
     "sogmm_model_merge": (STATUS, [HANDLE_OUT, HANDLE, HANDLE]),
     "sogmm_model_transform": (STATUS, [HANDLE_OUT, HANDLE, F64_IN]),
@@ -219,17 +204,14 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_create": (STATUS, [HANDLE_OUT, HANDLE]),
     "sogmm_map_free": (None, [HANDLE]),
     "sogmm_map_insert_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F64_IN]),
-    "sogmm_map_insert_rgbd": (
-        STATUS,
-        [HANDLE, U16_IN, U8_IN, c_int32, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN],
-    ),
     "sogmm_map_insert_frame": (STATUS, [HANDLE, HANDLE, F64_IN]),
     "sogmm_map_flush": (STATUS, [HANDLE]),
     "sogmm_map_discard_pending": (STATUS, [HANDLE, POINTER(c_uint64)]),
     "sogmm_map_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
-    "sogmm_map_get_stats": (STATUS, [HANDLE, POINTER(MapStats)]),
-    "sogmm_map_get_frame_stats": (STATUS, [HANDLE, c_uint64, POINTER(MapFrameStats)]),
-    "sogmm_map_get_frame_replaced": (STATUS, [HANDLE, c_uint64, POINTER(c_uint64)]),
+    "sogmm_map_get_i64": (STATUS, [HANDLE, KEY, POINTER(c_int64)]),
+    "sogmm_map_frame_get_i64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_int64)]),
+    "sogmm_map_frame_get_f64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_double)]),
+    "sogmm_map_frame_get_pose": (STATUS, [HANDLE, c_uint64, F64_OUT]),
     "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
     "sogmm_map_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_map_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
@@ -261,8 +243,8 @@ def _library_file_names() -> list[str]:
     if sys.platform == "win32":
         return ["sogmm.dll", "libsogmm.dll"]
     if sys.platform == "darwin":
-        return ["libsogmm.dylib", "libsogmm.1.dylib"]
-    return ["libsogmm.so", "libsogmm.so.1"]
+        return ["libsogmm.dylib", f"libsogmm.{ABI_VERSION}.dylib"]
+    return ["libsogmm.so", f"libsogmm.so.{ABI_VERSION}"]
 
 
 def _is_sanitizer_build(build_dir: Path) -> bool:

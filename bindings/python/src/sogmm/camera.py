@@ -1,7 +1,7 @@
 """Pinhole camera intrinsics and RGB-D back-projection.
 
 :func:`rgbd_to_points` returns the points the C library fits for a frame
-(``sogmm_rgbd_to_points_f32``: decimated pixel (u, v) is source pixel
+(``sogmm_frame_to_points_f32``: decimated pixel (u, v) is source pixel
 (d u, d v), intrinsics divided by the factor, valid depth in (depth_min, depth_trunc], gray from
 uint8 gray, uint8 RGB or float gray).
 """
@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ctypes import byref, c_size_t
+from contextlib import contextmanager
+from ctypes import byref, c_size_t, c_void_p
 
 from . import _ffi
 from ._input_file import read_input_file
@@ -197,8 +198,8 @@ def rgbd_to_points(
     capacity = 4 * (f.camera.width // d) * (f.camera.height // d)  # every decimated pixel valid
     out = np.empty(capacity, dtype=np.float32)
     n = c_size_t(0)
-    with _ffi.Options(f64=f.f64, i64=f.i64) as o:
-        _ffi.check(_ffi.lib.sogmm_rgbd_to_points_f32(out, capacity, byref(n), *f.frame_args(), o.ptr))
+    with _ffi.Options(f64=f.f64, i64=f.i64) as o, f.handle() as frame:
+        _ffi.check(_ffi.lib.sogmm_frame_to_points_f32(out, capacity, byref(n), frame, o.ptr))
     return out[: 4 * n.value].reshape(n.value, 4).copy()
 
 
@@ -207,7 +208,7 @@ _COLOR_FORMATS = {"gray8": _ffi.COLOR_GRAY8, "rgb8": _ffi.COLOR_RGB8, "grayf": _
 
 @dataclass(frozen=True)
 class PreparedFrame:
-    """An RGB-D frame checked and laid out as the C library's RGB-D calls take it."""
+    """An RGB-D frame checked and laid out as sogmm_frame_from_arrays takes it."""
 
     camera: Camera
     depth: np.ndarray  # (H, W) C-contiguous uint16
@@ -216,10 +217,19 @@ class PreparedFrame:
     f64: dict  # back-projection options (depth scale and range)
     i64: dict  # (decimation)
 
-    def frame_args(self) -> tuple:
-        """depth, color, color_format, width, height, fx, fy, cx, cy."""
+    @contextmanager
+    def handle(self):
+        """The frame as a C ``sogmm_frame`` (sogmm_frame_from_arrays with the
+        camera's intrinsics), freed when the block ends."""
         c = self.camera
-        return (self.depth, self.color, self.color_format, c.width, c.height, c.fx, c.fy, c.cx, c.cy)
+        h = c_void_p()
+        _ffi.check(_ffi.lib.sogmm_frame_from_arrays(byref(h), c.width, c.height, self.depth,
+                                                    self.color.ctypes.data, self.color_format))
+        try:
+            _ffi.check(_ffi.lib.sogmm_frame_set_intrinsics(h, c.fx, c.fy, c.cx, c.cy))
+            yield h
+        finally:
+            _ffi.lib.sogmm_frame_free(h)
 
 
 def prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate) -> PreparedFrame:

@@ -13,7 +13,7 @@ import os
 import threading
 import weakref
 from contextlib import contextmanager
-from ctypes import byref, c_int64, c_uint64, c_void_p
+from ctypes import byref, c_double, c_int64, c_uint64, c_void_p
 
 import numpy as np
 
@@ -33,18 +33,27 @@ __all__ = ["Map"]
 _FUSION = {None: None, "off": None, "hellinger": _ffi.FUSION_HELLINGER, "kl": _ffi.FUSION_KL}
 
 
-def _frame_dict(s: _ffi.MapFrameStats, n_replaced: int) -> dict:
-    return {
-        "n_points": int(s.n_points),
-        "n_novel": int(s.n_novel),
-        "n_components": int(s.n_components),
-        "flushed": bool(s.flushed),
-        "ms_novelty": float(s.ms_novelty),
-        "ms_fit": float(s.ms_fit),
-        "ms_merge": float(s.ms_merge),
-        "n_replaced": n_replaced,
-        "pose": np.array(list(s.pose), dtype=np.float64).reshape(4, 4),
-    }
+# The keys behind stats() and frame_stats(): name -> key.
+_MAP_KEYS = {
+    "n_components": _ffi.MAP_N_COMPONENTS,
+    "n_pending": _ffi.MAP_N_PENDING,
+    "n_frames": _ffi.MAP_N_FRAMES,
+    "n_flushes": _ffi.MAP_N_FLUSHES,
+    "n_fused": _ffi.MAP_N_FUSED,
+    "n_refits": _ffi.MAP_N_REFITS,
+}
+_FRAME_I64_KEYS = {
+    "n_points": _ffi.MAP_FRAME_N_POINTS,
+    "n_novel": _ffi.MAP_FRAME_N_NOVEL,
+    "n_components": _ffi.MAP_FRAME_N_COMPONENTS,
+    "flushed": _ffi.MAP_FRAME_FLUSHED,
+    "n_replaced": _ffi.MAP_FRAME_N_REPLACED,
+}
+_FRAME_F64_KEYS = {
+    "ms_novelty": _ffi.MAP_FRAME_MS_NOVELTY,
+    "ms_fit": _ffi.MAP_FRAME_MS_FIT,
+    "ms_merge": _ffi.MAP_FRAME_MS_MERGE,
+}
 
 
 class _UseGuard:
@@ -232,7 +241,8 @@ class Map:
         camera-to-world ``pose``; returns that frame's statistics."""
         f = prepare_frame(depth, color, camera, *self._depth)
         p = _pose(pose)
-        self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_rgbd(h, *f.frame_args(), p))
+        with f.handle() as frame:
+            self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_frame(h, frame, p))
         return self.frame_stats(-1)
 
     def flush(self, progress: ProgressArg = None) -> int:
@@ -252,11 +262,15 @@ class Map:
 
     # ---- statistics ----------------------------------------------------------
     def stats(self) -> dict:
-        """n_components, n_pending, n_frames, n_flushes, n_fused."""
-        s = _ffi.MapStats()
+        """n_components, n_pending, n_frames, n_flushes, n_fused, n_refits
+        (revisit refits, also counted in n_flushes)."""
+        out = {}
+        v = c_int64()
         with self._guard.reading("stats"):
-            check(lib.sogmm_map_get_stats(self._h(), byref(s)))
-        return {name: int(getattr(s, name)) for name, _ in _ffi.MapStats._fields_}
+            for name, key in _MAP_KEYS.items():
+                check(lib.sogmm_map_get_i64(self._h(), key, byref(v)))
+                out[name] = int(v.value)
+        return out
 
     @property
     def n_components_(self) -> int:
@@ -278,12 +292,20 @@ class Map:
         n = len(self)
         if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or not -n <= frame < n:
             raise InvalidArgumentError(f"frame {frame!r} does not exist ({n} frames)")
-        s = _ffi.MapFrameStats()
-        replaced = c_uint64()
+        i = int(frame) % n
+        out: dict = {}
+        iv, fv = c_int64(), c_double()
+        pose = np.empty(16, dtype=np.float64)
         with self._guard.reading("frame_stats"):
-            check(lib.sogmm_map_get_frame_stats(self._h(), int(frame) % n, byref(s)))
-            check(lib.sogmm_map_get_frame_replaced(self._h(), int(frame) % n, byref(replaced)))
-        return _frame_dict(s, int(replaced.value))
+            for name, key in _FRAME_I64_KEYS.items():
+                check(lib.sogmm_map_frame_get_i64(self._h(), i, key, byref(iv)))
+                out[name] = bool(iv.value) if name == "flushed" else int(iv.value)
+            for name, key in _FRAME_F64_KEYS.items():
+                check(lib.sogmm_map_frame_get_f64(self._h(), i, key, byref(fv)))
+                out[name] = float(fv.value)
+            check(lib.sogmm_map_frame_get_pose(self._h(), i, pose))
+        out["pose"] = pose.reshape(4, 4)
+        return out
 
     def frames(self) -> list[dict]:
         """frame_stats of every frame, in insertion order."""

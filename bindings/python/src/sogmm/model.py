@@ -404,7 +404,7 @@ class GMM:
         out = np.empty(x.shape[0], dtype=np.float64)
         with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_score_samples_f32_v2(h, x, x.shape[0], x.shape[1], o.ptr, out))
+                               lambda: lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], o.ptr, out))
         return out
 
     def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
@@ -454,7 +454,7 @@ class GMM:
         var = np.empty(x.shape[0], dtype=np.float32)
         with _query_options(truncation_nats, n_threads) as o:
             call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_regress_gray_f32_v2(h, x, x.shape[0], o.ptr, mean, var))
+                               lambda: lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], o.ptr, mean, var))
         return mean, var
 
     def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
@@ -727,19 +727,16 @@ class SOGMM(GMM):
         ``init``: warm start from a model of an earlier, overlapping cloud,
         already in these points' frame (e.g. ``prev.transform(relative_pose)``);
         the rule for keeping, removing and adding components is that of
-        ``sogmm_fit_points_warm_f32`` (needs ``n_init == 1``)."""
+        ``sogmm_fit_points_f32`` with ``initial`` (needs ``n_init == 1``)."""
         x = _rows(X, (4,), "X")
         if init is not None and not isinstance(init, GMM):
             raise InvalidArgumentError(f"init must be a fitted GMM or SOGMM, got {type(init).__name__}")
         out = c_void_p()
+        initial = None if init is None else init._h()
         with self._fit_options() as o:
-            if init is None:
-                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], o.ptr),
-                                   keep=lambda: self._attach(out))
-            else:
-                call_with_progress(o, progress, lambda: lib.sogmm_fit_points_warm_f32(byref(out), x, x.shape[0],
-                                                                                       init._h(), o.ptr),
-                                   keep=lambda: self._attach(out))
+            call_with_progress(o, progress,
+                               lambda: lib.sogmm_fit_points_f32(byref(out), x, x.shape[0], initial, o.ptr),
+                               keep=lambda: self._attach(out))
         return self
 
     def fit_rgbd(self, depth, color, camera: Camera, depth_scale: float = _D.depth_scale,
@@ -751,8 +748,8 @@ class SOGMM(GMM):
         Ctrl-C as :meth:`fit`. Returns self."""
         f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
         out = c_void_p()
-        with self._fit_options(f.f64, f.i64) as o:
-            call_with_progress(o, progress, lambda: lib.sogmm_fit_rgbd(byref(out), *f.frame_args(), o.ptr),
+        with self._fit_options(f.f64, f.i64) as o, f.handle() as frame:
+            call_with_progress(o, progress, lambda: lib.sogmm_fit_frame(byref(out), frame, o.ptr),
                                keep=lambda: self._attach(out))
         return self
 

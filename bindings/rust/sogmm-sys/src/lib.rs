@@ -56,7 +56,7 @@ pub const SOGMM_VERSION_MAJOR: u32 = 0;
 pub const SOGMM_VERSION_MINOR: u32 = 1;
 pub const SOGMM_VERSION_PATCH: u32 = 0;
 pub const SOGMM_VERSION_STRING: &str = "0.1.0";
-pub const SOGMM_ABI_VERSION: u32 = 1;
+pub const SOGMM_ABI_VERSION: u32 = 2;
 
 // ---- status codes ---------------------------------------------------------
 pub const SOGMM_OK: sogmm_status = 0;
@@ -171,6 +171,22 @@ pub const SOGMM_INFO_CAMERA_DEPTH_SCALE: sogmm_key = 10207;
 pub const SOGMM_INFO_CAMERA_DEPTH_MIN: sogmm_key = 10208;
 pub const SOGMM_INFO_CAMERA_DEPTH_MAX: sogmm_key = 10209;
 
+// Map statistic keys (sogmm_map_get_i64, sogmm_map_frame_get_i64 / _f64).
+pub const SOGMM_MAP_N_COMPONENTS: sogmm_key = 20000;
+pub const SOGMM_MAP_N_PENDING: sogmm_key = 20001;
+pub const SOGMM_MAP_N_FRAMES: sogmm_key = 20002;
+pub const SOGMM_MAP_N_FLUSHES: sogmm_key = 20003;
+pub const SOGMM_MAP_N_FUSED: sogmm_key = 20004;
+pub const SOGMM_MAP_N_REFITS: sogmm_key = 20005;
+pub const SOGMM_MAP_FRAME_N_POINTS: sogmm_key = 20100;
+pub const SOGMM_MAP_FRAME_N_NOVEL: sogmm_key = 20101;
+pub const SOGMM_MAP_FRAME_N_COMPONENTS: sogmm_key = 20102;
+pub const SOGMM_MAP_FRAME_FLUSHED: sogmm_key = 20103;
+pub const SOGMM_MAP_FRAME_N_REPLACED: sogmm_key = 20104;
+pub const SOGMM_MAP_FRAME_MS_NOVELTY: sogmm_key = 20150;
+pub const SOGMM_MAP_FRAME_MS_FIT: sogmm_key = 20151;
+pub const SOGMM_MAP_FRAME_MS_MERGE: sogmm_key = 20152;
+
 /// SOGMM_TYPE_F64 / SOGMM_TYPE_I64 (sogmm_option_info.type).
 pub const SOGMM_TYPE_F64: i32 = 0;
 pub const SOGMM_TYPE_I64: i32 = 1;
@@ -195,30 +211,6 @@ pub struct sogmm_option_info {
     pub doc: *const c_char,
 }
 
-/// Totals of a map (sogmm_map_get_stats).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default)]
-pub struct sogmm_map_stats {
-    pub n_components: u64,
-    pub n_pending: u64,
-    pub n_frames: u64,
-    pub n_flushes: u64,
-    pub n_fused: u64,
-}
-/// What one insert did (sogmm_map_get_frame_stats).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default)]
-pub struct sogmm_map_frame_stats {
-    pub n_points: u64,
-    pub n_novel: u64,
-    pub n_components: u64,
-    pub flushed: i32,
-    pub ms_novelty: f64,
-    pub ms_fit: f64,
-    pub ms_merge: f64,
-    pub pose: [f64; 16],
-}
-
 extern "C" {
     pub fn sogmm_version_number() -> u32;
     pub fn sogmm_version_string() -> *const c_char;
@@ -238,54 +230,6 @@ extern "C" {
         options: *mut sogmm_options,
         fn_: sogmm_progress_fn,
         user_data: *mut c_void,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_points_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_points_fixed_k_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        k: usize,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_points_warm_f32(
-        out: *mut *mut sogmm_model,
-        points: *const f32,
-        n: usize,
-        initial: *const sogmm_model,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_fit_rgbd(
-        out: *mut *mut sogmm_model,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        options: *const sogmm_options,
-    ) -> sogmm_status;
-    pub fn sogmm_rgbd_to_points_f32(
-        out: *mut f32,
-        capacity: usize,
-        n_points: *mut usize,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        options: *const sogmm_options,
     ) -> sogmm_status;
     pub fn sogmm_model_from_arrays_f32(
         out: *mut *mut sogmm_model,
@@ -333,25 +277,11 @@ extern "C" {
         model: *const sogmm_model,
         xyz: *const f32,
         n: usize,
-        mean_out: *mut f32,
-        variance_out: *mut f32,
-    ) -> sogmm_status;
-    pub fn sogmm_model_score_samples_f32(
-        model: *const sogmm_model,
-        points: *const f32,
-        n: usize,
-        dims: i32,
-        out: *mut f64,
-    ) -> sogmm_status;
-    pub fn sogmm_model_regress_gray_f32_v2(
-        model: *const sogmm_model,
-        xyz: *const f32,
-        n: usize,
         options: *const sogmm_options,
         mean_out: *mut f32,
         variance_out: *mut f32,
     ) -> sogmm_status;
-    pub fn sogmm_model_score_samples_f32_v2(
+    pub fn sogmm_model_score_samples_f32(
         model: *const sogmm_model,
         points: *const f32,
         n: usize,
@@ -402,30 +332,14 @@ extern "C" {
         n: usize,
         pose: *const f64,
     ) -> sogmm_status;
-    pub fn sogmm_map_insert_rgbd(
-        map: *mut sogmm_map,
-        depth: *const u16,
-        color: *const u8,
-        color_format: i32,
-        width: u32,
-        height: u32,
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        pose: *const f64,
-    ) -> sogmm_status;
     pub fn sogmm_map_insert_frame(map: *mut sogmm_map, frame: *const sogmm_frame, pose: *const f64) -> sogmm_status;
     pub fn sogmm_map_flush(map: *mut sogmm_map) -> sogmm_status;
     pub fn sogmm_map_discard_pending(map: *mut sogmm_map, dropped: *mut u64) -> sogmm_status;
     pub fn sogmm_map_set_progress(map: *mut sogmm_map, fn_: sogmm_progress_fn, user_data: *mut c_void) -> sogmm_status;
-    pub fn sogmm_map_get_stats(map: *const sogmm_map, out: *mut sogmm_map_stats) -> sogmm_status;
-    pub fn sogmm_map_get_frame_stats(
-        map: *const sogmm_map,
-        frame: u64,
-        out: *mut sogmm_map_frame_stats,
-    ) -> sogmm_status;
-    pub fn sogmm_map_get_frame_replaced(map: *const sogmm_map, frame: u64, out: *mut u64) -> sogmm_status;
+    pub fn sogmm_map_get_i64(map: *const sogmm_map, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_map_frame_get_i64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut i64) -> sogmm_status;
+    pub fn sogmm_map_frame_get_f64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut f64) -> sogmm_status;
+    pub fn sogmm_map_frame_get_pose(map: *const sogmm_map, frame: u64, pose_out: *mut f64) -> sogmm_status;
     pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
     pub fn sogmm_map_score_samples_f32(
         map: *const sogmm_map,
@@ -522,6 +436,28 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_fit_points_f32(
+        out: *mut *mut sogmm_model,
+        points: *const f32,
+        n: usize,
+        initial: *const sogmm_model,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
+    pub fn sogmm_frame_from_arrays(
+        out: *mut *mut sogmm_frame,
+        width: u32,
+        height: u32,
+        depth: *const u16,
+        color: *const c_void,
+        color_format: i32,
+    ) -> sogmm_status;
+    pub fn sogmm_frame_to_points_f32(
+        out: *mut f32,
+        capacity: usize,
+        n_points: *mut usize,
+        frame: *const sogmm_frame,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_frame_read(
         out: *mut *mut sogmm_frame,
         depth_path: *const c_char,

@@ -311,9 +311,9 @@ fn sys_crate_matches_header() {
 fn drift_is_detected() {
     let cases = [
         (
-            "size_t k, const sogmm_options* options",
-            "uint32_t k, const sogmm_options* options",
-            "sogmm_fit_points_fixed_k_f32",
+            "size_t capacity, size_t* n_points",
+            "uint32_t capacity, size_t* n_points",
+            "sogmm_frame_to_points_f32",
         ),
         ("uint64_t seed,\n", "uint64_t seed, int extra,\n", "arguments"),
         (

@@ -34,10 +34,10 @@ pub struct ImageFrame {
 }
 
 /// Frees the C frame on every way out.
-struct Handle(*mut sys::sogmm_frame);
+pub(crate) struct Handle(pub(crate) *mut sys::sogmm_frame);
 impl Drop for Handle {
     fn drop(&mut self) {
-        // SAFETY: created by sogmm_frame_read/decode (or NULL), freed once.
+        // SAFETY: created by sogmm_frame_read/decode/from_arrays (or NULL), freed once.
         unsafe { sys::sogmm_frame_free(self.0) }
     }
 }

@@ -29,6 +29,8 @@ pub struct MapStats {
     pub n_flushes: u64,
     /// New components fused into existing ones instead of appended.
     pub n_fused: u64,
+    /// Revisit refits run by this handle (also counted in `n_flushes`).
+    pub n_refits: u64,
 }
 
 /// What one insert did (frames of a loaded map have zero times).
@@ -120,23 +122,9 @@ impl Map {
     /// Inserts an RGB-D frame (decimation and depth range from the map's
     /// options) with its camera-to-world pose. The first frame fixes the camera.
     pub fn insert_frame(&mut self, frame: &Frame<'_>, pose: &Pose) -> Result<()> {
-        let (color, format) = frame.color_args()?;
-        // SAFETY: exclusive through &mut self; color_args checked the slices.
-        check(unsafe {
-            sys::sogmm_map_insert_rgbd(
-                self.ptr.as_ptr(),
-                frame.depth.as_ptr(),
-                color,
-                format,
-                frame.width,
-                frame.height,
-                frame.fx,
-                frame.fy,
-                frame.cx,
-                frame.cy,
-                pose.as_ptr(),
-            )
-        })
+        let h = frame.handle()?;
+        // SAFETY: exclusive through &mut self; a valid frame and 16 doubles.
+        check(unsafe { sys::sogmm_map_insert_frame(self.ptr.as_ptr(), h.0, pose.as_ptr()) })
     }
 
     /// Fits the pending points now (nothing when none are pending).
@@ -187,38 +175,52 @@ impl Map {
         with_map_progress(map, on_progress, || self.flush())
     }
 
-    /// The map's totals.
+    /// The map's totals (read key by key, `sogmm_map_get_i64`).
     pub fn stats(&self) -> Result<MapStats> {
-        let mut s = sys::sogmm_map_stats::default();
-        // SAFETY: valid handle and out-pointer.
-        check(unsafe { sys::sogmm_map_get_stats(self.raw(), &mut s) })?;
+        let get = |key| -> Result<u64> {
+            let mut v = 0i64;
+            // SAFETY: valid handle and out-pointer.
+            check(unsafe { sys::sogmm_map_get_i64(self.raw(), key, &mut v) })?;
+            Ok(v as u64)
+        };
         Ok(MapStats {
-            n_components: s.n_components,
-            n_pending: s.n_pending,
-            n_frames: s.n_frames,
-            n_flushes: s.n_flushes,
-            n_fused: s.n_fused,
+            n_components: get(sys::SOGMM_MAP_N_COMPONENTS)?,
+            n_pending: get(sys::SOGMM_MAP_N_PENDING)?,
+            n_frames: get(sys::SOGMM_MAP_N_FRAMES)?,
+            n_flushes: get(sys::SOGMM_MAP_N_FLUSHES)?,
+            n_fused: get(sys::SOGMM_MAP_N_FUSED)?,
+            n_refits: get(sys::SOGMM_MAP_N_REFITS)?,
         })
     }
 
-    /// What the insert of frame `frame` (insertion order, from 0) did.
+    /// What the insert of frame `frame` (insertion order, from 0) did (read
+    /// key by key, `sogmm_map_frame_get_*`).
     pub fn frame_stats(&self, frame: u64) -> Result<MapFrameStats> {
-        let mut s = sys::sogmm_map_frame_stats::default();
-        // SAFETY: valid handle and out-pointer.
-        check(unsafe { sys::sogmm_map_get_frame_stats(self.raw(), frame, &mut s) })?;
-        let mut n_replaced = 0u64;
-        // SAFETY: valid handle and out-pointer; the frame exists (checked above).
-        check(unsafe { sys::sogmm_map_get_frame_replaced(self.raw(), frame, &mut n_replaced) })?;
+        let int = |key| -> Result<u64> {
+            let mut v = 0i64;
+            // SAFETY: valid handle and out-pointer.
+            check(unsafe { sys::sogmm_map_frame_get_i64(self.raw(), frame, key, &mut v) })?;
+            Ok(v as u64)
+        };
+        let float = |key| -> Result<f64> {
+            let mut v = 0f64;
+            // SAFETY: valid handle and out-pointer.
+            check(unsafe { sys::sogmm_map_frame_get_f64(self.raw(), frame, key, &mut v) })?;
+            Ok(v)
+        };
+        let mut pose = [0f64; 16];
+        // SAFETY: valid handle; `pose` has room for the 16 doubles written.
+        check(unsafe { sys::sogmm_map_frame_get_pose(self.raw(), frame, pose.as_mut_ptr()) })?;
         Ok(MapFrameStats {
-            n_points: s.n_points,
-            n_novel: s.n_novel,
-            n_components: s.n_components,
-            flushed: s.flushed != 0,
-            ms_novelty: s.ms_novelty,
-            ms_fit: s.ms_fit,
-            ms_merge: s.ms_merge,
-            n_replaced,
-            pose: s.pose,
+            n_points: int(sys::SOGMM_MAP_FRAME_N_POINTS)?,
+            n_novel: int(sys::SOGMM_MAP_FRAME_N_NOVEL)?,
+            n_components: int(sys::SOGMM_MAP_FRAME_N_COMPONENTS)?,
+            flushed: int(sys::SOGMM_MAP_FRAME_FLUSHED)? != 0,
+            ms_novelty: float(sys::SOGMM_MAP_FRAME_MS_NOVELTY)?,
+            ms_fit: float(sys::SOGMM_MAP_FRAME_MS_FIT)?,
+            ms_merge: float(sys::SOGMM_MAP_FRAME_MS_MERGE)?,
+            n_replaced: int(sys::SOGMM_MAP_FRAME_N_REPLACED)?,
+            pose,
         })
     }
 

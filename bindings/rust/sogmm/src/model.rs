@@ -78,30 +78,36 @@ impl Frame<'_> {
         Ok((color, format))
     }
 
+    /// The frame as a C `sogmm_frame` (copied by `sogmm_frame_from_arrays`,
+    /// with the intrinsics), freed when the handle drops: what the fit, the
+    /// map insert and `to_points` hand to the library.
+    pub(crate) fn handle(&self) -> Result<crate::frames::Handle> {
+        let (color, format) = self.color_args()?;
+        let mut h = crate::frames::Handle(ptr::null_mut());
+        // SAFETY: color_args checked the slices against width x height.
+        check(unsafe {
+            sys::sogmm_frame_from_arrays(
+                &mut h.0,
+                self.width,
+                self.height,
+                self.depth.as_ptr(),
+                color.cast(),
+                format,
+            )
+        })?;
+        // SAFETY: a frame just made.
+        check(unsafe { sys::sogmm_frame_set_intrinsics(h.0, self.fx, self.fy, self.cx, self.cy) })?;
+        Ok(h)
+    }
+
     /// The points `Model::fit_rgbd` would fit, without fitting: N rows (x, y,
     /// z, gray) in the camera frame (decimation and depth range from
     /// `options`). A frame without a valid pixel gives an empty Vec.
     pub fn to_points(&self, options: Option<&Options>) -> Result<Vec<f32>> {
-        let (color, format) = self.color_args()?;
+        let frame = self.handle()?;
         let call = |out: *mut f32, capacity: usize, n: &mut usize| {
-            // SAFETY: slices checked by color_args; `out` has `capacity` floats.
-            check(unsafe {
-                sys::sogmm_rgbd_to_points_f32(
-                    out,
-                    capacity,
-                    n,
-                    self.depth.as_ptr(),
-                    color,
-                    format,
-                    self.width,
-                    self.height,
-                    self.fx,
-                    self.fy,
-                    self.cx,
-                    self.cy,
-                    opt_ptr(options),
-                )
-            })
+            // SAFETY: a valid frame; `out` has `capacity` floats.
+            check(unsafe { sys::sogmm_frame_to_points_f32(out, capacity, n, frame.0, opt_ptr(options)) })
         };
         let mut n = 0;
         call(ptr::null_mut(), 0, &mut n)?; // capacity 0: only counts
@@ -197,7 +203,7 @@ impl Model {
     pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
         let n = rows(points, 4, "points")?;
         // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, opt_ptr(options)) })
+        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), opt_ptr(options)) })
     }
 
     /// As `fit`, reporting progress to `on_progress` (called only on this
@@ -214,7 +220,7 @@ impl Model {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| {
             // SAFETY: as fit; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, o) })
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), o) })
         })
     }
 
@@ -239,7 +245,7 @@ impl Model {
         let n = rows(points, 4, "points")?;
         // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
         Model::make(|out| unsafe {
-            sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
+            sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
         })
     }
 
@@ -254,15 +260,23 @@ impl Model {
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| {
             // SAFETY: as fit_warm; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_warm_f32(out, points.as_ptr(), n, initial.raw(), o) })
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), o) })
         })
     }
 
-    /// Fits exactly `k` components (1 <= k <= n).
+    /// Fits exactly `k` components (1 <= k <= n): `fit` with
+    /// SOGMM_OPT_N_COMPONENTS = k on a copy of `options`.
     pub fn fit_fixed_k(points: &[f32], k: usize, options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        // SAFETY: as fit.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_fixed_k_f32(out, points.as_ptr(), n, k, opt_ptr(options)) })
+        if k == 0 {
+            return Err(invalid("k is 0: a fixed-K fit needs k >= 1".to_string()));
+        }
+        let k = i64::try_from(k).map_err(|_| invalid(format!("k = {k} is too large")))?;
+        let mut o = match options {
+            Some(o) => o.try_clone()?,
+            None => Options::new()?,
+        };
+        o.set_i64(sys::SOGMM_OPT_N_COMPONENTS, k)?;
+        Model::fit(points, Some(&o))
     }
 
     /// Fits one RGB-D frame; decimation and depth range come from `options`.
@@ -272,23 +286,9 @@ impl Model {
 
     /// fit_rgbd with a raw options pointer (NULL = defaults).
     fn fit_rgbd_raw(frame: &Frame<'_>, options: *const sys::sogmm_options) -> Result<Model> {
-        let (color, format) = frame.color_args()?;
-        // SAFETY: color_args checked the slices against width x height.
-        Model::make(|out| unsafe {
-            sys::sogmm_fit_rgbd(
-                out,
-                frame.depth.as_ptr(),
-                color,
-                format,
-                frame.width,
-                frame.height,
-                frame.fx,
-                frame.fy,
-                frame.cx,
-                frame.cy,
-                options,
-            )
-        })
+        let h = frame.handle()?;
+        // SAFETY: a valid frame.
+        Model::make(|out| unsafe { sys::sogmm_fit_frame(out, h.0, options) })
     }
 
     /// Builds a model from M weights, M x 4 means and M x 4 x 4 covariances
@@ -504,7 +504,7 @@ impl Model {
     fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
         // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
         regress_with(xyz, |n, mean, var| unsafe {
-            sys::sogmm_model_regress_gray_f32_v2(self.raw(), xyz.as_ptr(), n, o, mean, var)
+            sys::sogmm_model_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
         })
     }
 
@@ -536,7 +536,7 @@ impl Model {
     fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
         // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
         score_with(points, dims, |n, out| unsafe {
-            sys::sogmm_model_score_samples_f32_v2(self.raw(), points.as_ptr(), n, dims, o, out)
+            sys::sogmm_model_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
         })
     }
 

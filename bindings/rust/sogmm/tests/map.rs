@@ -278,6 +278,7 @@ fn revisit_refit_ratio_is_checked_and_reaches_the_map() {
         }
         let st = map.stats().unwrap();
         assert_eq!(st.n_pending, 0);
+        assert_eq!(st.n_refits, st.n_flushes - 1); // the refit is the second fit
         assert_eq!(map.frame_stats(0).unwrap().n_replaced, 0);
         let refit = map.frame_stats(1).unwrap();
         assert_eq!(refit.n_replaced > 0, st.n_flushes == 2, "{refit:?}");

@@ -1,15 +1,15 @@
-// sogmm_model_regress_gray_f32_v2 and sogmm_model_score_samples_f32_v2: the
-// model queries with options for progress and cancel
-// (sogmm/query_progress.hpp), with the checks of the functions without _v2.
+// sogmm_model_regress_gray_f32 and sogmm_model_score_samples_f32: the model
+// queries, with options for threads, culling, progress and cancel
+// (sogmm/query_progress.hpp).
 #include "internal.hpp"
 #include "queries.hpp"
 #include "sogmm/query_progress.hpp"
 
 extern "C" {
 
-SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model, const float* xyz, size_t n,
-                                                       const sogmm_options* options, float* mean_out,
-                                                       float* variance_out) {
+SOGMM_API sogmm_status sogmm_model_regress_gray_f32(const sogmm_model* model, const float* xyz, size_t n,
+                                                    const sogmm_options* options, float* mean_out,
+                                                    float* variance_out) {
   SOGMM_TRY {
     sogmm_capi::require_nonnull(model, "model");
     sogmm_capi::run_regress_query(xyz, n, options, mean_out, variance_out,
@@ -20,9 +20,9 @@ SOGMM_API sogmm_status sogmm_model_regress_gray_f32_v2(const sogmm_model* model,
   SOGMM_CATCH
 }
 
-SOGMM_API sogmm_status sogmm_model_score_samples_f32_v2(const sogmm_model* model, const float* points,
-                                                        size_t n, int32_t dims, const sogmm_options* options,
-                                                        double* out) {
+SOGMM_API sogmm_status sogmm_model_score_samples_f32(const sogmm_model* model, const float* points,
+                                                     size_t n, int32_t dims, const sogmm_options* options,
+                                                     double* out) {
   SOGMM_TRY {
     sogmm_capi::require_nonnull(model, "model");
     sogmm_capi::require_dims(dims);
