@@ -8,8 +8,11 @@
 // (medians of --repeats; the SOGMM map's renders kept, as between two
 // inserts; OctoMap's search on the same thread count).
 //
-// Usage: sogmm-occupancy-octomap --sequence DIR [--map-frames 0,1] [--ray-frame 2]
+// Usage: sogmm-occupancy-octomap --sequence DIR [--map-frames 0:2] [--ray-frames 2]
 //          [--decimate 5] [--octomap-decimate 1] [--resolutions 0.02,0.05] [--threads 2] [--repeats 3]
+// Frame selections as `sogmm map --frames`: I, A:B or A:B:STEP. The synthetic
+// loop of the issue: `sogmm demo --write-frame DIR --loop`, then
+// --map-frames 0:300:3 --ray-frames 1:300:30.
 #include <omp.h>
 
 #include <algorithm>
@@ -112,11 +115,12 @@ void report(const char* name, double auc, std::size_t bytes, double build_s, std
 
 int main(int argc, char** argv) {
   CLI::App app{"Occupancy of a SOGMM map against OctoMap on the rays of a held-out frame"};
-  std::string dir, map_frames = "0,1", resolutions = "0.02,0.05";
-  int ray_frame = 2, decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
+  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05";
+  int decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
   app.add_option("--sequence", dir, "Redwood folder: depth/, color/, intrinsics.json, trajectory.log")->required();
-  app.add_option("--map-frames", map_frames, "frames the maps are built from (comma-separated)")->capture_default_str();
-  app.add_option("--ray-frame", ray_frame, "frame whose rays are scored")->capture_default_str();
+  app.add_option("--map-frames", map_frames, "frames the maps are built from (I, A:B or A:B:STEP)")
+      ->capture_default_str();
+  app.add_option("--ray-frames", ray_frames, "frames whose rays are scored (I, A:B or A:B:STEP)")->capture_default_str();
   app.add_option("--decimate", decimate, "SOGMM map decimation and the scored pixel grid")->capture_default_str();
   app.add_option("--octomap-decimate", octomap_decimate, "pixels OctoMap inserts (1 = every pixel)")
       ->capture_default_str();
@@ -127,32 +131,29 @@ int main(int argc, char** argv) {
   try {
     using namespace sogmm;
     const auto frames = tools::list_sequence(dir);
-    std::vector<std::size_t> selected;
-    std::stringstream list(map_frames);
-    for (std::string item; std::getline(list, item, ',');) selected.push_back(std::stoul(item));
-    selected.push_back(static_cast<std::size_t>(ray_frame));
+    std::vector<std::size_t> selected = tools::parse_frame_range(map_frames, frames.size());
+    const std::size_t n_map = selected.size();
+    for (std::size_t f : tools::parse_frame_range(ray_frames, frames.size())) selected.push_back(f);
     const std::string traj_path = dir + "/trajectory.log";
     const std::vector<Pose> poses =
         tools::poses_of_frames(tools::read_trajectory_log(traj_path), traj_path, frames, selected, false);
     const Camera cam = read_intrinsics_json(dir + "/intrinsics.json");
-    std::vector<tools::LoadedFrame> loaded;
-    for (std::size_t f : selected) loaded.push_back(tools::load_frame(frames[f].depth, frames[f].color));
-    const std::size_t n_map = selected.size() - 1;
+    const auto frame = [&](std::size_t k) { return tools::load_frame(frames[selected[k]].depth, frames[selected[k]].color); };
 
     MapOptions mo;
     mo.depth.decimate = decimate;
     mo.fit.em.threads = threads;
     std::vector<float> xyz;
     std::vector<int> label;
-    ray_points(loaded.back(), cam, mo.depth, decimate, poses.back(), xyz, label);
+    for (std::size_t k = n_map; k < selected.size(); ++k) ray_points(frame(k), cam, mo.depth, decimate, poses[k], xyz, label);
     const std::size_t n = label.size();
-    std::printf("sequence %s: maps from frames %s, the rays of frame %d at d = %d: %zu points (%zu occupied)\n",
-                dir.c_str(), map_frames.c_str(), ray_frame, decimate, n,
+    std::printf("sequence %s: maps from frames %s (%zu), the rays of frames %s (%zu) at d = %d: %zu points (%zu occupied)\n",
+                dir.c_str(), map_frames.c_str(), n_map, ray_frames.c_str(), selected.size() - n_map, decimate, n,
                 static_cast<std::size_t>(std::count(label.begin(), label.end(), 1)));
 
     auto t0 = Clock::now();
     Map map(mo);
-    for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(loaded[k].view(cam), poses[k]);
+    for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(frame(k).view(cam), poses[k]);
     map.flush();
     const double map_build = seconds_since(t0);
     const std::size_t map_bytes = format::to_bytes(map.to_model()).size();
@@ -172,7 +173,7 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < n_map; ++k) {
         DepthOptions od = mo.depth;
         od.decimate = octomap_decimate;
-        const PointCloud cloud = backproject(loaded[k].view(cam), od);
+        const PointCloud cloud = backproject(frame(k).view(cam), od);
         octomap::Pointcloud scan;
         for (std::size_t i = 0; i < cloud.size(); ++i) {
           const double c[3] = {cloud.xyzg[4 * i], cloud.xyzg[4 * i + 1], cloud.xyzg[4 * i + 2]};
