@@ -12,6 +12,7 @@
 
 #include "covariance_storage.hpp"
 #include "em_kernel.hpp"
+#include "em_truncation.hpp"
 #include "sogmm/options.hpp"
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
@@ -82,7 +83,8 @@ struct SoaPoints {
   std::vector<float> x, y, z, g;
   std::size_t n = 0;
   std::size_t n_blocks = 0;
-  std::vector<float> box;  // per block: min[4], max[4]
+  std::vector<float> box;        // per block: min[4], max[4]
+  std::vector<float> group_box;  // per group of detail::kGroupBlocks blocks: the union of their boxes
 
   SoaPoints(const PointsView& pts, const Frame& frame) : n(pts.size) {
     std::vector<std::uint32_t> order(n);
@@ -113,6 +115,17 @@ struct SoaPoints {
         }
       }
     }
+    const std::size_t n_groups = (n_blocks + detail::kGroupBlocks - 1) / detail::kGroupBlocks;
+    group_box.resize(8 * n_groups);
+    for (std::size_t gi = 0; gi < n_groups; ++gi) {
+      float* gb = &group_box[8 * gi];
+      std::copy(&box[8 * gi * detail::kGroupBlocks], &box[8 * gi * detail::kGroupBlocks] + 8, gb);
+      for (std::size_t b = gi * detail::kGroupBlocks + 1; b < std::min(n_blocks, (gi + 1) * detail::kGroupBlocks); ++b)
+        for (int j = 0; j < 4; ++j) {
+          gb[j] = std::min(gb[j], box[8 * b + j]);
+          gb[4 + j] = std::max(gb[4 + j], box[8 * b + 4 + j]);
+        }
+    }
   }
 
  private:
@@ -130,114 +143,6 @@ struct SoaPoints {
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
   }
 };
-
-// The truncated E-step's bound. For x in a block's bounding box B,
-// log w_k N(x | mu_k, Sigma_k) = c_k - |U_k^T (x - mu_k)|^2 / 2, and each
-// coordinate y_j = sum_{i<=j} U_ij (x_i - mu_i) lies in an interval that
-// interval arithmetic gives from B; the squared distance of each interval from
-// 0 bounds y_j^2 below. This follows the component's orientation, so thin
-// planar components are bounded tightly too.
-//
-// The components' parameters are held as columns (BoundParams) so that the
-// loop over components vectorizes; each bound is the same sequence of double
-// operations as a scalar loop, so the bounds, and with them the evaluated
-// lists and the fit, do not depend on the vector width.
-struct BoundParams {
-  std::size_t m = 0;
-  std::vector<double> col;  // 15 columns of m: mean (4), U row-major upper (10), log constant (1)
-  void load(const std::vector<float>& params) {
-    m = params.size() / kParamStride;
-    col.resize(15 * m);
-    for (std::size_t k = 0; k < m; ++k)
-      for (int i = 0; i < 15; ++i) col[i * m + k] = params[k * kParamStride + i];
-  }
-};
-
-void log_density_upper_bounds(const BoundParams& bp, const float* box, double* upper) {
-  const std::size_t m = bp.m;
-  const double* c = bp.col.data();
-  const double b0 = box[0], b1 = box[1], b2 = box[2], b3 = box[3];
-  const double t0 = box[4], t1 = box[5], t2 = box[6], t3 = box[7];
-  auto lohi = [](double u, double lo, double hi, double& ylo, double& yhi) {
-    const double a = u * lo, b = u * hi;
-    ylo += std::min(a, b);
-    yhi += std::max(a, b);
-  };
-  // The distance of [ylo, yhi] from 0 (ylo <= yhi): ylo if > 0, -yhi if
-  // yhi < 0, else 0; one of the two terms is always exactly 0, so the sum is
-  // that distance bit for bit, without a branch.
-  auto gap2 = [](double ylo, double yhi) {
-    const double gap = std::max(ylo, 0.0) + std::max(-yhi, 0.0);
-    return gap * gap;
-  };
-#pragma omp simd
-  for (std::size_t k = 0; k < m; ++k) {
-    const double l0 = b0 - c[k], l1 = b1 - c[m + k], l2 = b2 - c[2 * m + k], l3 = b3 - c[3 * m + k];
-    const double h0 = t0 - c[k], h1 = t1 - c[m + k], h2 = t2 - c[2 * m + k], h3 = t3 - c[3 * m + k];
-    // Column j of U: U_ij for i <= j (packed row-major: U00 U01 U02 U03 U11 U12 U13 U22 U23 U33).
-    const double* u = c + 4 * m;
-    double lo = 0.0, hi = 0.0, q_min = 0.0;
-    lohi(u[k], l0, h0, lo, hi);
-    q_min += gap2(lo, hi);
-    lo = hi = 0.0;
-    lohi(u[m + k], l0, h0, lo, hi);
-    lohi(u[4 * m + k], l1, h1, lo, hi);
-    q_min += gap2(lo, hi);
-    lo = hi = 0.0;
-    lohi(u[2 * m + k], l0, h0, lo, hi);
-    lohi(u[5 * m + k], l1, h1, lo, hi);
-    lohi(u[7 * m + k], l2, h2, lo, hi);
-    q_min += gap2(lo, hi);
-    lo = hi = 0.0;
-    lohi(u[3 * m + k], l0, h0, lo, hi);
-    lohi(u[6 * m + k], l1, h1, lo, hi);
-    lohi(u[8 * m + k], l2, h2, lo, hi);
-    lohi(u[9 * m + k], l3, h3, lo, hi);
-    q_min += gap2(lo, hi);
-    upper[k] = c[14 * m + k] - 0.5 * q_min;
-  }
-}
-
-// Chooses and evaluates the components of one block for the truncated E-step.
-// It starts from `warm` (the components that mattered for this block in the
-// previous iteration; on the first iteration, the kFirst components with the
-// highest upper bound), then adds every other component whose upper bound is
-// within `nats` of the lowest per-point maximum found: all others are provably
-// more than `nats` below every point's best. The evaluated list is left in
-// `list` (warm first, then the additions in ascending order) and its
-// log-density rows in `rows`.
-void truncated_log_density(const detail::EmKernels& kernels, const detail::Block& block, const float* box,
-                           const std::vector<float>& params, const std::vector<double>& exact,
-                           const BoundParams& bounds, double nats,
-                           const std::vector<std::uint32_t>& warm,
-                           std::vector<double>& upper, std::vector<char>& taken, std::vector<std::uint32_t>& list,
-                           float* rows, float* row_lp_max, float* max_lp) {
-  constexpr std::size_t kFirst = 32;
-  const std::size_t m = params.size() / kParamStride;
-  upper.resize(m);
-  log_density_upper_bounds(bounds, box, upper.data());
-  list = warm;
-  if (list.empty()) {
-    std::vector<std::uint32_t> idx(m);
-    for (std::size_t k = 0; k < m; ++k) idx[k] = static_cast<std::uint32_t>(k);
-    const std::size_t first = std::min(m, kFirst);
-    std::nth_element(idx.begin(), idx.begin() + (first - 1), idx.end(),
-                     [&](std::uint32_t a, std::uint32_t b) { return upper[a] > upper[b]; });
-    list.assign(idx.begin(), idx.begin() + first);
-    std::sort(list.begin(), list.end());
-  }
-  kernels.log_density(block, params.data(), exact.data(), list.data(), list.size(), rows, row_lp_max, max_lp);
-  float worst = max_lp[0];
-  for (int p = 1; p < block.count; ++p) worst = std::min(worst, max_lp[p]);
-  const double cut = static_cast<double>(worst) - nats;
-  taken.assign(m, 0);
-  for (std::uint32_t k : list) taken[k] = 1;
-  const std::size_t first = list.size();
-  for (std::size_t k = 0; k < m; ++k)
-    if (!taken[k] && upper[k] >= cut) list.push_back(static_cast<std::uint32_t>(k));
-  kernels.log_density(block, params.data(), exact.data(), list.data() + first, list.size() - first, rows + first * kBlock,
-                      row_lp_max + first, max_lp);
-}
 
 // The fit's working model, in double and relative to the frame's origin:
 // float32 means would round every update to the float grid at the data's
@@ -410,7 +315,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
 
   std::vector<float> params;
   std::vector<double> exact;
-  BoundParams bounds;
+  detail::BoundParams bounds;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
   // Per chunk of a wave: its partial sums, reduced in chunk order afterwards
@@ -422,8 +327,8 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   // floats, so the scratch is threads x block, not waves x block.
   const std::size_t scratch_floats = checked::mul<std::size_t>(kBlock + 1, m, "EM scratch");
   std::vector<float> thread_scratch(checked::mul<std::size_t>(static_cast<std::size_t>(threads), scratch_floats, "EM scratch"));
-  // Truncated E-step: per block, the components that mattered last iteration.
-  std::vector<std::vector<std::uint32_t>> warm(truncated ? n_blocks : 0);
+  // Truncated E-step: per block, what it keeps across iterations.
+  detail::TruncationMemory memory(truncated ? n_blocks : 0);
   std::vector<double> stats(m * kStatStride);
   std::vector<double> nk(m);
 
@@ -450,9 +355,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
           std::fill(st, st + m * kStatStride, 0.0);
           float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
           float* row_max = scratch + m * kBlock;
-          std::vector<std::uint32_t> list;
-          std::vector<double> upper;
-          std::vector<char> taken;
+          detail::TruncatedScan scan(bounds, options.truncation_nats, n_blocks);
           alignas(64) float max_lp[kBlock];
           double ll = 0.0, pairs = 0.0;
           const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
@@ -464,24 +367,18 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
             std::fill(max_lp, max_lp + kBlock, -std::numeric_limits<float>::infinity());
             const std::vector<std::uint32_t>* evaluated = &all;
             if (truncated) {
-              truncated_log_density(kernels, block, &soa.box[8 * b], params, exact, bounds, options.truncation_nats, warm[b],
-                                    upper, taken, list, scratch, row_max, max_lp);
-              evaluated = &list;
+              scan.evaluate(kernels, block, b, soa.box.data(), soa.group_box.data(), params, exact, memory, scratch,
+                            row_max, max_lp);
+              evaluated = &scan.list();
             } else {
               kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
             }
             const std::size_t ne = evaluated->size();
             ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
             pairs += static_cast<double>(block.count) * ne;
-            if (truncated) {
-              // Next iteration starts from the components some point of this
-              // block still gives at least exp(-nats) of its best weight.
-              const float keep = std::exp(static_cast<float>(-options.truncation_nats));
-              warm[b].clear();
-              for (std::size_t i = 0; i < ne; ++i)
-                if (row_max[i] >= keep) warm[b].push_back(list[i]);
-              std::sort(warm[b].begin(), warm[b].end());
-            }
+            // Next iteration starts from the components some point of this
+            // block still gives at least exp(-nats) of its best weight.
+            if (truncated) scan.remember(b, row_max, memory);
           }
           slot_ll[s] = ll;
           slot_pairs[s] = pairs;
@@ -531,6 +428,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         }
     } while (promoted);
     pairs_evaluated += iteration_pairs;
+    if (truncated) memory.next_iteration();
     params.swap(next_params);
     exact.swap(next_exact);
     shift = next_shift;

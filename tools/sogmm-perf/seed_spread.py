@@ -11,6 +11,9 @@ log-likelihood at most 0.05 below).
 
 Usage: seed_spread.py [--sogmm build/tools/sogmm/sogmm] [--data ../shared/data/rgbd]
                       [--seeds 20] [--n-init 1] [--csv out.csv]
+                      [--truncate NATS] [--case livingroom:0.02 ...]
+--truncate passes the truncated E-step's cutoff to every fit (0, the default:
+exact); --case restricts the run to the given frame:bandwidth cases.
 """
 import argparse
 import csv
@@ -57,6 +60,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--n-init", type=int, default=1)
     ap.add_argument("--csv", help="also write every run to this CSV file")
+    ap.add_argument("--truncate", type=float, default=0.0, help="truncated E-step cutoff in nats (0: exact)")
+    ap.add_argument("--case", action="append", default=[], help="frame:bandwidth to run (repeatable; default all)")
     a = ap.parse_args()
     if not os.path.isdir(a.data):
         print("SKIP: %s is absent (the shared RGB-D frames)" % a.data)
@@ -64,16 +69,23 @@ def main():
     if a.seeds < 1:
         ap.error("--seeds must be >= 1")
     rows = []
-    print("d = 5, %d seeds (0..%d), n_init %d; each cell: seed 0 | mean +- sd [min, max] (reference; threshold)"
-          % (a.seeds, a.seeds - 1, a.n_init))
+    cases = {(c.split(":")[0], float(c.split(":")[1])) for c in a.case}
+    unknown = cases - set(REFERENCE)
+    if unknown:
+        ap.error("unknown --case %s (frames: livingroom, tum; bandwidths 0.01, 0.02, 0.03)" % sorted(unknown))
+    print("d = 5, %d seeds (0..%d), n_init %d, truncate %g; each cell: seed 0 | mean +- sd [min, max] "
+          "(reference; threshold)" % (a.seeds, a.seeds - 1, a.n_init, a.truncate))
     print()
     print("| frame, bandwidth | M (ref) | honest PSNR dB | MRE m | F | mean log-likelihood |")
     print("|---|---|---|---|---|---|")
     for (frame, bw), ref in REFERENCE.items():
+        if cases and (frame, bw) not in cases:
+            continue
         runs = []
         for seed in range(a.seeds):
             cmd = [a.sogmm, "eval"] + frame_args(a.data, frame) + [
-                "--decimate", "5", "--bandwidth", str(bw), "--seed", str(seed), "--n-init", str(a.n_init), "--json"]
+                "--decimate", "5", "--bandwidth", str(bw), "--seed", str(seed), "--n-init", str(a.n_init), "--truncate", str(a.truncate),
+                "--json"]
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
                 sys.exit("seed_spread: %s failed: %s" % (" ".join(cmd), p.stderr.strip()))
@@ -95,7 +107,7 @@ def main():
         print("| " + " | ".join(cells) + " |", flush=True)
     if a.csv:
         keys = ["frame", "bandwidth", "seed", "n_components", "psnr", "mre", "fscore", "log_likelihood",
-                "em_iterations", "seconds_total"]
+                "em_iterations", "log_likelihood_heldout", "seconds_em", "seconds_total"]
         with open(a.csv, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(keys)

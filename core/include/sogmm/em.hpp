@@ -40,7 +40,11 @@ struct EmOptions {
   /// The bound is interval arithmetic of the whitened coordinates U^T (x - mu)
   /// over the block's bounding box, compared with the per-point maxima of
   /// the components already evaluated, so it holds from the first iteration
-  /// on (the tight k-means++ start included) without any fallback.
+  /// on (the tight k-means++ start included) without any fallback. From the
+  /// second iteration on, all components are bounded once per group of 8
+  /// blocks and each block bounds only the group's candidates (those within
+  /// a slack of the previous iteration's cuts; a block whose cut fell below
+  /// bounds all), which evaluates the same components (em_truncation.cpp).
   double truncation_nats = 0.0;
   /// Depth quantisation of the points (empty by default: none). When set, every
   /// M-step floors each component's variance along its viewing ray at the
