@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_inputs.hpp"
 #include "fuzz_model_check.hpp"
 #include "fuzz_util.hpp"
 #include "sogmm/sogmm.h"
@@ -47,88 +48,18 @@ struct State {
   }
 };
 
-bool documented(sogmm_status s) { return s == SOGMM_OK || (s <= SOGMM_E_NULL_ARG && s >= SOGMM_E_INTERNAL); }
-
-// Every status is documented; an error carries a message; INTERNAL is a bug.
-void check_status(sogmm_status s) {
-  if (std::getenv("SOGMM_FUZZ_TRACE")) std::fprintf(stderr, "  status %d %s\n", s, s ? sogmm_last_error() : "");
-  FUZZ_CHECK(documented(s));
-  FUZZ_CHECK(s != SOGMM_E_INTERNAL);
-  if (s != SOGMM_OK) FUZZ_CHECK(sogmm_last_error()[0] != '\0');
-}
-
+using sogmm_fuzz::check_created;
 using sogmm_fuzz::check_model;
-
-// A handle-creating call: on error *out is NULL; on success the model is valid.
-void check_created(sogmm_status s, sogmm_model* out) {
-  check_status(s);
-  if (s == SOGMM_OK) {
-    FUZZ_CHECK(out != nullptr);
-    check_model(out);
-  } else {
-    FUZZ_CHECK(out == nullptr);
-  }
-}
+using sogmm_fuzz::check_status;
+using sogmm_fuzz::take_double;
+using sogmm_fuzz::take_float;
+using sogmm_fuzz::take_points;
+using sogmm_fuzz::take_pose;
 
 void put(State& st, int slot, sogmm_model* m) {
   if (std::getenv("SOGMM_FUZZ_TRACE")) std::fprintf(stderr, "  -> model in slot %d\n", slot);
   sogmm_model_free(st.models[slot]);
   st.models[slot] = m;
-}
-
-// A double from the input: either a raw bit pattern (NaN, Inf, denormals, huge)
-// or a tame value in [-8, 8) in steps of 1/16, chosen by one bit.
-double take_double(sogmm_fuzz::Reader& in) {
-  const std::uint8_t how = in.take<std::uint8_t>();
-  if (how & 1) return in.take<double>();
-  return (static_cast<int>(in.take<std::uint8_t>()) - 128) / 16.0;
-}
-
-float take_float(sogmm_fuzz::Reader& in) { return static_cast<float>(take_double(in)); }
-
-// n points (x, y, z, gray): mostly a tame cloud around a plane, so that fits
-// reach EM; the input bytes perturb it.
-std::vector<float> take_points(sogmm_fuzz::Reader& in, std::size_t n) {
-  std::vector<float> p(4 * n + 4);
-  const std::uint8_t raw = in.take<std::uint8_t>();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t b = in.take<std::uint8_t>();
-    p[4 * i + 0] = static_cast<float>(i % 13) * 0.05f + (b & 7) * 1e-3f;
-    p[4 * i + 1] = static_cast<float>(i / 13) * 0.05f + ((b >> 3) & 7) * 1e-3f;
-    p[4 * i + 2] = 1.0f + (b >> 6) * 0.01f;
-    p[4 * i + 3] = static_cast<float>(b) / 255.0f;
-  }
-  // Raw overrides: a few values straight from the input (NaN, Inf, huge).
-  for (int r = 0; r < (raw & 3) && n > 0; ++r) {
-    const std::size_t at = in.take<std::uint16_t>() % (4 * n);
-    p[at] = in.take<float>();
-  }
-  return p;
-}
-
-// A pose: a rotation from a (possibly unnormalised) quaternion plus a
-// translation, or 16 raw doubles.
-std::array<double, 16> take_pose(sogmm_fuzz::Reader& in) {
-  std::array<double, 16> t{};
-  if (in.take<std::uint8_t>() & 1) {
-    for (double& v : t) v = take_double(in);
-    return t;
-  }
-  double q[4];
-  for (double& v : q) v = (static_cast<int>(in.take<std::uint8_t>()) - 128) / 64.0;
-  double nq = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (nq == 0) nq = q[0] = 1;
-  for (double& v : q) v /= nq;
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                       2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                       2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) t[4 * i + j] = r[3 * i + j];
-    t[4 * i + 3] = take_double(in);
-  }
-  t[15] = 1;
-  return t;
 }
 
 std::string take_string(sogmm_fuzz::Reader& in) {
