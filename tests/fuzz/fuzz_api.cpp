@@ -89,25 +89,9 @@ sogmm_key take_key(sogmm_fuzz::Reader& in) {
   return in.take<sogmm_key>();
 }
 
-// Options used for work: one thread (the fuzzer is single-threaded), small
-// EM budgets, the fastest compression, so that a step stays cheap.
+// The program's two options handles, bounded for work (bound_work).
 sogmm_options* work_options(State& st, std::uint8_t which) {
-  sogmm_options*& o = st.options[which & 1];
-  if (!o) {
-    FUZZ_CHECK(sogmm_options_create(&o) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 4) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 1) == SOGMM_OK);
-  }
-  // Whatever the program set, keep the work bounded.
-  FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
-  std::int64_t v = 0;
-  if (sogmm_options_get_i64(o, SOGMM_OPT_MAX_ITER, &v) == SOGMM_OK && v > 8)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 8) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_N_INIT, &v) == SOGMM_OK && v > 2)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_ZSTD_LEVEL, &v) == SOGMM_OK && v > 3)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 3) == SOGMM_OK);
-  return o;
+  return sogmm_fuzz::bound_work(st.options[which & 1]);
 }
 
 void step_set_option(State& st, sogmm_fuzz::Reader& in) {

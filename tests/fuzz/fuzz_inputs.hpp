@@ -40,6 +40,26 @@ inline void check_created(sogmm_status s, sogmm_model* out, sogmm_status lowest 
   }
 }
 
+/// Options for work, created on first use: one thread (the fuzzer is
+/// single-threaded), small EM budgets, the fastest compression; whatever a
+/// program set since, kept within those bounds, so that a step stays cheap.
+inline sogmm_options* bound_work(sogmm_options*& o) {
+  if (!o) {
+    FUZZ_CHECK(sogmm_options_create(&o) == SOGMM_OK);
+    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 4) == SOGMM_OK);
+    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 1) == SOGMM_OK);
+  }
+  FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
+  std::int64_t v = 0;
+  if (sogmm_options_get_i64(o, SOGMM_OPT_MAX_ITER, &v) == SOGMM_OK && v > 8)
+    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 8) == SOGMM_OK);
+  if (sogmm_options_get_i64(o, SOGMM_OPT_N_INIT, &v) == SOGMM_OK && v > 2)
+    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2) == SOGMM_OK);
+  if (sogmm_options_get_i64(o, SOGMM_OPT_ZSTD_LEVEL, &v) == SOGMM_OK && v > 3)
+    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 3) == SOGMM_OK);
+  return o;
+}
+
 // A double from the input: either a raw bit pattern (NaN, Inf, denormals, huge)
 // or a tame value in [-8, 8) in steps of 1/16, chosen by one bit.
 inline double take_double(Reader& in) {

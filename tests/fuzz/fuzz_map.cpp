@@ -132,23 +132,13 @@ struct State {
   }
 };
 
-// Whatever a program set, keep each call bounded: one thread, small EM
-// budgets, at most kMaxComponents fixed components, fast compression.
+// The work bounds of every call-sequence target (bound_work), plus a batch
+// of 256 points and at most kMaxComponents fixed components.
 sogmm_options* bounded(sogmm_options*& o) {
-  if (!o) {
-    FUZZ_CHECK(sogmm_options_create(&o) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 4) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 1) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, 256) == SOGMM_OK);
-  }
-  FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
+  const bool fresh = o == nullptr;
+  sogmm_fuzz::bound_work(o);
+  if (fresh) FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_BATCH_SIZE, 256) == SOGMM_OK);
   std::int64_t v = 0;
-  if (sogmm_options_get_i64(o, SOGMM_OPT_MAX_ITER, &v) == SOGMM_OK && v > 8)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 8) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_N_INIT, &v) == SOGMM_OK && v > 2)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_ZSTD_LEVEL, &v) == SOGMM_OK && v > 3)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 3) == SOGMM_OK);
   if (sogmm_options_get_i64(o, SOGMM_OPT_N_COMPONENTS, &v) == SOGMM_OK && v > kMaxComponents)
     FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_N_COMPONENTS, kMaxComponents) == SOGMM_OK);
   return o;

@@ -9,6 +9,8 @@ Deterministic."""
 import os
 import struct
 
+from make_api_seeds import tame, write_seeds  # the same reader layouts (fuzz_inputs.hpp)
+
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "seeds", "map")
 
 # Opcodes (LLVMFuzzerTestOneInput's switch, modulo 12).
@@ -18,11 +20,6 @@ OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "seeds", "map")
 EXPORT, SCORE, REGRESS, SAMPLE, RENDER, OCCUPANCY, SURFACE, COLLISION = range(8)
 # Indices into take_special's table.
 SPECIAL = {1e-30: 1, 5e5: 5, 1e10: 9, 1e39: 11}
-
-
-def tame(v):
-    """take_double's tame form: (byte - 128) / 16."""
-    return bytes([0, max(0, min(255, int(round(v * 16)) + 128))])
 
 
 def pose(tx=0.0, ty=0.0, special_x=None):
@@ -63,7 +60,6 @@ MAP_BATCH_SIZE, N_COMPONENTS = 602, 101
 
 
 def main():
-    os.makedirs(OUT, exist_ok=True)
     seeds = {
         "points_flush_save_query": create(0) + insert_points(0, 150) + bytes([FLUSH, 0]) + bytes([SAVE_LOAD, 0, 2])
         + query(0, SCORE, 40, points_bytes(40)) + query(1, SAMPLE, 30, struct.pack("<Q", 5))
@@ -85,10 +81,7 @@ def main():
         "first_frame_tiny_focal": create(0) + frame(8, 8, 0, special_f=1e-30) + bytes([INSERT_FRAME, 0]) + pose()
         + frame(8, 8, 10, salt=3) + bytes([INSERT_FRAME, 0]) + pose() + bytes([FLUSH, 0]),
     }
-    for name, data in seeds.items():
-        with open(os.path.join(OUT, name), "wb") as f:
-            f.write(data)
-    print(f"wrote {len(seeds)} seeds to {OUT}")
+    write_seeds(OUT, seeds)
 
 
 if __name__ == "__main__":
