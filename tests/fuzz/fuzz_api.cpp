@@ -429,34 +429,22 @@ void step_misc(State& st, sogmm_fuzz::Reader& in) {
   }
 }
 
+// After every step: every model that exists is valid.
+void check_models(const State& st) {
+  for (const sogmm_model* m : st.models)
+    if (m) check_model(m);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  // SOGMM_FUZZ_TRACE=1 prints the steps of a program (to read a finding).
-  static const bool trace = std::getenv("SOGMM_FUZZ_TRACE") != nullptr;
-  static const char* const names[] = {"set_option", "fit", "from_arrays", "info", "metadata", "pose",
-                                      "inference", "merge", "roundtrip", "load_bytes", "rgbd", "misc"};
+  static const sogmm_fuzz::Step<State> steps[] = {
+      {"set_option", step_set_option}, {"fit", step_fit},           {"from_arrays", step_from_arrays},
+      {"info", step_info},             {"metadata", step_metadata}, {"pose", step_pose},
+      {"inference", step_inference},   {"merge", step_merge},       {"roundtrip", step_roundtrip},
+      {"load_bytes", step_load_bytes}, {"rgbd", step_rgbd},         {"misc", step_misc}};
   sogmm_fuzz::Reader in(data, size);
   State st;
-  for (int step = 0; step < kMaxSteps && in.remaining() > 0; ++step) {
-    const int op = in.take<std::uint8_t>() % 12;
-    if (trace) std::fprintf(stderr, "step %d: %s\n", step, names[op]);
-    switch (op) {
-      case 0: step_set_option(st, in); break;
-      case 1: step_fit(st, in); break;
-      case 2: step_from_arrays(st, in); break;
-      case 3: step_info(st, in); break;
-      case 4: step_metadata(st, in); break;
-      case 5: step_pose(st, in); break;
-      case 6: step_inference(st, in); break;
-      case 7: step_merge(st, in); break;
-      case 8: step_roundtrip(st, in); break;
-      case 9: step_load_bytes(st, in); break;
-      case 10: step_rgbd(st, in); break;
-      default: step_misc(st, in); break;
-    }
-    for (const sogmm_model* m : st.models)
-      if (m) check_model(m);
-  }
+  sogmm_fuzz::run_program(in, st, kMaxSteps, steps, check_models);
   return 0;
 }

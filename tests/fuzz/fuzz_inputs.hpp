@@ -115,4 +115,27 @@ inline std::array<double, 16> take_pose(Reader& in) {
   return t;
 }
 
+/// One kind of step of a program: its name (for SOGMM_FUZZ_TRACE) and what
+/// it does with the state and the bytes that follow its opcode.
+template <typename State>
+struct Step {
+  const char* name;
+  void (*run)(State&, Reader&);
+};
+
+/// Runs the program in `in`: at most `max_steps` steps, each an opcode byte
+/// (modulo the number of step kinds) and the step's bytes, with `after`
+/// checking the state after every step. SOGMM_FUZZ_TRACE=1 prints the steps
+/// (to read a finding).
+template <typename State, std::size_t N>
+void run_program(Reader& in, State& st, int max_steps, const Step<State> (&steps)[N], void (*after)(const State&)) {
+  static const bool trace = std::getenv("SOGMM_FUZZ_TRACE") != nullptr;
+  for (int step = 0; step < max_steps && in.remaining() > 0; ++step) {
+    const Step<State>& s = steps[in.take<std::uint8_t>() % N];
+    if (trace) std::fprintf(stderr, "step %d: %s\n", step, s.name);
+    s.run(st, in);
+    after(st);
+  }
+}
+
 }  // namespace sogmm_fuzz

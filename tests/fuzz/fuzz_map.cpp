@@ -697,35 +697,23 @@ void check_never_locked(Slot& slot) {
   }
 }
 
+// After every step: every map answers its statistics (its use guard was released).
+void check_stats(const State& st) {
+  for (const Slot& s : st.maps)
+    if (s.map) counts(s.map);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  // SOGMM_FUZZ_TRACE=1 prints the steps of a program (to read a finding).
-  static const bool trace = std::getenv("SOGMM_FUZZ_TRACE") != nullptr;
-  static const char* const names[] = {"set_option", "create", "insert_points", "frame", "insert_frame", "flush",
-                                      "discard", "progress", "save_load", "load_bytes", "query", "misc"};
+  static const sogmm_fuzz::Step<State> steps[] = {
+      {"set_option", step_set_option}, {"create", step_create},       {"insert_points", step_insert_points},
+      {"frame", step_frame},           {"insert_frame", step_insert_frame}, {"flush", step_flush},
+      {"discard", step_discard},       {"progress", step_progress},   {"save_load", step_save_load},
+      {"load_bytes", step_load_bytes}, {"query", step_query},         {"misc", step_misc}};
   Reader in(data, size);
   State st;
-  for (int step = 0; step < kMaxSteps && in.remaining() > 0; ++step) {
-    const int op = in.take<std::uint8_t>() % 12;
-    if (trace) std::fprintf(stderr, "step %d: %s\n", step, names[op]);
-    switch (op) {
-      case 0: step_set_option(st, in); break;
-      case 1: step_create(st, in); break;
-      case 2: step_insert_points(st, in); break;
-      case 3: step_frame(st, in); break;
-      case 4: step_insert_frame(st, in); break;
-      case 5: step_flush(st, in); break;
-      case 6: step_discard(st, in); break;
-      case 7: step_progress(st, in); break;
-      case 8: step_save_load(st, in); break;
-      case 9: step_load_bytes(st, in); break;
-      case 10: step_query(st, in); break;
-      default: step_misc(st, in); break;
-    }
-    for (const Slot& s : st.maps)
-      if (s.map) counts(s.map);
-  }
+  sogmm_fuzz::run_program(in, st, kMaxSteps, steps, check_stats);
   for (Slot& s : st.maps) check_never_locked(s);
   return 0;
 }
