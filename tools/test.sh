@@ -59,9 +59,10 @@ if [ "${SOGMM_SKIP_HARDENING:-0}" != 1 ]; then
   # libFuzzer (clang, ASan + UBSan): a seeded search with a fixed number of
   # runs per target from the committed seeds and regressions. The counts give
   # each target about a minute on one core of a 2-core CI machine (the parsers
-  # run 2k-30k inputs/s, fit and the call sequences a few hundred).
+  # run 2k-30k inputs/s, fit and the call sequences a few hundred, the map
+  # sessions 10-25).
   stage "seeded fuzzing (tests/fuzz, fixed seed and run counts)"
   bash tests/fuzz/run_long.sh --runs 1 --seed 1 --jobs 2 --build build-fuzz \
-    load_memory=400000 load_file=200000 verify=120000 fit=12000 api=12000
+    load_memory=400000 load_file=200000 verify=120000 fit=12000 api=12000 map=800
 fi
 stage "all stages passed"

@@ -68,6 +68,10 @@ SOGMM_API sogmm_status sogmm_map_render_f32(const sogmm_map* map, uint32_t width
                                             float* variance_out) {
   SOGMM_TRY {
     require_nonnull(map, "map");
+    // Shared use, as every const map call: an insert or flush (from another
+    // thread, or from this render's progress callback) would change the model
+    // under the render (fuzz_map found the callback's flush succeeding).
+    const sogmm_capi::MapReader use(map, "sogmm_map_render_f32");
     const sogmm::Model& model = map->map.model();  // SOGMM_E_INVALID_DATA for an empty map
     render_into(model.gmm, width, height, fx, fy, cx, cy, camera_to_world, options, depth_out, gray_out,
                 variance_out);

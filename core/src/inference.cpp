@@ -106,8 +106,13 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
   Gmm out = gmm;
   for (std::size_t k = 0; k < gmm.size(); ++k) {
     const Eigen::Vector4d mu = a * mean_of(gmm, k) + shift;
-    Mat4 c = a * covariance_of(gmm, k) * a.transpose();
-    c = 0.5 * (c + c.transpose());
+    const Mat4 moved = a * covariance_of(gmm, k) * a.transpose();
+    // Its symmetric part, bit-symmetric once in float32, into a new matrix:
+    // `moved = 0.5 * (moved + moved.transpose())` would be evaluated in place
+    // (Eigen's aliasing), reading entries it already overwrote, and left the
+    // map's covariances asymmetric by ~1e-23, so that a saved map was stored
+    // in the FULL layout and its reload differed (fuzz_map, issue 36).
+    const Mat4 c = 0.5 * (moved + moved.transpose());
     for (int i = 0; i < 4; ++i) out.means[4 * k + i] = static_cast<float>(mu[i]);
     for (int i = 0; i < 16; ++i) out.covariances[16 * k + i] = static_cast<float>(c(i / 4, i % 4));
     // A finite pose can still move a mean out of float32 range (a translation

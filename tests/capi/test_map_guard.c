@@ -141,6 +141,51 @@ static void test_reentry_from_callback(void) {
   free(pts);
 }
 
+/* A render is a const call and holds the map like the other queries: from
+ * its callback a flush is refused and the pending points stay (fuzz_map: the
+ * render took no guard, so the nested flush fitted them while the render
+ * read the model). */
+typedef struct {
+  sogmm_map* map;
+  int calls;
+  sogmm_status flush;
+  int busy_message;
+} RenderReentry;
+
+static int32_t flush_from_render(int32_t stage, uint64_t step, uint64_t total, double ll, void* user_data) {
+  RenderReentry* r = (RenderReentry*)user_data;
+  (void)step, (void)total, (void)ll;
+  if (stage != SOGMM_STAGE_RENDERING || r->calls++ > 0) return 0;
+  r->flush = sogmm_map_flush(r->map);
+  r->busy_message = message_starts("map busy: sogmm_map_flush");
+  return 0;
+}
+
+static void test_render_holds_the_map(void) {
+  float* pts = make_clusters(3000, 11);
+  sogmm_map* map = small_batch_map();
+  sogmm_options* o = NULL;
+  sogmm_map_stats before, after;
+  float depth[16 * 12], gray[16 * 12];
+  RenderReentry r;
+  memset(&r, 0, sizeof r);
+  r.map = map;
+  REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 3000, k_identity)); /* fitted: batch of 2000 */
+  REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 500, k_identity));  /* pending or not: the flush is refused */
+  REQUIRE_OK(sogmm_map_get_stats(map, &before));
+  REQUIRE_OK(sogmm_options_create(&o));
+  REQUIRE_OK(sogmm_options_set_progress(o, flush_from_render, &r));
+  REQUIRE_OK(sogmm_map_render_f32(map, 16, 12, 10.0, 10.0, 8.0, 6.0, NULL, o, depth, gray, NULL));
+  EXPECT_TRUE(r.calls > 0);
+  EXPECT_TRUE(r.flush == SOGMM_E_BUSY && r.busy_message);
+  REQUIRE_OK(sogmm_map_get_stats(map, &after));
+  EXPECT_TRUE(after.n_flushes == before.n_flushes && after.n_pending == before.n_pending &&
+              after.n_components == before.n_components);
+  sogmm_options_free(o);
+  sogmm_map_free(map);
+  free(pts);
+}
+
 /* ---- two threads --------------------------------------------------------- */
 
 typedef struct {
@@ -318,6 +363,7 @@ static void test_slow_callback_reports_per_interval(void) {
 
 int main(void) {
   test_reentry_from_callback();
+  test_render_holds_the_map();
   test_two_threads();
   test_nested_calls_have_no_callback();
   test_slow_callback_reports_per_interval();

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_inputs.hpp"
 #include "fuzz_model_check.hpp"
 #include "../hardening/capi_calls.hpp"
 #include "fuzz_util.hpp"
@@ -48,88 +49,18 @@ struct State {
   }
 };
 
-bool documented(sogmm_status s) { return s == SOGMM_OK || (s <= SOGMM_E_NULL_ARG && s >= SOGMM_E_INTERNAL); }
-
-// Every status is documented; an error carries a message; INTERNAL is a bug.
-void check_status(sogmm_status s) {
-  if (std::getenv("SOGMM_FUZZ_TRACE")) std::fprintf(stderr, "  status %d %s\n", s, s ? sogmm_last_error() : "");
-  FUZZ_CHECK(documented(s));
-  FUZZ_CHECK(s != SOGMM_E_INTERNAL);
-  if (s != SOGMM_OK) FUZZ_CHECK(sogmm_last_error()[0] != '\0');
-}
-
+using sogmm_fuzz::check_created;
 using sogmm_fuzz::check_model;
-
-// A handle-creating call: on error *out is NULL; on success the model is valid.
-void check_created(sogmm_status s, sogmm_model* out) {
-  check_status(s);
-  if (s == SOGMM_OK) {
-    FUZZ_CHECK(out != nullptr);
-    check_model(out);
-  } else {
-    FUZZ_CHECK(out == nullptr);
-  }
-}
+using sogmm_fuzz::check_status;
+using sogmm_fuzz::take_double;
+using sogmm_fuzz::take_float;
+using sogmm_fuzz::take_points;
+using sogmm_fuzz::take_pose;
 
 void put(State& st, int slot, sogmm_model* m) {
   if (std::getenv("SOGMM_FUZZ_TRACE")) std::fprintf(stderr, "  -> model in slot %d\n", slot);
   sogmm_model_free(st.models[slot]);
   st.models[slot] = m;
-}
-
-// A double from the input: either a raw bit pattern (NaN, Inf, denormals, huge)
-// or a tame value in [-8, 8) in steps of 1/16, chosen by one bit.
-double take_double(sogmm_fuzz::Reader& in) {
-  const std::uint8_t how = in.take<std::uint8_t>();
-  if (how & 1) return in.take<double>();
-  return (static_cast<int>(in.take<std::uint8_t>()) - 128) / 16.0;
-}
-
-float take_float(sogmm_fuzz::Reader& in) { return static_cast<float>(take_double(in)); }
-
-// n points (x, y, z, gray): mostly a tame cloud around a plane, so that fits
-// reach EM; the input bytes perturb it.
-std::vector<float> take_points(sogmm_fuzz::Reader& in, std::size_t n) {
-  std::vector<float> p(4 * n + 4);
-  const std::uint8_t raw = in.take<std::uint8_t>();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t b = in.take<std::uint8_t>();
-    p[4 * i + 0] = static_cast<float>(i % 13) * 0.05f + (b & 7) * 1e-3f;
-    p[4 * i + 1] = static_cast<float>(i / 13) * 0.05f + ((b >> 3) & 7) * 1e-3f;
-    p[4 * i + 2] = 1.0f + (b >> 6) * 0.01f;
-    p[4 * i + 3] = static_cast<float>(b) / 255.0f;
-  }
-  // Raw overrides: a few values straight from the input (NaN, Inf, huge).
-  for (int r = 0; r < (raw & 3) && n > 0; ++r) {
-    const std::size_t at = in.take<std::uint16_t>() % (4 * n);
-    p[at] = in.take<float>();
-  }
-  return p;
-}
-
-// A pose: a rotation from a (possibly unnormalised) quaternion plus a
-// translation, or 16 raw doubles.
-std::array<double, 16> take_pose(sogmm_fuzz::Reader& in) {
-  std::array<double, 16> t{};
-  if (in.take<std::uint8_t>() & 1) {
-    for (double& v : t) v = take_double(in);
-    return t;
-  }
-  double q[4];
-  for (double& v : q) v = (static_cast<int>(in.take<std::uint8_t>()) - 128) / 64.0;
-  double nq = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (nq == 0) nq = q[0] = 1;
-  for (double& v : q) v /= nq;
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                       2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                       2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) t[4 * i + j] = r[3 * i + j];
-    t[4 * i + 3] = take_double(in);
-  }
-  t[15] = 1;
-  return t;
 }
 
 std::string take_string(sogmm_fuzz::Reader& in) {
@@ -159,25 +90,9 @@ sogmm_key take_key(sogmm_fuzz::Reader& in) {
   return in.take<sogmm_key>();
 }
 
-// Options used for work: one thread (the fuzzer is single-threaded), small
-// EM budgets, the fastest compression, so that a step stays cheap.
+// The program's two options handles, bounded for work (bound_work).
 sogmm_options* work_options(State& st, std::uint8_t which) {
-  sogmm_options*& o = st.options[which & 1];
-  if (!o) {
-    FUZZ_CHECK(sogmm_options_create(&o) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 4) == SOGMM_OK);
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 1) == SOGMM_OK);
-  }
-  // Whatever the program set, keep the work bounded.
-  FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1) == SOGMM_OK);
-  std::int64_t v = 0;
-  if (sogmm_options_get_i64(o, SOGMM_OPT_MAX_ITER, &v) == SOGMM_OK && v > 8)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_MAX_ITER, 8) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_N_INIT, &v) == SOGMM_OK && v > 2)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_N_INIT, 2) == SOGMM_OK);
-  if (sogmm_options_get_i64(o, SOGMM_OPT_ZSTD_LEVEL, &v) == SOGMM_OK && v > 3)
-    FUZZ_CHECK(sogmm_options_set_i64(o, SOGMM_OPT_ZSTD_LEVEL, 3) == SOGMM_OK);
-  return o;
+  return sogmm_fuzz::bound_work(st.options[which & 1]);
 }
 
 void step_set_option(State& st, sogmm_fuzz::Reader& in) {
@@ -524,34 +439,22 @@ void step_misc(State& st, sogmm_fuzz::Reader& in) {
   }
 }
 
+// After every step: every model that exists is valid.
+void check_models(const State& st) {
+  for (const sogmm_model* m : st.models)
+    if (m) check_model(m);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  // SOGMM_FUZZ_TRACE=1 prints the steps of a program (to read a finding).
-  static const bool trace = std::getenv("SOGMM_FUZZ_TRACE") != nullptr;
-  static const char* const names[] = {"set_option", "fit", "from_arrays", "info", "metadata", "pose",
-                                      "inference", "merge", "roundtrip", "load_bytes", "rgbd", "misc"};
+  static const sogmm_fuzz::Step<State> steps[] = {
+      {"set_option", step_set_option}, {"fit", step_fit},           {"from_arrays", step_from_arrays},
+      {"info", step_info},             {"metadata", step_metadata}, {"pose", step_pose},
+      {"inference", step_inference},   {"merge", step_merge},       {"roundtrip", step_roundtrip},
+      {"load_bytes", step_load_bytes}, {"rgbd", step_rgbd},         {"misc", step_misc}};
   sogmm_fuzz::Reader in(data, size);
   State st;
-  for (int step = 0; step < kMaxSteps && in.remaining() > 0; ++step) {
-    const int op = in.take<std::uint8_t>() % 12;
-    if (trace) std::fprintf(stderr, "step %d: %s\n", step, names[op]);
-    switch (op) {
-      case 0: step_set_option(st, in); break;
-      case 1: step_fit(st, in); break;
-      case 2: step_from_arrays(st, in); break;
-      case 3: step_info(st, in); break;
-      case 4: step_metadata(st, in); break;
-      case 5: step_pose(st, in); break;
-      case 6: step_inference(st, in); break;
-      case 7: step_merge(st, in); break;
-      case 8: step_roundtrip(st, in); break;
-      case 9: step_load_bytes(st, in); break;
-      case 10: step_rgbd(st, in); break;
-      default: step_misc(st, in); break;
-    }
-    for (const sogmm_model* m : st.models)
-      if (m) check_model(m);
-  }
+  sogmm_fuzz::run_program(in, st, kMaxSteps, steps, check_models);
   return 0;
 }

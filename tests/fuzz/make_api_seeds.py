@@ -19,6 +19,15 @@ def tame(v):
     return bytes([0, max(0, min(255, int(round(v * 16)) + 128))])
 
 
+def write_seeds(out, seeds):
+    """Writes each seed program (name -> bytes) into the folder `out`."""
+    os.makedirs(out, exist_ok=True)
+    for name, data in seeds.items():
+        with open(os.path.join(out, name), "wb") as f:
+            f.write(data)
+    print(f"wrote {len(seeds)} seeds to {out}")
+
+
 def fit(slot, n, fixed_k=0):
     how = (1 | (fixed_k << 1)) if fixed_k else 0
     return bytes([FIT, slot, 0, how, n, 0]) + bytes((37 * i + 11) % 256 for i in range(n))
@@ -38,7 +47,6 @@ def identity_pose_with_translation(t):
 
 
 def main():
-    os.makedirs(OUT, exist_ok=True)
     seeds = {
         "fit_roundtrip_sample": fit(0, 150) + bytes([ROUNDTRIP, 0, 0])
         + bytes([INFERENCE, 0, 0, 100]) + struct.pack("<Q", 7),
@@ -54,10 +62,7 @@ def main():
         "options_then_fit": bytes([SET_OPTION, 0, 0, 1]) + tame(0.5) + bytes([SET_OPTION, 0, 9, 0, 2])
         + fit(2, 100) + bytes([INFO, 2, 22]),
     }
-    for name, data in seeds.items():
-        with open(os.path.join(OUT, name), "wb") as f:
-            f.write(data)
-    print(f"wrote {len(seeds)} seeds to {OUT}")
+    write_seeds(OUT, seeds)
 
 
 if __name__ == "__main__":

@@ -15,14 +15,16 @@
 #                -fork=1 -ignore_crashes ...): every finding of the campaign is
 #                kept in DIR/fuzz-artifacts/<target>/, and the script fails if
 #                there is any
+#   --fork F     with --keep-going: F libFuzzer worker processes per target
+#                (default 1), so that one target can use several cores
 #   --jobs J     targets run at the same time (default 1)
 #   --build DIR  fuzz build folder (default build-fuzz), configured here with
 #                clang, -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON unless --no-build
-#   TARGET       load_memory load_file verify fit api (default: all); with
+#   TARGET       load_memory load_file verify fit api map (default: all); with
 #                --runs, TARGET=RUNS gives that target its own run count
 #                (the targets' speeds differ by 100x)
 # Corpus: each format target starts from the spec/conformance .sogmm vectors,
-# fit from tests/fuzz/seeds/fit; all from tests/fuzz/regressions/<target>; what it
+# fit, api and map from tests/fuzz/seeds/<target>; all from tests/fuzz/regressions/<target>; what it
 # finds is kept in DIR/fuzz-corpus/<target>. A crash writes its input to
 # DIR/fuzz-artifacts/<target>/ and makes this script fail: turn it into a
 # regression (tests/fuzz/regressions/<target>/, see README.md there).
@@ -34,6 +36,7 @@ SECONDS_PER_TARGET=3600
 RUNS=""
 FUZZ_SEED=1
 KEEP_GOING=0
+FORK=1
 JOBS=1
 BUILD=build-fuzz
 DO_BUILD=1
@@ -44,14 +47,15 @@ while [ $# -gt 0 ]; do
     --runs) RUNS=$2; shift 2 ;;
     --seed) FUZZ_SEED=$2; shift 2 ;;
     --keep-going) KEEP_GOING=1; shift ;;
+    --fork) FORK=$2; shift 2 ;;
     --jobs) JOBS=$2; shift 2 ;;
     --build) BUILD=$2; shift 2 ;;
     --no-build) DO_BUILD=0; shift ;;
-    -h|--help) sed -n '2,32p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,34p' "$0"; exit 0 ;;
     *) TARGETS+=("$1"); shift ;;
   esac
 done
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(load_memory load_file verify fit api)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(load_memory load_file verify fit api map)
 # TARGET=RUNS: split into the target names and their run counts.
 declare -A RUNS_OF=()
 for i in "${!TARGETS[@]}"; do
@@ -67,7 +71,7 @@ if [ "$DO_BUILD" = 1 ]; then
 fi
 
 # Per-input limits: a slow input (> 25 s) or more than 2 GiB of memory is a finding too.
-max_len_for() { case "$1" in fit) echo 4200 ;; *) echo 40000 ;; esac; }
+max_len_for() { case "$1" in fit) echo 4200 ;; map) echo 8192 ;; *) echo 40000 ;; esac; }
 
 # Seeds of the format targets: the .sogmm conformance vectors (not the .json dumps).
 SEEDS="$BUILD/fuzz-seeds/sogmm"
@@ -79,7 +83,7 @@ cp spec/conformance/valid/*.sogmm spec/conformance/invalid/*.sogmm "$SEEDS/"
 budget_flags() {
   if [ -n "$RUNS" ]; then echo "-runs=${RUNS_OF[$1]:-$RUNS} -seed=$FUZZ_SEED -reload=0"; return; fi
   echo "-max_total_time=$SECONDS_PER_TARGET"
-  if [ "$KEEP_GOING" = 1 ]; then echo "-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"; fi
+  if [ "$KEEP_GOING" = 1 ]; then echo "-fork=$FORK -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"; fi
 }
 budget_words() {
   if [ -n "$RUNS" ]; then echo "from seed $FUZZ_SEED"; else echo "in ${SECONDS_PER_TARGET} s"; fi
@@ -91,7 +95,7 @@ run_one() {
   if [ -n "$RUNS" ]; then corpus="$BUILD/fuzz-corpus-seeded/$t"; rm -rf "$corpus" "$artifacts"; fi
   mkdir -p "$corpus" "$artifacts" "$(dirname "$log")"
   local dirs=("$corpus") d
-  case "$t" in fit|api) ;; *) dirs+=("$SEEDS") ;; esac
+  case "$t" in fit|api|map) ;; *) dirs+=("$SEEDS") ;; esac
   for d in "tests/fuzz/seeds/$t" "tests/fuzz/regressions/$t"; do
     if [ -d "$d" ]; then dirs+=("$d"); fi
   done
