@@ -165,20 +165,20 @@ static void test_render_holds_the_map(void) {
   float* pts = make_clusters(3000, 11);
   sogmm_map* map = small_batch_map();
   sogmm_options* o = NULL;
-  sogmm_map_stats before, after;
+  test_map_stats before, after;
   float depth[16 * 12], gray[16 * 12];
   RenderReentry r;
   memset(&r, 0, sizeof r);
   r.map = map;
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 3000, k_identity)); /* fitted: batch of 2000 */
   REQUIRE_OK(sogmm_map_insert_points_f32(map, pts, 500, k_identity));  /* pending or not: the flush is refused */
-  REQUIRE_OK(sogmm_map_get_stats(map, &before));
+  REQUIRE_OK(test_map_get_stats(map, &before));
   REQUIRE_OK(sogmm_options_create(&o));
   REQUIRE_OK(sogmm_options_set_progress(o, flush_from_render, &r));
   REQUIRE_OK(sogmm_map_render_f32(map, 16, 12, 10.0, 10.0, 8.0, 6.0, NULL, o, depth, gray, NULL));
   EXPECT_TRUE(r.calls > 0);
   EXPECT_TRUE(r.flush == SOGMM_E_BUSY && r.busy_message);
-  REQUIRE_OK(sogmm_map_get_stats(map, &after));
+  REQUIRE_OK(test_map_get_stats(map, &after));
   EXPECT_TRUE(after.n_flushes == before.n_flushes && after.n_pending == before.n_pending &&
               after.n_components == before.n_components);
   sogmm_options_free(o);

@@ -99,8 +99,9 @@ std::int32_t on_progress(std::int32_t stage, std::uint64_t step, std::uint64_t, 
   if (std::getenv("SOGMM_FUZZ_TRACE")) std::fprintf(stderr, "  progress stage %d step %llu\n", stage, (unsigned long long)step);
   if (p->map) {
     FUZZ_CHECK(sogmm_map_flush(p->map) == SOGMM_E_BUSY);
-    sogmm_map_stats s{};
-    FUZZ_CHECK(sogmm_map_get_stats(p->map, &s) == (p->outer_writes ? SOGMM_E_BUSY : SOGMM_OK));
+    int64_t components = 0;
+    FUZZ_CHECK(sogmm_map_get_i64(p->map, SOGMM_MAP_N_COMPONENTS, &components) ==
+               (p->outer_writes ? SOGMM_E_BUSY : SOGMM_OK));
     sogmm_map_free(p->map);  // refused: the map stays valid (ASan would see a use after free)
     FUZZ_CHECK(std::strncmp(sogmm_last_error(), "map busy", 8) == 0);
   }
@@ -203,9 +204,11 @@ struct Counts {
 };
 
 Counts counts(const sogmm_map* m) {
-  sogmm_map_stats s{};
-  FUZZ_CHECK(sogmm_map_get_stats(m, &s) == SOGMM_OK);
-  return {s.n_components, s.n_pending, s.n_frames};
+  int64_t v[3] = {0, 0, 0};
+  FUZZ_CHECK(sogmm_map_get_i64(m, SOGMM_MAP_N_COMPONENTS, &v[0]) == SOGMM_OK);
+  FUZZ_CHECK(sogmm_map_get_i64(m, SOGMM_MAP_N_PENDING, &v[1]) == SOGMM_OK);
+  FUZZ_CHECK(sogmm_map_get_i64(m, SOGMM_MAP_N_FRAMES, &v[2]) == SOGMM_OK);
+  return {static_cast<std::uint64_t>(v[0]), static_cast<std::uint64_t>(v[1]), static_cast<std::uint64_t>(v[2])};
 }
 
 // Replaces the slot's map by `m`, made with `options` (a copy is kept: a map
@@ -546,7 +549,7 @@ void step_query(State& st, Reader& in) {
       std::vector<double> out(n + 1, kUntouchedD), want(n + 1, kUntouchedD);
       if (ok(sogmm_map_score_samples_f32(map, pts.data(), n, dims, o, out.data()))) {
         FUZZ_CHECK(sogmm_options_set_progress(o, nullptr, nullptr) == SOGMM_OK);
-        FUZZ_CHECK(sogmm_model_score_samples_f32_v2(exported, pts.data(), n, dims, o, want.data()) == SOGMM_OK);
+        FUZZ_CHECK(sogmm_model_score_samples_f32(exported, pts.data(), n, dims, o, want.data()) == SOGMM_OK);
         FUZZ_CHECK(std::memcmp(out.data(), want.data(), n * sizeof(double)) == 0);
         for (std::size_t i = 0; i < n; ++i) FUZZ_CHECK(!std::isnan(out[i]) && out[i] != INFINITY);
       } else {
@@ -560,7 +563,7 @@ void step_query(State& st, Reader& in) {
       if (ok(sogmm_map_regress_gray_f32(map, xyz.data(), n, o, mean.data(), var.data()))) {
         for (std::size_t i = 0; i < n; ++i) FUZZ_CHECK(std::isfinite(mean[i]) && var[i] >= 0);
         FUZZ_CHECK(sogmm_options_set_progress(o, nullptr, nullptr) == SOGMM_OK);
-        FUZZ_CHECK(sogmm_model_regress_gray_f32_v2(exported, xyz.data(), n, o, want.data(), want.data() + n + 1) ==
+        FUZZ_CHECK(sogmm_model_regress_gray_f32(exported, xyz.data(), n, o, want.data(), want.data() + n + 1) ==
                    SOGMM_OK);
         FUZZ_CHECK(std::memcmp(mean.data(), want.data(), n * sizeof(float)) == 0);
         FUZZ_CHECK(std::memcmp(var.data(), want.data() + n + 1, n * sizeof(float)) == 0);
@@ -650,13 +653,13 @@ void step_misc(State& st, Reader& in) {
     case 1: {
       if (!slot.map) break;
       const std::uint64_t frame = in.take<std::uint8_t>();
-      sogmm_map_frame_stats fs{};
-      std::uint64_t replaced = 0;
-      const sogmm_status s = sogmm_map_get_frame_stats(slot.map, frame, &fs);
+      int64_t points = -1, novel = -1, replaced = -1;
+      const sogmm_status s = sogmm_map_frame_get_i64(slot.map, frame, SOGMM_MAP_FRAME_N_POINTS, &points);
       check_status(s);
       FUZZ_CHECK((s == SOGMM_OK) == (frame < counts(slot.map).frames));
-      FUZZ_CHECK(sogmm_map_get_frame_replaced(slot.map, frame, &replaced) == s);
-      if (s == SOGMM_OK) FUZZ_CHECK(fs.n_novel <= fs.n_points);
+      FUZZ_CHECK(sogmm_map_frame_get_i64(slot.map, frame, SOGMM_MAP_FRAME_N_NOVEL, &novel) == s);
+      FUZZ_CHECK(sogmm_map_frame_get_i64(slot.map, frame, SOGMM_MAP_FRAME_N_REPLACED, &replaced) == s);
+      if (s == SOGMM_OK) FUZZ_CHECK(0 <= novel && novel <= points && replaced >= 0);
       break;
     }
     default:

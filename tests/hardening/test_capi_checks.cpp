@@ -391,7 +391,7 @@ TEST(CapiTransform, RotatedCovariancesStayBitSymmetricAndReloadToTheSameBytes) {
                            1.0f + 0.01f * (i * 7 % 5), static_cast<float>(i * 37 % 256) / 255.0f});
   }
   sogmm_model* m = nullptr;
-  ASSERT_EQ(sogmm_fit_points_f32(&m, pts.data(), 150, nullptr), SOGMM_OK) << last_error();
+  ASSERT_EQ(sogmm_fit_points_f32(&m, pts.data(), 150, nullptr, nullptr), SOGMM_OK) << last_error();
   std::size_t n_components = 0;
   ASSERT_EQ(sogmm_model_n_components(m, &n_components), SOGMM_OK);
   // A generic rotation (the pose of the fuzz finding) and a translation.
