@@ -144,6 +144,10 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
   Mat36 jac;
   jac.leftCols<3>() = -skew(x - c);
   jac.rightCols<3>().setIdentity();
+  // J is the same for every component of the point: sum the weighted
+  // precisions and precision-weighted residuals first, then one J^T W J.
+  Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
   Vec6 gbar = Vec6::Zero();
   Mat6 ggt = Mat6::Zero();
   for (std::size_t j = 0; j < s.ids.size(); ++j) {
@@ -151,15 +155,17 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
     if (w < 1e-12) continue;
     const Eigen::Matrix3d& p = level.comps[s.ids[j]].prec;
     const Eigen::Vector3d pr = p * s.res[j];
-    const Vec6 g = jac.transpose() * pr;
-    out.hessian.noalias() += w * (jac.transpose() * p * jac);
-    out.gradient += w * g;
+    wp += w * p;
+    wpr += w * pr;
     if (inlier) out.mahalanobis += w * s.res[j].dot(pr);
     if (spread) {
+      const Vec6 g = jac.transpose() * pr;
       gbar += w * g;
       ggt.noalias() += w * g * g.transpose();
     }
   }
+  out.hessian.noalias() += jac.transpose() * wp * jac;
+  out.gradient.noalias() += jac.transpose() * wpr;
   if (spread) out.spread += ggt - gbar * gbar.transpose();
 }
 
@@ -250,16 +256,18 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
     radius2 += (Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]) - centroid).squaredNorm();
   const double radius = std::max(std::sqrt(radius2 / double(n)), 1e-6);
 
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
-  std::vector<Sums> partial(blocks);
-  auto evaluate = [&](const Level& level, const Rigid& pose, bool spread) {
+  std::vector<Sums> partial;
+  // Every `stride`-th point (coarse levels need fewer: their targets are smooth).
+  auto evaluate = [&](const Level& level, const Rigid& pose, bool spread, std::size_t stride) {
     const Eigen::Vector3d c = pose.r * centroid + pose.t;
+    const std::size_t used = (n + stride - 1) / stride, blocks = (used + kBlock - 1) / kBlock;
+    partial.assign(blocks, Sums{});
     detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
-      for (std::size_t i = blk * kBlock; i < std::min(n, (blk + 1) * kBlock); ++i) {
-        const float* p = points + 4 * i;
+      for (std::size_t v = blk * kBlock; v < std::min(used, (blk + 1) * kBlock); ++v) {
+        const float* p = points + 4 * v * stride;
         const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
         score_point(level, x, p[3], c, log_outlier, options.use_gray, spread, sc, s);
       }
@@ -278,12 +286,15 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   Level level;
   for (std::int32_t l = 0; l < levels; ++l) {
     const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
+    // Level l of L uses every 2^(L-1-l)-th point (at most 4x fewer), keeping at least min_points.
+    std::size_t stride = std::size_t{1} << std::min(levels - 1 - l, 2);
+    while (stride > 1 && n / stride < static_cast<std::size_t>(options.min_points)) stride /= 2;
     level = make_level(target, s, eps, options.use_gray);
     converged = false;
     for (std::int32_t it = 0; it < options.max_iter && !converged; ++it) {
-      const Sums sums = evaluate(level, pose, false);
+      const Sums sums = evaluate(level, pose, false, stride);
       ++result.iterations;
-      detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / double(n));
+      detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / double((n + stride - 1) / stride));
       const double scale = sums.hessian.diagonal().maxCoeff();
       if (!(scale > 0)) break;  // no point near the target: nothing to move towards
       const Vec6 step = -(sums.hessian + 1e-9 * scale * Mat6::Identity()).ldlt().solve(sums.gradient);
@@ -300,7 +311,7 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   }
 
   // The figures at the final pose, on the unsmoothed model.
-  const Sums fin = evaluate(level, pose, true);
+  const Sums fin = evaluate(level, pose, true, 1);
   const Mat6 info_c = fin.hessian - fin.spread;  // about the centroid c
   const Eigen::Vector3d c = pose.r * centroid + pose.t;
   // xi_origin = A xi_c with A = [I 0; [c]x I]: information_origin = A^-T info_c A^-1.

@@ -18,7 +18,8 @@
 //
 // Coarse to fine: `levels` levels smooth the target by s = coarse_sigma,
 // coarse_sigma / 2, ..., and the last level by 0 (the model itself), so a
-// start a few centimetres off still sees the surface. Each point tests only
+// start a few centimetres off still sees the surface; the smooth coarse
+// levels use every 2nd or 4th point. Each point tests only
 // the components whose 3-sigma box (ComponentIndex) holds it.
 //
 // What comes back. The pose; the mean log-likelihood, the inlier ratio (a
@@ -46,7 +47,7 @@ struct RegistrationOptions {
   std::int32_t max_iter = 30;
   /// A level ends when a step moves the source by less than this (metres:
   /// |translation| + |rotation| x the source's RMS radius). > 0.
-  double tol = 1e-5;
+  double tol = 1e-4;
   /// eps: prior weight of the uniform outlier term, in [0, 1).
   double outlier_ratio = 0.1;
   /// true: score gray too (the 4-D joint density); false: the 3-D marginal.
