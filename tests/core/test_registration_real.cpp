@@ -84,8 +84,7 @@ sogmm::RegistrationResult register_pair(const Livingroom& d, int a, int b, const
 
 // The bound: 1 cm and 0.5 degrees. Measured 0.10-0.14 cm and
 // 0.014-0.055 degrees (the same under sse2, avx2 and default), so kernel
-// rounding (which moves the fit's last bits)
-// cannot cross it.
+// rounding (which moves the fit's last bits) cannot cross it.
 TEST(RegistrationReal, LivingroomPairsFromIdentity) {
   const Livingroom* d = livingroom();
   if (!d) GTEST_SKIP() << "real-frame data folder " << SOGMM_SHARED_DATA << "/rgbd/livingroom is absent";
