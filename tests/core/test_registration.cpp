@@ -13,12 +13,14 @@
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/registration.hpp"
+#include "pose_util.hpp"
 #include "test_util.hpp"
 
 namespace {
 
 using sogmm::RegistrationStatus;
 using Pose = std::array<double, 16>;
+using sogmm_test::pose_error;
 
 constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
@@ -50,18 +52,6 @@ sogmm::Gmm planes(std::initializer_list<int> normals, Eigen::Vector3d shift = Ei
   return g;
 }
 
-Eigen::Matrix4d mat(const Pose& p) {
-  Eigen::Matrix4d m;
-  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = p[i];
-  return m;
-}
-
-Pose arr(const Eigen::Matrix4d& m) {
-  Pose p;
-  for (int i = 0; i < 16; ++i) p[i] = m(i / 4, i % 4);
-  return p;
-}
-
 // The pose rotating by `deg` about `axis` and then translating by `t`.
 Eigen::Matrix4d rigid(double deg, Eigen::Vector3d axis, Eigen::Vector3d t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
@@ -80,13 +70,6 @@ std::vector<float> samples(const sogmm::Gmm& g, std::size_t n, const Eigen::Matr
     for (int k = 0; k < 3; ++k) pts[4 * i + k] = static_cast<float>(y(k));
   }
   return pts;
-}
-
-// Translation (m) and rotation (degrees) between two poses.
-std::pair<double, double> pose_error(const Pose& a, const Eigen::Matrix4d& b) {
-  const Eigen::Matrix4d d = mat(a).inverse() * b;
-  const double c = std::clamp((d.topLeftCorner<3, 3>().trace() - 1) / 2, -1.0, 1.0);
-  return {(mat(a).topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm(), std::acos(c) * 180 / M_PI};
 }
 
 }  // namespace
@@ -142,7 +125,7 @@ TEST(Registration, GlobalTranslationInvariance) {
   const auto b = sogmm::register_points(planes({0, 1, 2}, shift), moved.data(), 5000, kIdentity, o);
   ASSERT_EQ(a.status, RegistrationStatus::Converged);
   ASSERT_EQ(b.status, RegistrationStatus::Converged);
-  Eigen::Matrix4d expect = mat(a.pose);
+  Eigen::Matrix4d expect = sogmm_test::pose_matrix(a.pose);
   expect.topRightCorner<3, 1>() += shift - expect.topLeftCorner<3, 3>() * shift;
   const auto [dt, dr] = pose_error(b.pose, expect);
   EXPECT_LT(dt, 2e-5);
@@ -169,7 +152,7 @@ TEST(Registration, SinglePlaneIsDegenerate) {
   EXPECT_LT(std::fabs(info(4, 4)), 1e-3 * z);
   EXPECT_LT(std::fabs(info(2, 2)), 1e-3 * z);
   // The observable directions are still solved: tz and the tilt about x.
-  const Eigen::Matrix4d p = mat(r.pose);
+  const Eigen::Matrix4d p = sogmm_test::pose_matrix(r.pose);
   EXPECT_NEAR(p(2, 3), 0.01, 1e-3);
   EXPECT_NEAR(std::asin(p(2, 1)) * 180 / M_PI, 2.0, 0.1);
 }

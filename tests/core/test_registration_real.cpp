@@ -12,6 +12,7 @@
 #include <map>
 #include <random>
 
+#include "pose_util.hpp"
 #include "real_frame.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/model.hpp"
@@ -23,25 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Pose = std::array<double, 16>;
-
-Eigen::Matrix4d mat(const Pose& p) {
-  Eigen::Matrix4d m;
-  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = p[i];
-  return m;
-}
-
-Pose arr(const Eigen::Matrix4d& m) {
-  Pose p;
-  for (int i = 0; i < 16; ++i) p[i] = m(i / 4, i % 4);
-  return p;
-}
-
-// (translation cm, rotation degrees) of `est` against `truth`.
-std::pair<double, double> errors(const Pose& est, const Eigen::Matrix4d& truth) {
-  const Eigen::Matrix4d d = truth.inverse() * mat(est);
-  const double c = std::clamp((d.topLeftCorner<3, 3>().trace() - 1) / 2, -1.0, 1.0);
-  return {100 * (mat(est).topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), std::acos(c) * 180 / M_PI};
-}
 
 struct Livingroom {
   std::map<int, sogmm::PointCloud> clouds;
@@ -67,7 +49,7 @@ const Livingroom* livingroom() {
     o.seed = 0;
     for (int i : {0, 1}) d->models.emplace(i, sogmm::fit(d->clouds.at(i).view(), o).gmm);
     const auto traj = sogmm::format::read_trajectory_log((dir / "trajectory.log").string());
-    for (std::size_t k = 0; k < traj.poses.size(); ++k) d->world[int(traj.ids[k])] = mat(traj.poses[k]);
+    for (std::size_t k = 0; k < traj.poses.size(); ++k) d->world[int(traj.ids[k])] = sogmm_test::pose_matrix(traj.poses[k]);
     return d;
   }();
   return data;
@@ -77,7 +59,7 @@ constexpr std::array<std::pair<int, int>, 3> kPairs = {{{0, 1}, {1, 2}, {0, 2}}}
 
 sogmm::RegistrationResult register_pair(const Livingroom& d, int a, int b, const Eigen::Matrix4d& init) {
   const sogmm::PointCloud& pc = d.clouds.at(b);
-  return sogmm::register_points(d.models.at(a), pc.view().data, pc.size(), arr(init));
+  return sogmm::register_points(d.models.at(a), pc.view().data, pc.size(), sogmm_test::pose_array(init));
 }
 
 }  // namespace
@@ -91,7 +73,8 @@ TEST(RegistrationReal, LivingroomPairsFromIdentity) {
   for (const auto& [a, b] : kPairs) {
     const Eigen::Matrix4d truth = d->world.at(a).inverse() * d->world.at(b);
     const sogmm::RegistrationResult r = register_pair(*d, a, b, Eigen::Matrix4d::Identity());
-    const auto [dt, dr] = errors(r.pose, truth);
+    const auto [dt_m, dr] = sogmm_test::pose_error(r.pose, truth);
+    const double dt = 100 * dt_m;
     std::printf("livingroom %d->%d: %.3f cm, %.4f deg, %s, %d iterations, inliers %.3f\n", a, b, dt, dr,
                 sogmm::status_name(r.status), r.iterations, r.inlier_ratio);
     EXPECT_EQ(r.status, sogmm::RegistrationStatus::Converged) << a << "->" << b;
@@ -120,7 +103,8 @@ TEST(RegistrationReal, LivingroomPerturbations) {
     kick.topRightCorner<3, 1>() =
         Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized() * (unit(rng) * 0.10);
     const sogmm::RegistrationResult r = register_pair(*d, a, b, kick * truth);
-    const auto [dt, dr] = errors(r.pose, truth);
+    const auto [dt_m, dr] = sogmm_test::pose_error(r.pose, truth);
+    const double dt = 100 * dt_m;
     const bool good = dt <= 1.0 && dr <= 0.5;
     if (r.status == sogmm::RegistrationStatus::Converged) {
       EXPECT_TRUE(good) << "trial " << k << ": converged at " << dt << " cm, " << dr << " deg";
