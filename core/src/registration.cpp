@@ -328,6 +328,10 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   for (int k = 0; k < 6; ++k)
     if (!(ev(k) > options.degeneracy_ratio * top)) ++result.unobservable;
 
+  // Many small rotations multiplied: project R back onto the rotations so
+  // that the answer passes rigid_pose_error as the next call's start.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(pose.r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  pose.r = svd.matrixU() * svd.matrixV().transpose();
   result.pose = array_of(pose);
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) result.information[6 * i + j] = 0.5 * (info(i, j) + info(j, i));

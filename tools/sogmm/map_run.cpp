@@ -100,7 +100,10 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptio
       const Pose last = used.back();
       const Pose motion = used.size() > 1 ? compose_poses(inverse_rigid(used[used.size() - 2]), last) : kIdentity;
       if (map.pending() > 0) map.flush(progress.fit_callback(r.label + " flush"));
-      r.registration = register_points(map.model().gmm, points.view().data, points.size(), compose_poses(last, motion));
+      const Pose guess = compose_poses(last, motion);
+      const std::string bad = rigid_pose_error(guess);
+      require(bad.empty(), ErrorCode::Numeric, r.file.depth + ": the constant-velocity guess " + bad);
+      r.registration = register_points(map.model().gmm, points.view().data, points.size(), guess);
       r.registered = r.registration.status == RegistrationStatus::Converged;
       r.skipped = !r.registered;
       if (r.skipped) {
