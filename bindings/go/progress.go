@@ -18,14 +18,15 @@ import (
 type Stage int32
 
 const (
-	StageModeCount  Stage = C.SOGMM_STAGE_MODE_COUNT // mean shift; Step/Total: seeds or blurring iterations
-	StageSeeding    Stage = C.SOGMM_STAGE_SEEDING    // k-means++; Step/Total: components seeded / K
-	StageEM         Stage = C.SOGMM_STAGE_EM         // EM; Step: iterations done (0 at start), Total: max_iter
-	StageRun        Stage = C.SOGMM_STAGE_RUN        // n_init > 1: run Step (from 1) of Total starts
-	StageSampling   Stage = C.SOGMM_STAGE_SAMPLING   // sampling; Step/Total: points drawn / requested
-	StageScoring    Stage = C.SOGMM_STAGE_SCORING    // scoring on a map; Step/Total: points scored / requested
-	StageRegression Stage = C.SOGMM_STAGE_REGRESSION // gray regression on a map; Step/Total: points done / requested
-	StageRendering  Stage = C.SOGMM_STAGE_RENDERING  // rendering an image; Step/Total: rows done / height
+	StageModeCount    Stage = C.SOGMM_STAGE_MODE_COUNT   // mean shift; Step/Total: seeds or blurring iterations
+	StageSeeding      Stage = C.SOGMM_STAGE_SEEDING      // k-means++; Step/Total: components seeded / K
+	StageEM           Stage = C.SOGMM_STAGE_EM           // EM; Step: iterations done (0 at start), Total: max_iter
+	StageRun          Stage = C.SOGMM_STAGE_RUN          // n_init > 1: run Step (from 1) of Total starts
+	StageSampling     Stage = C.SOGMM_STAGE_SAMPLING     // sampling; Step/Total: points drawn / requested
+	StageScoring      Stage = C.SOGMM_STAGE_SCORING      // scoring on a map; Step/Total: points scored / requested
+	StageRegression   Stage = C.SOGMM_STAGE_REGRESSION   // gray regression on a map; Step/Total: points done / requested
+	StageRendering    Stage = C.SOGMM_STAGE_RENDERING    // rendering an image; Step/Total: rows done / height
+	StageRegistration Stage = C.SOGMM_STAGE_REGISTRATION // registration; Step/Total: iterations done / levels x max_iter
 )
 
 // Progress is one report. Total is 0 when unknown; LogLikelihood is the mean

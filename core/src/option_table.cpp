@@ -144,6 +144,28 @@ std::vector<OptionSpec> make_table() {
                     "standard deviations",
                     "distance to the surface: each component is the disc of its two largest axes out to this many "
                     "standard deviations"),
+      SOGMM_I64_ROW(REGISTRATION_MAX_ITER, registration.max_iter, 1, kInt32Max, "[1, 2^31-1]", "iterations",
+                    "registration: EM / Gauss-Newton iterations per coarse-to-fine level"),
+      SOGMM_F64_ROW(REGISTRATION_TOL, registration.tol, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
+                    "> 0, finite", "m",
+                    "registration: a level ends when a step moves the source by less than this"),
+      SOGMM_F64_ROW(REGISTRATION_OUTLIER_RATIO, registration.outlier_ratio, 0.0, 1.0, [](double v) { return v < 1; },
+                    "in [0, 1)", "", "registration: prior weight of the uniform outlier term"),
+      SOGMM_I64_ROW(REGISTRATION_USE_GRAY, registration.use_gray, 0, 1, "0 or 1", "",
+                    "registration: 1 scores gray too (the 4-D joint density), 0 the 3-D marginal"),
+      SOGMM_I64_ROW(REGISTRATION_LEVELS, registration.levels, 1, 16, "[1, 16]", "levels",
+                    "registration: coarse-to-fine levels; the last uses the model unsmoothed"),
+      SOGMM_F64_ROW(REGISTRATION_COARSE_SIGMA, registration.coarse_sigma, 0.0, kInf,
+                    [](double v) { return v > 0 && std::isfinite(v); }, "> 0, finite", "m",
+                    "registration: smoothing standard deviation of the coarsest level (halved per level)"),
+      SOGMM_F64_ROW(REGISTRATION_MIN_INLIER_RATIO, registration.min_inlier_ratio, 0.0, 1.0, finite, "in [0, 1]", "",
+                    "registration: below this inlier ratio the status is low fitness"),
+      SOGMM_F64_ROW(REGISTRATION_DEGENERACY_RATIO, registration.degeneracy_ratio, 0.0, 1.0,
+                    [](double v) { return v < 1; }, "in [0, 1)", "",
+                    "registration: directions whose scaled information is below this fraction of the largest are "
+                    "unobservable"),
+      SOGMM_I64_ROW(REGISTRATION_MIN_POINTS, registration.min_points, 6, kI64Max, ">= 6", "points",
+                    "registration: fewer finite source points are an error"),
   };
   return t;
 }

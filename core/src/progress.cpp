@@ -30,6 +30,7 @@ const char* stage_name(Stage stage) {
     case Stage::Scoring: return "scoring";
     case Stage::Regression: return "gray regression";
     case Stage::Rendering: return "rendering";
+    case Stage::Registration: return "registration";
   }
   return "an unknown stage";
 }

@@ -5,49 +5,19 @@
 
 #include <chrono>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/reg_covar.hpp"
+#include "real_frame.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;
 
-namespace {
-
-struct Frame {
-  cv::Mat depth;  // CV_16U
-  sogmm::GrayImage gray;
-  sogmm::Camera camera;
-};
-
-Frame load_frame(const fs::path& color, const fs::path& depth, const fs::path& intrinsics) {
-  Frame f;
-  cv::Mat bgr = cv::imread(color.string(), cv::IMREAD_COLOR);
-  f.depth = cv::imread(depth.string(), cv::IMREAD_UNCHANGED);
-  if (bgr.empty() || f.depth.empty() || f.depth.type() != CV_16U)
-    throw std::runtime_error("cannot read frame " + color.string() + " / " + depth.string());
-  cv::Mat rgb;
-  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-  if (!rgb.isContinuous()) rgb = rgb.clone();
-  f.gray = sogmm::gray_from_rgb_image(rgb.ptr<std::uint8_t>(), rgb.cols, rgb.rows);
-  f.camera = sogmm::read_intrinsics_json(intrinsics.string());
-  return f;
-}
-
-sogmm::PointCloud cloud_of(const Frame& f, double depth_scale, int d) {
-  if (!f.depth.isContinuous()) throw std::runtime_error("depth not continuous");
-  sogmm::RgbdView view{f.depth.ptr<std::uint16_t>(), f.gray.pixels.data(), f.camera};
-  sogmm::DepthOptions o;
-  o.depth_scale = depth_scale;
-  o.decimate = d;
-  return sogmm::backproject(view, o);
-}
-
-}  // namespace
+using sogmm_test::cloud_of;
+using sogmm_test::Frame;
+using sogmm_test::load_frame;
 
 TEST(RealFrames, LivingroomFrame0Bandwidth002) {
   const fs::path dir = fs::path(SOGMM_SHARED_DATA) / "rgbd" / "livingroom";

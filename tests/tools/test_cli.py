@@ -455,6 +455,24 @@ def mode_map(tmp):
               "eval --sequence frame %d: map PSNR %.2f F %.3f, append-everything PSNR %.2f F %.3f" %
               (r["frame"], r["psnr"], r["fscore"], a["psnr"], a["fscore"]))
     query_map(tmp, d, out, lines)
+    # Without --trajectory each pose is registered to the map from a
+    # constant-velocity guess: on the first 10 frames of the 300-frame loop
+    # (1.2 degrees apart; the 16-frame loop's 22.5 degrees are beyond the
+    # registration's reach) every frame is inserted and the estimated poses
+    # (relative to the first) are within 1 cm of the truth.
+    slow = os.path.join(tmp, "loop300")
+    run(["demo", "--write-frame", slow, "--loop"])
+    lines = open(os.path.join(slow, "trajectory.log")).read().split("\n")
+    est_log = os.path.join(tmp, "estimated.log")
+    est = run_json(["map", slow, "--frames", "0:10", "-o", os.path.join(tmp, "est.sogmm"), "--trajectory-out", est_log])
+    check(est.get("n_skipped") == 0 and est.get("n_frames") == 10, "map without a trajectory: %r" % est)
+    blocks = open(est_log).read().split("\n")
+    truth = [np.array(" ".join(lines[5 * k + 1:5 * k + 5]).split(), dtype=float).reshape(4, 4) for k in range(10)]
+    poses = [np.array(" ".join(blocks[5 * k + 1:5 * k + 5]).split(), dtype=float).reshape(4, 4)
+             for k in range(len(blocks) // 5)]
+    check(len(poses) == 10, "--trajectory-out: %d poses for 10 frames" % len(poses))
+    ate = max([np.linalg.norm((np.linalg.inv(truth[0]) @ t)[:3, 3] - e[:3, 3]) for t, e in zip(truth, poses)] + [0])
+    check(ate <= 0.01, "map without a trajectory: largest position error %.4f m" % ate)
     no_temp_files(tmp)
 
     def err(args, code, names):
@@ -481,6 +499,7 @@ def mode_map(tmp):
     err(["map", bad, "--trajectory", scaled] + badargs, 3, "scaled.log")
     err(["map", bad, "--trajectory", os.path.join(tmp, "none.log")] + badargs, 4, "none.log")
     err(["map", bad, "--trajectory", traj, "--threshold", "nan"] + badargs, 2, "threshold")
+    err(["map", bad, "--trajectory", traj, "--trajectory-out", traj] + badargs, 2, "trajectory")  # would replace an input
     err(["map", bad, "--trajectory", traj, "--batch", 0] + badargs, 2, "batch")
     write_png16(os.path.join(bad, "depth", "00001.png"), np.zeros((480, 640), np.uint16))
     err(["map", bad, "--trajectory", traj] + badargs, 3, "00001.png")  # empty frame

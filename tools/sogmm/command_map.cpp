@@ -1,6 +1,7 @@
-// `sogmm map DIR --trajectory LOG`: build an incremental world map of a posed
-// RGB-D sequence with the core's Map (novelty test, batched fits, optional
-// fusion; sogmm/map.hpp), with live progress, a per-frame CSV and a plot.
+// `sogmm map DIR [--trajectory LOG]`: build an incremental world map of an
+// RGB-D sequence (posed, or posed by registration to the map) with the core's
+// Map (novelty test, batched fits, optional fusion; sogmm/map.hpp), with live
+// progress, a per-frame CSV and a plot.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -21,7 +22,7 @@ namespace {
 
 struct MapState {
   FrameSource src;
-  std::string output, csv, plot;
+  std::string output, csv, plot, trajectory_out;
   CameraFlags camera;
   MapOptions options;
   std::string fusion = "off";
@@ -75,7 +76,9 @@ std::string plot_text(const std::vector<Row>& rows, const std::string& title) {
 int run_map(MapState& s) {
   const std::string csv = s.csv.empty() ? beside(s.output, ".csv") : s.csv;
   const std::string plot = s.plot.empty() ? beside(s.output, ".svg") : s.plot;
-  check_outputs(sequence_inputs(s.src, s.camera), {{"-o", s.output}, {"--csv", csv}, {"--plot", plot}});
+  std::vector<NamedFile> outputs = {{"-o", s.output}, {"--csv", csv}, {"--plot", plot}};
+  if (!s.trajectory_out.empty()) outputs.push_back({"--trajectory-out", s.trajectory_out});
+  check_outputs(sequence_inputs(s.src, s.camera), outputs);
   s.options.novelty = !s.no_novelty;
   s.options.fusion = s.fusion != "off";
   s.options.fusion_method = s.fusion == "kl" ? FusionMethod::KL : FusionMethod::Hellinger;
@@ -85,7 +88,14 @@ int run_map(MapState& s) {
   std::vector<Row> rows;
   std::size_t points = 0, novel = 0;
   double ms_novelty = 0, ms_fit = 0, ms_merge = 0;
+  std::vector<Pose> poses_used;
+  std::size_t skipped = 0;
   run_map_over_sequence(map, in, s.options.depth, progress, [&](const MapRunFrame& f) {
+    if (f.skipped) {
+      ++skipped;
+      return;
+    }
+    poses_used.push_back(f.pose);
     const FrameStats& st = f.stats;
     const std::size_t pending = map.pending();
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
@@ -107,6 +117,7 @@ int run_map(MapState& s) {
   const std::size_t added = map.flush(progress.fit_callback("final flush"));
   const double ms_flush = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   progress.finish();
+  if (!s.trajectory_out.empty()) write_trajectory_log(s.trajectory_out, poses_used);
   const Model model = with_sequence_metadata(map.to_model(), in);
   const std::uint64_t bytes = save_model(s.output, model);
   const std::string frames = frame_list(in);
@@ -121,6 +132,7 @@ int run_map(MapState& s) {
     j["csv"] = csv;
     j["plot"] = plot;
     j["n_frames"] = rows.size();
+    j["n_skipped"] = skipped;
     j["n_points"] = points;
     j["n_novel"] = novel;
     j["n_components"] = model.gmm.size();
@@ -172,10 +184,15 @@ Command add_map_command(CLI::App& root) {
       "Examples:\n"
       "  sogmm demo --write-frame /tmp/loop --loop\n"
       "  sogmm map /tmp/loop --trajectory /tmp/loop/trajectory.log -o loop.sogmm\n"
+      "  sogmm map /tmp/loop -o loop.sogmm --trajectory-out /tmp/loop/estimated.log   (poses from the map)\n"
       "  sogmm map ../shared/data/rgbd/livingroom --trajectory ../shared/data/rgbd/livingroom/trajectory.log \\\n"
       "    --frames 0:3 --fusion hellinger -o room.sogmm");
   app->add_option("DIR", s->src.sequence, "sequence folder: depth/*.png and color/*.{jpg,png}")->required();
-  app->add_option("--trajectory", s->src.trajectory, "Redwood .log camera-to-world poses")->required();
+  app->add_option("--trajectory", s->src.trajectory,
+                  "Redwood .log camera-to-world poses (default: estimate each frame's pose by registering it to the "
+                  "map from a constant-velocity guess; frames that fail are skipped with a warning)");
+  app->add_option("--trajectory-out", s->trajectory_out,
+                  "write the poses of the inserted frames (given or estimated) as a Redwood .log");
   app->add_option("--frames", s->src.frames, "I, A:B (B excluded) or A:B:STEP; default all");
   add_pair_by_order_flag(*app, s->src.pair_by_order);
   add_camera_flags(*app, s->camera, s->options.depth);

@@ -1,10 +1,12 @@
 #include "map_run.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "sogmm/error.hpp"
+#include "sogmm/model.hpp"
 
 namespace sogmm::tools {
 
@@ -49,8 +51,9 @@ SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera
   in.trajectory = src.trajectory;
   in.frames = list_sequence(src.sequence, src.pair_by_order);
   in.selected = parse_frame_range(src.frames.empty() ? std::string(":") : src.frames, in.frames.size());
-  in.poses = poses_of_frames(read_trajectory_log(src.trajectory), src.trajectory, in.frames, in.selected,
-                             src.pair_by_order);
+  if (!src.trajectory.empty())
+    in.poses = poses_of_frames(read_trajectory_log(src.trajectory), src.trajectory, in.frames, in.selected,
+                               src.pair_by_order);
   in.camera = camera;
   if (!camera_flags_given(in.camera)) {
     const std::string guess = (std::filesystem::path(src.sequence) / "intrinsics.json").string();
@@ -65,12 +68,16 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
   std::string intrinsics = camera.intrinsics;
   if (intrinsics.empty() && !src.sequence.empty())
     intrinsics = (std::filesystem::path(src.sequence) / "intrinsics.json").string();
-  return {{"--trajectory", src.trajectory}, {"--intrinsics", intrinsics}};
+  std::vector<NamedFile> out = {{"--intrinsics", intrinsics}};
+  if (!src.trajectory.empty()) out.push_back({"--trajectory", src.trajectory});
+  return out;
 }
 
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
                              const std::function<void(const MapRunFrame&)>& after) {
   Camera camera;
+  constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  std::vector<Pose> used;  // the poses of the frames inserted so far
   for (std::size_t k = 0; k < in.selected.size(); ++k) {
     MapRunFrame r;
     r.file = in.frames[in.selected[k]];
@@ -83,9 +90,33 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptio
       rethrow_naming(e, r.file.depth);
     }
     // The tool's check first: its message names the file and the depth range.
-    backproject_nonempty(frame, camera, depth, r.file.depth);
+    const PointCloud points = backproject_nonempty(frame, camera, depth, r.file.depth);
+    if (!in.poses.empty()) {
+      r.pose = in.poses[k];
+    } else if (used.empty()) {
+      r.pose = kIdentity;
+    } else {
+      // Constant velocity: the last motion (in the camera) once more.
+      const Pose last = used.back();
+      const Pose motion = used.size() > 1 ? compose_poses(inverse_rigid(used[used.size() - 2]), last) : kIdentity;
+      if (map.pending() > 0) map.flush(progress.fit_callback(r.label + " flush"));
+      const Pose guess = compose_poses(last, motion);
+      const std::string bad = rigid_pose_error(guess);
+      require(bad.empty(), ErrorCode::Numeric, r.file.depth + ": the constant-velocity guess " + bad);
+      r.registration = register_points(map.model().gmm, points.view().data, points.size(), guess);
+      r.registered = r.registration.status == RegistrationStatus::Converged;
+      r.skipped = !r.registered;
+      if (r.skipped) {
+        std::fprintf(stderr, "warning: %s not inserted: its registration to the map ended %s (inliers %.2f)\n",
+                     r.file.depth.c_str(), status_name(r.registration.status), r.registration.inlier_ratio);
+        if (after) after(r);
+        continue;
+      }
+      r.pose = r.registration.pose;
+    }
+    used.push_back(r.pose);
     try {
-      r.stats = map.insert_rgbd(frame.view(camera), in.poses[k],
+      r.stats = map.insert_rgbd(frame.view(camera), r.pose,
                                 recording(progress.fit_callback(r.label), r.fit));
     } catch (const Error& e) {
       rethrow_naming(e, r.file.depth);

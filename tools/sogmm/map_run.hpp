@@ -12,6 +12,7 @@
 #include "file_util.hpp"
 #include "sequence.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/registration.hpp"
 
 namespace sogmm::tools {
 
@@ -29,6 +30,10 @@ struct MapRunFrame {
   std::string label;  ///< "frame k/N (00012.png)"
   FrameStats stats;
   FitRecord fit;
+  Pose pose{};               ///< the camera-to-world pose used (given or estimated)
+  bool registered = false;   ///< the pose was estimated (no trajectory)
+  bool skipped = false;      ///< the registration failed: the frame was not inserted
+  RegistrationResult registration;  ///< when registered or skipped
 };
 
 /// A sequence resolved from the command line: frame files, poses, the
@@ -37,10 +42,11 @@ struct SequenceInput {
   std::string dir, trajectory;
   std::vector<SequenceFrame> frames;
   std::vector<std::size_t> selected;
-  std::vector<Pose> poses;  ///< poses[k]: the pose of frames[selected[k]] (poses_of_frames)
+  std::vector<Pose> poses;  ///< poses[k]: the pose of frames[selected[k]] (poses_of_frames); empty: estimate them
   CameraFlags camera;
 };
-/// Lists, reads and checks them (errors name the file; a selected frame
+/// Lists, reads and checks them (no trajectory: no poses, they are estimated;
+/// errors name the file; a selected frame
 /// without its pose -> Error(InvalidData)); images and poses are paired by
 /// frame number unless src.pair_by_order (sequence.hpp).
 SequenceInput resolve_sequence(const FrameSource& src, const CameraFlags& camera);
@@ -53,6 +59,10 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
 /// unreadable file -> Error(Io) naming it), checks the camera against the
 /// frame size (another size -> Error(InvalidData)), back-projects it (no valid
 /// pixel -> Error(InvalidData) naming the file) and inserts it with its pose.
+/// Without poses each frame's pose is estimated: the first is the identity,
+/// the others are registered to the map (flushed first, so that everything
+/// seen is a target) from a constant-velocity prediction; a frame whose
+/// registration does not converge is skipped with a warning on stderr.
 /// `progress` shows each fit's stages; `after` is called after each insert.
 /// Returns the camera of the frames.
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,

@@ -242,6 +242,26 @@ typedef int32_t sogmm_key;
                                            * of the surface along a ray is occupied */
 #define SOGMM_OPT_SURFACE_DISC_SIGMAS 702 /* f64, (0, 10]; default 2.0: each component is the disc of its two
                                            * largest principal axes out to this many standard deviations */
+/* Registration (sogmm_register_points_f32). */
+#define SOGMM_OPT_REGISTRATION_MAX_ITER 800 /* i64, [1, 2^31-1]; default 30: EM / Gauss-Newton iterations
+                                             * per coarse-to-fine level */
+#define SOGMM_OPT_REGISTRATION_TOL 801 /* f64, > 0, finite; default 0.0001 m: a level ends when a step moves
+                                        * the source by less than this (|t| + |rotation| x RMS radius) */
+#define SOGMM_OPT_REGISTRATION_OUTLIER_RATIO 802 /* f64, [0, 1); default 0.1: prior weight of the uniform
+                                                  * outlier term (over the target's 3-sigma box) */
+#define SOGMM_OPT_REGISTRATION_USE_GRAY 803 /* i64, 0 or 1; default 0. 1: score gray too (the 4-D joint
+                                             * density: gray marginal times the conditional x | gray) */
+#define SOGMM_OPT_REGISTRATION_LEVELS 804 /* i64, [1, 16]; default 3: coarse-to-fine levels; level l smooths
+                                           * the target by COARSE_SIGMA / 2^l, the last not at all */
+#define SOGMM_OPT_REGISTRATION_COARSE_SIGMA 805 /* f64, > 0, finite; default 0.04 m: smoothing standard
+                                                 * deviation of the coarsest level */
+#define SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO 806 /* f64, [0, 1]; default 0.5: below this inlier ratio the
+                                                     * status is SOGMM_REGISTRATION_LOW_FITNESS */
+#define SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO 807 /* f64, [0, 1); default 0.001: a direction whose scaled
+                                                     * information eigenvalue is below this fraction of the
+                                                     * largest is unobservable */
+#define SOGMM_OPT_REGISTRATION_MIN_POINTS 808 /* i64, >= 6; default 100: fewer source points are
+                                               * SOGMM_E_INVALID_DATA */
 #define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
 #define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
 #define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default SOGMM_FUSION_HELLINGER */
@@ -315,6 +335,8 @@ SOGMM_API sogmm_status sogmm_option_keys(sogmm_key* keys, size_t capacity, size_
                                   * (the last report has step = total) */
 #define SOGMM_STAGE_REGRESSION 7 /* sogmm_*_regress_gray_f32*; step/total as SCORING */
 #define SOGMM_STAGE_RENDERING 8  /* sogmm_*_render_f32; step/total: image rows done / height */
+#define SOGMM_STAGE_REGISTRATION 9 /* sogmm_register_points_f32; step: iterations done, total: levels x
+                                    * max_iter; the mean log-likelihood of the last iteration */
 
 /* Progress callback. Return 0 to continue; any non-zero value cancels: the
  * call stops within one report interval, frees everything it allocated,
@@ -991,6 +1013,55 @@ SOGMM_API sogmm_status sogmm_model_collision_probability(const sogmm_model* mode
 SOGMM_API sogmm_status sogmm_map_collision_probability(const sogmm_map* map, const double* centers,
                                                        const double* shapes, size_t n,
                                                        const sogmm_options* options, double* out);
+
+/* ---- registration ----------------------------------------------------- */
+/* How a registration ended (sogmm_registration_info.status). */
+#define SOGMM_REGISTRATION_CONVERGED 0     /* the last level converged; fitness and observability fine */
+#define SOGMM_REGISTRATION_NOT_CONVERGED 1 /* the last level hit REGISTRATION_MAX_ITER, or no source
+                                            * point came near the target: the pose is not an estimate */
+#define SOGMM_REGISTRATION_LOW_FITNESS 2   /* converged, but the inlier ratio is below
+                                            * REGISTRATION_MIN_INLIER_RATIO: likely a wrong pose */
+#define SOGMM_REGISTRATION_DEGENERATE 3    /* converged, but `unobservable` directions are not
+                                            * constrained by the scene (e.g. a single plane) */
+
+/* The figures of one registration. The caller sets struct_size to
+ * sizeof(sogmm_registration_info); later versions only append fields and
+ * write only the first struct_size bytes. */
+typedef struct sogmm_registration_info {
+  size_t struct_size;     /* in: sizeof(sogmm_registration_info) as the caller knows it */
+  int32_t status;         /* SOGMM_REGISTRATION_* */
+  int32_t iterations;     /* EM / Gauss-Newton iterations, summed over the levels */
+  double log_likelihood;  /* mean log-likelihood per source point at the pose (model plus outlier term) */
+  double inlier_ratio;    /* fraction of points the mixture explains better than the outlier term */
+  double rmse;            /* Mahalanobis RMS of the inliers per dimension (about 1 when they fit) */
+  double information[36]; /* observed information (negative Hessian of the log-likelihood), row-major
+                           * 6 x 6 over x -> x + w x x + v, (w_x, w_y, w_z, v_x, v_y, v_z) in radians and
+                           * metres about the target frame's origin; near-zero eigenvalues are the
+                           * unobservable directions */
+  int32_t unobservable;   /* number of unobservable directions (0 to 6; REGISTRATION_DEGENERACY_RATIO) */
+  double eigen_ratio;     /* smallest / largest eigenvalue of the information with rotations scaled by
+                           * the source's RMS radius (0 to 1) */
+} sogmm_registration_info;
+
+/* The rigid pose that best explains n source points (`points`: rows of x,
+ * y, z, gray float32, in their own frame) under the model `target`:
+ * pose_out (row-major 4 x 4) maps source points into the target's frame.
+ * It maximises the points' log-likelihood under the target's 3-D marginal
+ * (or, with REGISTRATION_USE_GRAY, its 4-D density) mixed with a uniform
+ * outlier term, by EM / Gauss-Newton steps coarse to fine (formula and why:
+ * core/include/sogmm/registration.hpp), from `init` (a rigid 4 x 4 pose;
+ * NULL = identity). Always check info_out->status: pose_out is the last
+ * iterate, an estimate only with SOGMM_REGISTRATION_CONVERGED (and, along
+ * the observable directions, DEGENERATE). Keys: SOGMM_OPT_REGISTRATION_*,
+ * SOGMM_OPT_THREADS (changes no result); progress SOGMM_STAGE_REGISTRATION;
+ * a cancel leaves the outputs untouched. Errors: NULL target, points,
+ * pose_out or info_out -> SOGMM_E_NULL_ARG; info_out->struct_size too small,
+ * a non-rigid or non-finite init -> SOGMM_E_INVALID_ARG; fewer than
+ * REGISTRATION_MIN_POINTS points or a non-finite point ->
+ * SOGMM_E_INVALID_DATA naming it. Nothing is written on error. */
+SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, const float* points, size_t n,
+                                                 const double* init, const sogmm_options* options,
+                                                 double* pose_out, sogmm_registration_info* info_out);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

@@ -22,6 +22,7 @@
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
 #include "sogmm/occupancy.hpp"
+#include "sogmm/registration.hpp"
 #include "sogmm/surface_distance.hpp"
 
 namespace sogmm {
@@ -46,6 +47,7 @@ struct Settings {
   MapOptions map;
   OccupancyOptions occupancy;
   SurfaceDistanceOptions surface;
+  RegistrationOptions registration;
 };
 
 /// The MapOptions of `s`: s.map with s.fit and s.depth. Throws as
@@ -54,7 +56,7 @@ MapOptions map_options(const Settings& s);
 
 /// The key of each setting: the numbers and (after SOGMM_OPT_) the names of
 /// sogmm.h's SOGMM_OPT_* (stable; grouped by hundreds: fit, RGB-D, write,
-/// read, sample and query, map, occupancy and distance).
+/// read, sample and query, map, occupancy and distance, registration).
 enum class OptionKey : int {
   BANDWIDTH = 100,
   N_COMPONENTS = 101,
@@ -90,6 +92,15 @@ enum class OptionKey : int {
   OCCUPANCY_SIGMA = 700,
   OCCUPANCY_THICKNESS = 701,
   SURFACE_DISC_SIGMAS = 702,
+  REGISTRATION_MAX_ITER = 800,
+  REGISTRATION_TOL = 801,
+  REGISTRATION_OUTLIER_RATIO = 802,
+  REGISTRATION_USE_GRAY = 803,
+  REGISTRATION_LEVELS = 804,
+  REGISTRATION_COARSE_SIGMA = 805,
+  REGISTRATION_MIN_INLIER_RATIO = 806,
+  REGISTRATION_DEGENERACY_RATIO = 807,
+  REGISTRATION_MIN_POINTS = 808,
 };
 
 /// The value type of a setting (sogmm.h: SOGMM_TYPE_F64 = 0, SOGMM_TYPE_I64 = 1).

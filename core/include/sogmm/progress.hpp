@@ -23,6 +23,7 @@ enum class Stage : std::int32_t {
   Scoring = 6,    ///< log-likelihood of points (map queries); step = points scored, total = points
   Regression = 7, ///< gray regression (map queries); step = points done, total = points
   Rendering = 8,  ///< rendering an image (sogmm/render.hpp); step = rows done, total = image height
+  Registration = 9,  ///< registration (sogmm/registration.hpp); step = iterations done, total = levels x max_iter, mean LL
 };
 
 /// One report. `total` is 0 when unknown; `log_likelihood` is the mean

@@ -36,6 +36,7 @@ from .map import Map
 from .metrics import PSNR, psnr_images
 from .model import GMM, SOGMM, from_bytes, load
 from .ply import read_ply, write_ply
+from .registration import register
 
 __version__ = "0.1.0"
 
@@ -95,6 +96,7 @@ __all__ = [
     "load",
     "psnr_images",
     "read_ply",
+    "register",
     "rgbd_to_points",
     "write_ply",
 ]

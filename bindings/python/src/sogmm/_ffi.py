@@ -70,6 +70,16 @@ OPT_MAP_WARM_START = 606
 OPT_OCCUPANCY_SIGMA = 700
 OPT_OCCUPANCY_THICKNESS = 701
 OPT_SURFACE_DISC_SIGMAS = 702
+OPT_REGISTRATION_MAX_ITER = 800
+OPT_REGISTRATION_TOL = 801
+OPT_REGISTRATION_OUTLIER_RATIO = 802
+OPT_REGISTRATION_USE_GRAY = 803
+OPT_REGISTRATION_LEVELS = 804
+OPT_REGISTRATION_COARSE_SIGMA = 805
+OPT_REGISTRATION_MIN_INLIER_RATIO = 806
+OPT_REGISTRATION_DEGENERACY_RATIO = 807
+OPT_REGISTRATION_MIN_POINTS = 808
+REGISTRATION_STATUS = {0: "converged", 1: "not_converged", 2: "low_fitness", 3: "degenerate"}
 OCCUPANCY_FREE = 0
 OCCUPANCY_OCCUPIED = 1
 OCCUPANCY_UNKNOWN = 2
@@ -222,6 +232,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_surface_distance_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F64_OUT, c_void_p]),
     "sogmm_model_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
     "sogmm_map_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
+    "sogmm_register_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_void_p, HANDLE, F64_OUT, c_void_p]),
     "sogmm_model_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,
                                         HANDLE, F32_OUT, F32_OUT, F32_OUT]),
     "sogmm_map_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,
@@ -451,6 +462,15 @@ OPTION_NAMES = {
     OPT_OCCUPANCY_SIGMA: "surface_sigma",
     OPT_OCCUPANCY_THICKNESS: "thickness",
     OPT_SURFACE_DISC_SIGMAS: "disc_sigmas",
+    OPT_REGISTRATION_MAX_ITER: "max_iter",
+    OPT_REGISTRATION_TOL: "tol",
+    OPT_REGISTRATION_OUTLIER_RATIO: "outlier_ratio",
+    OPT_REGISTRATION_USE_GRAY: "use_gray",
+    OPT_REGISTRATION_LEVELS: "levels",
+    OPT_REGISTRATION_COARSE_SIGMA: "coarse_sigma",
+    OPT_REGISTRATION_MIN_INLIER_RATIO: "min_inlier_ratio",
+    OPT_REGISTRATION_DEGENERACY_RATIO: "degeneracy_ratio",
+    OPT_REGISTRATION_MIN_POINTS: "min_points",
 }
 
 

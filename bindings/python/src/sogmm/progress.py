@@ -40,6 +40,7 @@ STAGE_SAMPLING = 5
 STAGE_SCORING = 6
 STAGE_REGRESSION = 7
 STAGE_RENDERING = 8
+STAGE_REGISTRATION = 9
 STAGE_NAMES = {
     STAGE_MODE_COUNT: "mode count",
     STAGE_SEEDING: "seeding",
@@ -49,6 +50,7 @@ STAGE_NAMES = {
     STAGE_SCORING: "scoring",
     STAGE_REGRESSION: "gray regression",
     STAGE_RENDERING: "rendering",
+    STAGE_REGISTRATION: "registration",
 }
 
 #: progress= accepts None, True (a tqdm bar) or callable(stage, step, total, log_likelihood) -> truthy cancels.

@@ -90,7 +90,7 @@ pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
 /// i64, SOGMM_DEQUANTISE_AUTO (default), 0 or 1: floor variances along viewing rays at the depth
 /// quantisation (see sogmm.h).
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
-/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for sogmm_fit_rgbd, off for arrays.
+/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
 pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
 pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
 pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
@@ -117,6 +117,19 @@ pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
 pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
 pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
 pub const SOGMM_OPT_SURFACE_DISC_SIGMAS: sogmm_key = 702;
+pub const SOGMM_OPT_REGISTRATION_MAX_ITER: sogmm_key = 800;
+pub const SOGMM_OPT_REGISTRATION_TOL: sogmm_key = 801;
+pub const SOGMM_OPT_REGISTRATION_OUTLIER_RATIO: sogmm_key = 802;
+pub const SOGMM_OPT_REGISTRATION_USE_GRAY: sogmm_key = 803;
+pub const SOGMM_OPT_REGISTRATION_LEVELS: sogmm_key = 804;
+pub const SOGMM_OPT_REGISTRATION_COARSE_SIGMA: sogmm_key = 805;
+pub const SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO: sogmm_key = 806;
+pub const SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO: sogmm_key = 807;
+pub const SOGMM_OPT_REGISTRATION_MIN_POINTS: sogmm_key = 808;
+pub const SOGMM_REGISTRATION_CONVERGED: i32 = 0;
+pub const SOGMM_REGISTRATION_NOT_CONVERGED: i32 = 1;
+pub const SOGMM_REGISTRATION_LOW_FITNESS: i32 = 2;
+pub const SOGMM_REGISTRATION_DEGENERATE: i32 = 3;
 pub const SOGMM_FUSION_HELLINGER: i64 = 0;
 pub const SOGMM_FUSION_KL: i64 = 1;
 
@@ -129,6 +142,7 @@ pub const SOGMM_STAGE_SAMPLING: i32 = 5;
 pub const SOGMM_STAGE_SCORING: i32 = 6;
 pub const SOGMM_STAGE_REGRESSION: i32 = 7;
 pub const SOGMM_STAGE_RENDERING: i32 = 8;
+pub const SOGMM_STAGE_REGISTRATION: i32 = 9;
 pub const SOGMM_OCCUPANCY_FREE: u8 = 0;
 pub const SOGMM_OCCUPANCY_OCCUPIED: u8 = 1;
 pub const SOGMM_OCCUPANCY_UNKNOWN: u8 = 2;
@@ -190,6 +204,22 @@ pub const SOGMM_MAP_FRAME_MS_MERGE: sogmm_key = 20152;
 /// SOGMM_TYPE_F64 / SOGMM_TYPE_I64 (sogmm_option_info.type).
 pub const SOGMM_TYPE_F64: i32 = 0;
 pub const SOGMM_TYPE_I64: i32 = 1;
+
+/// The figures of one registration (sogmm_register_points_f32). Set
+/// `struct_size` to `size_of::<sogmm_registration_info>()` before the call.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct sogmm_registration_info {
+    pub struct_size: usize,
+    pub status: i32,
+    pub iterations: i32,
+    pub log_likelihood: f64,
+    pub inlier_ratio: f64,
+    pub rmse: f64,
+    pub information: [f64; 36],
+    pub unobservable: i32,
+    pub eigen_ratio: f64,
+}
 
 /// What the library's option registry says of one key (sogmm_option_get_info).
 /// Set `struct_size` to `size_of::<sogmm_option_info>()` before the call.
@@ -386,6 +416,15 @@ extern "C" {
         options: *const sogmm_options,
         probability_out: *mut f64,
         state_out: *mut u8,
+    ) -> sogmm_status;
+    pub fn sogmm_register_points_f32(
+        target: *const sogmm_model,
+        points: *const f32,
+        n: usize,
+        init: *const f64,
+        options: *const sogmm_options,
+        pose_out: *mut f64,
+        info_out: *mut sogmm_registration_info,
     ) -> sogmm_status;
     pub fn sogmm_model_surface_distance_f32(
         model: *const sogmm_model,

@@ -29,6 +29,7 @@ pub mod metrics;
 pub mod model;
 pub mod options;
 pub mod progress;
+pub mod registration;
 pub mod render;
 pub mod surface;
 
@@ -44,6 +45,7 @@ pub use options::{
     option_info, option_keys, FusionMethod, ModeCounter, OptionInfo, OptionValues, Options, OptionsBuilder,
 };
 pub use progress::{Progress, Stage};
+pub use registration::{Registration, RegistrationStatus};
 pub use render::{Camera, Rendered};
 pub use sogmm_sys as sys;
 pub use surface::{OCCUPANCY_FREE, OCCUPANCY_OCCUPIED, OCCUPANCY_UNKNOWN};

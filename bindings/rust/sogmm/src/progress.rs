@@ -37,6 +37,8 @@ pub enum Stage {
     Regression,
     /// Rendering an image; step/total: rows done / height.
     Rendering,
+    /// Registration; step/total: iterations done / levels x max_iter.
+    Registration,
     Unknown(i32),
 }
 
@@ -51,6 +53,7 @@ impl Stage {
             sys::SOGMM_STAGE_SCORING => Stage::Scoring,
             sys::SOGMM_STAGE_REGRESSION => Stage::Regression,
             sys::SOGMM_STAGE_RENDERING => Stage::Rendering,
+            sys::SOGMM_STAGE_REGISTRATION => Stage::Registration,
             other => Stage::Unknown(other),
         }
     }

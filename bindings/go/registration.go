@@ -1,0 +1,69 @@
+package sogmm
+
+// #include "sogmm/sogmm.h"
+import "C"
+
+import "unsafe"
+
+// Rigid registration of a point cloud to a model (issue 32; sogmm.h,
+// sogmm_register_points_f32). Options (nil = defaults): OptRegistration*,
+// Threads; progress StageRegistration.
+
+const (
+	OptRegistrationMaxIter         Key = C.SOGMM_OPT_REGISTRATION_MAX_ITER
+	OptRegistrationTol             Key = C.SOGMM_OPT_REGISTRATION_TOL
+	OptRegistrationOutlierRatio    Key = C.SOGMM_OPT_REGISTRATION_OUTLIER_RATIO
+	OptRegistrationUseGray         Key = C.SOGMM_OPT_REGISTRATION_USE_GRAY
+	OptRegistrationLevels          Key = C.SOGMM_OPT_REGISTRATION_LEVELS
+	OptRegistrationCoarseSigma     Key = C.SOGMM_OPT_REGISTRATION_COARSE_SIGMA
+	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
+	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
+	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
+
+	RegistrationConverged    = C.SOGMM_REGISTRATION_CONVERGED     // the pose is an estimate
+	RegistrationNotConverged = C.SOGMM_REGISTRATION_NOT_CONVERGED // iterations ran out, or no point near the target
+	RegistrationLowFitness   = C.SOGMM_REGISTRATION_LOW_FITNESS   // too few points explained by the target
+	RegistrationDegenerate   = C.SOGMM_REGISTRATION_DEGENERATE    // some directions are unobservable
+)
+
+// Registration is what RegisterPoints returns (sogmm_registration_info).
+type Registration struct {
+	Pose          [16]float64 // row-major 4 x 4, source to target frame
+	Status        int         // Registration* constant: check it before using Pose
+	Iterations    int
+	LogLikelihood float64     // mean per source point
+	InlierRatio   float64     // points the mixture explains better than the outlier term
+	RMSE          float64     // Mahalanobis RMS of the inliers per dimension
+	Information   [36]float64 // row-major 6 x 6 observed information over (rotation, translation)
+	Unobservable  int         // number of unobservable directions
+	EigenRatio    float64     // smallest / largest eigenvalue of the scaled information
+}
+
+// RegisterPoints gives the rigid pose that best explains points (rows of x,
+// y, z, gray in their own frame) under the model, from init (nil = identity).
+func (m *Model) RegisterPoints(points []float32, init *[16]float64, o *Options) (*Registration, error) {
+	n, err := rowsOf(points, 4, "points")
+	if err != nil {
+		return nil, err
+	}
+	var pose [16]float64
+	info := C.sogmm_registration_info{struct_size: C.size_t(unsafe.Sizeof(C.sogmm_registration_info{}))}
+	var initPtr *C.double
+	if init != nil {
+		initPtr = (*C.double)(unsafe.Pointer(&init[0]))
+	}
+	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+		return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
+			(*C.double)(unsafe.Pointer(&pose[0])), &info)
+	})
+	if err != nil {
+		return nil, err
+	}
+	r := &Registration{Pose: pose, Status: int(info.status), Iterations: int(info.iterations),
+		LogLikelihood: float64(info.log_likelihood), InlierRatio: float64(info.inlier_ratio), RMSE: float64(info.rmse),
+		Unobservable: int(info.unobservable), EigenRatio: float64(info.eigen_ratio)}
+	for i := range r.Information {
+		r.Information[i] = float64(info.information[i])
+	}
+	return r, nil
+}

@@ -1,0 +1,79 @@
+"""Rigid registration of a point cloud to a model (``sogmm_register_points_f32``)."""
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from . import _ffi
+from ._ffi import DEFAULTS as _D
+from .model import GMM, _pose, _rows
+from .progress import ProgressArg, call_with_progress
+
+
+class _Info(ctypes.Structure):
+    """sogmm_registration_info."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_size_t),
+        ("status", ctypes.c_int32),
+        ("iterations", ctypes.c_int32),
+        ("log_likelihood", ctypes.c_double),
+        ("inlier_ratio", ctypes.c_double),
+        ("rmse", ctypes.c_double),
+        ("information", ctypes.c_double * 36),
+        ("unobservable", ctypes.c_int32),
+        ("eigen_ratio", ctypes.c_double),
+    ]
+
+
+def register(source_points, target_model: GMM, init=None, *, progress: ProgressArg = None,
+             max_iter: int = _D.registration_max_iter, tol: float = _D.registration_tol,
+             outlier_ratio: float = _D.registration_outlier_ratio, use_gray: bool = bool(_D.registration_use_gray),
+             levels: int = _D.registration_levels, coarse_sigma: float = _D.registration_coarse_sigma,
+             min_inlier_ratio: float = _D.registration_min_inlier_ratio,
+             degeneracy_ratio: float = _D.registration_degeneracy_ratio,
+             min_points: int = _D.registration_min_points, n_threads: int = _D.threads) -> tuple[np.ndarray, dict]:
+    """The rigid pose that best explains ``source_points`` under ``target_model``.
+
+    Args:
+        source_points: (N, 4) rows of x, y, z, gray in the source's own frame.
+        target_model: a fitted GMM (or a Map's exported model).
+        init: 4 x 4 rigid initial guess, source to target frame (None = identity).
+
+    Returns ``(pose, info)``: ``pose`` a 4 x 4 float64 array mapping source
+    points into the target frame; ``info`` a dict with ``status``
+    ("converged", "not_converged", "low_fitness", "degenerate"),
+    ``converged`` (status == "converged"), ``iterations``,
+    ``log_likelihood``, ``inlier_ratio``, ``rmse``, ``information`` (6 x 6
+    observed information over (rotation, translation) about the target
+    origin), ``unobservable`` and ``eigen_ratio``. The pose is an estimate
+    only when converged: check ``info["status"]``. Bad input raises
+    (InvalidArgumentError, InvalidDataError) as the C call does.
+    """
+    x = _rows(source_points, (4,), "source_points")
+    start = None if init is None else np.ascontiguousarray(_pose(init))
+    pose = np.empty(16, dtype=np.float64)
+    info = _Info(struct_size=ctypes.sizeof(_Info))
+    f64 = {_ffi.OPT_REGISTRATION_TOL: tol, _ffi.OPT_REGISTRATION_OUTLIER_RATIO: outlier_ratio,
+           _ffi.OPT_REGISTRATION_COARSE_SIGMA: coarse_sigma, _ffi.OPT_REGISTRATION_MIN_INLIER_RATIO: min_inlier_ratio,
+           _ffi.OPT_REGISTRATION_DEGENERACY_RATIO: degeneracy_ratio}
+    i64 = {_ffi.OPT_REGISTRATION_MAX_ITER: max_iter, _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(use_gray)),
+           _ffi.OPT_REGISTRATION_LEVELS: levels, _ffi.OPT_REGISTRATION_MIN_POINTS: min_points,
+           _ffi.OPT_THREADS: n_threads}
+    with _ffi.Options(f64=f64, i64=i64) as o:
+        call_with_progress(o, progress, lambda: _ffi.lib.sogmm_register_points_f32(
+            target_model._h(), x, x.shape[0], None if start is None else start.ctypes.data, o.ptr, pose,
+            ctypes.byref(info)))
+    status = _ffi.REGISTRATION_STATUS[info.status]
+    return pose.reshape(4, 4), {
+        "status": status,
+        "converged": status == "converged",
+        "iterations": int(info.iterations),
+        "log_likelihood": float(info.log_likelihood),
+        "inlier_ratio": float(info.inlier_ratio),
+        "rmse": float(info.rmse),
+        "information": np.array(info.information, dtype=np.float64).reshape(6, 6),
+        "unobservable": int(info.unobservable),
+        "eigen_ratio": float(info.eigen_ratio),
+    }

@@ -1,0 +1,54 @@
+//! `Model::register_points` (issue 32): points sampled from a corner of three
+//! planes and moved by -t register back to the translation t; a NaN initial
+//! pose is an invalid argument.
+use sogmm::{Model, Pose, RegistrationStatus, Status};
+
+/// Flat components tiling the unit squares of the planes x = 0, y = 0, z = 0.
+fn corner() -> Model {
+    let (mut w, mut mu, mut cov) = (Vec::new(), Vec::new(), Vec::new());
+    for axis in 0..3 {
+        for a in 0..5 {
+            for b in 0..5 {
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut m = [0.0f32; 4];
+                m[u] = 0.1 + 0.2 * a as f32;
+                m[v] = 0.1 + 0.2 * b as f32;
+                m[3] = 0.5;
+                let mut c = [0.0f32; 16];
+                c[5 * u] = 0.08 * 0.08;
+                c[5 * v] = 0.08 * 0.08;
+                c[5 * axis] = 0.003 * 0.003;
+                c[15] = 0.01;
+                w.push(1.0 / 75.0);
+                mu.extend_from_slice(&m);
+                cov.extend_from_slice(&c);
+            }
+        }
+    }
+    Model::from_arrays(&w, &mu, &cov, 1).unwrap()
+}
+
+#[test]
+fn recovers_a_translation() {
+    let model = corner();
+    let t = [0.02f32, -0.01, 0.03];
+    let mut pts = model.sample(3000, 1, 4).unwrap();
+    for row in pts.chunks_mut(4) {
+        for k in 0..3 {
+            row[k] -= t[k];
+        }
+    }
+    let r = model.register_points(&pts, None, None).unwrap();
+    assert_eq!(r.status, RegistrationStatus::Converged);
+    // Noise: 3 mm / sqrt(1000) per plane normal, far below 1 mm.
+    for k in 0..3 {
+        assert!((r.pose[4 * k + 3] - t[k] as f64).abs() < 1e-3, "{:?}", r.pose);
+        assert!((r.pose[5 * k] - 1.0).abs() < 1e-4);
+    }
+    assert!(r.inlier_ratio > 0.95 && r.unobservable == 0);
+
+    let mut nan: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
+    nan[3] = f64::NAN;
+    let e = model.register_points(&pts, Some(&nan), None).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+}

@@ -1,0 +1,124 @@
+// Rigid registration of a point cloud to a model (issue 32): the pose that
+// best explains the source points (x, y, z, gray) under a target Gmm.
+//
+// The objective. The transformed source points x_i = R p_i + t are scored by
+// the target's 3-D marginal mixed with a uniform outlier density:
+//   p(x) = (1 - eps) sum_k pi_k N(x; mu_k, Sigma_k + s^2 I) + eps / V,
+// eps = outlier_ratio, V the volume of the target's 3-sigma box, s the
+// smoothing of the current level. The pose maximises sum_i log p(x_i). Each
+// iteration is one EM step: responsibilities w_ik (E), then one Gauss-Newton
+// step on sum_ik w_ik (x_i - mu_k)^T (Sigma_k + s^2 I)^-1 (x_i - mu_k) / 2 over
+// a left perturbation of the pose (M). Flat components make this a
+// point-to-plane cost near the surface and a point-to-point one at edges; the
+// outlier term bounds the influence of points the target does not explain
+// (its responsibility goes to the uniform term, not to a far component).
+// With use_gray, each component scores the point's gray by its gray marginal
+// and its position by the conditional N(x; mu_x|g, Sigma_x|g): the 4-D joint
+// density, as colored ICP adds the photometric term.
+//
+// Coarse to fine: `levels` levels smooth the target by s = coarse_sigma,
+// coarse_sigma / 2, ..., and the last level by 0 (the model itself), so a
+// start a few centimetres off still sees the surface; the smooth coarse
+// levels use every 2nd or 4th point. Each point tests only
+// the components whose 3-sigma box (ComponentIndex) holds it.
+//
+// What comes back. The pose; the mean log-likelihood, the inlier ratio (a
+// point is an inlier when the mixture explains it better than the outlier
+// term) and the Mahalanobis RMS of the inliers; the 6 x 6 observed
+// information (the negative Hessian of the log-likelihood at the pose, by
+// Louis' identity: sum_ik w_ik J^T P_k J minus the covariance of the
+// per-component gradients), which is near zero along directions the scene
+// does not constrain (a plane slides in itself) even though every component
+// alone would constrain them; and a status: Converged, or why not.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "sogmm/gmm.hpp"
+#include "sogmm/progress.hpp"
+
+namespace sogmm {
+
+/// How register_points() runs (the option registry's REGISTRATION_* rows).
+struct RegistrationOptions {
+  /// EM / Gauss-Newton iterations per level, >= 1.
+  std::int32_t max_iter = 30;
+  /// A level ends when a step moves the source by less than this (metres:
+  /// |translation| + |rotation| x the source's RMS radius). > 0.
+  double tol = 1e-4;
+  /// eps: prior weight of the uniform outlier term, in [0, 1).
+  double outlier_ratio = 0.1;
+  /// true: score gray too (the 4-D joint density); false: the 3-D marginal.
+  bool use_gray = false;
+  /// Coarse-to-fine levels, >= 1; the last one uses the model unsmoothed.
+  std::int32_t levels = 3;
+  /// Smoothing standard deviation of the coarsest level (metres), > 0.
+  double coarse_sigma = 0.04;
+  /// Below this inlier ratio at the end the status is LowFitness. [0, 1].
+  double min_inlier_ratio = 0.5;
+  /// A direction of the information matrix (rotations scaled by the source's
+  /// RMS radius) whose eigenvalue is below this fraction of the largest one
+  /// is unobservable; any such direction makes the status Degenerate. [0, 1).
+  double degeneracy_ratio = 1e-3;
+  /// Fewer finite source points than this: Error(InvalidData). >= 6.
+  std::int64_t min_points = 100;
+};
+
+/// Throws Error(InvalidArgument) naming the first bad setting.
+void validate(const RegistrationOptions& options);
+
+/// How a registration ended. Values are stable (sogmm.h SOGMM_REGISTRATION_*).
+enum class RegistrationStatus : std::int32_t {
+  Converged = 0,     ///< the last level's steps fell below tol; fitness and observability acceptable
+  NotConverged = 1,  ///< the last level hit max_iter
+  LowFitness = 2,    ///< converged, but the inlier ratio is below min_inlier_ratio
+  Degenerate = 3,    ///< converged, but some directions are unobservable (see `unobservable`)
+};
+
+struct RegistrationResult {
+  /// Row-major 4 x 4 rigid transform taking source points into the target's
+  /// frame (x_target = R p + t): the last iterate, whatever the status.
+  std::array<double, 16> pose{};
+  RegistrationStatus status = RegistrationStatus::NotConverged;
+  /// Iterations run, summed over the levels.
+  std::int32_t iterations = 0;
+  /// Mean log-likelihood per source point at the pose (the unsmoothed
+  /// model with its outlier term; nats, 3-D or 4-D as use_gray).
+  double log_likelihood = 0.0;
+  /// Fraction of source points the mixture explains better than the outlier term.
+  double inlier_ratio = 0.0;
+  /// sqrt of the mean over inliers of sum_k w_k (x - mu_k)^T P_k (x - mu_k) / 3:
+  /// about 1 for points spread as the model says.
+  double rmse = 0.0;
+  /// Observed information, row-major 6 x 6, over a left perturbation of the
+  /// pose in the target frame: x -> x + w x x + v with xi = (w_x, w_y, w_z,
+  /// v_x, v_y, v_z) (radians, metres); its inverse approximates the pose's
+  /// covariance where it is invertible.
+  std::array<double, 36> information{};
+  /// Number of unobservable directions (0 to 6; see degeneracy_ratio).
+  std::int32_t unobservable = 0;
+  /// Smallest over largest eigenvalue of the scaled information (0 when the
+  /// largest is 0): how close the scene is to degenerate.
+  double eigen_ratio = 0.0;
+};
+
+/// Registers `n` source points (`points`: rows of x, y, z, gray float32)
+/// to `target`, starting at `init` (row-major 4 x 4 rigid transform, source
+/// to target frame). `threads` as QueryOptions::threads (the result does not
+/// depend on it). `progress` receives Stage::Registration reports (step =
+/// iterations done, total = levels x max_iter, the mean log-likelihood) and
+/// may cancel. Errors: an invalid target or bad options ->
+/// Error(InvalidArgument/InvalidData); a non-rigid or non-finite `init` ->
+/// Error(InvalidArgument) saying what is wrong; a non-finite point ->
+/// Error(InvalidData) naming its row; fewer than min_points points ->
+/// Error(InvalidData).
+RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options = {},
+                                   int threads = 0, const ProgressSink& progress = {});
+
+/// Name of a status ("converged", "not converged", "low fitness", "degenerate").
+const char* status_name(RegistrationStatus status);
+
+}  // namespace sogmm

@@ -1,0 +1,352 @@
+// Point-to-model registration (sogmm/registration.hpp).
+#include "sogmm/registration.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "finite_rows.hpp"
+#include "parallel.hpp"
+#include "progress.hpp"
+#include "sogmm/component_index.hpp"
+#include "sogmm/error.hpp"
+#include "sogmm/model.hpp"
+#include "sogmm/options.hpp"
+
+namespace sogmm {
+
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat36 = Eigen::Matrix<double, 3, 6>;
+
+constexpr double kLog2Pi = 1.8378770664093453;
+constexpr std::size_t kBlock = 256;  // points per partial sum: fixed, so sums do not depend on threads
+
+// One component as a level scores it: the (conditional) spatial Gaussian and
+// the constant terms of its log-density.
+struct Component {
+  Eigen::Vector3d mu;       // spatial mean
+  Eigen::Matrix3d prec;     // inverse of the (conditional, smoothed) spatial covariance
+  double log_norm = 0.0;    // log((1 - eps) pi_k) - log det(2 pi Sigma) / 2
+  Eigen::Vector3d gain;     // use_gray: Sigma_xg / s_gg (conditional mean slope); else 0
+  double mu_g = 0.0, inv_sgg = 0.0, log_norm_g = 0.0;  // use_gray: the gray marginal
+};
+
+// The target smoothed by s: its components and an index over their boxes.
+struct Level {
+  std::vector<Component> comps;
+  ComponentIndex index;
+};
+
+Level make_level(const Gmm& gmm, double s, double eps, bool use_gray) {
+  Level level;
+  Gmm smoothed = gmm;
+  level.comps.resize(gmm.size());
+  for (std::size_t m = 0; m < gmm.size(); ++m) {
+    const float* c = gmm.covariance(m);
+    Eigen::Matrix4d cov;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) cov(i, j) = 0.5 * (double(c[4 * i + j]) + double(c[4 * j + i]));
+    for (int i = 0; i < 3; ++i) {
+      cov(i, i) += s * s;
+      smoothed.covariances[16 * m + 5 * i] = static_cast<float>(cov(i, i));
+    }
+    Component& k = level.comps[m];
+    const float* mu = gmm.mean(m);
+    k.mu = Eigen::Vector3d(mu[0], mu[1], mu[2]);
+    Eigen::Matrix3d spatial = cov.topLeftCorner<3, 3>();
+    k.gain.setZero();
+    k.log_norm = std::log((1.0 - eps) * double(gmm.weights[m]));
+    if (use_gray) {
+      const double sgg = cov(3, 3);
+      k.gain = cov.block<3, 1>(0, 3) / sgg;
+      spatial -= k.gain * cov.block<1, 3>(3, 0);
+      k.mu_g = mu[3];
+      k.inv_sgg = 1.0 / sgg;
+      k.log_norm_g = -0.5 * (kLog2Pi + std::log(sgg));
+    }
+    const Eigen::LLT<Eigen::Matrix3d> llt(spatial);
+    require(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0, ErrorCode::Numeric,
+            "registration: the spatial covariance of target component " + std::to_string(m) +
+                " is not positive definite");
+    k.prec = llt.solve(Eigen::Matrix3d::Identity());
+    k.log_norm -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
+  }
+  level.index.build(smoothed);
+  return level;
+}
+
+// The sums one pass over the points gives at a pose.
+struct Sums {
+  Mat6 hessian = Mat6::Zero();      // sum w J^T P J (Gauss-Newton)
+  Vec6 gradient = Vec6::Zero();     // sum w J^T P r (of the cost)
+  Mat6 spread = Mat6::Zero();       // sum_i (sum_k w G G^T - Gbar Gbar^T) (Louis' correction)
+  double log_likelihood = 0.0;
+  double inliers = 0.0;
+  double mahalanobis = 0.0;         // over inliers
+  void add(const Sums& o) {
+    hessian += o.hessian;
+    gradient += o.gradient;
+    spread += o.spread;
+    log_likelihood += o.log_likelihood;
+    inliers += o.inliers;
+    mahalanobis += o.mahalanobis;
+  }
+};
+
+struct Scratch {
+  std::vector<std::uint32_t> ids;
+  std::vector<double> logp;
+  std::vector<Eigen::Vector3d> res;
+  ComponentIndex::Cursor cursor;
+};
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d s;
+  s << 0, -v(2), v(1), v(2), 0, -v(0), -v(1), v(0), 0;
+  return s;
+}
+
+// One point's share: x is the transformed point, c the perturbation centre.
+void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Vector3d& c,
+                 double log_outlier, bool use_gray, bool spread, Scratch& s, Sums& out) {
+  const double xyz[3] = {x(0), x(1), x(2)};
+  level.index.query_point(xyz, s.ids, s.cursor);
+  s.logp.resize(s.ids.size());
+  s.res.resize(s.ids.size());
+  double top = log_outlier;
+  for (std::size_t j = 0; j < s.ids.size(); ++j) {
+    const Component& k = level.comps[s.ids[j]];
+    Eigen::Vector3d r = x - k.mu;
+    double lp = k.log_norm;
+    if (use_gray) {
+      const double dg = gray - k.mu_g;
+      r -= k.gain * dg;
+      lp += k.log_norm_g - 0.5 * dg * dg * k.inv_sgg;
+    }
+    lp -= 0.5 * r.dot(k.prec * r);
+    s.res[j] = r;
+    s.logp[j] = lp;
+    top = std::max(top, lp);
+  }
+  double total = std::exp(log_outlier - top);
+  for (double lp : s.logp) total += std::exp(lp - top);
+  const double lse = top + std::log(total);
+  out.log_likelihood += lse;
+  const double w_out = std::exp(log_outlier - lse);
+  const bool inlier = w_out < 0.5;
+  if (inlier) out.inliers += 1.0;
+  Mat36 jac;
+  jac.leftCols<3>() = -skew(x - c);
+  jac.rightCols<3>().setIdentity();
+  // J is the same for every component of the point: sum the weighted
+  // precisions and precision-weighted residuals first, then one J^T W J.
+  Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
+  Vec6 gbar = Vec6::Zero();
+  Mat6 ggt = Mat6::Zero();
+  for (std::size_t j = 0; j < s.ids.size(); ++j) {
+    const double w = std::exp(s.logp[j] - lse);
+    if (w < 1e-12) continue;
+    const Eigen::Matrix3d& p = level.comps[s.ids[j]].prec;
+    const Eigen::Vector3d pr = p * s.res[j];
+    wp += w * p;
+    wpr += w * pr;
+    if (inlier) out.mahalanobis += w * s.res[j].dot(pr);
+    if (spread) {
+      const Vec6 g = jac.transpose() * pr;
+      gbar += w * g;
+      ggt.noalias() += w * g * g.transpose();
+    }
+  }
+  out.hessian.noalias() += jac.transpose() * wp * jac;
+  out.gradient.noalias() += jac.transpose() * wpr;
+  if (spread) out.spread += ggt - gbar * gbar.transpose();
+}
+
+// The pose as R, t.
+struct Rigid {
+  Eigen::Matrix3d r;
+  Eigen::Vector3d t;
+};
+
+Rigid rigid_of(const std::array<double, 16>& p) {
+  Rigid g;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) g.r(i, j) = p[4 * i + j];
+    g.t(i) = p[4 * i + 3];
+  }
+  return g;
+}
+
+std::array<double, 16> array_of(const Rigid& g) {
+  std::array<double, 16> p{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) p[4 * i + j] = g.r(i, j);
+    p[4 * i + 3] = g.t(i);
+  }
+  p[15] = 1.0;
+  return p;
+}
+
+}  // namespace
+
+void validate(const RegistrationOptions& o) {
+  require_option(OptionKey::REGISTRATION_MAX_ITER, std::int64_t{o.max_iter}, "registration max_iter");
+  require_option(OptionKey::REGISTRATION_TOL, o.tol, "registration tol");
+  require_option(OptionKey::REGISTRATION_OUTLIER_RATIO, o.outlier_ratio, "registration outlier_ratio");
+  require_option(OptionKey::REGISTRATION_USE_GRAY, std::int64_t{o.use_gray}, "registration use_gray");
+  require_option(OptionKey::REGISTRATION_LEVELS, std::int64_t{o.levels}, "registration levels");
+  require_option(OptionKey::REGISTRATION_COARSE_SIGMA, o.coarse_sigma, "registration coarse_sigma");
+  require_option(OptionKey::REGISTRATION_MIN_INLIER_RATIO, o.min_inlier_ratio, "registration min_inlier_ratio");
+  require_option(OptionKey::REGISTRATION_DEGENERACY_RATIO, o.degeneracy_ratio, "registration degeneracy_ratio");
+  require_option(OptionKey::REGISTRATION_MIN_POINTS, o.min_points, "registration min_points");
+}
+
+const char* status_name(RegistrationStatus status) {
+  switch (status) {
+    case RegistrationStatus::Converged: return "converged";
+    case RegistrationStatus::NotConverged: return "not converged";
+    case RegistrationStatus::LowFitness: return "low fitness";
+    case RegistrationStatus::Degenerate: return "degenerate";
+  }
+  return "unknown";
+}
+
+RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options,
+                                   int threads, const ProgressSink& progress) {
+  validate(options);
+  validate(target);
+  const std::string pose_error = rigid_pose_error(init);
+  require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
+  require(n >= static_cast<std::uint64_t>(options.min_points), ErrorCode::InvalidData,
+          "registration: " + std::to_string(n) + " source points, fewer than min_points = " +
+              std::to_string(options.min_points));
+  require(points != nullptr, ErrorCode::InvalidArgument, "registration: null points");
+  detail::require_finite_rows(points, n, 4, "source points for registration");
+  const ProgressScope scope(progress);
+  const int team = detail::team_size(threads);
+  const double eps = options.outlier_ratio;
+
+  // The outlier density: uniform over the target's 3-sigma box.
+  Box3 span = component_box(target, 0, 3.0);
+  for (std::size_t m = 1; m < target.size(); ++m) {
+    const Box3 b = component_box(target, m, 3.0);
+    for (int k = 0; k < 3; ++k) {
+      span.lo[k] = std::min(span.lo[k], b.lo[k]);
+      span.hi[k] = std::max(span.hi[k], b.hi[k]);
+    }
+  }
+  double volume = 1.0;
+  for (int k = 0; k < 3; ++k) volume *= std::max(span.hi[k] - span.lo[k], 1e-3);
+  const double log_outlier = eps > 0 ? std::log(eps / volume) : -std::numeric_limits<double>::infinity();
+
+  // The source's centroid and RMS radius (pose invariant: the step's scale).
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) centroid += Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]);
+  centroid /= double(n);
+  double radius2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    radius2 += (Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]) - centroid).squaredNorm();
+  const double radius = std::max(std::sqrt(radius2 / double(n)), 1e-6);
+
+  std::vector<Scratch> scratch(static_cast<std::size_t>(team));
+  std::vector<Sums> partial;
+  // Every `stride`-th point (coarse levels need fewer: their targets are smooth).
+  auto evaluate = [&](const Level& level, const Rigid& pose, bool spread, std::size_t stride) {
+    const Eigen::Vector3d c = pose.r * centroid + pose.t;
+    const std::size_t used = (n + stride - 1) / stride, blocks = (used + kBlock - 1) / kBlock;
+    partial.assign(blocks, Sums{});
+    detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
+      Sums s;
+      Scratch& sc = scratch[static_cast<std::size_t>(thread)];
+      for (std::size_t v = blk * kBlock; v < std::min(used, (blk + 1) * kBlock); ++v) {
+        const float* p = points + 4 * v * stride;
+        const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
+        score_point(level, x, p[3], c, log_outlier, options.use_gray, spread, sc, s);
+      }
+      partial[blk] = s;
+    });
+    Sums total;
+    for (const Sums& s : partial) total.add(s);
+    return total;
+  };
+
+  RegistrationResult result;
+  Rigid pose = rigid_of(init);
+  const std::int32_t levels = options.levels;
+  detail::progress_begin(Stage::Registration, std::uint64_t(levels) * std::uint64_t(options.max_iter));
+  bool converged = false;
+  Level level;
+  for (std::int32_t l = 0; l < levels; ++l) {
+    const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
+    // Level l of L uses every 2^(L-1-l)-th point (at most 4x fewer), keeping at least min_points.
+    std::size_t stride = std::size_t{1} << std::min(levels - 1 - l, 2);
+    while (stride > 1 && n / stride < static_cast<std::size_t>(options.min_points)) stride /= 2;
+    level = make_level(target, s, eps, options.use_gray);
+    converged = false;
+    for (std::int32_t it = 0; it < options.max_iter && !converged; ++it) {
+      const Sums sums = evaluate(level, pose, false, stride);
+      ++result.iterations;
+      detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / double((n + stride - 1) / stride));
+      const double scale = sums.hessian.diagonal().maxCoeff();
+      if (!(scale > 0)) break;  // no point near the target: nothing to move towards
+      const Vec6 step = -(sums.hessian + 1e-9 * scale * Mat6::Identity()).ldlt().solve(sums.gradient);
+      if (!step.allFinite()) break;
+      const Eigen::Vector3d w = step.head<3>(), v = step.tail<3>();
+      const double angle = w.norm();
+      const Eigen::Matrix3d rot =
+          angle > 0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+      const Eigen::Vector3d c = pose.r * centroid + pose.t;
+      pose.r = rot * pose.r;
+      pose.t = rot * (pose.t - c) + c + v;
+      converged = v.norm() + angle * radius < options.tol;
+    }
+  }
+
+  // The figures at the final pose, on the unsmoothed model.
+  const Sums fin = evaluate(level, pose, true, 1);
+  const Mat6 info_c = fin.hessian - fin.spread;  // about the centroid c
+  const Eigen::Vector3d c = pose.r * centroid + pose.t;
+  // xi_origin = A xi_c with A = [I 0; [c]x I]: information_origin = A^-T info_c A^-1.
+  Mat6 a_inv = Mat6::Identity();
+  a_inv.bottomLeftCorner<3, 3>() = -skew(c);
+  const Mat6 info = a_inv.transpose() * info_c * a_inv;
+  Vec6 d;
+  d << radius, radius, radius, 1, 1, 1;
+  const Mat6 scaled = d.cwiseInverse().asDiagonal() * (0.5 * (info_c + info_c.transpose())) * d.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Mat6> eig(scaled, Eigen::EigenvaluesOnly);
+  const Vec6 ev = eig.eigenvalues().cwiseMax(0.0);
+  const double top = ev.maxCoeff();
+  result.eigen_ratio = top > 0 ? ev.minCoeff() / top : 0.0;
+  for (int k = 0; k < 6; ++k)
+    if (!(ev(k) > options.degeneracy_ratio * top)) ++result.unobservable;
+
+  // Many small rotations multiplied: project R back onto the rotations so
+  // that the answer passes rigid_pose_error as the next call's start.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(pose.r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  pose.r = svd.matrixU() * svd.matrixV().transpose();
+  result.pose = array_of(pose);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) result.information[6 * i + j] = 0.5 * (info(i, j) + info(j, i));
+  result.log_likelihood = fin.log_likelihood / double(n);
+  result.inlier_ratio = fin.inliers / double(n);
+  result.rmse = fin.inliers > 0 ? std::sqrt(fin.mahalanobis / (3.0 * fin.inliers)) : 0.0;
+  if (!converged)
+    result.status = RegistrationStatus::NotConverged;
+  else if (result.inlier_ratio < options.min_inlier_ratio)
+    result.status = RegistrationStatus::LowFitness;
+  else if (result.unobservable > 0)
+    result.status = RegistrationStatus::Degenerate;
+  else
+    result.status = RegistrationStatus::Converged;
+  return result;
+}
+
+}  // namespace sogmm

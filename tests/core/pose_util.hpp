@@ -1,0 +1,33 @@
+// Row-major 4 x 4 poses as Eigen matrices, and the error of an estimate
+// against the truth (the registration tests).
+#pragma once
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+namespace sogmm_test {
+
+inline Eigen::Matrix4d pose_matrix(const std::array<double, 16>& p) {
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = p[i];
+  return m;
+}
+
+inline std::array<double, 16> pose_array(const Eigen::Matrix4d& m) {
+  std::array<double, 16> p;
+  for (int i = 0; i < 16; ++i) p[i] = m(i / 4, i % 4);
+  return p;
+}
+
+/// (translation metres, rotation degrees) of `est` against `truth`.
+inline std::pair<double, double> pose_error(const std::array<double, 16>& est, const Eigen::Matrix4d& truth) {
+  const Eigen::Matrix4d e = pose_matrix(est);
+  const Eigen::Matrix4d d = truth.inverse() * e;
+  const double c = std::clamp((d.topLeftCorner<3, 3>().trace() - 1) / 2, -1.0, 1.0);
+  return {(e.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), std::acos(c) * 180 / M_PI};
+}
+
+}  // namespace sogmm_test

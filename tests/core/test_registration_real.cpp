@@ -1,0 +1,116 @@
+// Registration on the shared livingroom frames 0-2 (issue 32): each later
+// frame's d = 5 points registered to the earlier frame's fit (bandwidth 0.02,
+// seed 0) from the identity, against trajectory.log's relative pose
+// inv(T_a) T_b; then seeded perturbations of up to 10 cm and 10 degrees
+// about the truth. Skips with a message when the data folder is absent.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <random>
+
+#include "pose_util.hpp"
+#include "real_frame.hpp"
+#include "sogmm/fit.hpp"
+#include "sogmm/model.hpp"
+#include "sogmm/registration.hpp"
+#include "sogmm/trajectory_log.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Pose = std::array<double, 16>;
+
+struct Livingroom {
+  std::map<int, sogmm::PointCloud> clouds;
+  std::map<int, sogmm::Gmm> models;
+  std::map<int, Eigen::Matrix4d> world;
+};
+
+// Loaded once for the suite: the fits take seconds.
+const Livingroom* livingroom() {
+  static const Livingroom* data = [] () -> const Livingroom* {
+    const fs::path dir = fs::path(SOGMM_SHARED_DATA) / "rgbd" / "livingroom";
+    if (!fs::is_directory(dir)) return nullptr;
+    auto* d = new Livingroom;
+    for (int i = 0; i < 3; ++i) {
+      char name[16];
+      std::snprintf(name, sizeof name, "%05d", i);
+      const auto f = sogmm_test::load_frame(dir / "color" / (std::string(name) + ".jpg"),
+                                            dir / "depth" / (std::string(name) + ".png"), dir / "intrinsics.json");
+      d->clouds.emplace(i, sogmm_test::cloud_of(f, 1000.0, 5));
+    }
+    sogmm::FitOptions o;
+    o.bandwidth = 0.02;
+    o.seed = 0;
+    for (int i : {0, 1}) d->models.emplace(i, sogmm::fit(d->clouds.at(i).view(), o).gmm);
+    const auto traj = sogmm::format::read_trajectory_log((dir / "trajectory.log").string());
+    for (std::size_t k = 0; k < traj.poses.size(); ++k) d->world[int(traj.ids[k])] = sogmm_test::pose_matrix(traj.poses[k]);
+    return d;
+  }();
+  return data;
+}
+
+constexpr std::array<std::pair<int, int>, 3> kPairs = {{{0, 1}, {1, 2}, {0, 2}}};
+
+sogmm::RegistrationResult register_pair(const Livingroom& d, int a, int b, const Eigen::Matrix4d& init) {
+  const sogmm::PointCloud& pc = d.clouds.at(b);
+  return sogmm::register_points(d.models.at(a), pc.view().data, pc.size(), sogmm_test::pose_array(init));
+}
+
+}  // namespace
+
+// The issue's bound: 1 cm and 0.5 degrees. Measured 0.10-0.14 cm and
+// 0.014-0.055 degrees (the same under sse2, avx2 and default), so kernel
+// rounding (which moves the fit's last bits) cannot cross it.
+TEST(RegistrationReal, LivingroomPairsFromIdentity) {
+  const Livingroom* d = livingroom();
+  if (!d) GTEST_SKIP() << "real-frame data folder " << SOGMM_SHARED_DATA << "/rgbd/livingroom is absent";
+  for (const auto& [a, b] : kPairs) {
+    const Eigen::Matrix4d truth = d->world.at(a).inverse() * d->world.at(b);
+    const sogmm::RegistrationResult r = register_pair(*d, a, b, Eigen::Matrix4d::Identity());
+    const auto [dt_m, dr] = sogmm_test::pose_error(r.pose, truth);
+    const double dt = 100 * dt_m;
+    std::printf("livingroom %d->%d: %.3f cm, %.4f deg, %s, %d iterations, inliers %.3f\n", a, b, dt, dr,
+                sogmm::status_name(r.status), r.iterations, r.inlier_ratio);
+    EXPECT_EQ(r.status, sogmm::RegistrationStatus::Converged) << a << "->" << b;
+    EXPECT_LE(dt, 1.0) << a << "->" << b;
+    EXPECT_LE(dr, 0.5) << a << "->" << b;
+  }
+}
+
+// Seeded starts up to 10 cm and 10 degrees off: a converged status must come
+// with a pose within 1 cm and 0.5 degrees (never a wrong pose reported as
+// good), and most starts must recover.
+TEST(RegistrationReal, LivingroomPerturbations) {
+  const Livingroom* d = livingroom();
+  if (!d) GTEST_SKIP() << "real-frame data folder " << SOGMM_SHARED_DATA << "/rgbd/livingroom is absent";
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> unit;
+  constexpr int kTrials = 12;
+  int recovered = 0;
+  for (int k = 0; k < kTrials; ++k) {
+    const auto [a, b] = kPairs[k % 3];
+    const Eigen::Matrix4d truth = d->world.at(a).inverse() * d->world.at(b);
+    const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    Eigen::Matrix4d kick = Eigen::Matrix4d::Identity();
+    kick.topLeftCorner<3, 3>() = Eigen::AngleAxisd(unit(rng) * 10 * M_PI / 180, axis).toRotationMatrix();
+    kick.topRightCorner<3, 1>() =
+        Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized() * (unit(rng) * 0.10);
+    const sogmm::RegistrationResult r = register_pair(*d, a, b, kick * truth);
+    const auto [dt_m, dr] = sogmm_test::pose_error(r.pose, truth);
+    const double dt = 100 * dt_m;
+    const bool good = dt <= 1.0 && dr <= 0.5;
+    if (r.status == sogmm::RegistrationStatus::Converged) {
+      EXPECT_TRUE(good) << "trial " << k << ": converged at " << dt << " cm, " << dr << " deg";
+      recovered += good;
+    }
+  }
+  std::printf("perturbations: %d of %d recovered\n", recovered, kTrials);
+  EXPECT_GE(recovered, kTrials - 1);
+}

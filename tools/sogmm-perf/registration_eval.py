@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""Point-to-model registration (issue 32) on the shared livingroom frames 0-2.
+
+For the pairs 0->1, 1->2 and 0->2: the earlier frame's d = 5 points are fitted
+(bandwidth 0.02, seed 0) and the later frame's d = 5 points registered to that
+model from the identity; the errors are against trajectory.log's relative
+pose inv(T_a) T_b (translation in cm, rotation in degrees). Then --trials
+seeded perturbations of the true pose (random axis, angle uniform in
+[0, --max-deg], translation uniform in [0, --max-cm] along a random
+direction) start the registration: a trial recovers when the status is
+converged and the pose is within 1 cm and 0.5 degrees; a "false success" is a
+converged status with a pose outside those bounds (what must not happen).
+Times are medians of the calls (2 threads by default; the machine is shared,
+so the load average is printed).
+
+With Open3D importable (a venv with `pip install open3d==0.20.0`), the same
+pairs run Open3D's multi-scale colored ICP (Park et al. 2017, the parameters of
+its tutorial: voxel 4/2/1 cm, 50/30/14 iterations) on the d = 1 clouds and
+its hybrid RGB-D odometry on the full images.
+
+    SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
+      python3 tools/sogmm-perf/registration_eval.py [--data /work/shared/data/rgbd/livingroom]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+import sogmm
+
+PAIRS = [(0, 1), (1, 2), (0, 2)]
+
+
+def pose_error(est: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
+    """(translation cm, rotation degrees) of est against truth."""
+    d = np.linalg.inv(truth) @ est
+    c = np.clip((np.trace(d[:3, :3]) - 1) / 2, -1.0, 1.0)
+    return 100 * float(np.linalg.norm(est[:3, 3] - truth[:3, 3])), float(np.degrees(np.arccos(c)))
+
+
+def perturbation(rng: np.random.Generator, max_deg: float, max_cm: float) -> np.ndarray:
+    axis = rng.normal(size=3)
+    axis /= np.linalg.norm(axis)
+    angle = np.radians(rng.uniform(0, max_deg))
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    r = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+    t = rng.normal(size=3)
+    t *= rng.uniform(0, max_cm / 100) / np.linalg.norm(t)
+    p = np.eye(4)
+    p[:3, :3], p[:3, 3] = r, t
+    return p
+
+
+def open3d_baselines(data: Path, camera, truth_of, repeats: int):
+    try:
+        import open3d as o3d
+    except ImportError as e:
+        print(f"Open3D: not importable ({e}); colored ICP and RGB-D odometry not run")
+        return
+    print(f"Open3D {o3d.__version__}: colored ICP (multi-scale, tutorial parameters) and hybrid RGB-D odometry")
+    intr = o3d.camera.PinholeCameraIntrinsic(camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy)
+
+    def rgbd(i):
+        color = o3d.io.read_image(str(data / "color" / f"{i:05d}.jpg"))
+        depth = o3d.io.read_image(str(data / "depth" / f"{i:05d}.png"))
+        return o3d.geometry.RGBDImage.create_from_color_and_depth(color, depth, depth_scale=1000.0, depth_trunc=3.0,
+                                                                  convert_rgb_to_intensity=False)
+
+    def colored_icp(src, tgt):
+        cur = np.eye(4)
+        for voxel, iters in zip([0.04, 0.02, 0.01], [50, 30, 14]):
+            s, t = src.voxel_down_sample(voxel), tgt.voxel_down_sample(voxel)
+            for pc in (s, t):
+                pc.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=2 * voxel, max_nn=30))
+            r = o3d.pipelines.registration.registration_colored_icp(
+                s, t, 1.5 * voxel, cur, o3d.pipelines.registration.TransformationEstimationForColoredICP(),
+                o3d.pipelines.registration.ICPConvergenceCriteria(relative_fitness=1e-6, relative_rmse=1e-6,
+                                                                  max_iteration=iters))
+            cur = r.transformation
+        return cur
+
+    for a, b in PAIRS:
+        ra, rb = rgbd(a), rgbd(b)
+        pa = o3d.geometry.PointCloud.create_from_rgbd_image(ra, intr)
+        pb = o3d.geometry.PointCloud.create_from_rgbd_image(rb, intr)
+        truth = truth_of(a, b)
+        times, est = [], None
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            est = colored_icp(pb, pa)
+            times.append(time.perf_counter() - t0)
+        dt, dr = pose_error(est, truth)
+        print(f"  colored ICP   {a}->{b}: {dt:.2f} cm, {dr:.3f} deg, median {1000 * statistics.median(times):.0f} ms")
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            ok, trans, _ = o3d.pipelines.odometry.compute_rgbd_odometry(
+                rb, ra, intr, np.eye(4), o3d.pipelines.odometry.RGBDOdometryJacobianFromHybridTerm(),
+                o3d.pipelines.odometry.OdometryOption())
+            times.append(time.perf_counter() - t0)
+        dt, dr = pose_error(np.asarray(trans), truth)
+        print(f"  RGB-D odometry {a}->{b}: {dt:.2f} cm, {dr:.3f} deg (ok {ok}), "
+              f"median {1000 * statistics.median(times):.0f} ms")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", type=Path, default=Path("/work/shared/data/rgbd/livingroom"))
+    ap.add_argument("--trials", type=int, default=100, help="perturbation trials (over the three pairs)")
+    ap.add_argument("--max-deg", type=float, default=10.0)
+    ap.add_argument("--max-cm", type=float, default=10.0)
+    ap.add_argument("--repeats", type=int, default=5, help="timed calls per pair")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--use-gray", action="store_true")
+    ap.add_argument("--no-open3d", action="store_true")
+    args = ap.parse_args()
+    if not args.data.is_dir():
+        print(f"data folder {args.data} is absent: nothing to do")
+        return
+    camera = sogmm.Camera.from_json(args.data / "intrinsics.json")
+    ids, poses = sogmm.read_trajectory(args.data / "trajectory.log")
+    world = {int(i): p for i, p in zip(ids, poses)}
+
+    def truth_of(a, b):
+        return np.linalg.inv(world[a]) @ world[b]
+
+    points, models = {}, {}
+    for i in range(3):
+        depth, color = sogmm.read_frame(args.data / "depth" / f"{i:05d}.png", args.data / "color" / f"{i:05d}.jpg")
+        points[i] = sogmm.rgbd_to_points(depth, color, camera, decimate=5)
+    for a, _ in PAIRS:
+        if a not in models:
+            models[a] = sogmm.SOGMM(bandwidth=0.02, seed=0).fit(points[a])
+    kw = dict(n_threads=args.threads, use_gray=args.use_gray)
+    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {args.use_gray}")
+    for a, b in PAIRS:
+        times = []
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            pose, info = sogmm.register(points[b], models[a], **kw)
+            times.append(time.perf_counter() - t0)
+        dt, dr = pose_error(pose, truth_of(a, b))
+        print(f"  sogmm {a}->{b}: {dt:.2f} cm, {dr:.3f} deg, {info['status']}, {info['iterations']} iterations, "
+              f"inliers {info['inlier_ratio']:.3f}, eigen ratio {info['eigen_ratio']:.2e}, "
+              f"N = {len(points[b])}, M = {models[a].n_components_}, median {1000 * statistics.median(times):.1f} ms")
+    rng = np.random.default_rng(0)
+    recovered = false_success = failed = 0
+    times = []
+    for k in range(args.trials):
+        a, b = PAIRS[k % 3]
+        truth = truth_of(a, b)
+        init = perturbation(rng, args.max_deg, args.max_cm) @ truth
+        t0 = time.perf_counter()
+        pose, info = sogmm.register(points[b], models[a], init=init, **kw)
+        times.append(time.perf_counter() - t0)
+        dt, dr = pose_error(pose, truth)
+        good = dt <= 1.0 and dr <= 0.5
+        if info["converged"]:
+            recovered += good
+            false_success += not good
+        else:
+            failed += 1
+    print(f"perturbations up to {args.max_cm:g} cm / {args.max_deg:g} deg, {args.trials} seeded trials: "
+          f"recovered {recovered} ({100 * recovered / args.trials:.0f}%), reported failure {failed}, "
+          f"false success {false_success}; median {1000 * statistics.median(times):.1f} ms")
+    if not args.no_open3d:
+        open3d_baselines(args.data, camera, truth_of, args.repeats)
+
+
+if __name__ == "__main__":
+    main()
