@@ -263,6 +263,10 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
     const Eigen::Vector3d c = pose.r * centroid + pose.t;
     const std::size_t used = (n + stride - 1) / stride, blocks = (used + kBlock - 1) / kBlock;
     partial.assign(blocks, Sums{});
+    // A cursor remembers a cell of the index it last read: each level has its
+    // own index (rebuilt per level), so every evaluation starts fresh cursors
+    // (a kept one read a freed cell of the previous level's index: ASan).
+    for (Scratch& sc : scratch) sc.cursor = ComponentIndex::Cursor{};
     detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
