@@ -5,6 +5,7 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"runtime"
 	"unsafe"
 )
@@ -42,8 +43,9 @@ const (
 // returns an error with ErrBusy ("map busy: ...") and changes nothing; Close
 // then leaves the map open (close it after that call returns).
 type Map struct {
-	ptr   *C.sogmm_map
-	guard mapGuard
+	ptr      *C.sogmm_map
+	guard    mapGuard
+	progress ProgressFunc // of the options the map was created with (OnProgress)
 }
 
 // MapStats are the totals of a map.
@@ -71,9 +73,16 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	}
 	defer runtime.KeepAlive(o)
 	m := &Map{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if o != nil {
+		m.progress = o.progress
+	}
+	// The handle comes out in a local: cgo refuses a pointer into a struct
+	// that holds Go pointers (the progress func).
+	var ptr *C.sogmm_map
+	if err := call(func() C.sogmm_status { return f(&ptr, op) }); err != nil {
 		return nil, err
 	}
+	m.ptr = ptr
 	runtime.SetFinalizer(m, (*Map).Close)
 	return m, nil
 }
@@ -126,12 +135,10 @@ func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.s
 }
 
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the
-// frame's camera-to-world pose.
-func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
-	return m.insertPoints(points, pose, nil)
-}
-
-func (m *Map) insertPoints(points []float32, pose [16]float64, progress *mapProgress) error {
+// frame's camera-to-world pose. ctx cancels the fit the insert may run (as
+// Fit), which the progress func of the map's options (OnProgress) reports; a
+// cancelled or failed insert leaves the map as it was.
+func (m *Map) InsertPoints(ctx context.Context, points []float32, pose [16]float64) error {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return err
@@ -139,33 +146,29 @@ func (m *Map) insertPoints(points []float32, pose [16]float64, progress *mapProg
 	if n == 0 { // C sees a nil slice as a NULL pointer; the problem is the empty frame
 		return &Error{Status: ErrInvalidData, Message: "points: an empty frame (no point)"}
 	}
-	return m.change("InsertPoints", progress, func(p *C.sogmm_map) C.sogmm_status {
+	return m.change(ctx, "InsertPoints", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_points_f32(p, floats(points), C.size_t(n), (*C.double)(&pose[0]))
 	})
 }
 
 // InsertRGBD inserts an RGB-D frame (decimation and depth range from the
-// options the map was created with) with its camera-to-world pose.
-func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
-	return m.insertRGBD(f, pose, nil)
-}
-
-func (m *Map) insertRGBD(f Frame, pose [16]float64, progress *mapProgress) error {
+// options the map was created with) with its camera-to-world pose; ctx and
+// progress as InsertPoints.
+func (m *Map) InsertRGBD(ctx context.Context, f Frame, pose [16]float64) error {
 	h, err := f.handle()
 	if err != nil {
 		return err
 	}
 	defer C.sogmm_frame_free(h)
-	return m.change("InsertRGBD", progress, func(p *C.sogmm_map) C.sogmm_status {
+	return m.change(ctx, "InsertRGBD", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_frame(p, h, (*C.double)(&pose[0]))
 	})
 }
 
-// Flush fits the pending novel points now.
-func (m *Map) Flush() error { return m.flush(nil) }
-
-func (m *Map) flush(progress *mapProgress) error {
-	return m.change("Flush", progress, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
+// Flush fits the pending novel points now; ctx and progress as InsertPoints
+// (a cancelled flush keeps the pending points).
+func (m *Map) Flush(ctx context.Context) error {
+	return m.change(ctx, "Flush", func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
 }
 
 // DiscardPending drops the points pending for a fit (they never become
@@ -173,7 +176,7 @@ func (m *Map) flush(progress *mapProgress) error {
 // way out when a flush keeps failing and the map cannot be saved.
 func (m *Map) DiscardPending() (uint64, error) {
 	var dropped C.uint64_t
-	err := m.change("DiscardPending", nil, func(p *C.sogmm_map) C.sogmm_status {
+	err := m.change(context.Background(), "DiscardPending", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_discard_pending(p, &dropped)
 	})
 	return uint64(dropped), err

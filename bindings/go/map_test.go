@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"math"
 	"path/filepath"
@@ -26,10 +27,10 @@ func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 	var want *Model
 	for k, pose := range poses {
 		pts := twoBlobs(200 + 50*k)
-		if err := m.InsertPoints(pts, pose); err != nil {
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
 			t.Fatal(err)
 		}
-		f, err := Fit(pts, o)
+		f, err := Fit(context.Background(), pts, o)
 		if err != nil {
 			t.Fatal(err)
 		}
@@ -80,21 +81,21 @@ func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
 	defer m.Close()
 	scaled := yawPose(0, 0, 0, 0)
 	scaled[0] = 2
-	if err := m.InsertPoints(twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
+	if err := m.InsertPoints(context.Background(), twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("scaled pose: %v", err)
 	}
 	nan := yawPose(0, math.NaN(), 0, 0)
-	if err := m.InsertPoints(twoBlobs(50), nan); !errors.Is(err, ErrInvalidArg) {
+	if err := m.InsertPoints(context.Background(), twoBlobs(50), nan); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("NaN pose: %v", err)
 	}
-	if err := m.InsertPoints(nil, yawPose(0, 0, 0, 0)); !errors.Is(err, ErrInvalidData) {
+	if err := m.InsertPoints(context.Background(), nil, yawPose(0, 0, 0, 0)); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty frame: %v", err)
 	}
 	if s, err := m.Stats(); err != nil || s.Frames != 0 || s.Pending != 0 {
 		t.Fatalf("a failed insert changed the map: %+v (%v)", s, err)
 	}
 	m.Close()
-	if err := m.Flush(); !errors.Is(err, ErrClosed) {
+	if err := m.Flush(context.Background()); !errors.Is(err, ErrClosed) {
 		t.Fatalf("closed map: %v", err)
 	}
 }
@@ -104,7 +105,7 @@ func TestMapDiscardPendingUnlocksSave(t *testing.T) {
 	m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
 	defer m.Close()
 	pts := twoBlobs(200)
-	if err := m.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
+	if err := m.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)); err != nil {
 		t.Fatal(err)
 	}
 	path := filepath.Join(t.TempDir(), "pending.sogmm")

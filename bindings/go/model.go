@@ -5,6 +5,7 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"fmt"
 	"runtime"
 	"unsafe"
@@ -110,38 +111,21 @@ func rowsOf(data []float32, cols int, what string) (int, error) {
 	return len(data) / cols, nil
 }
 
-// Fit fits a model to n points: points holds n rows (x, y, z, gray). o may be nil.
-func Fit(points []float32, o *Options) (*Model, error) {
+// Fit fits a model to n points: points holds n rows (x, y, z, gray). o may
+// be nil (defaults; OptNComponents fixes K). ctx cancels: the call stops
+// within about 50 ms once ctx is done (the error then satisfies
+// errors.Is(err, ErrCancelled) and errors.Is(err, ctx.Err())); the progress
+// func of o (OnProgress) gets the reports.
+func Fit(ctx context.Context, points []float32, o *Options) (*Model, error) {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return nil, err
 	}
-	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), nil, op)
+	return withProgress(ctx, o, func(o *Options) (*Model, error) {
+		return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), nil, op)
+		})
 	})
-}
-
-// FitFixedK fits exactly k components (1 <= k <= n): Fit with
-// OptNComponents = k on a copy of o (o may be nil).
-func FitFixedK(points []float32, k int, o *Options) (*Model, error) {
-	if k < 1 {
-		return nil, invalidArg("k must be >= 1, got %d", k)
-	}
-	var fixed *Options
-	var err error
-	if o != nil {
-		fixed, err = o.Clone()
-	} else {
-		fixed, err = NewOptions()
-	}
-	if err != nil {
-		return nil, err
-	}
-	defer fixed.Close()
-	if err := fixed.SetI64(OptNComponents, int64(k)); err != nil {
-		return nil, err
-	}
-	return Fit(points, fixed)
 }
 
 // FromArrays builds a model from M weights, M x 4 means and M x 4 x 4

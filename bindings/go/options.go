@@ -38,7 +38,8 @@ const (
 // Options is an owned sogmm_options handle: parameters for fit, save, load
 // and sample. A nil *Options passed to any function means "all defaults".
 type Options struct {
-	ptr *C.sogmm_options
+	ptr      *C.sogmm_options
+	progress ProgressFunc // OnProgress; Go-side, installed per call (withProgress)
 }
 
 // Option sets one value; the library checks its range (ErrInvalidArg with a
@@ -51,9 +52,13 @@ func NewOptions(opts ...Option) (*Options, error) {
 		return nil, err
 	}
 	o := &Options{}
-	if err := call(func() C.sogmm_status { return C.sogmm_options_create(&o.ptr) }); err != nil {
+	// Out through a local: cgo refuses a pointer into a struct that holds Go
+	// pointers (the progress func).
+	var ptr *C.sogmm_options
+	if err := call(func() C.sogmm_status { return C.sogmm_options_create(&ptr) }); err != nil {
 		return nil, err
 	}
+	o.ptr = ptr
 	runtime.SetFinalizer(o, (*Options).Close)
 	if err := o.Set(opts...); err != nil {
 		o.Close()
@@ -132,11 +137,27 @@ func (o *Options) GetI64(key Key) (int64, error) {
 // Clone is a deep copy.
 func (o *Options) Clone() (*Options, error) {
 	c := &Options{}
-	if err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_clone(&c.ptr, p) }); err != nil {
+	var ptr *C.sogmm_options // a local, as in NewOptions
+	if err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_clone(&ptr, p) }); err != nil {
 		return nil, err
 	}
+	c.ptr = ptr
+	c.progress = o.progress
 	runtime.SetFinalizer(c, (*Options).Close)
 	return c, nil
+}
+
+// OnProgress makes every call given these options report to fn (see
+// ProgressFunc); nil removes it. A map keeps the one of the options it was
+// created with for its inserts and flushes.
+func OnProgress(fn ProgressFunc) Option {
+	return func(o *Options) error {
+		if o == nil || o.ptr == nil {
+			return ErrClosed
+		}
+		o.progress = fn
+		return nil
+	}
 }
 
 // F64 sets any f64 key (e.g. an experimental one).

@@ -3,7 +3,10 @@ package sogmm
 // #include "sogmm/sogmm.h"
 import "C"
 
-import "unsafe"
+import (
+	"context"
+	"unsafe"
+)
 
 // Rigid registration of a point cloud to a model (issue 32; sogmm.h,
 // sogmm_register_points_f32). Options (nil = defaults): OptRegistration*,
@@ -41,7 +44,8 @@ type Registration struct {
 
 // RegisterPoints gives the rigid pose that best explains points (rows of x,
 // y, z, gray in their own frame) under the model, from init (nil = identity).
-func (m *Model) RegisterPoints(points []float32, init *[16]float64, o *Options) (*Registration, error) {
+// ctx and the progress func of o (StageRegistration) as Fit.
+func (m *Model) RegisterPoints(ctx context.Context, points []float32, init *[16]float64, o *Options) (*Registration, error) {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return nil, err
@@ -52,9 +56,11 @@ func (m *Model) RegisterPoints(points []float32, init *[16]float64, o *Options) 
 	if init != nil {
 		initPtr = (*C.double)(unsafe.Pointer(&init[0]))
 	}
-	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
-			(*C.double)(unsafe.Pointer(&pose[0])), &info)
+	_, err = withProgress(ctx, o, func(o *Options) (struct{}, error) {
+		return struct{}{}, m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
+				(*C.double)(unsafe.Pointer(&pose[0])), &info)
+		})
 	})
 	if err != nil {
 		return nil, err

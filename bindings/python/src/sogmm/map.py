@@ -21,9 +21,10 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, MapBusyError
-from .model import (GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args,
-                    _surface_distance, _write_options, _collision)
+from ._arrays import _pose, _rows
+from .model import GMM, SOGMM, _read_options, _write_options
 from .progress import ProgressArg, call_with_progress
+from .queryable import Queryable
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
 _D = _ffi.DEFAULTS
@@ -99,7 +100,7 @@ class _UseGuard:
                 self._users -= 1
 
 
-class Map:
+class Map(Queryable):
     """An incremental world map of posed frames.
 
     Args:
@@ -326,40 +327,14 @@ class Map:
             check(lib.sogmm_map_export(byref(out), self._h(), None if b is None else b.ctypes.data_as(c_void_p)))
         return GMM._wrap(out)
 
-    # World-frame queries on the map itself (no export, no copy): each answer
-    # is bitwise what the same GMM method gives on export(). A map without
-    # components (nothing flushed yet) raises InvalidDataError. ``progress``
-    # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING);
-    # ``truncation_nats`` and ``n_threads`` as in GMM.score_samples.
-    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                      n_threads: int = _D.threads) -> np.ndarray:
-        """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
-        x = _rows(X, (3, 4), "X")
-        out = np.empty(x.shape[0], dtype=np.float64)
-        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("score_samples"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(self._h(), x, x.shape[0],
-                                                                                     x.shape[1], o.ptr, out))
-        return out
+    # The world-frame queries on the map itself (no export, no copy) come from
+    # Queryable: each answer is bitwise what the same GMM method gives on
+    # export(); a map without components (nothing flushed yet) raises
+    # InvalidDataError. Each holds the map's use guard for reading.
+    _C_PREFIX = "sogmm_map"
 
-    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                     n_threads: int = _D.threads) -> tuple[np.ndarray, np.ndarray]:
-        """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
-        x = _rows(xyz, (3,), "xyz")
-        mean = np.empty(x.shape[0], dtype=np.float32)
-        var = np.empty(x.shape[0], dtype=np.float32)
-        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("regress_gray"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(self._h(), x, x.shape[0], o.ptr,
-                                                                                    mean, var))
-        return mean, var
-
-    def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
-               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The map seen from ``camera`` at the camera-to-world ``pose``: bitwise
-        ``self.export().render(...)`` (see GMM.render). An empty map: InvalidDataError."""
-        from .render import render_images
-
-        return render_images(lib.sogmm_map_render_f32, self._h(), camera, pose, depth_min, depth_trunc, n_threads,
-                             progress)
+    def _reading(self, what: str):
+        return self._guard.reading(what)
 
     def occupancy(self, points, return_state: bool = False, *, surface_sigma: float = _D.occupancy_sigma,
                   thickness: float = _D.occupancy_thickness, n_threads: int = _D.threads,
@@ -377,34 +352,9 @@ class Map:
         state = np.empty(x.shape[0], dtype=np.uint8)
         state_ptr = state.ctypes.data if state.size else None
         f64 = {_ffi.OPT_OCCUPANCY_SIGMA: surface_sigma, _ffi.OPT_OCCUPANCY_THICKNESS: thickness}
-        with _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}) as o, self._guard.reading("occupancy"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_occupancy_f32(self._h(), x, x.shape[0], o.ptr,
-                                                                                 prob, state_ptr))
+        self._query("occupancy", "occupancy_f32", _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}), progress,
+                    lambda o: (x, x.shape[0], o, prob, state_ptr))
         return (prob, state) if return_state else prob
-
-    def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                         n_threads: int = _D.threads, progress: ProgressArg = None):
-        """Distance of (n, 3) world points to the map's surface (see GMM.surface_distance);
-        an empty map: InvalidDataError."""
-        with self._guard.reading("surface_distance"):
-            return _surface_distance(lib.sogmm_map_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
-                                     n_threads, progress)
-
-    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
-        """Collision probability of ellipsoidal robots against the map (see
-        GMM.collision_probability); an empty map: InvalidDataError."""
-        with self._guard.reading("collision_probability"):
-            return _collision(lib.sogmm_map_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
-                              progress)
-
-    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
-               spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
-        """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""
-        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
-        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o, self._guard.reading("sample"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_sample_f32(self._h(), n, seed, dims, o.ptr, out))
-        return out
 
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),

@@ -1,17 +1,15 @@
 //! `Map`: an owned sogmm_map handle, the incremental world map of posed
 //! frames (core/include/sogmm/map.hpp): only the points the map does not yet
 //! explain are fitted and merged in the world frame.
-use std::ops::ControlFlow;
 use std::path::Path;
 use std::ptr::{self, NonNull};
 
 use sogmm_sys as sys;
 
 use crate::error::{check, Result};
-use crate::model::{c_path, dims_ok, len_of, regress_with, rows, score_with, Frame, Model};
+use crate::model::{c_path, rows, Frame, Model};
 use crate::options::{opt_ptr, Options};
-use crate::progress::{with_map_progress, with_progress, Progress};
-use crate::render::{render_into, Camera, Rendered};
+use crate::progress::{with_map_progress, ProgressHook};
 
 /// A row-major 4 x 4 rigid camera-to-world transform [R t; 0 0 0 1].
 pub type Pose = [f64; 16];
@@ -52,27 +50,31 @@ pub struct MapFrameStats {
 }
 
 /// An incremental world map. Inserting needs `&mut self`; the queries
-/// (`stats`, `export`, `score_samples`, `regress_gray`, `sample`, `save`)
-/// take `&self` and may run on many threads at once.
+/// (`stats`, `export`, `save`, `occupancy` and those of `Queryable`) take
+/// `&self` and may run on many threads at once.
 ///
 /// The C library refuses a call on a map that another call is using
 /// (SOGMM_E_BUSY, "map busy"); here the borrow rules already forbid it, so
-/// `Status::Busy` never comes from safe code. A progress closure cannot reach
-/// the map whose insert runs it:
+/// `Status::Busy` never comes from safe code. A progress closure is
+/// `'static`, so it cannot reach the map whose insert runs it:
 ///
 /// ```compile_fail
-/// let mut map = sogmm::Map::new(None).unwrap();
-/// map.flush_with_progress(|_| {
-///     let _ = map.stats(); // error[E0502]: `map` is already borrowed as mutable
-///     std::ops::ControlFlow::Continue(())
-/// })
-/// .unwrap();
+/// let map = sogmm::Map::new(None).unwrap();
+/// let opts = sogmm::Options::builder()
+///     .on_progress(|_| {
+///         let _ = map.stats(); // error[E0373]: closure may outlive `map`
+///         std::ops::ControlFlow::Continue(())
+///     })
+///     .build()
+///     .unwrap();
 /// ```
 ///
 /// and dropping it from another thread while an insert runs needs the map
 /// by value, which the insert's `&mut` borrow prevents.
 pub struct Map {
     ptr: NonNull<sys::sogmm_map>,
+    /// The progress closure of the options the map was created with.
+    progress: Option<ProgressHook>,
 }
 
 // SAFETY: sogmm.h: functions taking a const map may run concurrently on one
@@ -83,12 +85,13 @@ unsafe impl Send for Map {}
 unsafe impl Sync for Map {}
 
 impl Map {
-    fn make(f: impl FnOnce(*mut *mut sys::sogmm_map) -> i32) -> Result<Map> {
+    fn make(options: Option<&Options>, f: impl FnOnce(*mut *mut sys::sogmm_map) -> i32) -> Result<Map> {
         crate::ensure_abi()?;
         let mut out = ptr::null_mut();
         check(f(&mut out))?;
         Ok(Map {
             ptr: NonNull::new(out).expect("libsogmm returned OK and a NULL map"),
+            progress: options.and_then(Options::progress).cloned(),
         })
     }
 
@@ -97,10 +100,14 @@ impl Map {
     }
 
     /// An empty map with the map, fit and RGB-D keys of `options` (None =
-    /// defaults: novelty 3.0 nats, batches of 12,288 points, no fusion).
+    /// defaults: novelty 3.0 nats, batches of 12,288 points, no fusion). Its
+    /// inserts and flushes report to the options' progress closure
+    /// (`OptionsBuilder::on_progress`), which may cancel them: `Err` with
+    /// `Status::Cancelled` (a panic cancels too, then resumes) and the map as
+    /// before the call.
     pub fn new(options: Option<&Options>) -> Result<Map> {
         // SAFETY: valid out-pointer; options a valid handle or NULL.
-        Map::make(|out| unsafe { sys::sogmm_map_create(out, opt_ptr(options)) })
+        Map::make(options, |out| unsafe { sys::sogmm_map_create(out, opt_ptr(options)) })
     }
 
     /// Reads a map file written by `save` (or any world-frame model, without
@@ -108,29 +115,41 @@ impl Map {
     pub fn load(path: impl AsRef<Path>, options: Option<&Options>) -> Result<Map> {
         let p = c_path(path.as_ref())?;
         // SAFETY: NUL-terminated path.
-        Map::make(|out| unsafe { sys::sogmm_map_load(out, p.as_ptr(), opt_ptr(options)) })
+        Map::make(options, |out| unsafe {
+            sys::sogmm_map_load(out, p.as_ptr(), opt_ptr(options))
+        })
     }
 
     /// Inserts n points (rows of x, y, z, gray) in the camera frame with the
     /// frame's camera-to-world pose. A failed insert leaves the map as it was.
     pub fn insert_points(&mut self, points: &[f32], pose: &Pose) -> Result<()> {
         let n = rows(points, 4, "points")?;
+        let map = self.ptr.as_ptr();
         // SAFETY: exclusive through &mut self; n * 4 floats and 16 doubles.
-        check(unsafe { sys::sogmm_map_insert_points_f32(self.ptr.as_ptr(), points.as_ptr(), n, pose.as_ptr()) })
+        with_map_progress(map, self.progress.as_ref(), || {
+            check(unsafe { sys::sogmm_map_insert_points_f32(map, points.as_ptr(), n, pose.as_ptr()) })
+        })
     }
 
     /// Inserts an RGB-D frame (decimation and depth range from the map's
     /// options) with its camera-to-world pose. The first frame fixes the camera.
     pub fn insert_frame(&mut self, frame: &Frame<'_>, pose: &Pose) -> Result<()> {
         let h = frame.handle()?;
+        let map = self.ptr.as_ptr();
         // SAFETY: exclusive through &mut self; a valid frame and 16 doubles.
-        check(unsafe { sys::sogmm_map_insert_frame(self.ptr.as_ptr(), h.0, pose.as_ptr()) })
+        with_map_progress(map, self.progress.as_ref(), || {
+            check(unsafe { sys::sogmm_map_insert_frame(map, h.0, pose.as_ptr()) })
+        })
     }
 
-    /// Fits the pending points now (nothing when none are pending).
+    /// Fits the pending points now (nothing when none are pending); a
+    /// cancelled flush keeps them.
     pub fn flush(&mut self) -> Result<()> {
+        let map = self.ptr.as_ptr();
         // SAFETY: exclusive through &mut self.
-        check(unsafe { sys::sogmm_map_flush(self.ptr.as_ptr()) })
+        with_map_progress(map, self.progress.as_ref(), || {
+            check(unsafe { sys::sogmm_map_flush(map) })
+        })
     }
 
     /// Drops the points pending for a fit (they never become components) and
@@ -141,38 +160,6 @@ impl Map {
         // SAFETY: exclusive through &mut self; `dropped` outlives the call.
         check(unsafe { sys::sogmm_map_discard_pending(self.ptr.as_ptr(), &mut dropped) })?;
         Ok(dropped)
-    }
-
-    /// As `insert_points`, reporting the fit it may run to `on_progress`
-    /// (see `Model::fit_with_progress`). `ControlFlow::Break(())` or a panic
-    /// cancels: `Err` with `Status::Cancelled` (the panic resumes) and the
-    /// map as before the call.
-    pub fn insert_points_with_progress(
-        &mut self,
-        points: &[f32],
-        pose: &Pose,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<()> {
-        let map = self.ptr.as_ptr();
-        with_map_progress(map, on_progress, || self.insert_points(points, pose))
-    }
-
-    /// As `insert_frame`, with progress and cancel as `insert_points_with_progress`.
-    pub fn insert_frame_with_progress(
-        &mut self,
-        frame: &Frame<'_>,
-        pose: &Pose,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<()> {
-        let map = self.ptr.as_ptr();
-        with_map_progress(map, on_progress, || self.insert_frame(frame, pose))
-    }
-
-    /// As `flush`, with progress and cancel; a cancelled flush keeps the
-    /// pending points.
-    pub fn flush_with_progress(&mut self, on_progress: impl FnMut(Progress) -> ControlFlow<()>) -> Result<()> {
-        let map = self.ptr.as_ptr();
-        with_map_progress(map, on_progress, || self.flush())
     }
 
     /// The map's totals (read key by key, `sogmm_map_get_i64`).
@@ -235,113 +222,6 @@ impl Map {
     pub fn export_box(&self, bounds: &[f32; 6]) -> Result<Model> {
         // SAFETY: valid handles; 6 floats.
         Model::make(|out| unsafe { sys::sogmm_map_export(out, self.raw(), bounds.as_ptr()) })
-    }
-
-    /// Log-density of world points (rows of `dims` floats; 4: joint, 3:
-    /// marginal over gray), bitwise what `export()?.score_samples` gives,
-    /// without the copy.
-    pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
-        self.score_raw(points, dims, opt_ptr(None))
-    }
-
-    /// As `score_samples`, with the threads and culling of `options` (as
-    /// `Model::score_samples_with`).
-    pub fn score_samples_with(&self, points: &[f32], dims: i32, options: Option<&Options>) -> Result<Vec<f64>> {
-        self.score_raw(points, dims, opt_ptr(options))
-    }
-
-    /// As `score_samples_with` (threads and culling of `options`), reporting
-    /// `Stage::Scoring` and cancellable.
-    pub fn score_samples_with_progress(
-        &self,
-        points: &[f32],
-        dims: i32,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Vec<f64>> {
-        with_progress(options, on_progress, |o| self.score_raw(points, dims, o))
-    }
-
-    fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
-        // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
-        score_with(points, dims, |n, out| unsafe {
-            sys::sogmm_map_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
-        })
-    }
-
-    /// Expected gray and its variance at world points (`xyz`: rows of 3).
-    pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
-        self.regress_raw(xyz, opt_ptr(None))
-    }
-
-    /// As `regress_gray`, with the threads and culling of `options` (as
-    /// `Model::regress_gray_with`).
-    pub fn regress_gray_with(&self, xyz: &[f32], options: Option<&Options>) -> Result<(Vec<f32>, Vec<f32>)> {
-        self.regress_raw(xyz, opt_ptr(options))
-    }
-
-    /// As `regress_gray_with` (threads and culling of `options`), reporting
-    /// `Stage::Regression` and cancellable.
-    pub fn regress_gray_with_progress(
-        &self,
-        xyz: &[f32],
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<(Vec<f32>, Vec<f32>)> {
-        with_progress(options, on_progress, |o| self.regress_raw(xyz, o))
-    }
-
-    fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
-        // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
-        regress_with(xyz, |n, mean, var| unsafe {
-            sys::sogmm_map_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
-        })
-    }
-
-    /// The map seen from `camera` at the camera-to-world `pose`: the same
-    /// bits as `self.export()?.render(...)` (see `Model::render`).
-    pub fn render(&self, camera: &Camera, pose: Option<&Pose>, options: Option<&Options>) -> Result<Rendered> {
-        self.render_raw(camera, pose, opt_ptr(options))
-    }
-
-    /// As `render`, reporting `Stage::Rendering` and cancellable.
-    pub fn render_with_progress(
-        &self,
-        camera: &Camera,
-        pose: Option<&Pose>,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Rendered> {
-        with_progress(options, on_progress, |o| self.render_raw(camera, pose, o))
-    }
-
-    fn render_raw(&self, camera: &Camera, pose: Option<&Pose>, o: *const sys::sogmm_options) -> Result<Rendered> {
-        render_into(sys::sogmm_map_render_f32, self.raw(), camera, pose, o)
-    }
-
-    /// Draws n world points (rows of `dims` floats, grouped by component);
-    /// `options` gives SOGMM_OPT_SAMPLE_TRUNCATION (None = 2.5).
-    pub fn sample(&self, n: usize, seed: u64, dims: i32, options: Option<&Options>) -> Result<Vec<f32>> {
-        self.sample_raw(n, seed, dims, opt_ptr(options))
-    }
-
-    /// As `sample`, reporting `Stage::Sampling` and cancellable.
-    pub fn sample_with_progress(
-        &self,
-        n: usize,
-        seed: u64,
-        dims: i32,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Vec<f32>> {
-        with_progress(options, on_progress, |o| self.sample_raw(n, seed, dims, o))
-    }
-
-    fn sample_raw(&self, n: usize, seed: u64, dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f32>> {
-        let mut out = vec![0.0f32; len_of(n, dims_ok(dims)?, "samples")?];
-        // SAFETY: `out` holds n * dims floats.
-        check(unsafe { sys::sogmm_map_sample_f32(self.raw(), n, seed, dims, o, out.as_mut_ptr()) })?;
-        Ok(out)
     }
 
     /// Writes the map as a world-frame .sogmm file with its frame provenance,

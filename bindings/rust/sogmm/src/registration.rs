@@ -7,7 +7,7 @@ use sogmm_sys as sys;
 use crate::error::{check, Result};
 use crate::map::Pose;
 use crate::model::rows;
-use crate::options::opt_ptr;
+use crate::progress::with_progress;
 use crate::{Model, Options};
 
 /// How a registration ended (`SOGMM_REGISTRATION_*`).
@@ -47,7 +47,8 @@ pub struct Registration {
 impl Model {
     /// The rigid pose that best explains `points` (rows of x, y, z, gray in
     /// their own frame) under this model, from `init` (None = identity).
-    /// Check `status`: the pose is an estimate only when `Converged`.
+    /// Check `status`: the pose is an estimate only when `Converged`. The
+    /// options' progress closure gets `Stage::Registration` reports.
     pub fn register_points(
         &self,
         points: &[f32],
@@ -68,17 +69,19 @@ impl Model {
             eigen_ratio: 0.0,
         };
         let init_ptr = init.map_or(std::ptr::null(), |p| p.as_ptr());
-        // SAFETY: n rows of 4 floats, init 16 doubles or NULL, room for 16 doubles and the sized struct.
-        check(unsafe {
-            sys::sogmm_register_points_f32(
-                self.raw(),
-                points.as_ptr(),
-                n,
-                init_ptr,
-                opt_ptr(options),
-                pose.as_mut_ptr(),
-                &mut info,
-            )
+        with_progress(options, |o| {
+            // SAFETY: n rows of 4 floats, init 16 doubles or NULL, room for 16 doubles and the sized struct.
+            check(unsafe {
+                sys::sogmm_register_points_f32(
+                    self.raw(),
+                    points.as_ptr(),
+                    n,
+                    init_ptr,
+                    o,
+                    pose.as_mut_ptr(),
+                    &mut info,
+                )
+            })
         })?;
         let status = match info.status {
             sys::SOGMM_REGISTRATION_CONVERGED => RegistrationStatus::Converged,
