@@ -3,13 +3,7 @@ package sogmm
 // reporting is a copy of o (nil: defaults) whose progress func is fn, as a
 // caller writes NewOptions(..., OnProgress(fn)).
 func reporting(o *Options, fn ProgressFunc) *Options {
-	var c *Options
-	var err error
-	if o == nil {
-		c, err = NewOptions()
-	} else {
-		c, err = o.Clone()
-	}
+	c, err := o.copyOrDefaults()
 	if err == nil {
 		err = c.Set(OnProgress(fn))
 	}

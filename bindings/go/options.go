@@ -147,6 +147,14 @@ func (o *Options) Clone() (*Options, error) {
 	return c, nil
 }
 
+// copyOrDefaults is a new handle: a Clone of o, or the defaults for a nil o.
+func (o *Options) copyOrDefaults() (*Options, error) {
+	if o == nil {
+		return NewOptions()
+	}
+	return o.Clone()
+}
+
 // OnProgress makes every call given these options report to fn (see
 // ProgressFunc); nil removes it. A map keeps the one of the options it was
 // created with for its inserts and flushes.

@@ -100,13 +100,7 @@ func withProgress[T any](ctx context.Context, o *Options, create func(o *Options
 	if ctx.Done() == nil && fn == nil { // nothing can cancel, nobody listens
 		return create(o)
 	}
-	var private *Options
-	var err error
-	if o == nil {
-		private, err = NewOptions()
-	} else {
-		private, err = o.Clone()
-	}
+	private, err := o.copyOrDefaults()
 	if err != nil {
 		return zero, err
 	}
