@@ -87,12 +87,15 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	return m, nil
 }
 
-// NewMap creates an empty map with the map, fit and RGB-D keys of o (nil = defaults).
+// NewMap creates an empty map with the map, fit and RGB-D keys of o (nil =
+// defaults) and its progress func (OnProgress), to which the map's inserts
+// and flushes report.
 func NewMap(o *Options) (*Map, error) {
 	return wrapMap(o, func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status { return C.sogmm_map_create(out, op) })
 }
 
-// LoadMap reads a map file (or any world-frame model); o's keys govern later inserts.
+// LoadMap reads a map file (or any world-frame model); o's keys and progress
+// func govern later inserts.
 func LoadMap(path string, o *Options) (*Map, error) {
 	cp := C.CString(path)
 	defer C.free(unsafe.Pointer(cp))

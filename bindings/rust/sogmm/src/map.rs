@@ -111,7 +111,8 @@ impl Map {
     }
 
     /// Reads a map file written by `save` (or any world-frame model, without
-    /// frame provenance); the keys of `options` govern later inserts.
+    /// frame provenance); the keys of `options` and their progress closure
+    /// govern later inserts.
     pub fn load(path: impl AsRef<Path>, options: Option<&Options>) -> Result<Map> {
         let p = c_path(path.as_ref())?;
         // SAFETY: NUL-terminated path.
