@@ -9,27 +9,11 @@ import (
 	"unsafe"
 )
 
-// Map option keys (sogmm.h): novelty test, batch size and fusion of an
-// incremental map; a map also uses the fit and RGB-D keys.
+// The values of OptMapFusionMethod (a map's keys are OptMap*; a map also
+// uses the fit and RGB-D keys).
 const (
-	OptMapNovelty          Key = C.SOGMM_OPT_MAP_NOVELTY
-	OptMapNoveltyThreshold Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
-	// OptMapNoveltyBandwidthScale (f64, (0, 1], default 0.7): with novelty on,
-	// the batches of novel points are fitted with OptBandwidth times this.
-	OptMapNoveltyBandwidthScale Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
-	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.25): an RGB-D
-	// insert whose explained points have at least this many times as many
-	// modes as the map has components on its surfaces replaces those
-	// components by a fit of its points plus samples of their unseen mass
-	// (not with a fixed K or OptMapWarmStart).
-	OptMapRevisitRefitRatio Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
-	OptMapBatchSize         Key = C.SOGMM_OPT_MAP_BATCH_SIZE
-	OptMapFusion            Key = C.SOGMM_OPT_MAP_FUSION
-	OptMapFusionMethod      Key = C.SOGMM_OPT_MAP_FUSION_METHOD
-	OptMapFusionThreshold   Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
-	OptMapWarmStart         Key = C.SOGMM_OPT_MAP_WARM_START
-	FusionHellinger             = C.SOGMM_FUSION_HELLINGER
-	FusionKL                    = C.SOGMM_FUSION_KL
+	FusionHellinger = C.SOGMM_FUSION_HELLINGER
+	FusionKL        = C.SOGMM_FUSION_KL
 )
 
 // Map is an owned sogmm_map: an incremental world map that fits only the

@@ -120,7 +120,7 @@ struct OptionSpec {
   std::int64_t upper_i64;  ///< I64 rows: largest accepted value
   const char* range;  ///< the accepted values in words, e.g. "> 0, finite"
   const char* unit;   ///< e.g. "m", "nats", "" when dimensionless
-  const char* doc;    ///< one sentence: what the setting does
+  const char* doc;    ///< what the setting does, complete: sogmm.h and spec/api.md document the key with it
   bool (*accepts_f64)(double);        ///< F64 rows: the whole rule
   bool (*accepts_i64)(std::int64_t);  ///< I64 rows: the whole rule
   double (*get_f64)(const Settings&);
