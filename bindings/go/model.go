@@ -10,22 +10,6 @@ import (
 	"unsafe"
 )
 
-// Information keys of a model (SOGMM_INFO_*); read with InfoF64 / InfoI64.
-const (
-	InfoSupportSize    Key = C.SOGMM_INFO_SUPPORT_SIZE
-	InfoCreatedUnixMs  Key = C.SOGMM_INFO_CREATED_UNIX_MS
-	InfoFitIterations  Key = C.SOGMM_INFO_FIT_ITERATIONS
-	InfoFitConverged   Key = C.SOGMM_INFO_FIT_CONVERGED
-	InfoFitLogLik      Key = C.SOGMM_INFO_FIT_LOG_LIKELIHOOD
-	InfoFitBandwidth   Key = C.SOGMM_INFO_FIT_BANDWIDTH
-	InfoFitSeed        Key = C.SOGMM_INFO_FIT_SEED
-	InfoFitNPoints     Key = C.SOGMM_INFO_FIT_N_POINTS
-	InfoFitSecondsTot  Key = C.SOGMM_INFO_FIT_SECONDS_TOTAL
-	InfoCameraWidth    Key = C.SOGMM_INFO_CAMERA_WIDTH
-	InfoCameraHeight   Key = C.SOGMM_INFO_CAMERA_HEIGHT
-	InfoCameraDecimate Key = C.SOGMM_INFO_CAMERA_DECIMATION
-)
-
 // Model is an owned sogmm_model: a fitted 4-D GMM (x, y, z, gray) with its
 // metadata. Arrays come out row-major: weights (M), means (M x 4),
 // covariances (M x 4 x 4).

@@ -201,9 +201,16 @@ impl Model {
     /// Fits a model to n points: `points` holds n rows (x, y, z, gray).
     /// Uses the fit keys of `options` (None = defaults).
     pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
+        Model::fit_points_raw(points, None, opt_ptr(options))
+    }
+
+    /// sogmm_fit_points_f32: cold (`initial` None) or warm; `o` valid options or NULL.
+    fn fit_points_raw(points: &[f32], initial: Option<&Model>, o: *const sys::sogmm_options) -> Result<Model> {
         let n = rows(points, 4, "points")?;
-        // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), opt_ptr(options)) })
+        let initial = initial.map_or(ptr::null(), Model::raw);
+        // SAFETY: `points` holds n * 4 floats and `initial` is a valid handle or NULL, both only read
+        // during the call.
+        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial, o) })
     }
 
     /// As `fit`, reporting progress to `on_progress` (called only on this
@@ -216,12 +223,9 @@ impl Model {
         options: Option<&Options>,
         on_progress: impl FnMut(Progress) -> ControlFlow<()>,
     ) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
+        rows(points, 4, "points")?;
         crate::ensure_abi()?;
-        with_progress(options, on_progress, |o| {
-            // SAFETY: as fit; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), o) })
-        })
+        with_progress(options, on_progress, |o| Model::fit_points_raw(points, None, o))
     }
 
     /// As `fit_rgbd`, with progress and cancel as `fit_with_progress`.
@@ -242,11 +246,7 @@ impl Model {
     /// = K, EM runs from `initial` as given (K must be its size). Needs
     /// n_init 1. `initial` is not changed.
     pub fn fit_warm(points: &[f32], initial: &Model, options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
-        Model::make(|out| unsafe {
-            sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
-        })
+        Model::fit_points_raw(points, Some(initial), opt_ptr(options))
     }
 
     /// As `fit_warm`, with progress and cancel as `fit_with_progress`.
@@ -256,11 +256,10 @@ impl Model {
         options: Option<&Options>,
         on_progress: impl FnMut(Progress) -> ControlFlow<()>,
     ) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
+        rows(points, 4, "points")?;
         crate::ensure_abi()?;
         with_progress(options, on_progress, |o| {
-            // SAFETY: as fit_warm; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), o) })
+            Model::fit_points_raw(points, Some(initial), o)
         })
     }
 
