@@ -49,13 +49,8 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Map{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&m.ptr, op) }); err != nil {
 		return nil, err
 	}
 	runtime.SetFinalizer(m, (*Map).Close)
@@ -100,13 +95,8 @@ func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the

@@ -26,13 +26,8 @@ func newModel(o *Options, f func(out **C.sogmm_model, op *C.sogmm_options) C.sog
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Model{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&m.ptr, op) }); err != nil {
 		return nil, err
 	}
 	runtime.SetFinalizer(m, func(m *Model) {
@@ -48,13 +43,8 @@ func (m *Model) do(o *Options, f func(p *C.sogmm_model, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // derive creates a new model from m (clone, merge, transform).

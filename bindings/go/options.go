@@ -117,6 +117,17 @@ func (o *Options) raw() (*C.sogmm_options, error) {
 	return o.ptr, nil
 }
 
+// callWith runs one C call with o's handle (nil o = NULL = defaults), keeping
+// o alive until it returns; a closed o gives ErrClosed.
+func callWith(o *Options, f func(op *C.sogmm_options) C.sogmm_status) error {
+	op, err := o.raw()
+	if err != nil {
+		return err
+	}
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return f(op) })
+}
+
 // do runs one C call on o's handle, keeping o alive until it returns.
 func (o *Options) do(f func(p *C.sogmm_options) C.sogmm_status) error {
 	if o == nil || o.ptr == nil {
