@@ -10,27 +10,11 @@ import (
 	"unsafe"
 )
 
-// Map option keys (sogmm.h): novelty test, batch size and fusion of an
-// incremental map; a map also uses the fit and RGB-D keys.
+// The values of OptMapFusionMethod (a map's keys are OptMap*; a map also
+// uses the fit and RGB-D keys).
 const (
-	OptMapNovelty          Key = C.SOGMM_OPT_MAP_NOVELTY
-	OptMapNoveltyThreshold Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
-	// OptMapNoveltyBandwidthScale (f64, (0, 1], default 0.7): with novelty on,
-	// the batches of novel points are fitted with OptBandwidth times this.
-	OptMapNoveltyBandwidthScale Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
-	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.25): an RGB-D
-	// insert whose explained points have at least this many times as many
-	// modes as the map has components on its surfaces replaces those
-	// components by a fit of its points plus samples of their unseen mass
-	// (not with a fixed K or OptMapWarmStart).
-	OptMapRevisitRefitRatio Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
-	OptMapBatchSize         Key = C.SOGMM_OPT_MAP_BATCH_SIZE
-	OptMapFusion            Key = C.SOGMM_OPT_MAP_FUSION
-	OptMapFusionMethod      Key = C.SOGMM_OPT_MAP_FUSION_METHOD
-	OptMapFusionThreshold   Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
-	OptMapWarmStart         Key = C.SOGMM_OPT_MAP_WARM_START
-	FusionHellinger             = C.SOGMM_FUSION_HELLINGER
-	FusionKL                    = C.SOGMM_FUSION_KL
+	FusionHellinger = C.SOGMM_FUSION_HELLINGER
+	FusionKL        = C.SOGMM_FUSION_KL
 )
 
 // Map is an owned sogmm_map: an incremental world map that fits only the
@@ -67,11 +51,6 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Map{}
 	if o != nil {
 		m.progress = o.progress
@@ -79,7 +58,7 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	// The handle comes out in a local: cgo refuses a pointer into a struct
 	// that holds Go pointers (the progress func).
 	var ptr *C.sogmm_map
-	if err := call(func() C.sogmm_status { return f(&ptr, op) }); err != nil {
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&ptr, op) }); err != nil {
 		return nil, err
 	}
 	m.ptr = ptr
@@ -128,13 +107,8 @@ func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the

@@ -11,22 +11,6 @@ import (
 	"unsafe"
 )
 
-// Information keys of a model (SOGMM_INFO_*); read with InfoF64 / InfoI64.
-const (
-	InfoSupportSize    Key = C.SOGMM_INFO_SUPPORT_SIZE
-	InfoCreatedUnixMs  Key = C.SOGMM_INFO_CREATED_UNIX_MS
-	InfoFitIterations  Key = C.SOGMM_INFO_FIT_ITERATIONS
-	InfoFitConverged   Key = C.SOGMM_INFO_FIT_CONVERGED
-	InfoFitLogLik      Key = C.SOGMM_INFO_FIT_LOG_LIKELIHOOD
-	InfoFitBandwidth   Key = C.SOGMM_INFO_FIT_BANDWIDTH
-	InfoFitSeed        Key = C.SOGMM_INFO_FIT_SEED
-	InfoFitNPoints     Key = C.SOGMM_INFO_FIT_N_POINTS
-	InfoFitSecondsTot  Key = C.SOGMM_INFO_FIT_SECONDS_TOTAL
-	InfoCameraWidth    Key = C.SOGMM_INFO_CAMERA_WIDTH
-	InfoCameraHeight   Key = C.SOGMM_INFO_CAMERA_HEIGHT
-	InfoCameraDecimate Key = C.SOGMM_INFO_CAMERA_DECIMATION
-)
-
 // Model is an owned sogmm_model: a fitted 4-D GMM (x, y, z, gray) with its
 // metadata. Arrays come out row-major: weights (M), means (M x 4),
 // covariances (M x 4 x 4).
@@ -43,13 +27,8 @@ func newModel(o *Options, f func(out **C.sogmm_model, op *C.sogmm_options) C.sog
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Model{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&m.ptr, op) }); err != nil {
 		return nil, err
 	}
 	runtime.SetFinalizer(m, func(m *Model) {
@@ -65,13 +44,8 @@ func (m *Model) do(o *Options, f func(p *C.sogmm_model, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // derive creates a new model from m (clone, merge, transform).

@@ -8,32 +8,57 @@ import "runtime"
 // Key names an option (SOGMM_OPT_*) or a model information value (SOGMM_INFO_*).
 type Key int32
 
-// Option keys (types and ranges: sogmm.h and spec/api.md).
+// BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp)
+
+// Option keys: the C macros by their Go names (types, ranges, defaults and
+// meaning: sogmm.h, spec/api.md, or OptionInfoOf at run time).
 const (
-	OptBandwidth        Key = C.SOGMM_OPT_BANDWIDTH
-	OptNComponents      Key = C.SOGMM_OPT_N_COMPONENTS
-	OptTol              Key = C.SOGMM_OPT_TOL
-	OptRegCovar         Key = C.SOGMM_OPT_REG_COVAR
-	OptMaxIter          Key = C.SOGMM_OPT_MAX_ITER
-	OptSeed             Key = C.SOGMM_OPT_SEED
-	OptThreads          Key = C.SOGMM_OPT_THREADS
-	OptModeCounter      Key = C.SOGMM_OPT_MODE_COUNTER
-	OptTruncationNats   Key = C.SOGMM_OPT_TRUNCATION_NATS
-	OptNInit            Key = C.SOGMM_OPT_N_INIT
-	OptDequantiseDepth  Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
-	OptDepthScale       Key = C.SOGMM_OPT_DEPTH_SCALE
-	OptDepthMin         Key = C.SOGMM_OPT_DEPTH_MIN
-	OptDepthMax         Key = C.SOGMM_OPT_DEPTH_MAX
-	OptDecimation       Key = C.SOGMM_OPT_DECIMATION
-	OptZstdLevel        Key = C.SOGMM_OPT_ZSTD_LEVEL
-	OptFloat64          Key = C.SOGMM_OPT_FLOAT64
-	OptCompress         Key = C.SOGMM_OPT_COMPRESS
-	OptMaxDecodedBytes  Key = C.SOGMM_OPT_MAX_DECODED_BYTES
-	OptVerifyChecksums  Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
-	OptSampleTruncation Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
-	// OptQueryTruncationNats culls the queries given these options (see QueryTruncationNats).
-	OptQueryTruncationNats Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
+	OptBandwidth                   Key = C.SOGMM_OPT_BANDWIDTH
+	OptNComponents                 Key = C.SOGMM_OPT_N_COMPONENTS
+	OptTol                         Key = C.SOGMM_OPT_TOL
+	OptRegCovar                    Key = C.SOGMM_OPT_REG_COVAR
+	OptMaxIter                     Key = C.SOGMM_OPT_MAX_ITER
+	OptSeed                        Key = C.SOGMM_OPT_SEED
+	OptThreads                     Key = C.SOGMM_OPT_THREADS
+	OptModeCounter                 Key = C.SOGMM_OPT_MODE_COUNTER
+	OptTruncationNats              Key = C.SOGMM_OPT_TRUNCATION_NATS
+	OptNInit                       Key = C.SOGMM_OPT_N_INIT
+	OptDequantiseDepth             Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
+	OptDepthScale                  Key = C.SOGMM_OPT_DEPTH_SCALE
+	OptDepthMin                    Key = C.SOGMM_OPT_DEPTH_MIN
+	OptDepthMax                    Key = C.SOGMM_OPT_DEPTH_MAX
+	OptDecimation                  Key = C.SOGMM_OPT_DECIMATION
+	OptZstdLevel                   Key = C.SOGMM_OPT_ZSTD_LEVEL
+	OptFloat64                     Key = C.SOGMM_OPT_FLOAT64
+	OptCompress                    Key = C.SOGMM_OPT_COMPRESS
+	OptMaxDecodedBytes             Key = C.SOGMM_OPT_MAX_DECODED_BYTES
+	OptVerifyChecksums             Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
+	OptSampleTruncation            Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
+	OptQueryTruncationNats         Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
+	OptMapNovelty                  Key = C.SOGMM_OPT_MAP_NOVELTY
+	OptMapNoveltyThreshold         Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
+	OptMapBatchSize                Key = C.SOGMM_OPT_MAP_BATCH_SIZE
+	OptMapFusion                   Key = C.SOGMM_OPT_MAP_FUSION
+	OptMapFusionMethod             Key = C.SOGMM_OPT_MAP_FUSION_METHOD
+	OptMapFusionThreshold          Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
+	OptMapWarmStart                Key = C.SOGMM_OPT_MAP_WARM_START
+	OptMapNoveltyBandwidthScale    Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
+	OptMapRevisitRefitRatio        Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
+	OptOccupancySigma              Key = C.SOGMM_OPT_OCCUPANCY_SIGMA
+	OptOccupancyThickness          Key = C.SOGMM_OPT_OCCUPANCY_THICKNESS
+	OptSurfaceDiscSigmas           Key = C.SOGMM_OPT_SURFACE_DISC_SIGMAS
+	OptRegistrationMaxIter         Key = C.SOGMM_OPT_REGISTRATION_MAX_ITER
+	OptRegistrationTol             Key = C.SOGMM_OPT_REGISTRATION_TOL
+	OptRegistrationOutlierRatio    Key = C.SOGMM_OPT_REGISTRATION_OUTLIER_RATIO
+	OptRegistrationUseGray         Key = C.SOGMM_OPT_REGISTRATION_USE_GRAY
+	OptRegistrationLevels          Key = C.SOGMM_OPT_REGISTRATION_LEVELS
+	OptRegistrationCoarseSigma     Key = C.SOGMM_OPT_REGISTRATION_COARSE_SIGMA
+	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
+	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
+	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
 )
+
+// END GENERATED option keys
 
 // Options is an owned sogmm_options handle: parameters for fit, save, load
 // and sample. A nil *Options passed to any function means "all defaults".
@@ -95,6 +120,17 @@ func (o *Options) raw() (*C.sogmm_options, error) {
 		return nil, ErrClosed
 	}
 	return o.ptr, nil
+}
+
+// callWith runs one C call with o's handle (nil o = NULL = defaults), keeping
+// o alive until it returns; a closed o gives ErrClosed.
+func callWith(o *Options, f func(op *C.sogmm_options) C.sogmm_status) error {
+	op, err := o.raw()
+	if err != nil {
+		return err
+	}
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return f(op) })
 }
 
 // do runs one C call on o's handle, keeping o alive until it returns.

@@ -13,16 +13,6 @@ import (
 // Threads; progress StageRegistration.
 
 const (
-	OptRegistrationMaxIter         Key = C.SOGMM_OPT_REGISTRATION_MAX_ITER
-	OptRegistrationTol             Key = C.SOGMM_OPT_REGISTRATION_TOL
-	OptRegistrationOutlierRatio    Key = C.SOGMM_OPT_REGISTRATION_OUTLIER_RATIO
-	OptRegistrationUseGray         Key = C.SOGMM_OPT_REGISTRATION_USE_GRAY
-	OptRegistrationLevels          Key = C.SOGMM_OPT_REGISTRATION_LEVELS
-	OptRegistrationCoarseSigma     Key = C.SOGMM_OPT_REGISTRATION_COARSE_SIGMA
-	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
-	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
-	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
-
 	RegistrationConverged    = C.SOGMM_REGISTRATION_CONVERGED     // the pose is an estimate
 	RegistrationNotConverged = C.SOGMM_REGISTRATION_NOT_CONVERGED // iterations ran out, or no point near the target
 	RegistrationLowFitness   = C.SOGMM_REGISTRATION_LOW_FITNESS   // too few points explained by the target

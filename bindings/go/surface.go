@@ -14,10 +14,6 @@ import (
 // Threads.
 
 const (
-	OptOccupancySigma     Key = C.SOGMM_OPT_OCCUPANCY_SIGMA
-	OptOccupancyThickness Key = C.SOGMM_OPT_OCCUPANCY_THICKNESS
-	OptSurfaceDiscSigmas  Key = C.SOGMM_OPT_SURFACE_DISC_SIGMAS
-
 	OccupancyFree     = C.SOGMM_OCCUPANCY_FREE
 	OccupancyOccupied = C.SOGMM_OCCUPANCY_OCCUPIED
 	OccupancyUnknown  = C.SOGMM_OCCUPANCY_UNKNOWN

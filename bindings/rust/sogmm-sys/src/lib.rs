@@ -75,25 +75,18 @@ pub const SOGMM_E_CANCELLED: sogmm_status = -12;
 pub const SOGMM_E_BUSY: sogmm_status = -13;
 
 // ---- option keys ----------------------------------------------------------
+// BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp)
 pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;
 pub const SOGMM_OPT_N_COMPONENTS: sogmm_key = 101;
 pub const SOGMM_OPT_TOL: sogmm_key = 102;
 pub const SOGMM_OPT_REG_COVAR: sogmm_key = 103;
-/// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).
-pub const SOGMM_REG_COVAR_AUTO: f64 = -1.0;
 pub const SOGMM_OPT_MAX_ITER: sogmm_key = 104;
 pub const SOGMM_OPT_SEED: sogmm_key = 105;
 pub const SOGMM_OPT_THREADS: sogmm_key = 106;
 pub const SOGMM_OPT_MODE_COUNTER: sogmm_key = 107;
 pub const SOGMM_OPT_TRUNCATION_NATS: sogmm_key = 108;
 pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
-/// i64, SOGMM_DEQUANTISE_AUTO (default), 0 or 1: floor variances along viewing rays at the depth
-/// quantisation (see sogmm.h).
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
-/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
-pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
-pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
-pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
 pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;
 pub const SOGMM_OPT_DEPTH_MIN: sogmm_key = 201;
 pub const SOGMM_OPT_DEPTH_MAX: sogmm_key = 202;
@@ -107,13 +100,13 @@ pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
 pub const SOGMM_OPT_QUERY_TRUNCATION_NATS: sogmm_key = 501;
 pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
 pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
-pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
-pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
 pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
 pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
 pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
+pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
+pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
 pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
 pub const SOGMM_OPT_SURFACE_DISC_SIGMAS: sogmm_key = 702;
@@ -126,6 +119,14 @@ pub const SOGMM_OPT_REGISTRATION_COARSE_SIGMA: sogmm_key = 805;
 pub const SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO: sogmm_key = 806;
 pub const SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO: sogmm_key = 807;
 pub const SOGMM_OPT_REGISTRATION_MIN_POINTS: sogmm_key = 808;
+// END GENERATED option keys
+// ---- named values of option keys -------------------------------------------
+/// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).
+pub const SOGMM_REG_COVAR_AUTO: f64 = -1.0;
+/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
+pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
+pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
+pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
 pub const SOGMM_REGISTRATION_CONVERGED: i32 = 0;
 pub const SOGMM_REGISTRATION_NOT_CONVERGED: i32 = 1;
 pub const SOGMM_REGISTRATION_LOW_FITNESS: i32 = 2;

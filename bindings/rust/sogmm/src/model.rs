@@ -180,11 +180,18 @@ impl Model {
     /// reports; `ControlFlow::Break(())` cancels: `Err` with
     /// `Status::Cancelled` and no model, within about 50 ms.
     pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
+        Model::fit_points(points, None, options)
+    }
+
+    /// sogmm_fit_points_f32: cold (`initial` None) or warm, with the options' progress.
+    fn fit_points(points: &[f32], initial: Option<&Model>, options: Option<&Options>) -> Result<Model> {
         let n = rows(points, 4, "points")?;
         crate::ensure_abi()?;
+        let initial = initial.map_or(ptr::null(), Model::raw);
         with_progress(options, |o| {
-            // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), o) })
+            // SAFETY: `points` holds n * 4 floats and `initial` is a valid handle or NULL, both only read
+            // during the call.
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial, o) })
         })
     }
 
@@ -196,12 +203,7 @@ impl Model {
     /// = K, EM runs from `initial` as given (K must be its size). Needs
     /// n_init 1. `initial` is not changed. Progress and cancel as `fit`.
     pub fn fit_warm(points: &[f32], initial: &Model, options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        crate::ensure_abi()?;
-        with_progress(options, |o| {
-            // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), o) })
-        })
+        Model::fit_points(points, Some(initial), options)
     }
 
     /// Fits one RGB-D frame; decimation and depth range come from `options`;
