@@ -252,6 +252,16 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
     check(ev.get("psnr_data_range") == 1 and ev2.get("psnr_data_range") == 2, "eval --data-range: %s" % ev2)
     check(abs(ev2.get("psnr", 0) - ev.get("psnr", 0) - 20 * math.log10(2)) < 1e-9 and
           ev2.get("psnr_paper") == ev.get("psnr_paper"), "eval --data-range 2: %s vs %s" % (ev2, ev))
+    # --surface-sigma S only rejects modes (a pixel shown at S = 2 shows a mode that S = 0 also
+    # finds, and a pixel empty at S = 0 has no mode at all): never fewer empty pixels, the same
+    # observed pixels, the mass-weighted figures untouched; S < 0 is a usage error.
+    ev3 = run_json(["eval", model] + fargs + ["--surface-sigma", 2])
+    for key in ("", "_heldout"):
+        check(ev3.get("empty_share" + key, -1) >= ev.get("empty_share" + key, 2) and
+              ev3.get("n_pixels" + key) == ev.get("n_pixels" + key), "eval --surface-sigma 2%s: %s vs %s" % (key, ev3, ev))
+    check(ev3.get("psnr") == ev.get("psnr") and ev3.get("mre") == ev.get("mre"), "eval --surface-sigma 2 moved MRE/PSNR")
+    p = run(["eval", model] + fargs + ["--surface-sigma", -1], expect=2)
+    check("--surface-sigma" in p.stderr, "eval --surface-sigma -1: %r" % p.stderr)
     # --n-init: the kept run is the best, and a single fit with its seed is the same model.
     best = run_json(["eval"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "--seed", 5,
                                                        "--n-init", 3])
@@ -270,6 +280,11 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
     img = read_png(out)
     check(img.shape == (expect_h, expect_w), "render: %s, expected %dx%d" % (img.shape, expect_w, expect_h))
     check((img > 0).mean() > 0.6, "render: only %.2f of the pixels show the surface" % (img > 0).mean())
+    run(["render", model, "-o", out, "--surface-sigma", 2])
+    strict = read_png(out)
+    # Empty pixels are black; S = 2 only rejects modes, so it shows no more pixels than S = 0.
+    check(strict.shape == img.shape and 0 < (strict > 0).sum() <= (img > 0).sum(),
+          "render --surface-sigma 2: %d shown pixels against %d at S = 0" % ((strict > 0).sum(), (img > 0).sum()))
     run(["render", model, "-o", out, "--scale", "2"])
     check(png_size(out)[:2] == (2 * expect_w, 2 * expect_h), "render --scale 2 size %s" % (png_size(out),))
     run(["render", model, "-o", out, "--depth", fargs[1]])

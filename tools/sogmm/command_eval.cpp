@@ -28,6 +28,7 @@ struct EvalState {
   DepthOptions depth_options;
   FitOptions fit;
   double data_range = 1.0;  // honest PSNR's peak (--data-range)
+  double surface_sigma = 0.0;  // per-pixel renders: RenderOptions::surface_sigma (--surface-sigma)
   int frame = -1;           // --frame I of --trajectory (one frame of a world-frame model)
   bool json = false;
 };
@@ -131,7 +132,7 @@ int run_fit_and_eval(const EvalState& s) {
   const Camera camera = resolve_camera(s.camera, frame);
   const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, s.src.depth);
   FitResult fitted = fit(cloud.view(), s.fit);
-  const PixelFigures pixels = pixel_figures(fitted.gmm, frame, camera, s.depth_options, s.data_range);
+  const PixelFigures pixels = pixel_figures(fitted.gmm, frame, camera, s.depth_options, s.data_range, s.surface_sigma);
   const Evaluation e =
       evaluate(std::move(fitted), cloud.view(), decimated(camera, s.depth_options.decimate), s.fit.seed, s.data_range);
   nlohmann::json extra;
@@ -176,7 +177,7 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
   f.psnr = psnr(gmm, cloud.view(), dc, s.data_range);
   f.rec = reconstruction_metrics(gmm, cloud.view(), 0.01, s.fit.seed);
   f.n_samples = cloud.size();
-  f.pixels = pixel_figures(gmm, frame, camera, d, s.data_range);
+  f.pixels = pixel_figures(gmm, frame, camera, d, s.data_range, s.surface_sigma);
   nlohmann::json j = to_json(f);
   j.erase("frame");
   describe_model(s.model, model, s.json, j);
@@ -243,7 +244,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
     sc.depth = f.depth;
     sc.n_points = cloud.size();
     sc.psnr = psnr(local, cloud.view(), dc, s.data_range);
-    sc.pixels = pixel_figures(local, frame, camera, d, s.data_range);
+    sc.pixels = pixel_figures(local, frame, camera, d, s.data_range, s.surface_sigma);
     // As many samples as the model was fitted on, kept where this camera sees.
     const std::size_t n = static_cast<std::size_t>(
         std::min<std::uint64_t>(std::max<std::uint64_t>(model.gmm.support_size, cloud.size()), 4000000));
@@ -333,11 +334,16 @@ Command add_eval_command(CLI::App& root) {
   add_camera_flags(*app, s->camera, s->depth_options);
   add_fit_flags(*app, s->fit);
   add_data_range_flag(*app, s->data_range);
+  app->add_option("--surface-sigma", s->surface_sigma,
+                  "per-pixel figures: render with sogmm render's --surface-sigma (0 = every mode is a surface)")
+      ->capture_default_str();
   app->add_option("--frame", s->frame,
                   "with MODEL, --depth/--color and --trajectory: the pose index of the frame (world-frame model)");
   app->add_flag("--json", s->json, "print one JSON object");
   CLI::App* a = app;
   return {app, [s, a]() {
+            require(std::isfinite(s->surface_sigma) && s->surface_sigma >= 0, ErrorCode::InvalidArgument,
+                    "eval: --surface-sigma must be finite and >= 0");
             if (s->model.empty()) {
               require(s->src.sequence.empty() && s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
                       "eval: --sequence needs a MODEL (fit one with: sogmm fit --sequence DIR --trajectory FILE -o M)");
