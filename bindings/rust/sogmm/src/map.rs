@@ -364,7 +364,14 @@ impl Map {
         let mut out = vec![0u8; size];
         // SAFETY: `out` has room for `size` bytes.
         check(unsafe {
-            sys::sogmm_map_export_delta(self.raw(), since, std::ptr::null(), out.as_mut_ptr().cast(), out.len(), &mut size)
+            sys::sogmm_map_export_delta(
+                self.raw(),
+                since,
+                std::ptr::null(),
+                out.as_mut_ptr().cast(),
+                out.len(),
+                &mut size,
+            )
         })?;
         out.truncate(size);
         Ok(out)

@@ -322,7 +322,10 @@ fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
         deltas.push(sender.export_delta(since).unwrap());
     }
     assert_eq!(sender.revision().unwrap(), 2);
-    assert_eq!(receiver.apply_delta(&deltas[1]).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        receiver.apply_delta(&deltas[1]).unwrap_err().status(),
+        Status::InvalidArg
+    );
     assert_eq!(receiver.revision().unwrap(), 0);
     for d in &deltas {
         receiver.apply_delta(d).unwrap();
