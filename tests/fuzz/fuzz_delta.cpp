@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "fuzz_util.hpp"
+#include "sogmm/error.hpp"
 #include "sogmm/map.hpp"
 #include "sogmm/map_delta.hpp"
 #include "sogmm/map_delta_file.hpp"
