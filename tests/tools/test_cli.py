@@ -536,6 +536,9 @@ def mode_deltas(tmp):
               "apply-deltas: the rebuilt components differ from the map's")
         v = subprocess.run([inspect, "--verify", os.path.join(deltas, names[0])], stdout=subprocess.PIPE, text=True)
         check(v.returncode == 0 and "map delta" in v.stdout, "sogmm-inspect --verify on a delta: %r" % v.stdout)
+    # From a base map: the sender's final map already holds every delta.
+    p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "none.sogmm"), "--base", out], expect=2)
+    check("no delta after revision %d" % revisions[-1] in p.stderr, "apply-deltas --base: %r" % p.stderr)
     # A gap: the second delta missing. Nothing is written.
     os.remove(os.path.join(deltas, names[1]))
     p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "gap.sogmm")], expect=3)
