@@ -241,11 +241,19 @@ int main(int argc, char** argv) {
       return 0;
     }
     fmt::FileInfo info = fmt::read_info_file(path);
-    // A map delta (spec/format.md 2.5) is verified by the delta rules and
-    // shown as the model form it is stored in (delta keys included).
-    const bool delta = (info.features_required & 1u) != 0;
-    const sogmm::Model model = delta ? sogmm::delta_to_model(fmt::load_delta(path)) : fmt::load(path, {}, &info);
-    if (delta) info.metadata = sogmm::Model{};
+    // A map delta (spec/format.md 2.5: bit 0 and its keys) is verified by
+    // the delta rules and shown as the model form it is stored in (delta
+    // keys included). Bit 0 without the keys is no delta: read as a model,
+    // it is refused as such (unsupported_feature).
+    const bool delta = (info.features_required & 1u) != 0 &&
+                       sogmm::find_value(info.metadata, sogmm::kDeltaOpsKey) != nullptr;
+    sogmm::Model model;
+    if (delta) {
+      model = sogmm::delta_to_model(fmt::load_delta(path));
+      info.metadata = sogmm::Model{};
+    } else {
+      model = fmt::load(path, {}, &info);
+    }
     if (mode == "verify") {
       std::printf(delta ? "ok (map delta)\n" : "ok\n");
       return 0;
