@@ -116,6 +116,7 @@ SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, in
       case SOGMM_MAP_N_FLUSHES: *out = count(s.n_flushes); break;
       case SOGMM_MAP_N_FUSED: *out = count(s.n_fused); break;
       case SOGMM_MAP_N_REFITS: *out = count(s.n_refits); break;
+      case SOGMM_MAP_REVISION: *out = count(map->map.revision()); break;
       default: fail(SOGMM_E_INTERNAL, "map key table out of sync");
     }
   }

@@ -77,6 +77,7 @@ struct Searchable {
   Model model;
   ComponentIndex index;
   std::vector<detail::Marginal3> marginals;
+  Gmm batch;  // the refit's world-frame fit, as merged (what a delta carries)
 };
 
 // The map after a revisit refit, built without touching the map: the seen
@@ -85,8 +86,9 @@ Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, co
   Model batch = world_model(s, plan.fit, pose, plan.bandwidth, from_rgbd);
   Model kept = s.model;
   kept.gmm = detail::without_components(s.model.gmm, plan.replaced);
+  Gmm batch_gmm = batch.gmm;
   Searchable out{kept.gmm.size() == 0 ? std::move(batch) : merge(kept, batch), ComponentIndex(s.options.index_sigmas),
-                 {}};
+                 {}, std::move(batch_gmm)};
   out.marginals.reserve(out.model.gmm.size());
   for (std::size_t k = 0; k < out.model.gmm.size(); ++k) out.marginals.push_back(detail::marginal3(out.model.gmm, k));
   out.index.build(out.model.gmm);
@@ -168,6 +170,7 @@ void check_frame(const PointsView& points) {
 FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const Pose& pose, bool from_rgbd,
                         const ProgressSink& progress) {
   check_frame(points);
+  detail::JournalScope journal(s.journal, s.frames.size());
   FrameStats f;
   f.index = s.frames.size();
   f.pose = pose;
@@ -224,7 +227,9 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       f.ms_fit += ms_since(t1);
       const auto t2 = std::chrono::steady_clock::now();
       Searchable next = after_refit(s, *plan, pose, from_rgbd);
-      before_refit = Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals)};
+      s.journal.remove(plan->replaced);
+      s.journal.merge(next.batch);
+      before_refit = Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals), {}};
       s.model = std::move(next.model);
       s.index = std::move(next.index);
       s.marginals = std::move(next.marginals);
@@ -275,6 +280,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     throw;
   }
   s.frames.back().n_components = s.model.gmm.size();
+  journal.commit(s.frames.size());
   return s.frames.back();
 }
 
@@ -335,6 +341,7 @@ std::size_t Map::discard_pending() {
 std::size_t Map::flush(const ProgressSink& progress) {
   State& s = *s_;
   if (s.n_pending == 0) return 0;
+  detail::JournalScope journal(s.journal, s.frames.size());
   const auto t0 = std::chrono::steady_clock::now();
   // The batch is fitted in the camera frame of its latest frame: a batch of
   // one frame is then fitted exactly on that frame's points, as `sogmm fit
@@ -359,9 +366,15 @@ std::size_t Map::flush(const ProgressSink& progress) {
 
   Model batch = world_model(s, r, last, batch_options.bandwidth, from_rgbd);
   const std::size_t first = s.model.gmm.size();
+  s.journal.merge(batch.gmm);
   Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);
   std::vector<std::size_t> changed;
-  if (s.options.fusion && first > 0) changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
+  if (s.options.fusion && first > 0) {
+    const Gmm appended = detail::tail(merged.gmm, first);
+    changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
+    s.journal.set(merged.gmm, changed);
+    s.journal.drop(detail::dropped_positions(appended, merged.gmm, first));
+  }
   const std::size_t added = merged.gmm.size() - first;
   const std::size_t fused = r.gmm.size() - added;
   // The marginals and index of the merged map, built on copies before
@@ -397,6 +410,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
     f.ms_merge += ms_since(t1);
     f.n_components = s.model.gmm.size();
   }
+  journal.commit(s.frames.size());
   return added;
 }
 

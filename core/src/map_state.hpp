@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "map_journal.hpp"
 #include "map_renders.hpp"
 #include "sogmm/map.hpp"
 
@@ -84,6 +85,13 @@ PendingVoxel pending_voxel(const double xyz[3]);
 /// Whether a pending point lies in the voxel or one of its 26 neighbours.
 bool near_pending(const PendingVoxelSet& voxels, const PendingVoxel& voxel);
 
+/// The provenance lines (kMapFramesKey format) of frames [first, end).
+std::string frames_text(const std::vector<FrameStats>& frames, std::size_t first = 0);
+/// Frames from provenance lines whose indices run from first_index; a
+/// malformed line -> Error(Format) naming `key` and the line.
+std::vector<FrameStats> parse_frames(const std::string& text, std::uint64_t first_index = 0,
+                                     const char* key = kMapFramesKey);
+
 /// A revisit refit worked out but not committed (map_revisit.cpp).
 struct RevisitRefit {
   std::vector<std::size_t> replaced;  ///< map components the frame sees (ascending), to be replaced
@@ -141,7 +149,10 @@ struct Map::State {
   /// undo): what is kept about them (renders) is valid for one revision.
   std::uint64_t revision = 0;
   mutable detail::FrameRenders renders;  // filled by const queries (Map::frame_depth)
-  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {}
+  /// The public revision and the changes deltas are cut from
+  /// (sogmm/map_delta.hpp); unlike `revision` it also counts frames.
+  detail::Journal journal;
+  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) { journal.map_id = detail::new_map_id(); }
 };
 
 }  // namespace sogmm

@@ -526,6 +526,41 @@ def mode_map(tmp):
     no_temp_files(tmp)
 
 
+def mode_deltas(tmp):
+    """sogmm map --deltas writes one delta per fitting insert, names that
+    sort; sogmm apply-deltas rebuilds the map bit for bit (sogmm-inspect
+    --components of both) and refuses a gap with one line naming the file."""
+    d = os.path.join(tmp, "loop")
+    run(["demo", "--write-frame", d, "--loop", "--frames", 6])
+    base = ["--trajectory", os.path.join(d, "trajectory.log"), "--decimate", 10, "--bandwidth", 0.05, "--batch", 400]
+    out, deltas = os.path.join(tmp, "loop.sogmm"), os.path.join(tmp, "deltas")
+    summary = run_json(["map", d] + base + ["-o", out, "--deltas", deltas])
+    names = sorted(os.listdir(deltas))
+    check(len(names) == summary.get("n_deltas") and len(names) >= 2, "map --deltas: %s for %s" % (names, summary))
+    revisions = [int(n[len("delta-"):-len(".sogmm")]) for n in names]
+    check(revisions == sorted(revisions) and revisions[-1] >= 6, "delta names do not sort by revision: %s" % names)
+    rebuilt = os.path.join(tmp, "rebuilt.sogmm")
+    r = run_json(["apply-deltas", deltas, "-o", rebuilt])
+    check(r.get("n_deltas") == len(names) and r.get("n_components") == summary.get("n_components"),
+          "apply-deltas: %s vs map %s" % (r, summary))
+    inspect = os.path.join(os.path.dirname(SOGMM), "..", "sogmm-inspect", "sogmm-inspect")
+    if os.path.exists(inspect):
+        comps = [subprocess.run([inspect, "--components", f], stdout=subprocess.PIPE, text=True).stdout
+                 for f in (out, rebuilt)]
+        check(comps[0] == comps[1] and comps[0].count("component") == summary.get("n_components"),
+              "apply-deltas: the rebuilt components differ from the map's")
+        v = subprocess.run([inspect, "--verify", os.path.join(deltas, names[0])], stdout=subprocess.PIPE, text=True)
+        check(v.returncode == 0 and "map delta" in v.stdout, "sogmm-inspect --verify on a delta: %r" % v.stdout)
+    # From a base map: the sender's final map already holds every delta.
+    p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "none.sogmm"), "--base", out], expect=2)
+    check("no delta after revision %d" % revisions[-1] in p.stderr, "apply-deltas --base: %r" % p.stderr)
+    # A gap: the second delta missing. Nothing is written.
+    os.remove(os.path.join(deltas, names[1]))
+    p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "gap.sogmm")], expect=3)
+    check(names[2 if len(names) > 2 else 1] in p.stderr or "missing" in p.stderr, "apply-deltas gap: %r" % p.stderr)
+    check(not os.path.exists(os.path.join(tmp, "gap.sogmm")), "apply-deltas wrote a map after a gap")
+
+
 def query_map(tmp, d, map_path, traj_lines):
     """sogmm query on the loop map against what the frames show: frame 0's
     observed surface (back-projected with its pose) is occupied and within
@@ -694,7 +729,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sogmm", required=True)
     ap.add_argument("--data", required=True)
-    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "shared"])
+    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "deltas", "shared"])
     a = ap.parse_args()
     SOGMM = a.sogmm
     with tempfile.TemporaryDirectory(prefix="sogmm_cli_test_") as tmp:
@@ -708,6 +743,8 @@ def main():
             mode_sequence(tmp)
         elif a.mode == "map":
             mode_map(tmp)
+        elif a.mode == "deltas":
+            mode_deltas(tmp)
         elif mode_shared(tmp, a.data) == "skip":
             return 0
     if FAILURES:

@@ -11,6 +11,7 @@
 
 #include "cli_common.hpp"
 #include "file_util.hpp"
+#include "map_deltas.hpp"
 #include "map_run.hpp"
 #include "model_io.hpp"
 #include "sogmm/error.hpp"
@@ -22,7 +23,7 @@ namespace {
 
 struct MapState {
   FrameSource src;
-  std::string output, csv, plot, trajectory_out;
+  std::string output, csv, plot, trajectory_out, deltas;
   CameraFlags camera;
   MapOptions options;
   std::string fusion = "off";
@@ -90,6 +91,7 @@ int run_map(MapState& s) {
   double ms_novelty = 0, ms_fit = 0, ms_merge = 0;
   std::vector<Pose> poses_used;
   std::size_t skipped = 0;
+  DeltaWriter deltas(s.deltas);
   run_map_over_sequence(map, in, s.options.depth, progress, [&](const MapRunFrame& f) {
     if (f.skipped) {
       ++skipped;
@@ -97,6 +99,7 @@ int run_map(MapState& s) {
     }
     poses_used.push_back(f.pose);
     const FrameStats& st = f.stats;
+    if (st.flushed) deltas.write(map);
     const std::size_t pending = map.pending();
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
                     st.ms_fit, st.ms_merge, st.n_replaced});
@@ -116,6 +119,7 @@ int run_map(MapState& s) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t added = map.flush(progress.fit_callback("final flush"));
   const double ms_flush = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  deltas.write(map);  // the final flush and the frames since the last delta
   progress.finish();
   if (!s.trajectory_out.empty()) write_trajectory_log(s.trajectory_out, poses_used);
   const Model model = with_sequence_metadata(map.to_model(), in);
@@ -146,6 +150,10 @@ int run_map(MapState& s) {
     j["ms_merge"] = ms_merge;
     j["ms_final_flush"] = ms_flush;
     j["file_bytes"] = bytes;
+    if (!s.deltas.empty()) {
+      j["n_deltas"] = deltas.count();
+      j["delta_bytes"] = deltas.bytes();
+    }
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
@@ -216,6 +224,9 @@ Command add_map_command(CLI::App& root) {
                   "fuse below this distance (Hellinger in [0, 1]; KL in nats)")
       ->capture_default_str();
   app->add_option("-o,--output", s->output, "output map file (.sogmm, world frame)")->required();
+  app->add_option("--deltas", s->deltas,
+                  "write a map delta (spec/format.md 2.5) into this folder after every insert that fitted and at "
+                  "the end, named by revision so that they sort (rebuild with sogmm apply-deltas)");
   app->add_option("--csv", s->csv, "per-frame CSV (default: OUTPUT with .csv)");
   app->add_option("--plot", s->plot, "SVG plot of components and time per frame (default: OUTPUT with .svg)");
   app->add_flag("--progress", s->progress, "print progress lines on stderr even when it is not a terminal");

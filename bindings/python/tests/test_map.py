@@ -261,3 +261,26 @@ def test_a_frame_far_from_the_pending_ones_fails_at_its_insert():
         assert len(m) == 1 and m.n_pending_ == len(pts)
         m.flush()
         assert m.n_components_ > 0
+
+
+def test_deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused():
+    with sogmm.Map(novelty=False, **FIT) as sender, sogmm.Map() as receiver:
+        deltas = []
+        for pts, pose in zip(frames(), POSES):
+            since = sender.revision
+            sender.insert_points(pts, pose)
+            deltas.append(sender.export_delta(since))
+        assert sender.revision == 2
+        with pytest.raises(sogmm.InvalidArgumentError, match="revision"):
+            receiver.apply_delta(deltas[1])  # a gap
+        assert receiver.revision == 0
+        with pytest.raises(sogmm.FormatError):
+            receiver.apply_delta(deltas[0][:-3])  # truncated
+        for d in deltas:
+            receiver.apply_delta(d)
+        assert receiver.revision == sender.revision
+        a, b = sender.export(), receiver.export()
+        for x, y in ((a.weights_, b.weights_), (a.means_, b.means_), (a.covariances_, b.covariances_)):
+            assert x.tobytes() == y.tobytes()
+        with pytest.raises(sogmm.InvalidArgumentError, match="already applied"):
+            receiver.apply_delta(deltas[1])  # a duplicate

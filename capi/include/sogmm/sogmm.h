@@ -914,6 +914,9 @@ SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn 
 #define SOGMM_MAP_N_FLUSHES 20003    /* i64: fits run by this handle (batches and revisit refits) */
 #define SOGMM_MAP_N_FUSED 20004      /* i64: new components fused into existing ones instead of appended */
 #define SOGMM_MAP_N_REFITS 20005     /* i64: revisit refits run by this handle (also in N_FLUSHES) */
+#define SOGMM_MAP_REVISION 20006     /* i64: the map's revision: 0 when created, +1 for every insert, flush
+                                      * that fitted or delta that changed it (a delta sets the sender's);
+                                      * a failed call keeps it. Saved with the map (spec/format.md 2.3) */
 SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, int64_t* out);
 
 /* What the insert of frame `frame` did (insertion order, from 0;
@@ -997,6 +1000,37 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
  * SOGMM_E_INVALID_ARG; malformed "map_frames" (a count with a sign
  * included) -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
+
+/* Map deltas (spec/format.md section 2.5): what changed in a map since one
+ * of its revisions (SOGMM_MAP_REVISION), so that a receiver that applies
+ * them in order holds a bitwise equal map (weights, means, covariances,
+ * support size, frame provenance) without the whole map being resent.
+ *
+ * Writes the delta file from revision `since_revision` to the map's current
+ * one into `out` (room for `capacity` bytes) and its size to *size. out =
+ * NULL with capacity 0 only queries the size; capacity below the size ->
+ * SOGMM_E_BUFFER_TOO_SMALL with *size set (nothing written). Pending points
+ * are not in a delta. Write keys of `options` apply (NULL = defaults). A
+ * revision the map holds no changes from (before it was created or loaded,
+ * after its current one, or, for a receiver, inside a delta it received) ->
+ * SOGMM_E_INVALID_ARG naming the range. The map keeps every explicit
+ * component it ever fitted (the cost of exporting from any revision). */
+SOGMM_API sogmm_status sogmm_map_export_delta(const sogmm_map* map, uint64_t since_revision,
+                                              const sogmm_options* options, void* out, size_t capacity,
+                                              size_t* size);
+/* Applies a delta of `size` bytes from `data` (read keys of `options`
+ * apply). Refused with the map unchanged (its revision included): a file
+ * that is not a valid delta (SOGMM_E_FORMAT and the other errors of
+ * sogmm_model_load_from_memory; a model file -> SOGMM_E_FORMAT
+ * "not_a_delta"); another map's delta, unless `map` is new (revision 0, no
+ * frame, no component: it then takes the sender's identity) ->
+ * SOGMM_E_INVALID_ARG; a delta that does not start at the map's revision (a
+ * gap, a duplicate, out of order) -> SOGMM_E_INVALID_ARG naming both
+ * revisions; points pending -> SOGMM_E_INVALID_ARG; steps that do not fit
+ * the map or a result that differs from the sender's digest ->
+ * SOGMM_E_FORMAT. Needs exclusive use of the map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_apply_delta(sogmm_map* map, const void* data, size_t size,
+                                             const sogmm_options* options);
 
 /* ---- trajectories (Redwood .log) -------------------------------------- */
 /* A .log file holds, per frame, a header line "i j n" and four lines of a

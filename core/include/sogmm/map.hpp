@@ -60,6 +60,8 @@
 
 namespace sogmm {
 
+struct MapDelta;  // sogmm/map_delta.hpp
+
 /// Row-major 4 x 4 rigid transform [R t; 0 0 0 1] (camera-to-world).
 using Pose = std::array<double, 16>;
 
@@ -289,6 +291,34 @@ class Map {
   /// have to guess its weight against the new points' (merge() refuses it).
   /// `options` govern later inserts.
   static Map from_model(const Model& model, const MapOptions& options = {});
+
+  /// The map's revision: 0 when built, +1 for every call that changed the
+  /// components or the frame provenance (an insert, a flush that fitted, a
+  /// delta applied: a delta sets the sender's revision). A failed call
+  /// changes nothing, the revision included. Kept in a saved map
+  /// (kMapRevisionKey), with id() (kMapIdKey).
+  std::uint64_t revision() const;
+  /// The map's identity, 32 lowercase hex digits, random when the map is
+  /// built (a receiver takes its sender's with its first delta).
+  const std::string& id() const;
+  /// What changed from revision `since` to revision() (sogmm/map_delta.hpp),
+  /// pending points left out. Error(InvalidArgument) naming the range unless
+  /// `since` is a revision this map recorded the changes after: from the
+  /// revision it was built or loaded at, up to revision(); a receiver can
+  /// relay from the revisions its deltas started at. Memory: the map keeps
+  /// every explicit component it ever received (batches, fusion results).
+  MapDelta delta_since(std::uint64_t since) const;
+  /// Applies a delta of the sender (the map id()). Refused, nothing changed:
+  /// another map's delta (unless this map is new: revision 0, no frame, no
+  /// component, then it takes the sender's id) -> Error(InvalidArgument); a
+  /// delta that does not start at revision() (a gap, a duplicate, one out of
+  /// order) -> Error(InvalidArgument) naming both revisions; points pending
+  /// -> Error(InvalidArgument); a delta whose steps do not fit this map or
+  /// whose result differs from the sender's digest -> Error(Format). The new
+  /// state is built aside and committed at once: a throw at any point leaves
+  /// the map at its last revision. This map's options are kept (they govern
+  /// later inserts).
+  void apply_delta(const MapDelta& delta);
 
   struct State;  ///< the implementation (core/src/map_state.hpp)
 

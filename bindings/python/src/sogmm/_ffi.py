@@ -129,6 +129,7 @@ MAP_N_FRAMES = 20002
 MAP_N_FLUSHES = 20003
 MAP_N_FUSED = 20004
 MAP_N_REFITS = 20005
+MAP_REVISION = 20006
 MAP_FRAME_N_POINTS = 20100
 MAP_FRAME_N_NOVEL = 20101
 MAP_FRAME_N_COMPONENTS = 20102
@@ -241,6 +242,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
                                       HANDLE, F32_OUT, F32_OUT, F32_OUT]),
     "sogmm_map_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
     "sogmm_map_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
+    "sogmm_map_export_delta": (STATUS, [HANDLE, c_uint64, HANDLE, c_void_p, c_size_t, POINTER(c_size_t)]),
+    "sogmm_map_apply_delta": (STATUS, [HANDLE, c_void_p, c_size_t, HANDLE]),
     "sogmm_trajectory_read": (STATUS, [HANDLE_OUT, c_char_p]),
     "sogmm_trajectory_free": (None, [HANDLE]),
     "sogmm_trajectory_size": (c_size_t, [HANDLE]),

@@ -9,11 +9,12 @@ algorithm is documented in core/include/sogmm/map.hpp.
 
 from __future__ import annotations
 
+import ctypes
 import os
 import threading
 import weakref
 from contextlib import contextmanager
-from ctypes import byref, c_double, c_int64, c_uint64, c_void_p
+from ctypes import byref, c_double, c_int64, c_size_t, c_uint64, c_void_p
 
 import numpy as np
 
@@ -355,6 +356,34 @@ class Map(Queryable):
         self._query("occupancy", "occupancy_f32", _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}), progress,
                     lambda o: (x, x.shape[0], o, prob, state_ptr))
         return (prob, state) if return_state else prob
+
+    # ---- deltas (spec/format.md section 2.5) ---------------------------------------
+    @property
+    def revision(self) -> int:
+        """The map's revision: 0 when created, +1 for every insert, fitting
+        flush or applied delta that changed it."""
+        v = c_int64()
+        with self._guard.reading("revision"):
+            check(lib.sogmm_map_get_i64(self._h(), _ffi.MAP_REVISION, byref(v)))
+        return int(v.value)
+
+    def export_delta(self, since_revision: int) -> bytes:
+        """The delta file (bytes) from ``since_revision`` to the current
+        revision; a receiver at that revision applies it with apply_delta."""
+        size = c_size_t()
+        with self._guard.reading("export_delta"):
+            check(lib.sogmm_map_export_delta(self._h(), since_revision, None, None, 0, byref(size)))
+            buf = ctypes.create_string_buffer(size.value)
+            check(lib.sogmm_map_export_delta(self._h(), since_revision, None, buf, size.value, byref(size)))
+        return buf.raw[: size.value]
+
+    def apply_delta(self, delta: bytes) -> None:
+        """Applies a delta of the sender's map; afterwards this map is bitwise
+        the sender's. A gap, a duplicate, another map's or a damaged delta
+        raises (InvalidArgumentError / FormatError) and changes nothing."""
+        data = bytes(delta)
+        with self._guard.changing("apply_delta"):
+            check(lib.sogmm_map_apply_delta(self._h(), data, len(data), None))
 
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),

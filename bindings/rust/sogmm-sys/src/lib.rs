@@ -193,6 +193,7 @@ pub const SOGMM_MAP_N_FRAMES: sogmm_key = 20002;
 pub const SOGMM_MAP_N_FLUSHES: sogmm_key = 20003;
 pub const SOGMM_MAP_N_FUSED: sogmm_key = 20004;
 pub const SOGMM_MAP_N_REFITS: sogmm_key = 20005;
+pub const SOGMM_MAP_REVISION: sogmm_key = 20006;
 pub const SOGMM_MAP_FRAME_N_POINTS: sogmm_key = 20100;
 pub const SOGMM_MAP_FRAME_N_NOVEL: sogmm_key = 20101;
 pub const SOGMM_MAP_FRAME_N_COMPONENTS: sogmm_key = 20102;
@@ -476,6 +477,20 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_map_export_delta(
+        map: *const sogmm_map,
+        since_revision: u64,
+        options: *const sogmm_options,
+        out: *mut c_void,
+        capacity: usize,
+        size: *mut usize,
+    ) -> sogmm_status;
+    pub fn sogmm_map_apply_delta(
+        map: *mut sogmm_map,
+        data: *const c_void,
+        size: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_fit_points_f32(
         out: *mut *mut sogmm_model,
         points: *const f32,

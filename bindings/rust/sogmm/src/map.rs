@@ -225,6 +225,49 @@ impl Map {
         Model::make(|out| unsafe { sys::sogmm_map_export(out, self.raw(), bounds.as_ptr()) })
     }
 
+    /// The map's revision: 0 when created, +1 for every insert, fitting flush
+    /// or applied delta that changed it.
+    pub fn revision(&self) -> Result<u64> {
+        let mut v = 0i64;
+        // SAFETY: valid handle and out-pointer.
+        check(unsafe { sys::sogmm_map_get_i64(self.raw(), sys::SOGMM_MAP_REVISION, &mut v) })?;
+        Ok(v as u64)
+    }
+
+    /// The delta file (spec/format.md section 2.5) from revision `since` to
+    /// the current one; a receiver at `since` applies it with `apply_delta`.
+    pub fn export_delta(&self, since: u64) -> Result<Vec<u8>> {
+        let mut size = 0usize;
+        // SAFETY: a size query (out NULL, capacity 0).
+        check(unsafe {
+            sys::sogmm_map_export_delta(self.raw(), since, std::ptr::null(), std::ptr::null_mut(), 0, &mut size)
+        })?;
+        let mut out = vec![0u8; size];
+        // SAFETY: `out` has room for `size` bytes.
+        check(unsafe {
+            sys::sogmm_map_export_delta(
+                self.raw(),
+                since,
+                std::ptr::null(),
+                out.as_mut_ptr().cast(),
+                out.len(),
+                &mut size,
+            )
+        })?;
+        out.truncate(size);
+        Ok(out)
+    }
+
+    /// Applies a delta of the sender's map; afterwards this map is bitwise
+    /// the sender's. A gap, a duplicate, another map's or a damaged delta is
+    /// an error (InvalidArg / Format) and the map is unchanged.
+    pub fn apply_delta(&mut self, delta: &[u8]) -> Result<()> {
+        // SAFETY: exclusive use of the map; `delta` is read during the call.
+        check(unsafe {
+            sys::sogmm_map_apply_delta(self.ptr.as_ptr(), delta.as_ptr().cast(), delta.len(), std::ptr::null())
+        })
+    }
+
     /// Writes the map as a world-frame .sogmm file with its frame provenance,
     /// atomically (write keys of `options` apply). Flush pending points first.
     pub fn save(&self, path: impl AsRef<Path>, options: Option<&Options>) -> Result<()> {

@@ -370,3 +370,31 @@ fn discard_pending_unlocks_a_map_that_cannot_be_saved() {
     assert_eq!(map.frame_stats(1).unwrap().n_novel, 300);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Deltas applied in order rebuild the sender's map bit for bit; a gap is
+/// refused and leaves the receiver at its revision.
+#[test]
+fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
+    let mut sender = Map::new(Some(&map_options(false))).unwrap();
+    let mut receiver = Map::new(None).unwrap();
+    let mut deltas = Vec::new();
+    for (k, tx) in [0.0, 3.0].into_iter().enumerate() {
+        let since = sender.revision().unwrap();
+        sender.insert_points(&blobs(1500, 11 + k as u64), &shifted(tx)).unwrap();
+        deltas.push(sender.export_delta(since).unwrap());
+    }
+    assert_eq!(sender.revision().unwrap(), 2);
+    assert_eq!(
+        receiver.apply_delta(&deltas[1]).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    assert_eq!(receiver.revision().unwrap(), 0);
+    for d in &deltas {
+        receiver.apply_delta(d).unwrap();
+    }
+    let (a, b) = (sender.export().unwrap(), receiver.export().unwrap());
+    let bits = |v: Vec<f32>| v.into_iter().map(f32::to_bits).collect::<Vec<u32>>();
+    assert_eq!(bits(a.weights().unwrap()), bits(b.weights().unwrap()));
+    assert_eq!(bits(a.means().unwrap()), bits(b.means().unwrap()));
+    assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
+}
