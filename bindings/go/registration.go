@@ -41,7 +41,7 @@ func (m *Model) RegisterPoints(ctx context.Context, points []float32, init *[16]
 		return nil, err
 	}
 	var pose [16]float64
-	info := C.sogmm_registration_info{struct_size: C.size_t(unsafe.Sizeof(C.sogmm_registration_info{}))}
+	info := newRegistrationInfo()
 	var initPtr *C.double
 	if init != nil {
 		initPtr = (*C.double)(unsafe.Pointer(&init[0]))
@@ -55,11 +55,21 @@ func (m *Model) RegisterPoints(ctx context.Context, points []float32, init *[16]
 	if err != nil {
 		return nil, err
 	}
+	return registrationOf(pose, &info), nil
+}
+
+// newRegistrationInfo is a sogmm_registration_info sized for this binding.
+func newRegistrationInfo() C.sogmm_registration_info {
+	return C.sogmm_registration_info{struct_size: C.size_t(unsafe.Sizeof(C.sogmm_registration_info{}))}
+}
+
+// registrationOf is what a call wrote into info, with its pose.
+func registrationOf(pose [16]float64, info *C.sogmm_registration_info) *Registration {
 	r := &Registration{Pose: pose, Status: int(info.status), Iterations: int(info.iterations),
 		LogLikelihood: float64(info.log_likelihood), InlierRatio: float64(info.inlier_ratio), RMSE: float64(info.rmse),
 		Unobservable: int(info.unobservable), EigenRatio: float64(info.eigen_ratio)}
 	for i := range r.Information {
 		r.Information[i] = float64(info.information[i])
 	}
-	return r, nil
+	return r
 }

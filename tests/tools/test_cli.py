@@ -438,7 +438,8 @@ def mode_map(tmp):
     summary, progress = run_json(["map", d] + base + ["-o", out, "--progress"], with_stderr=True)
     check(progress.count("novel") >= n, "map --progress: one line per frame expected: %r" % progress[-500:])
     rows = open(os.path.join(tmp, "loop.csv")).read().strip().split("\n")
-    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced",
+    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced,"
+          "pose,inlier_ratio,registration_ll",
           "map CSV header: %r" % rows[0])
     check(len(rows) == n + 1, "map CSV: %d rows for %d frames" % (len(rows) - 1, n))
     table = [r.split(",") for r in rows[1:]]

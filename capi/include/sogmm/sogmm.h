@@ -1176,6 +1176,33 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
                                                  const double* init, const sogmm_options* options,
                                                  double* pose_out, sogmm_registration_info* info_out);
 
+/* Tracking: inserts an RGB-D `frame` into `map` at the camera-to-world pose
+ * that registration to the map finds (sogmm_register_points_f32's method,
+ * with the map's creation options: SOGMM_OPT_REGISTRATION_*,
+ * SOGMM_OPT_THREADS; progress and cancel through the map's callback), so
+ * that a stream without poses still gives a map. Start: `guess` (a rigid
+ * row-major 4 x 4 camera-to-world pose), or with NULL the constant-velocity
+ * prediction from the map's last two frames (frames assumed evenly spaced:
+ * a caller that skips frames passes its own guess). The map's first frame
+ * (no component, nothing pending) is inserted at the guess (NULL: the
+ * identity) without registration. The target is the map's components;
+ * pending points are flushed first when the map has none, or when the
+ * registration to the components alone does not converge (then it runs
+ * again). The frame is inserted only when the registration's status is
+ * SOGMM_REGISTRATION_CONVERGED: otherwise the call still returns SOGMM_OK,
+ * *inserted_out is 0, info_out says why, and the map keeps only the flush
+ * it may have run. Outputs (each may be NULL): pose_out (16 doubles) the
+ * pose used or the registration's last iterate, inserted_out 1/0,
+ * info_out the registration's figures (struct_size set by the caller; for
+ * the first frame status CONVERGED and iterations 0). Errors: NULL map or
+ * frame -> SOGMM_E_NULL_ARG; a non-rigid guess, info_out->struct_size too
+ * small -> SOGMM_E_INVALID_ARG; fewer than REGISTRATION_MIN_POINTS valid
+ * pixels -> SOGMM_E_INVALID_DATA; a busy map -> SOGMM_E_BUSY; otherwise as
+ * sogmm_map_insert_frame and sogmm_map_flush. */
+SOGMM_API sogmm_status sogmm_map_track_frame(sogmm_map* map, const sogmm_frame* frame, const double* guess,
+                                             double* pose_out, int32_t* inserted_out,
+                                             sogmm_registration_info* info_out);
+
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.
  * NULL buffer -> NULL / 0. These never fail and do not touch

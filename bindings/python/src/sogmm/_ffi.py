@@ -218,6 +218,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_free": (None, [HANDLE]),
     "sogmm_map_insert_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F64_IN]),
     "sogmm_map_insert_frame": (STATUS, [HANDLE, HANDLE, F64_IN]),
+    # guess, inserted_out and info_out may be NULL: c_void_p.
+    "sogmm_map_track_frame": (STATUS, [HANDLE, HANDLE, c_void_p, F64_OUT, c_void_p, c_void_p]),
     "sogmm_map_flush": (STATUS, [HANDLE]),
     "sogmm_map_discard_pending": (STATUS, [HANDLE, POINTER(c_uint64)]),
     "sogmm_map_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),

@@ -26,6 +26,7 @@ from ._arrays import _pose, _rows
 from .model import GMM, SOGMM, _read_options, _write_options
 from .progress import ProgressArg, call_with_progress
 from .queryable import Queryable
+from .registration import RegistrationInfo, info_dict
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
 _D = _ffi.DEFAULTS
@@ -129,6 +130,9 @@ class Map(Queryable):
             ``novelty=False``, needs ``n_init=1``.
         depth_scale, depth_min, depth_trunc, decimate: back-projection of
             :meth:`insert_rgbd` frames (as :func:`sogmm.rgbd_to_points`).
+        registration_use_gray: :meth:`track_rgbd` registers with gray too (the
+            4-D density, as :func:`sogmm.register`'s ``use_gray``), which holds
+            the pose where geometry alone lets a frame slide (a wall, a floor).
         **fit_params: parameters of each batch's fit, as :class:`sogmm.SOGMM`
             (bandwidth, seed, n_threads, ...).
 
@@ -153,19 +157,20 @@ class Map(Queryable):
                  revisit_refit_ratio: float = _D.map_revisit_refit_ratio,
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
+                 registration_use_gray: bool = bool(_D.registration_use_gray),
                  **fit_params):
         self._ptr = None
         self._finalizer = None
         self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio) as o:
+                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) as o:
             out = c_void_p()
             check(lib.sogmm_map_create(byref(out), o.ptr))
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
@@ -182,7 +187,8 @@ class Map(Queryable):
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
-               _ffi.OPT_MAP_WARM_START: int(bool(warm_start))}
+               _ffi.OPT_MAP_WARM_START: int(bool(warm_start)),
+               _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(registration_use_gray))}
         if _FUSION[fusion] is not None:
             i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
         # The fit keys exactly as SOGMM sets them (same checks and messages).
@@ -246,6 +252,32 @@ class Map(Queryable):
         with f.handle() as frame:
             self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_frame(h, frame, p))
         return self.frame_stats(-1)
+
+    def track_rgbd(self, depth, color, camera: Camera, guess=None,
+                   progress: ProgressArg = None) -> tuple[np.ndarray, dict]:
+        """Inserts an RGB-D frame at the camera-to-world pose that registration
+        to the map finds (``sogmm_map_track_frame``): from ``guess`` (4 x 4),
+        or with None the constant-velocity prediction from the map's last two
+        frames. The map's first frame is inserted at the guess (None: the
+        identity). The frame is inserted only when the registration converged.
+
+        Returns ``(pose, info)``: the pose used (or the registration's last
+        iterate when not inserted) and :func:`sogmm.register`'s figures plus
+        ``inserted`` (bool) and ``registered`` (False for the first frame).
+        Bad input raises as :meth:`insert_rgbd` and :func:`sogmm.register`.
+        """
+        f = prepare_frame(depth, color, camera, *self._depth)
+        start = None if guess is None else np.ascontiguousarray(_pose(guess))
+        pose = np.empty(16, dtype=np.float64)
+        inserted = ctypes.c_int32(0)
+        info = RegistrationInfo(struct_size=ctypes.sizeof(RegistrationInfo))
+        with f.handle() as frame:
+            self._call("track_rgbd", progress, lambda h: lib.sogmm_map_track_frame(
+                h, frame, None if start is None else start.ctypes.data, pose, byref(inserted), byref(info)))
+        out = info_dict(info)
+        out["inserted"] = bool(inserted.value)
+        out["registered"] = out["iterations"] > 0
+        return pose.reshape(4, 4), out
 
     def flush(self, progress: ProgressArg = None) -> int:
         """Fits the pending points now; returns the number of components added."""
@@ -409,7 +441,8 @@ class Map(Queryable):
         map_keys = dict(novelty=bool(d.map_novelty), novelty_threshold=d.map_novelty_threshold,
                         batch_size=d.map_batch_size, fusion=None, fusion_threshold=d.map_fusion_threshold,
                         warm_start=bool(d.map_warm_start), novelty_bandwidth_scale=d.map_novelty_bandwidth_scale,
-                        revisit_refit_ratio=d.map_revisit_refit_ratio)
+                        revisit_refit_ratio=d.map_revisit_refit_ratio,
+                        registration_use_gray=bool(d.registration_use_gray))
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

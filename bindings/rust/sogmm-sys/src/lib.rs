@@ -428,6 +428,14 @@ extern "C" {
         pose_out: *mut f64,
         info_out: *mut sogmm_registration_info,
     ) -> sogmm_status;
+    pub fn sogmm_map_track_frame(
+        map: *mut sogmm_map,
+        frame: *const sogmm_frame,
+        guess: *const f64,
+        pose_out: *mut f64,
+        inserted_out: *mut i32,
+        info_out: *mut sogmm_registration_info,
+    ) -> sogmm_status;
     pub fn sogmm_model_surface_distance_f32(
         model: *const sogmm_model,
         xyz: *const f32,

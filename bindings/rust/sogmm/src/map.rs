@@ -10,6 +10,7 @@ use crate::error::{check, Result};
 use crate::model::{c_path, rows, Frame, Model};
 use crate::options::{opt_ptr, Options};
 use crate::progress::{with_map_progress, ProgressHook};
+use crate::registration::{self, Registration};
 
 /// A row-major 4 x 4 rigid camera-to-world transform [R t; 0 0 0 1].
 pub type Pose = [f64; 16];
@@ -141,6 +142,31 @@ impl Map {
         with_map_progress(map, self.progress.as_ref(), || {
             check(unsafe { sys::sogmm_map_insert_frame(map, h.0, pose.as_ptr()) })
         })
+    }
+
+    /// Tracking (`sogmm_map_track_frame`): inserts `frame` at the
+    /// camera-to-world pose that registration to the map finds, from `guess`
+    /// or (None) the constant-velocity prediction from the map's last two
+    /// frames; the map's first frame goes in at the guess (None: identity).
+    /// Registration options are the map's creation options
+    /// (`SOGMM_OPT_REGISTRATION_*`). Returns the registration (its pose is the
+    /// one used, or the last iterate) and whether the frame was inserted: only
+    /// when the status is `Converged`. The first frame reports `Converged`
+    /// with 0 iterations.
+    pub fn track_frame(&mut self, frame: &Frame<'_>, guess: Option<&Pose>) -> Result<(Registration, bool)> {
+        let h = frame.handle()?;
+        let map = self.ptr.as_ptr();
+        let mut pose: Pose = [0.0; 16];
+        let mut inserted = 0i32;
+        let mut info = registration::empty_info();
+        let guess_ptr = guess.map_or(ptr::null(), |p| p.as_ptr());
+        // SAFETY: exclusive through &mut self; a valid frame, 16 doubles or NULL, and room for every output.
+        with_map_progress(map, self.progress.as_ref(), || {
+            check(unsafe {
+                sys::sogmm_map_track_frame(map, h.0, guess_ptr, pose.as_mut_ptr(), &mut inserted, &mut info)
+            })
+        })?;
+        Ok((registration::registration_of(pose, &info), inserted != 0))
     }
 
     /// Fits the pending points now (nothing when none are pending); a

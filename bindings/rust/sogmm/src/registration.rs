@@ -57,17 +57,7 @@ impl Model {
     ) -> Result<Registration> {
         let n = rows(points, 4, "points")?;
         let mut pose: Pose = [0.0; 16];
-        let mut info = sys::sogmm_registration_info {
-            struct_size: std::mem::size_of::<sys::sogmm_registration_info>(),
-            status: 0,
-            iterations: 0,
-            log_likelihood: 0.0,
-            inlier_ratio: 0.0,
-            rmse: 0.0,
-            information: [0.0; 36],
-            unobservable: 0,
-            eigen_ratio: 0.0,
-        };
+        let mut info = empty_info();
         let init_ptr = init.map_or(std::ptr::null(), |p| p.as_ptr());
         with_progress(options, |o| {
             // SAFETY: n rows of 4 floats, init 16 doubles or NULL, room for 16 doubles and the sized struct.
@@ -83,22 +73,42 @@ impl Model {
                 )
             })
         })?;
-        let status = match info.status {
-            sys::SOGMM_REGISTRATION_CONVERGED => RegistrationStatus::Converged,
-            sys::SOGMM_REGISTRATION_LOW_FITNESS => RegistrationStatus::LowFitness,
-            sys::SOGMM_REGISTRATION_DEGENERATE => RegistrationStatus::Degenerate,
-            _ => RegistrationStatus::NotConverged,
-        };
-        Ok(Registration {
-            pose,
-            status,
-            iterations: info.iterations,
-            log_likelihood: info.log_likelihood,
-            inlier_ratio: info.inlier_ratio,
-            rmse: info.rmse,
-            information: info.information,
-            unobservable: info.unobservable,
-            eigen_ratio: info.eigen_ratio,
-        })
+        Ok(registration_of(pose, &info))
+    }
+}
+
+/// A `sogmm_registration_info` sized for this binding, to be filled by a call.
+pub(crate) fn empty_info() -> sys::sogmm_registration_info {
+    sys::sogmm_registration_info {
+        struct_size: std::mem::size_of::<sys::sogmm_registration_info>(),
+        status: 0,
+        iterations: 0,
+        log_likelihood: 0.0,
+        inlier_ratio: 0.0,
+        rmse: 0.0,
+        information: [0.0; 36],
+        unobservable: 0,
+        eigen_ratio: 0.0,
+    }
+}
+
+/// The figures a call wrote into `info`, with its pose.
+pub(crate) fn registration_of(pose: Pose, info: &sys::sogmm_registration_info) -> Registration {
+    let status = match info.status {
+        sys::SOGMM_REGISTRATION_CONVERGED => RegistrationStatus::Converged,
+        sys::SOGMM_REGISTRATION_LOW_FITNESS => RegistrationStatus::LowFitness,
+        sys::SOGMM_REGISTRATION_DEGENERATE => RegistrationStatus::Degenerate,
+        _ => RegistrationStatus::NotConverged,
+    };
+    Registration {
+        pose,
+        status,
+        iterations: info.iterations,
+        log_likelihood: info.log_likelihood,
+        inlier_ratio: info.inlier_ratio,
+        rmse: info.rmse,
+        information: info.information,
+        unobservable: info.unobservable,
+        eigen_ratio: info.eigen_ratio,
     }
 }
