@@ -183,6 +183,27 @@ func (m *Map) Stats() (MapStats, error) {
 	return s, err
 }
 
+// Origin returns the map's origin (anchor; world x, y, z in metres): the map
+// holds its components relative to it, so that far from the world origin
+// (geo-referenced poses) they keep room-scale resolution. By default the first
+// frame's translation rounded to 1 km per axis (0 near the world origin); a
+// loaded map's comes from its file (sogmm_map_get_origin).
+func (m *Map) Origin() ([3]float64, error) {
+	var o [3]C.double
+	err := m.read("Origin", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_origin(p, &o[0]) })
+	})
+	return [3]float64{float64(o[0]), float64(o[1]), float64(o[2])}, err
+}
+
+// SetOrigin declares the origin (finite, within float32 range) instead of the
+// first frame's; only before the first insert, else an error with
+// StatusInvalidArg (sogmm_map_set_origin).
+func (m *Map) SetOrigin(origin [3]float64) error {
+	o := [3]C.double{C.double(origin[0]), C.double(origin[1]), C.double(origin[2])}
+	return m.change("SetOrigin", nil, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_origin(p, &o[0]) })
+}
+
 // FrameStats returns what the insert of frame i (insertion order) did (read
 // key by key, sogmm_map_frame_get_*).
 func (m *Map) FrameStats(i uint64) (MapFrameStats, error) {

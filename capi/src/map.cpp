@@ -1,4 +1,5 @@
 // sogmm_map_*: the incremental world map (sogmm::Map) behind a handle.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -88,6 +89,27 @@ SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropp
     const sogmm_capi::MapWriter use(map, "sogmm_map_discard_pending");
     const std::size_t n = map->map.discard_pending();
     if (dropped != nullptr) *dropped = n;
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_get_origin(const sogmm_map* map, double* origin_out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_origin");
+    require_nonnull(origin_out, "origin_out");
+    const sogmm::Origin& o = map->map.origin();
+    std::copy(o.begin(), o.end(), origin_out);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_set_origin(sogmm_map* map, const double* origin) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_set_origin");
+    require_nonnull(origin, "origin");
+    map->map.set_origin({origin[0], origin[1], origin[2]});
   }
   SOGMM_CATCH
 }

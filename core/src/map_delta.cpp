@@ -149,6 +149,15 @@ MapDelta Map::delta_since(std::uint64_t since) const {
   d.frames = detail::frames_text(s.frames, static_cast<std::size_t>(d.frames_from));
   d.model = s.model;
   d.model.gmm = Gmm{};
+  // The map's origin (Map::origin) travels as the model's pose, as in a map
+  // file (spec/format.md 2.3.1): the steps act on components held relative
+  // to it, so a receiver must hold them relative to the same origin.
+  d.model.pose.reset();
+  if (s.origin_fixed && !detail::is_zero(s.origin)) {
+    Pose pose = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int i = 0; i < 3; ++i) pose[4 * i + 3] = s.origin[i];
+    d.model.pose = pose;
+  }
   for (auto e = first; !current && e != j.entries.end(); ++e) {
     d.ops.insert(d.ops.end(), e->ops.begin(), e->ops.end());
     Gmm& c = d.model.gmm;
@@ -178,9 +187,25 @@ void Map::apply_delta(const MapDelta& d) {
     throw bad_delta("it expects " + std::to_string(d.frames_before) + " frames before it, this map has " +
                     std::to_string(s.frames.size()));
   if (d.frames_from > d.frames_before) throw bad_delta("its frame lines start after the receiver's last frame");
+  Origin origin{};
+  if (d.model.pose) {
+    const Pose& p = *d.model.pose;
+    const Pose translation_only = {1, 0, 0, p[3], 0, 1, 0, p[7], 0, 0, 1, p[11], 0, 0, 0, 1};
+    if (p != translation_only) throw bad_delta("its pose (the map's origin) is not a pure translation");
+    origin = {p[3], p[7], p[11]};
+    detail::require_origin(origin);
+  }
+  // A receiver that has an origin (its own inserts, a loaded map, an earlier
+  // delta) takes only deltas of that origin; a fresh one adopts it.
+  if (!fresh && origin != s.origin)
+    throw bad_delta("it holds components relative to origin (" + std::to_string(origin[0]) + ", " +
+                    std::to_string(origin[1]) + ", " + std::to_string(origin[2]) + "), this map's origin is (" +
+                    std::to_string(s.origin[0]) + ", " + std::to_string(s.origin[1]) + ", " +
+                    std::to_string(s.origin[2]) + ")");
 
   // Everything aside first; the commit below only moves.
   Model model = d.model;
+  model.pose.reset();
   model.gmm = replay(s.model.gmm, d);
   if (model.gmm.size() > 0) validate(model.gmm);
   if (model.gmm.support_size != d.model.gmm.support_size)
@@ -204,9 +229,14 @@ void Map::apply_delta(const MapDelta& d) {
   entry.components = d.model.gmm;
   j.entries.reserve(j.entries.size() + 1);
 
+  Model world = detail::is_zero(origin) ? Model{} : detail::world_frame(model, origin);
+
   // Commit.
   if (model.camera.known) s.camera = model.camera.camera;
+  s.origin = origin;
+  s.origin_fixed = s.origin_fixed || !detail::is_zero(origin) || !frames.empty();
   s.model = std::move(model);
+  s.world = std::move(world);
   s.frames = std::move(frames);
   s.marginals = std::move(marginals);
   s.index = std::move(index);

@@ -135,7 +135,7 @@ void restore_warm_start(Map::State& s) {
     std::copy_n(s.model.gmm.covariance(k), 16, block.covariances.data() + 16 * (k - before));
   }
   block.support_size = std::max<std::uint64_t>(1, f[camera].n_novel);
-  s.previous_pose = f[camera].pose;
+  s.previous_pose = detail::anchored(s.origin, f[camera].pose);
   s.previous_fit = transform(block, inverse_rigid(s.previous_pose));
 }
 
@@ -144,7 +144,16 @@ void restore_warm_start(Map::State& s) {
 Model Map::to_model() const {
   require(s_->n_pending == 0, ErrorCode::InvalidArgument,
           "map: " + std::to_string(s_->n_pending) + " points are pending; flush first (a map file holds components only)");
-  Model m = model();
+  (void)model();  // Error(InvalidData) for an empty map
+  // The components as the map holds them, with the origin as their pose
+  // (spec/format.md 2.3): a world-frame file would round them to float32
+  // world coordinates (6.25 cm steps at 1000 km).
+  Model m = s_->model;
+  if (!detail::is_zero(s_->origin)) {
+    Pose pose = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int i = 0; i < 3; ++i) pose[4 * i + 3] = s_->origin[i];
+    m.pose = pose;
+  }
   erase_value(m, kMapFramesKey);
   erase_value(m, kMapOptionsKey);
   m.key_values.emplace_back(kMapFramesKey, detail::frames_text(s_->frames));
@@ -163,6 +172,10 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   Map map(options);
   State& s = *map.s_;
   s.model = model;
+  s.origin = detail::split_origin(s.model);
+  detail::require_origin(s.origin);
+  s.origin_fixed = true;
+  if (!detail::is_zero(s.origin)) s.world = detail::world_frame(s.model, s.origin);
   if (const std::string* frames = find_value(model, kMapFramesKey)) s.frames = detail::parse_frames(*frames);
   // The provenance lives in s.frames now; to_model() writes it afresh.
   erase_value(s.model, kMapFramesKey);
@@ -170,9 +183,9 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   detail::read_identity(s.model, s.journal);
   if (model.camera.known) s.camera = model.camera.camera;
   restore_warm_start(s);
-  s.marginals.reserve(model.gmm.size());
-  for (std::size_t k = 0; k < model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(model.gmm, k));
-  s.index.build(model.gmm);
+  s.marginals.reserve(s.model.gmm.size());
+  for (std::size_t k = 0; k < s.model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(s.model.gmm, k));
+  s.index.build(s.model.gmm);
   return map;
 }
 

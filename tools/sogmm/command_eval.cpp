@@ -149,7 +149,7 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
     const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
     require(static_cast<std::size_t>(s.frame) < poses.size(), ErrorCode::InvalidArgument,
             "eval: --frame must be in [0, " + std::to_string(poses.size()) + ") for " + s.src.trajectory);
-    gmm = transform(gmm, inverse_rigid(poses[static_cast<std::size_t>(s.frame)]));
+    gmm = in_camera(model, poses[static_cast<std::size_t>(s.frame)]);
   } else {
     // A world-frame model seen from the world origin scores nothing the
     // frame saw: refuse instead of printing meaningless figures.
@@ -238,7 +238,7 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
             f.depth + ": image size differs from the camera (give --intrinsics)");
     const PointCloud cloud = backproject_nonempty(frame, camera, d, f.depth);
     const Camera dc = decimated(camera, d.decimate);
-    const Gmm local = transform(model.gmm, inverse_rigid(poses[k]));
+    const Gmm local = in_camera(model, poses[k]);
     FrameScore sc;
     sc.frame = i;
     sc.depth = f.depth;

@@ -70,7 +70,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     const std::vector<Pose> poses = read_trajectory(s.trajectory);
     require(s.frame >= 0 && static_cast<std::size_t>(s.frame) < poses.size(), ErrorCode::InvalidArgument,
             "render: --frame must be in [0, " + std::to_string(poses.size()) + ") for " + s.trajectory);
-    gmm = transform(gmm, inverse_rigid(poses[s.frame]));
+    gmm = in_camera(model, poses[s.frame]);
     view_note = " seen from pose " + std::to_string(s.frame) + " of " + s.trajectory;
   } else if (key_value(model, "coordinate_frame") == "world") {
     std::fprintf(stderr,

@@ -937,6 +937,25 @@ SOGMM_API sogmm_status sogmm_map_frame_get_f64(const sogmm_map* map, uint64_t fr
  * doubles, row-major). frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
 SOGMM_API sogmm_status sogmm_map_frame_get_pose(const sogmm_map* map, uint64_t frame, double* pose_out);
 
+/* The map's origin (anchor) into origin_out (3 doubles: x, y, z in the world
+ * frame, metres). The map holds its components relative to it, so that far
+ * from the world origin (geo-referenced poses: 1000 km out a float32
+ * coordinate moves in steps of 6.25 cm) they keep room-scale resolution;
+ * every computation with a pose is in double relative to it. By default the
+ * first frame's translation rounded to a multiple of 1 km per axis (0 for a
+ * map that starts within 500 m of the world origin, which is held and saved
+ * as before origins existed); a loaded map's comes from its file's pose
+ * (spec/format.md 2.3.1). World-frame exports and queries convert at the
+ * boundary. 0 0 0 for a map before its first insert unless set. */
+SOGMM_API sogmm_status sogmm_map_get_origin(const sogmm_map* map, double* origin_out);
+/* Declares the map's origin (3 doubles, world frame, metres; e.g. a site's
+ * surveyed point, so that the maps of one site share it) instead of the
+ * first frame's. Only before the first insert: a map with a frame or a
+ * component -> SOGMM_E_INVALID_ARG; a NaN/Inf entry or one beyond float32
+ * range -> SOGMM_E_INVALID_ARG naming the axis. Needs exclusive use of the
+ * map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_set_origin(sogmm_map* map, const double* origin);
+
 /* New world-frame model (key "coordinate_frame" = "world") of the whole map
  * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:
  * x_min, y_min, z_min, x_max, y_max, z_max; weights renormalised over them).

@@ -227,6 +227,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_frame_get_i64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_int64)]),
     "sogmm_map_frame_get_f64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_double)]),
     "sogmm_map_frame_get_pose": (STATUS, [HANDLE, c_uint64, F64_OUT]),
+    "sogmm_map_get_origin": (STATUS, [HANDLE, F64_OUT]),
+    "sogmm_map_set_origin": (STATUS, [HANDLE, F64_IN]),
     "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
     "sogmm_map_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_map_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),

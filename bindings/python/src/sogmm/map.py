@@ -22,7 +22,7 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, MapBusyError
-from ._arrays import _pose, _rows
+from ._arrays import _pose, _real_array, _rows
 from .model import GMM, SOGMM, _read_options, _write_options
 from .progress import ProgressArg, call_with_progress
 from .queryable import Queryable
@@ -293,6 +293,28 @@ class Map(Queryable):
         with self._guard.changing("discard_pending"):
             check(lib.sogmm_map_discard_pending(self._h(), byref(dropped)))
         return int(dropped.value)
+
+    @property
+    def origin(self) -> np.ndarray:
+        """The map's origin (anchor; 3 world coordinates, metres): the map holds
+        its components relative to it, so that far from the world origin
+        (geo-referenced poses) they keep room-scale resolution. By default the
+        first frame's translation rounded to 1 km per axis (0 near the world
+        origin); a loaded map's comes from its file (sogmm_map_get_origin)."""
+        out = np.empty(3, dtype=np.float64)
+        with self._guard.reading("origin"):
+            check(lib.sogmm_map_get_origin(self._h(), out))
+        return out
+
+    def set_origin(self, origin) -> None:
+        """Declares the origin (3 world coordinates, metres, finite within
+        float32 range) instead of the first frame's; only before the first
+        insert, else InvalidArgumentError (sogmm_map_set_origin)."""
+        o = _real_array(origin, np.float64, "origin")
+        if o.shape != (3,):
+            raise InvalidArgumentError(f"origin must hold 3 values, got shape {o.shape}")
+        with self._guard.changing("set_origin"):
+            check(lib.sogmm_map_set_origin(self._h(), o))
 
     # ---- statistics ----------------------------------------------------------
     def stats(self) -> dict:

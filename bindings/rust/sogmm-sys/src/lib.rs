@@ -372,6 +372,8 @@ extern "C" {
     pub fn sogmm_map_frame_get_i64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut i64) -> sogmm_status;
     pub fn sogmm_map_frame_get_f64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_map_frame_get_pose(map: *const sogmm_map, frame: u64, pose_out: *mut f64) -> sogmm_status;
+    pub fn sogmm_map_get_origin(map: *const sogmm_map, origin_out: *mut f64) -> sogmm_status;
+    pub fn sogmm_map_set_origin(map: *mut sogmm_map, origin: *const f64) -> sogmm_status;
     pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
     pub fn sogmm_map_score_samples_f32(
         map: *const sogmm_map,

@@ -207,6 +207,26 @@ impl Map {
         })
     }
 
+    /// The map's origin (anchor; world x, y, z in metres): the map holds its
+    /// components relative to it, so that far from the world origin
+    /// (geo-referenced poses) they keep room-scale resolution. By default the
+    /// first frame's translation rounded to 1 km per axis (0 near the world
+    /// origin); a loaded map's comes from its file (`sogmm_map_get_origin`).
+    pub fn origin(&self) -> Result<[f64; 3]> {
+        let mut out = [0f64; 3];
+        // SAFETY: valid handle; `out` has room for the 3 doubles written.
+        check(unsafe { sys::sogmm_map_get_origin(self.raw(), out.as_mut_ptr()) })?;
+        Ok(out)
+    }
+
+    /// Declares the origin (finite, within float32 range) instead of the
+    /// first frame's; only before the first insert, else `Err` with
+    /// `Status::InvalidArg` (`sogmm_map_set_origin`).
+    pub fn set_origin(&mut self, origin: [f64; 3]) -> Result<()> {
+        // SAFETY: exclusive through &mut self; 3 doubles.
+        check(unsafe { sys::sogmm_map_set_origin(self.ptr.as_ptr(), origin.as_ptr()) })
+    }
+
     /// What the insert of frame `frame` (insertion order, from 0) did (read
     /// key by key, `sogmm_map_frame_get_*`).
     pub fn frame_stats(&self, frame: u64) -> Result<MapFrameStats> {

@@ -397,4 +397,41 @@ fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
     assert_eq!(bits(a.weights().unwrap()), bits(b.weights().unwrap()));
     assert_eq!(bits(a.means().unwrap()), bits(b.means().unwrap()));
     assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
+
+// Issue 36: a map 1000 km out holds its components relative to its origin
+// (the first frame's translation rounded to 1 km), finds in a mapped frame
+// the novel points it finds at the world origin, and keeps the origin
+// through save and load; it is declared only before the first insert.
+#[test]
+fn a_far_map_keeps_its_origin() {
+    let pts = blobs(300, 3);
+    let dir = std::env::temp_dir().join(format!("sogmm_rust_origin_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("far.sogmm");
+    let mut novel = Vec::new();
+    for km in [0.0, 1000.0] {
+        let mut pose = IDENTITY;
+        pose[3] = 1000.0 * km + 3.37;
+        pose[7] = -1000.0 * km;
+        let mut map = Map::new(Some(&map_options(true))).unwrap();
+        map.insert_points(&pts, &pose).unwrap();
+        map.flush().unwrap();
+        assert_eq!(map.origin().unwrap(), [1000.0 * km, -1000.0 * km, 0.0]);
+        map.insert_points(&pts, &pose).unwrap();
+        novel.push(map.frame_stats(1).unwrap().n_novel);
+        map.discard_pending().unwrap();
+        map.save(&path, None).unwrap();
+    }
+    assert_eq!(novel[1], novel[0]);
+    let mut loaded = Map::load(&path, Some(&map_options(true))).unwrap();
+    assert_eq!(loaded.origin().unwrap(), [1.0e6, -1.0e6, 0.0]);
+    assert_eq!(loaded.set_origin([0.0; 3]).unwrap_err().status(), Status::InvalidArg);
+    let mut fresh = Map::new(Some(&map_options(true))).unwrap();
+    assert_eq!(
+        fresh.set_origin([f64::NAN, 0.0, 0.0]).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    fresh.set_origin([5.0e5, 0.5, 0.0]).unwrap();
+    assert_eq!(fresh.origin().unwrap(), [5.0e5, 0.5, 0.0]);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
