@@ -397,6 +397,7 @@ fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
     assert_eq!(bits(a.weights().unwrap()), bits(b.weights().unwrap()));
     assert_eq!(bits(a.means().unwrap()), bits(b.means().unwrap()));
     assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
+}
 
 // Issue 36: a map 1000 km out holds its components relative to its origin
 // (the first frame's translation rounded to 1 km), finds in a mapped frame
