@@ -201,7 +201,7 @@ func (m *Map) Origin() ([3]float64, error) {
 // StatusInvalidArg (sogmm_map_set_origin).
 func (m *Map) SetOrigin(origin [3]float64) error {
 	o := [3]C.double{C.double(origin[0]), C.double(origin[1]), C.double(origin[2])}
-	return m.change("SetOrigin", nil, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_origin(p, &o[0]) })
+	return m.change(context.Background(), "SetOrigin", func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_origin(p, &o[0]) })
 }
 
 // FrameStats returns what the insert of frame i (insertion order) did (read

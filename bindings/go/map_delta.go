@@ -5,6 +5,7 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"runtime"
 	"unsafe"
 )
@@ -49,7 +50,7 @@ func (m *Map) ApplyDelta(delta []byte) error {
 	data := C.CBytes(delta)
 	defer C.free(data)
 	defer runtime.KeepAlive(delta)
-	return m.change("ApplyDelta", nil, func(p *C.sogmm_map) C.sogmm_status {
+	return m.change(context.Background(), "ApplyDelta", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_apply_delta(p, unsafe.Pointer(data), C.size_t(len(delta)), nil)
 	})
 }

@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"slices"
 	"testing"
@@ -23,7 +24,7 @@ func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
 	var deltas [][]byte
 	for k, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)} {
 		since, _ := sender.Revision()
-		if err := sender.InsertPoints(twoBlobs(200+50*k), pose); err != nil {
+		if err := sender.InsertPoints(context.Background(), twoBlobs(200+50*k), pose); err != nil {
 			t.Fatal(err)
 		}
 		d, err := sender.ExportDelta(since)

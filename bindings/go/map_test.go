@@ -136,16 +136,16 @@ func TestMapFarFromTheOriginKeepsItsOrigin(t *testing.T) {
 	for _, km := range []float64{0, 1000} {
 		m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
 		pose := yawPose(20, 1000*km+3.37, -1000*km, 0)
-		if err := m.InsertPoints(pts, pose); err != nil {
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
 			t.Fatal(err)
 		}
-		if err := m.Flush(); err != nil {
+		if err := m.Flush(context.Background()); err != nil {
 			t.Fatal(err)
 		}
 		if o, err := m.Origin(); err != nil || o != [3]float64{1000 * km, -1000 * km, 0} {
 			t.Fatalf("origin %v (%v) at %v km", o, err, km)
 		}
-		if err := m.InsertPoints(pts, pose); err != nil {
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
 			t.Fatal(err)
 		}
 		f, err := m.FrameStats(1)
