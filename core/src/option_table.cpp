@@ -80,6 +80,9 @@ std::vector<OptionSpec> make_table() {
                     "runs of k-means++ then EM (seeds seed + r); the best final likelihood is kept"),
       SOGMM_I64_ROW(DEQUANTISE_DEPTH, fit.dequantise_depth, -1, 1, "SOGMM_DEQUANTISE_AUTO (-1), 0 or 1", "",
                     "the depth-quantisation floor: AUTO is on for points from a depth image, off for arrays"),
+      SOGMM_I64_ROW(EM_ACCELERATION, fit.em.acceleration, 0, 1, "0 (plain EM) or 1 (SQUAREM)", "",
+                    "0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the "
+                    "log-likelihood would fall), fewer iterations to the same tol"),
       // ---- RGB-D back-projection ----
       SOGMM_F64_ROW(DEPTH_SCALE, depth.depth_scale, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v) && std::isfinite(1.0 / v); },
                     "> 0, finite, 1 / value finite", "raw units per metre",

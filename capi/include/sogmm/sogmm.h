@@ -187,6 +187,12 @@ typedef int32_t sogmm_key;
                                         * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
                                         * points of sogmm_fit_frame, 0 for points given as arrays */
 #define SOGMM_DEQUANTISE_AUTO (-1)
+#define SOGMM_OPT_EM_ACCELERATION 111 /* i64, 0 or 1; default 0 = plain EM. 1: SQUAREM (Varadhan & Roland
+                                       * 2008, S3): after every two EM steps the model is extrapolated
+                                       * along them and one EM step is taken from there; an extrapolation
+                                       * whose likelihood would fall is rejected (the run continues as plain
+                                       * EM), so likelihoods never decrease and the model returned is an
+                                       * M-step's. MAX_ITER counts E+M passes, rejected ones included */
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 

@@ -92,6 +92,8 @@ pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
 /// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
 pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
+/// i64, 0 (default: plain EM) or 1 (SQUAREM-accelerated EM; see sogmm.h).
+pub const SOGMM_OPT_EM_ACCELERATION: sogmm_key = 111;
 pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
 pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
 pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;
