@@ -432,13 +432,19 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   };
 
   if (options.acceleration == EmAcceleration::Squarem) {
-    // Makes an extrapolated model current (detail::EmLoad): only when every
-    // component packs as it is, so pack_all then changes nothing in it.
+    // Makes a model current (detail::EmLoad): only when every component
+    // packs as it is, so pack_all then changes nothing in it, and an
+    // extrapolated one only when it keeps its reg_covar floors.
     std::vector<float> one(kParamStride);
     std::vector<double> one_exact(kParamStride);
-    const detail::EmLoad load = [&](Working& cur) {
-      for (std::size_t k = 0; k < m; ++k)
+    const detail::EmLoad load = [&](Working& cur, bool extrapolated) {
+      for (std::size_t k = 0; k < m; ++k) {
         if (!pack_component(cur, k, one.data(), one_exact.data())) return false;
+        if (!extrapolated) continue;
+        Eigen::Matrix4d above = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&cur.covariance[16 * k]);
+        for (int i = 0; i < 4; ++i) above(i, i) -= reg[i];
+        if (Eigen::LLT<Eigen::Matrix4d>(above).info() != Eigen::Success) return false;
+      }
       shift = pack_all(cur, reg, data_scale2, params, exact);
       return true;
     };

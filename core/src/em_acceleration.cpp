@@ -137,12 +137,12 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
       continue;
     }
     Working next = squarem_extrapolate(t0, t1, w, a);
-    bool loaded = load(next);
+    bool loaded = load(next, true);
     for (int pull = 0; !loaded && pull < kMaxPullBacks; ++pull) {
       a = 0.5 * (a + 1.0);
       if (!(a > kPlain)) break;
       next = squarem_extrapolate(t0, t1, w, a);
-      loaded = load(next);
+      loaded = load(next, true);
     }
     if (!loaded) continue;  // no extrapolation was a model: t2 is still current
     t2.mean.swap(w.mean);
@@ -160,7 +160,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
       ++report.extrapolations_rejected;
       if (capped) step_max = std::max(kStepMax0, step_max / kStepFactor);
       w = t2;
-      load(w);
+      load(w, false);
       report.iterations = iter;
     }
   }

@@ -20,17 +20,21 @@ namespace sogmm::detail {
 using EmPass = std::function<double(Working& w)>;
 /// Makes `w` the current model; returns false and changes nothing when `w`
 /// is not a model (a covariance not positive definite, a non-finite
-/// constant).
-using EmLoad = std::function<bool(Working& w)>;
+/// constant) or, with `extrapolated`, lies outside the set the M-step maps
+/// into (a covariance minus the reg_covar diagonal not positive definite):
+/// from there the next M-step, which adds the floors back, could lower the
+/// likelihood.
+using EmLoad = std::function<bool(Working& w, bool extrapolated)>;
 
 /// Runs EM from the current model `w` with SQUAREM steps until
 /// |change of the log-likelihood| < options.tol or options.max_iter passes.
 /// Safeguards: an extrapolated model that is not a model is pulled back
 /// towards t2 (a halved, down to the plain step), and one whose
 /// log-likelihood is below t1's is rejected (the run continues from t2, as
-/// plain EM would). So the log-likelihoods of the models kept never decrease
-/// by more than plain EM's own rounding, and the model returned in `w` is
-/// always an M-step's (its floors and the depth floor hold). `on_iteration`
+/// plain EM would). The model returned in `w` is always an M-step's (its
+/// floors and the depth floor hold). The EM step after a kept extrapolation
+/// may lower the likelihood slightly (the M-step's reg_covar floors: see
+/// EmOptions::acceleration). `on_iteration`
 /// sees every pass but the rejected ones (its numbers then skip one);
 /// report->iterations counts every pass.
 void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,

@@ -191,8 +191,8 @@ typedef int32_t sogmm_key;
                                        * 2008, S3): after every two EM steps the model is extrapolated
                                        * along them and one EM step is taken from there; an extrapolation
                                        * whose likelihood would fall is rejected (the run continues as plain
-                                       * EM), so likelihoods never decrease and the model returned is an
-                                       * M-step's. MAX_ITER counts E+M passes, rejected ones included */
+                                       * EM); the model returned is an M-step's. MAX_ITER counts E+M passes,
+                                       * rejected ones included */
 #define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
 
