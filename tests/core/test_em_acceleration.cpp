@@ -37,27 +37,7 @@ std::vector<float> overlapping_mixture() {
   return sogmm_test::draw_mixture(mus, covs, {600, 500, 400}, 35);
 }
 
-// A room-like scene: 6 planar patches (1 m x 0.6 m, 3 mm thick) with gray
-// gradients, 3000 points.
-std::vector<float> patches() {
-  sogmm_test::TestRng r(7);
-  std::vector<float> pts;
-  for (int patch = 0; patch < 6; ++patch) {
-    Eigen::Matrix3d a;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) a(i, j) = r.normal();
-    const Eigen::Matrix3d q = Eigen::HouseholderQR<Eigen::Matrix3d>(a).householderQ();
-    const Eigen::Vector3d centre(r.uniform() * 2 - 1, r.uniform() - 0.5, 1.5 + 1.5 * r.uniform());
-    const double g0 = r.uniform();
-    for (int i = 0; i < 500; ++i) {
-      const double u = r.uniform() - 0.5, v = 0.6 * (r.uniform() - 0.5);
-      const Eigen::Vector3d p = centre + q * Eigen::Vector3d(u, v, 0.003 * r.normal());
-      pts.insert(pts.end(), {static_cast<float>(p(0)), static_cast<float>(p(1)), static_cast<float>(p(2)),
-                             static_cast<float>(g0 + 0.3 * u + 0.02 * r.normal())});
-    }
-  }
-  return pts;
-}
+using sogmm_test::frame_points;
 
 struct Traced {
   sogmm::Gmm gmm;
@@ -114,12 +94,13 @@ TEST(EmAcceleration, ReachesPlainEmsFixedPoint) {
 // pass before it, but the EM step that follows it is not an ascent step of
 // the likelihood: the M-step adds the reg_covar floors (Sigma = S + reg),
 // which only models that are themselves M-step outputs absorb without loss.
-// Plain EM never falls on this scene (3 mm thick patches; worst drop 0 under
-// sse2, avx2 and the default kernel); SQUAREM's reported likelihoods fell by
-// at most 2.5e-4 nats/point (sse2; 5.0e-5 avx2). Bound: the default tol,
-// 1e-3, so a drop never stops a fit early. tol 0 runs all 80 passes.
+// On this scene (EmProperties' room-like frame) SQUAREM's reported
+// likelihoods fell by at most 2.5e-4 nats/point on a 6-patch variant under
+// sse2 where plain EM never fell; plain EM falls here too, by float32
+// rounding, under avx2. Bound for both: the default tol, 1e-3, so a drop
+// never stops a fit early. tol 0 runs all 80 passes.
 TEST(EmAcceleration, LikelihoodDropsStayBelowTol) {
-  const std::vector<float> pts = patches();
+  const std::vector<float> pts = frame_points();
   sogmm::EmOptions o;
   o.tol = 0.0;
   o.max_iter = 80;
@@ -137,14 +118,14 @@ TEST(EmAcceleration, LikelihoodDropsStayBelowTol) {
     EXPECT_EQ(r.report.iterations, 80);
     EXPECT_GT(r.report.extrapolations_kept, 0);
     EXPECT_EQ(static_cast<int>(r.ll.size()), 80 - r.report.extrapolations_rejected);
-    EXPECT_EQ(plain, 0.0);
-    EXPECT_LE(worst_drop(r.ll), 1e-3);
+    EXPECT_LE(plain, 1e-3);
+    EXPECT_LE(worst_drop(r.ll), 1e-3) << "plain EM's worst drop " << plain;
   }
 }
 
 // Bitwise the same model, likelihood and pass count for 1, 2 and 3 threads.
 TEST(EmAcceleration, BitIdenticalForOneTwoThreeThreads) {
-  const std::vector<float> pts = patches();
+  const std::vector<float> pts = frame_points();
   sogmm::FitOptions o;
   o.n_components = 18;
   o.seed = 4;
@@ -165,7 +146,7 @@ TEST(EmAcceleration, BitIdenticalForOneTwoThreeThreads) {
 // EmProperties.TranslationKeepsTheLikelihood): the same likelihood within
 // 1e-3 nats/point, the bound plain EM meets there.
 TEST(EmAcceleration, TranslationKeepsTheLikelihood) {
-  const std::vector<float> base = patches();
+  const std::vector<float> base = frame_points();
   for (double t : {10.0, 1e3}) {
     SCOPED_TRACE("offset " + std::to_string(t) + " m");
     const float off[3] = {static_cast<float>(0.6 * t), static_cast<float>(-0.48 * t), static_cast<float>(0.64 * t)};
