@@ -24,6 +24,7 @@ const (
 	OptTruncationNats              Key = C.SOGMM_OPT_TRUNCATION_NATS
 	OptNInit                       Key = C.SOGMM_OPT_N_INIT
 	OptDequantiseDepth             Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
+	OptEmAcceleration              Key = C.SOGMM_OPT_EM_ACCELERATION
 	OptDepthScale                  Key = C.SOGMM_OPT_DEPTH_SCALE
 	OptDepthMin                    Key = C.SOGMM_OPT_DEPTH_MIN
 	OptDepthMax                    Key = C.SOGMM_OPT_DEPTH_MAX
@@ -257,6 +258,15 @@ func DequantiseDepth(on bool) Option {
 		return I64(OptDequantiseDepth, 1)
 	}
 	return I64(OptDequantiseDepth, 0)
+}
+
+// Squarem turns SQUAREM-accelerated EM on (1) or off (0: plain EM, the
+// default); see SOGMM_OPT_EM_ACCELERATION in sogmm.h.
+func Squarem(on bool) Option {
+	if on {
+		return I64(OptEmAcceleration, 1)
+	}
+	return I64(OptEmAcceleration, 0)
 }
 
 // DequantiseAuto is OptDequantiseDepth's default value (see sogmm.h).

@@ -94,6 +94,9 @@ std::vector<OptionSpec> make_table() {
                     "onto single levels (every seed converges; higher likelihood of held-out pixels spread in their "
                     "bins, lower training likelihood); 0: the paper's plain EM; SOGMM_DEQUANTISE_AUTO (-1): 1 for "
                     "the points of sogmm_fit_frame, 0 for points given as arrays"),
+      SOGMM_I64_ROW(EM_ACCELERATION, fit.em.acceleration, 0, 1, "0 (plain EM) or 1 (SQUAREM)", "",
+                    "0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the "
+                    "log-likelihood would fall), fewer iterations to the same tol"),
       // ---- RGB-D back-projection ----
       SOGMM_F64_ROW(DEPTH_SCALE, depth.depth_scale, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v) && std::isfinite(1.0 / v); },
                     "> 0, finite, 1 / value finite", "raw units per metre",

@@ -352,9 +352,9 @@ Command add_eval_command(CLI::App& root) {
               return run_fit_and_eval(*s);
             }
             require(!any_given(*a, {"--bandwidth", "--components", "--tol", "--max-iter", "--reg-covar", "--n-init",
-                                     "--truncate"}),
+                                     "--truncate", "--em-acceleration"}),
                     ErrorCode::InvalidArgument,
-                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate apply only "
+                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate/--em-acceleration apply only "
                     "without MODEL");
             if (!s->src.sequence.empty()) {
               require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");

@@ -205,6 +205,10 @@ typedef int32_t sogmm_key;
  * SOGMM_DEQUANTISE_AUTO (-1): 1 for the points of sogmm_fit_frame, 0 for points given as arrays.
  * i64, SOGMM_DEQUANTISE_AUTO (-1), 0 or 1; default -1. */
 #define SOGMM_OPT_DEQUANTISE_DEPTH 110
+/* 0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the
+ * log-likelihood would fall), fewer iterations to the same tol.
+ * i64, 0 (plain EM) or 1 (SQUAREM); default 0. */
+#define SOGMM_OPT_EM_ACCELERATION 111
 
 /* RGB-D back-projection. Read by sogmm_fit_frame, sogmm_map_insert_frame,
  * sogmm_frame_to_points_f32. */

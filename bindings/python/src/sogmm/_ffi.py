@@ -45,6 +45,7 @@ OPT_MODE_COUNTER = 107
 OPT_TRUNCATION_NATS = 108
 OPT_N_INIT = 109
 OPT_DEQUANTISE_DEPTH = 110
+OPT_EM_ACCELERATION = 111
 OPT_DEPTH_SCALE = 200
 OPT_DEPTH_MIN = 201
 OPT_DEPTH_MAX = 202
@@ -448,6 +449,7 @@ OPTION_NAMES = {
     OPT_TRUNCATION_NATS: "truncation_nats",
     OPT_N_INIT: "n_init",
     OPT_DEQUANTISE_DEPTH: "dequantise_depth",
+    OPT_EM_ACCELERATION: "em_acceleration",
     OPT_DEPTH_SCALE: "depth_scale",
     OPT_DEPTH_MIN: "depth_min",
     OPT_DEPTH_MAX: "depth_trunc",

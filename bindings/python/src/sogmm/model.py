@@ -445,6 +445,9 @@ _MODE_COUNTERS = {
     "flat_binned": _ffi.MODE_COUNTER_FLAT_BINNED,
     "gaussian_blurring": _ffi.MODE_COUNTER_GAUSSIAN_BLURRING,
 }
+# SOGMM_OPT_EM_ACCELERATION's values by name; the keyword's default is the library's.
+_EM_ACCELERATIONS = {"none": 0, "squarem": 1}
+_EM_ACCELERATION_DEFAULT = next(k for k, v in _EM_ACCELERATIONS.items() if v == _D.em_acceleration)
 
 
 class SOGMM(GMM):
@@ -479,6 +482,10 @@ class SOGMM(GMM):
         n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
             the highest final mean log-likelihood is kept (as scikit-learn's
             GaussianMixture(n_init)). 1 (default) = the paper's single run.
+        em_acceleration: "none" = plain EM, "squarem" = SQUAREM steps
+            (extrapolation along two EM steps, rejected when the likelihood
+            would fall; max_iter counts every E+M pass). The default is the
+            library's (SOGMM_OPT_EM_ACCELERATION).
 
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
@@ -487,7 +494,7 @@ class SOGMM(GMM):
                  reg_covar: float | str = "auto", max_iter: int = _D.max_iter, n_components: int | None = None, n_threads: int = _D.threads,
                  mode_counter: str = "flat_binned", truncation_nats: float = _D.truncation_nats,
                  n_init: int = _D.n_init,
-                 dequantise_depth: bool | None = None):
+                 dequantise_depth: bool | None = None, em_acceleration: str = _EM_ACCELERATION_DEFAULT):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -499,12 +506,13 @@ class SOGMM(GMM):
         self.truncation_nats = truncation_nats
         self.n_init = n_init
         self.dequantise_depth = dequantise_depth
+        self.em_acceleration = em_acceleration
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats", "n_init", "dequantise_depth")
+               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -519,6 +527,9 @@ class SOGMM(GMM):
     def _fit_options(self, extra_f64=None, extra_i64=None) -> _ffi.Options:
         if self.mode_counter not in _MODE_COUNTERS:
             raise InvalidArgumentError(f"mode_counter must be one of {sorted(_MODE_COUNTERS)}, got {self.mode_counter!r}")
+        if self.em_acceleration not in _EM_ACCELERATIONS:
+            raise InvalidArgumentError(
+                f"em_acceleration must be one of {sorted(_EM_ACCELERATIONS)}, got {self.em_acceleration!r}")
         k = self.n_components
         if k is None:
             k = 0
@@ -550,6 +561,7 @@ class SOGMM(GMM):
             _ffi.OPT_DEQUANTISE_DEPTH: (_ffi.DEQUANTISE_AUTO if self.dequantise_depth is None
                                         else int(bool(self.dequantise_depth))),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
+            _ffi.OPT_EM_ACCELERATION: _EM_ACCELERATIONS[self.em_acceleration],
         }
         f64.update(extra_f64 or {})
         i64.update(extra_i64 or {})

@@ -213,6 +213,9 @@ impl OptionsBuilder {
         /// Forces the depth-quantisation floor on or off; the default
         /// (sogmm_sys::SOGMM_DEQUANTISE_AUTO) floors RGB-D frames and not arrays.
         dequantise_depth(bool) => SOGMM_OPT_DEQUANTISE_DEPTH as i64 i64::from;
+        /// SQUAREM-accelerated EM (true) or plain EM (false, default); see
+        /// SOGMM_OPT_EM_ACCELERATION in sogmm.h.
+        squarem(bool) => SOGMM_OPT_EM_ACCELERATION as i64 i64::from;
         /// Raw depth units per metre (default 1000).
         depth_scale(f64) => SOGMM_OPT_DEPTH_SCALE as f64 |v| v;
         /// Nearest valid depth in metres, exclusive (default 0.1).

@@ -329,3 +329,44 @@ fn option_info_reports_every_default_a_fresh_handle_holds() {
     assert_eq!(tol.name, "SOGMM_OPT_TOL");
     assert_eq!(sogmm::option_info(99).unwrap_err().status(), sogmm::Status::InvalidArg);
 }
+
+/// SQUAREM (`squarem(true)`, SOGMM_OPT_EM_ACCELERATION) reaches plain EM's
+/// fixed point on three overlapping clusters in fewer passes, no lower; a
+/// value outside 0..=1 is refused.
+#[test]
+fn squarem_reaches_the_fixed_point_in_fewer_passes() {
+    let mut s: u64 = 35;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 40) as f32 / (1u64 << 24) as f32) - 0.5 // [-0.5, 0.5)
+    };
+    let mut pts = Vec::new();
+    for i in 0..3000 {
+        let k = (i % 3) as f32;
+        pts.extend_from_slice(&[
+            0.8 * k + 1.5 * next(),
+            0.5 * next(),
+            1.0 + 0.3 * next(),
+            0.3 + 0.3 * next(),
+        ]);
+    }
+    let fit = |squarem: bool| {
+        let o = Options::builder()
+            .n_components(3)
+            .seed(1)
+            .threads(1)
+            .tol(1e-7)
+            .max_iter(3000)
+            .squarem(squarem);
+        let m = Model::fit(&pts, Some(&o.build().unwrap())).unwrap();
+        let it = m.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap().unwrap();
+        let ll = m.info_f64(sogmm::sys::SOGMM_INFO_FIT_LOG_LIKELIHOOD).unwrap().unwrap();
+        (it, ll)
+    };
+    let (plain, fast) = (fit(false), fit(true));
+    assert!(fast.0 < plain.0, "{fast:?} vs {plain:?}");
+    assert!(fast.1 >= plain.1 - 1e-5, "{fast:?} vs {plain:?}");
+    let mut o = Options::new().unwrap();
+    assert_eq!(o.get_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION).unwrap(), 0);
+    assert!(o.set_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION, 2).is_err());
+}
