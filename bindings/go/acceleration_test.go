@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"testing"
 )
@@ -25,7 +26,7 @@ func TestSquaremReachesTheFixedPointInFewerPasses(t *testing.T) {
 			t.Fatal(err)
 		}
 		defer o.Close()
-		m, err := Fit(pts, o)
+		m, err := Fit(context.Background(), pts, o)
 		if err != nil {
 			t.Fatal(err)
 		}
