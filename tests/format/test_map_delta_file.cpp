@@ -52,8 +52,12 @@ TEST(MapDeltaFile, RoundTripIsBitExactAndReadersKeepApart) {
     const std::vector<std::uint8_t> bytes = sogmm::format::delta_to_bytes(d);
     const sogmm::MapDelta back = sogmm::format::delta_from_bytes(bytes.data(), bytes.size());
     ASSERT_EQ(back.model.gmm.weights.size(), d.model.gmm.weights.size());
-    EXPECT_EQ(std::memcmp(back.model.gmm.covariances.data(), d.model.gmm.covariances.data(),
-                          d.model.gmm.covariances.size() * sizeof(float)), 0);
+    // A delta of a frame that only pends carries no component: memcmp on
+    // the empty vectors' null data() is undefined (UBSan), so compare only
+    // what there is.
+    EXPECT_TRUE(d.model.gmm.covariances.empty() ||
+                std::memcmp(back.model.gmm.covariances.data(), d.model.gmm.covariances.data(),
+                            d.model.gmm.covariances.size() * sizeof(float)) == 0);
     EXPECT_EQ(back.digest, d.digest);
     const sogmm::format::FileInfo info = sogmm::format::read_info(bytes.data(), bytes.size(),
                                                                   sogmm::format::ReadOptions{});
