@@ -45,6 +45,7 @@ const (
 	OptMapWarmStart                Key = C.SOGMM_OPT_MAP_WARM_START
 	OptMapNoveltyBandwidthScale    Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
 	OptMapRevisitRefitRatio        Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
+	OptMapDeltaHistory             Key = C.SOGMM_OPT_MAP_DELTA_HISTORY
 	OptOccupancySigma              Key = C.SOGMM_OPT_OCCUPANCY_SIGMA
 	OptOccupancyThickness          Key = C.SOGMM_OPT_OCCUPANCY_THICKNESS
 	OptSurfaceDiscSigmas           Key = C.SOGMM_OPT_SURFACE_DISC_SIGMAS

@@ -139,7 +139,11 @@ MapDelta Map::delta_since(std::uint64_t since) const {
           ErrorCode::InvalidArgument,
           "map: no delta from revision " + std::to_string(since) + ": this map is at revision " +
               std::to_string(j.revision) + " and holds its changes from revision " + std::to_string(j.first_revision) +
-              (since > j.revision ? "" : " (a relayed delta is cut only where the deltas it received start)"));
+              (since > j.revision     ? ""
+               : since < j.first_revision && j.history > 0
+                   ? " (it keeps the changes of its last " + std::to_string(j.history) +
+                         " revisions: MapOptions::delta_history; send the whole map)"
+                   : " (a relayed delta is cut only where the deltas it received start)"));
   MapDelta d;
   d.map_id = j.map_id;
   d.base_revision = since;
@@ -241,7 +245,7 @@ void Map::apply_delta(const MapDelta& d) {
   s.marginals = std::move(marginals);
   s.index = std::move(index);
   ++s.revision;
-  if (d.revision > d.base_revision) j.entries.push_back(std::move(entry));
+  if (d.revision > d.base_revision) j.append(std::move(entry));
   j.map_id = d.map_id;
   j.revision = d.revision;
 }

@@ -89,6 +89,13 @@ std::string new_map_id() {
   return buf;
 }
 
+void Journal::append(JournalEntry&& e) {
+  entries.push_back(std::move(e));
+  if (history == 0 || entries.size() <= history) return;
+  entries.erase(entries.begin(), entries.end() - static_cast<std::ptrdiff_t>(history));
+  first_revision = entries.front().revision_before;
+}
+
 JournalScope::JournalScope(Journal& journal, std::size_t n_frames) : j_(journal) {
   if (j_.depth++ > 0) return;
   j_.open_ops.clear();
@@ -114,7 +121,7 @@ void JournalScope::commit(std::size_t n_frames) {
   e.frames_before = j_.open_frames_before;
   e.ops = std::move(j_.open_ops);
   e.components = std::move(j_.open_components);
-  j_.entries.push_back(std::move(e));
+  j_.append(std::move(e));
   ++j_.revision;
   j_.open_ops.clear();
   j_.open_components = Gmm{};

@@ -32,6 +32,7 @@ struct Journal {
   std::string map_id;               ///< 32 hex digits, random at construction
   std::uint64_t revision = 0;       ///< the map's revision (Map::revision)
   std::uint64_t first_revision = 0; ///< deltas can start here or later (a loaded map starts later)
+  std::uint64_t history = 0;        ///< entries kept (MapOptions::delta_history; 0 = all)
   std::vector<JournalEntry> entries;
   // The entry of the call under way.
   int depth = 0;
@@ -46,6 +47,9 @@ struct Journal {
   /// Set steps for components `ids` of `gmm` (their values after the change).
   void set(const Gmm& gmm, const std::vector<std::size_t>& ids);
   void drop(const std::vector<std::size_t>& ids);
+  /// Appends a committed entry and forgets the oldest beyond `history`
+  /// (moves only: it cannot throw once the entry is in).
+  void append(JournalEntry&& e);
 };
 
 /// Components [first, end) of `gmm` (support size 0).

@@ -183,7 +183,10 @@ struct Map::State {
   /// The public revision and the changes deltas are cut from
   /// (sogmm/map_delta.hpp); unlike `revision` it also counts frames.
   detail::Journal journal;
-  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) { journal.map_id = detail::new_map_id(); }
+  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {
+    journal.map_id = detail::new_map_id();
+    journal.history = o.delta_history;
+  }
 };
 
 }  // namespace sogmm

@@ -160,6 +160,10 @@ std::vector<OptionSpec> make_table() {
                     "are replaced by a fit of those points plus samples of their mass it does not see (details and "
                     "why: MapOptions::revisit_refit_ratio); 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START "
                     "1; a refit counts as a fit (flushed, n_flushes)"),
+      SOGMM_I64_ROW(MAP_DELTA_HISTORY, map.delta_history, 0, std::int64_t{1} << 62, "[0, 2^62]", "revisions",
+                    "how many of its latest revisions a map keeps the changes of, for deltas (sogmm_map_export_delta "
+                    "since an older one is refused naming the oldest kept); 0: every revision since it was created or "
+                    "loaded (memory grows with every fit)"),
       // ---- occupancy and distance to the surface ----
       SOGMM_F64_ROW(OCCUPANCY_SIGMA, occupancy.surface_sigma, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "m",

@@ -113,6 +113,25 @@ int main(void) {
   EXPECT_TRUE(same_maps(sender, receiver));
   EXPECT_STATUS(sogmm_map_apply_delta(NULL, d[2], size[2], NULL), SOGMM_E_NULL_ARG);
 
+  /* SOGMM_OPT_MAP_DELTA_HISTORY 1: only the last revision's change is kept. */
+  {
+    sogmm_map* bounded = NULL;
+    size_t n = 0;
+    int64_t history = -1;
+    EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_MAP_DELTA_HISTORY, &history));
+    EXPECT_TRUE(history == 0); /* the default keeps every revision */
+    EXPECT_STATUS(sogmm_options_set_i64(o, SOGMM_OPT_MAP_DELTA_HISTORY, -1), SOGMM_E_INVALID_ARG);
+    REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_MAP_DELTA_HISTORY, 1));
+    REQUIRE_OK(sogmm_map_create(&bounded, o));
+    REQUIRE_OK(sogmm_map_insert_points_f32(bounded, pts, 3000, k_identity));
+    REQUIRE_OK(sogmm_map_flush(bounded));
+    EXPECT_TRUE(revision_of(bounded) == 2);
+    EXPECT_OK(sogmm_map_export_delta(bounded, 1, NULL, NULL, 0, &n));
+    EXPECT_STATUS(sogmm_map_export_delta(bounded, 0, NULL, NULL, 0, &n), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(strstr(sogmm_last_error(), "changes from revision 1") != NULL);
+    sogmm_map_free(bounded);
+  }
+
   for (i = 0; i < 3; ++i) free(d[i]);
   free(pts);
   sogmm_map_free(sender);

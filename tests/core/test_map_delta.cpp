@@ -239,4 +239,41 @@ TEST(MapDeltaTest, AFailedInsertKeepsTheRevisionAndRangesAreChecked) {
   EXPECT_EQ(map.revision(), 1u);  // pending points are not in a delta
 }
 
+// MapOptions::delta_history bounds what the sender keeps: deltas from its
+// last N revisions are cut as before (a receiver that follows stays bitwise
+// equal), an older start is refused naming the oldest kept, and a receiver
+// that fell behind catches up from the whole map.
+TEST(MapDeltaTest, ABoundedHistoryKeepsTheLastRevisionsOnly) {
+  MapOptions o = points_options(true, false);
+  o.delta_history = 2;
+  Map sender(o), follower(o);
+  for (int k = 0; k < 6; ++k) {
+    const std::vector<float> p = scene_points(900, 40 + k, 0.3 * k);
+    sender.insert_points({p.data(), p.size() / 4}, kIdentity);
+    send(sender, follower);
+    expect_same_map(sender, follower);
+  }
+  const std::uint64_t head = sender.revision();
+  ASSERT_GE(head, 6u);
+  EXPECT_NO_THROW(sender.delta_since(head - 2));
+  EXPECT_NO_THROW(sender.delta_since(head));
+  try {
+    sender.delta_since(head - 3);
+    ADD_FAILURE() << "a delta from beyond the history was cut";
+  } catch (const sogmm::Error& e) {
+    EXPECT_EQ(e.code(), sogmm::ErrorCode::InvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("changes from revision " + std::to_string(head - 2)), std::string::npos)
+        << e.what();
+  }
+  // The unbounded default still cuts from revision 0.
+  Map unbounded(points_options(true, false));
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<float> p = scene_points(900, 40 + k, 0.3 * k);
+    unbounded.insert_points({p.data(), p.size() / 4}, kIdentity);
+  }
+  Map late(points_options(true, false));
+  late.apply_delta(unbounded.delta_since(0));
+  expect_same_map(unbounded, late);
+}
+
 }  // namespace

@@ -295,6 +295,11 @@ typedef int32_t sogmm_key;
  * or MAP_WARM_START 1; a refit counts as a fit (flushed, n_flushes).
  * f64, 0 (off) or >= 1, finite; default 1.25. */
 #define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608
+/* How many of its latest revisions a map keeps the changes of, for deltas
+ * (sogmm_map_export_delta since an older one is refused naming the oldest kept); 0: every
+ * revision since it was created or loaded (memory grows with every fit).
+ * i64 (revisions), [0, 2^62]; default 0. */
+#define SOGMM_OPT_MAP_DELTA_HISTORY 609
 
 /* Occupancy and distance to the surface. Read by sogmm_map_occupancy_f32,
  * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32. */
@@ -1036,8 +1041,11 @@ SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const s
  * are not in a delta. Write keys of `options` apply (NULL = defaults). A
  * revision the map holds no changes from (before it was created or loaded,
  * after its current one, or, for a receiver, inside a delta it received) ->
- * SOGMM_E_INVALID_ARG naming the range. The map keeps every explicit
- * component it ever fitted (the cost of exporting from any revision). */
+ * SOGMM_E_INVALID_ARG naming the range. The map keeps the changes of its
+ * last SOGMM_OPT_MAP_DELTA_HISTORY revisions (default 0: every revision,
+ * so every explicit component it ever fitted: the cost of exporting from
+ * any revision); a revision before those -> SOGMM_E_INVALID_ARG naming the
+ * oldest kept. */
 SOGMM_API sogmm_status sogmm_map_export_delta(const sogmm_map* map, uint64_t since_revision,
                                               const sogmm_options* options, void* out, size_t capacity,
                                               size_t* size);

@@ -144,6 +144,15 @@ struct MapOptions {
   /// beyond that variation (MapTest.RevisitRefitAtTheDefaultRatioDoesNot-
   /// CreepOnRepeats).
   double revisit_refit_ratio = 1.25;
+  /// How many of its latest revisions a map keeps the changes of, so that
+  /// deltas (sogmm/map_delta.hpp) can be cut from any of them: 0 keeps every
+  /// revision since the map was created or loaded (memory grows with every
+  /// fit: each explicit component it ever fitted is kept); N keeps the last
+  /// N, so a robot that streams deltas to receivers at most N revisions
+  /// behind holds a bounded record. A delta from an older revision is then
+  /// refused naming the oldest one kept (a receiver that far behind takes
+  /// the whole map instead).
+  std::uint64_t delta_history = 0;
 };
 
 /// Throws Error(InvalidArgument) naming the field unless every option is in
