@@ -28,7 +28,7 @@ struct MapState {
   MapOptions options;
   RegistrationOptions registration;  // tracking, without --trajectory
   std::string fusion = "off";
-  bool no_novelty = false;
+  bool no_novelty = false, refine_poses = false;
   bool json = false, progress = false, quiet = false;
 };
 
@@ -100,7 +100,10 @@ int run_map(MapState& s) {
   s.options.fusion = s.fusion != "off";
   s.options.fusion_method = s.fusion == "kl" ? FusionMethod::KL : FusionMethod::Hellinger;
   Map map(s.options);  // checks the options before any file is read
-  const SequenceInput in = resolve_sequence(s.src, s.camera);
+  if (s.refine_poses && s.src.trajectory.empty())
+    throw Error(ErrorCode::InvalidArgument, "--refine-poses refines the poses of --trajectory: give one");
+  SequenceInput in = resolve_sequence(s.src, s.camera);
+  in.refine_poses = s.refine_poses;
   ProgressPrinter progress(progress_mode(s.quiet, s.progress));
   std::vector<Row> rows;
   std::size_t points = 0, novel = 0;
@@ -119,7 +122,7 @@ int run_map(MapState& s) {
     const FrameStats& st = f.stats;
     if (st.flushed) deltas.write(map);
     const std::size_t pending = map.pending();
-    const bool given = !in.poses.empty();
+    const bool given = !in.poses.empty() && !in.refine_poses;
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
                     st.ms_fit, st.ms_merge, st.n_replaced,
                     given ? "given" : (f.registered ? "registered" : "first"), f.registration.inlier_ratio,
@@ -224,8 +227,11 @@ Command add_map_command(CLI::App& root) {
                   "map from a constant-velocity guess; frames that fail are skipped with a warning)");
   app->add_option("--trajectory-out", s->trajectory_out,
                   "write the poses of the inserted frames (given or estimated) as a Redwood .log");
+  app->add_flag("--refine-poses", s->refine_poses,
+                "with --trajectory: register each frame to the map from its given pose (e.g. odometry) and insert\n"
+                "it at the pose found; a frame that does not register is skipped with a warning");
   app->add_flag("--registration-gray", s->registration.use_gray,
-                "without --trajectory: register with gray too (the 4-D density; SOGMM_OPT_REGISTRATION_USE_GRAY),\n"
+                "without --trajectory or with --refine-poses: register with gray too (the 4-D density; SOGMM_OPT_REGISTRATION_USE_GRAY),\n"
                 "which holds the pose where the geometry alone lets a frame slide (a wall, a floor)");
   app->add_option("--frames", s->src.frames, "I, A:B (B excluded) or A:B:STEP; default all");
   add_pair_by_order_flag(*app, s->src.pair_by_order);

@@ -92,11 +92,12 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter&
     // The tool's check first: its message names the file and the depth range.
     const PointCloud points = backproject_nonempty(frame, camera, map.options().depth, r.file.depth);
     try {
-      if (!in.poses.empty()) {
+      if (!in.poses.empty() && !in.refine_poses) {
         r.pose = in.poses[k];
         r.stats = map.insert_backprojected(points.view(), camera, r.pose, recording(progress.fit_callback(r.label), r.fit));
-      } else {  // the core's tracking: registered to the map from a constant-velocity guess
-        const TrackedFrame t = track_backprojected(map, points.view(), camera, predict_constant_velocity(map),
+      } else {  // the core's tracking: registered to the map from the given pose or a constant-velocity guess
+        const Pose guess = in.poses.empty() ? predict_constant_velocity(map) : in.poses[k];
+        const TrackedFrame t = track_backprojected(map, points.view(), camera, guess,
                                                    registration, 0, recording(progress.fit_callback(r.label), r.fit));
         r.registration = t.registration;
         r.registered = t.registered;

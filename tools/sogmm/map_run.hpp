@@ -43,6 +43,9 @@ struct SequenceInput {
   std::vector<SequenceFrame> frames;
   std::vector<std::size_t> selected;
   std::vector<Pose> poses;  ///< poses[k]: the pose of frames[selected[k]] (poses_of_frames); empty: estimate them
+  /// With poses: register each frame to the map from its given pose (a guess,
+  /// e.g. odometry) instead of inserting it there (--refine-poses).
+  bool refine_poses = false;
   CameraFlags camera;
 };
 /// Lists, reads and checks them (no trajectory: no poses, they are estimated;
@@ -63,8 +66,9 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
 /// Without poses each frame's pose is estimated by the core's tracking
 /// (track_backprojected of sogmm/map_tracking.hpp, with `registration`): the
 /// first is the identity, the others are registered to the map from a
-/// constant-velocity prediction; a frame whose registration does not
-/// converge is skipped with a warning on stderr.
+/// constant-velocity prediction (with in.refine_poses: from its given pose);
+/// a frame whose registration does not converge is skipped with a warning
+/// on stderr.
 /// `progress` shows each fit's stages; `after` is called after each insert.
 /// Returns the camera of the frames.
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter& progress,
