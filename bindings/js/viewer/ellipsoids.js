@@ -10,8 +10,10 @@ import * as THREE from 'three';
 import { mergeVertices } from 'three/examples/jsm/utils/BufferGeometryUtils.js';
 
 // The unit sphere as a polyhedron: positions (also its normals) and triangles.
-function unitSphere(detailed) {
-  const g = detailed ? new THREE.IcosahedronGeometry(1, 1) : new THREE.OctahedronGeometry(1, 0);
+const SPHERES = [() => new THREE.OctahedronGeometry(1, 0), () => new THREE.IcosahedronGeometry(1, 0),
+  () => new THREE.IcosahedronGeometry(1, 1)];
+function unitSphere(level) {
+  const g = SPHERES[level]();
   g.deleteAttribute('normal');
   g.deleteAttribute('uv');
   const indexed = mergeVertices(g);
@@ -19,12 +21,14 @@ function unitSphere(detailed) {
 }
 
 /**
- * A mesh for M components: detailed (an 80-triangle icosphere, smooth
- * shading) or coarse (an octahedron, 8 triangles, flat shading: a large map
- * must draw within a second in software). Place and colour it before drawing.
+ * A mesh for M components at a level of detail: 2, an 80-triangle icosphere;
+ * 1, an icosahedron (20 triangles); both smooth-shaded; 0, an octahedron
+ * (8 triangles, flat-shaded: a large map must draw within a second in
+ * software). Place and colour it before drawing.
  */
-export function ellipsoidMesh(M, detailed) {
-  const unit = unitSphere(detailed);
+export function ellipsoidMesh(M, level) {
+  const detailed = level > 0;
+  const unit = unitSphere(level);
   const V = unit.position.length / 3;
   const I = unit.index.length;
   const index = new Uint32Array(I * M);

@@ -12,7 +12,10 @@ import { parseMapFrames } from './provenance.js';
 
 const BACKGROUND = 0x101418;
 const SAMPLE_COUNT = 100000;
-const LARGE = 20000; // components above which drawing is coarser
+// Components above which drawing is coarser: about 400,000 triangles at most
+// (80 per ellipsoid up to DETAILED, 20 up to LARGE, 8 beyond).
+const DETAILED = 5000;
+const LARGE = 20000;
 const $ = (id) => document.getElementById(id);
 const state = { status: 'loading', reason: null, drawn: 0, frame: null, frames: 0, timings: {} };
 window.sogmmViewer = state;
@@ -269,7 +272,7 @@ function load(bytes, name) {
   clearScene();
   const M = Number(model.n_components);
   useRenderer(M <= LARGE);
-  const mesh = ellipsoidMesh(M, M <= LARGE);
+  const mesh = ellipsoidMesh(M, M <= DETAILED ? 2 : M <= LARGE ? 1 : 0);
   world.add(mesh);
   const frames = parseMapFrames(getValue(model, 'map_frames'));
   const cameras = frames.length ? frustums(frames, model.camera) : null;
