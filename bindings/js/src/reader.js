@@ -218,6 +218,18 @@ function decodeArray(data, r, rows, cols, name, verifyChecksums) {
 function canonicalBytes(bytes, rows, cols, width, split, columnMajor) {
   const n = rows * cols;
   const out = new Uint8Array(n * width);
+  if (split && width === 4 && LITTLE_ENDIAN) { // float32 (the usual case): a word at a time
+    const words = new Uint32Array(out.buffer);
+    const n2 = 2 * n;
+    const n3 = 3 * n;
+    for (let c = 0, e = 0; c < (columnMajor ? cols : 1); c++) {
+      const step = columnMajor ? cols : 1; // canonical index of element e: m cols + c
+      for (let d = c, end = e + (columnMajor ? rows : n); e < end; e++, d += step) {
+        words[d] = bytes[e] | (bytes[n + e] << 8) | (bytes[n2 + e] << 16) | (bytes[n3 + e] << 24);
+      }
+    }
+    return out;
+  }
   const byteStride = split ? n : 1;
   const elementStride = split ? 1 : width;
   for (let k = 0; k < width; k++) {
