@@ -16,6 +16,12 @@ const SAMPLE_COUNT = 100000;
 // (80 per ellipsoid up to DETAILED, 20 up to LARGE, 8 beyond).
 const DETAILED = 5000;
 const LARGE = 20000;
+// The page's cap on decoded arrays (spec/format.md section 8: applications
+// may choose their own): 128 MiB, about 2.2 million float32 components, whose
+// mesh already takes some 450 MB. The reference cap (1 GiB) would let a
+// valid but huge file keep the tab busy for minutes and then run it out of
+// memory; this one answers at once with the reason `limit`.
+const MAX_DECODED_BYTES = 2 ** 27;
 const $ = (id) => document.getElementById(id);
 const state = { status: 'loading', reason: null, drawn: 0, frame: null, frames: 0, timings: {} };
 window.sogmmViewer = state;
@@ -263,7 +269,7 @@ function load(bytes, name) {
   state.status = 'loading';
   let model;
   try {
-    model = read(bytes);
+    model = read(bytes, { maxDecodedBytes: MAX_DECODED_BYTES });
   } catch (e) {
     showError(e);
     return;
