@@ -5,7 +5,7 @@ through the progress mechanism: exit 130, one line on stderr, no output file
 (its EM is configured to run minutes: --tol 1e-300 --max-iter 500).
 `sogmm view --serve` and Ctrl-C: the served page is byte for byte the page
 -o writes; other paths 404, other methods 405, a foreign Host 403, a
-malformed request 400; SIGINT stops it with exit 0.
+malformed request 400, a port in use exit 4; SIGINT stops it with exit 0.
 
 Usage: test_cli_interrupt.py --sogmm PATH. Frame: `sogmm demo --write-frame`
 (640 x 480 synthetic scene). Exit 0 = pass, 1 = failure."""
@@ -57,6 +57,10 @@ def check_serve(sogmm, d, failures):
             reply = s.recv(64)
         if not reply.startswith(b"HTTP/1.0 400"):
             failures.append(f"a malformed request got {reply!r}")
+        busy = subprocess.run([sogmm, "view", VECTOR, "--serve", "--port", str(port)], capture_output=True,
+                              text=True, timeout=30)
+        if busy.returncode != 4 or "cannot listen: Address already in use" not in busy.stderr:
+            failures.append(f"a second server on port {port}: exit {busy.returncode}, {busy.stderr!r}")
     except (OSError, IndexError, ValueError, http.client.HTTPException) as e:
         failures.append(f"sogmm view --serve: {e!r}")
     p.send_signal(signal.SIGINT)

@@ -130,17 +130,18 @@ void answer(int fd, const std::string& page, int port) {
 
 void serve_page(const std::string& page, int port) {
   require(port >= 0 && port <= 65535, ErrorCode::InvalidArgument, "--port must be in 0..65535");
+  // Each call's errno is read before anything else can change it (the
+  // arguments of require() are evaluated in no fixed order).
   Socket listener(socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-  require(listener.fd >= 0, ErrorCode::Io, std::string("socket: ") + std::strerror(errno));
+  if (listener.fd < 0) throw Error(ErrorCode::Io, std::string("socket: ") + std::strerror(errno));
   const int one = 1;
   setsockopt(listener.fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  require(bind(listener.fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0, ErrorCode::Io,
-          "127.0.0.1:" + std::to_string(port) + ": cannot listen: " + std::strerror(errno));
-  require(listen(listener.fd, 16) == 0, ErrorCode::Io, std::string("listen: ") + std::strerror(errno));
+  if (bind(listener.fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 || listen(listener.fd, 16) != 0)
+    throw Error(ErrorCode::Io, "127.0.0.1:" + std::to_string(port) + ": cannot listen: " + std::strerror(errno));
   socklen_t len = sizeof addr;
   getsockname(listener.fd, reinterpret_cast<sockaddr*>(&addr), &len);
   const int bound = ntohs(addr.sin_port);
