@@ -10,6 +10,7 @@
 #include "file_util.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/format.hpp"
+#include "serve_page.hpp"
 #include "viewer_page.hpp"
 
 namespace sogmm::tools {
@@ -47,6 +48,8 @@ Command add_view_command(CLI::App& root) {
   struct State {
     std::string model, output;
     bool embed_invalid = false;
+    bool serve = false;
+    int port = 0;
   };
   auto s = std::make_shared<State>();
   CLI::App* app = root.add_subcommand("view", "Write a self-contained HTML page that shows a model in a browser");
@@ -59,14 +62,22 @@ Command add_view_command(CLI::App& root) {
       "A file the reader rejects is refused (exit 3) unless --embed-invalid, whose page shows the reason.\n\n"
       "Examples:\n"
       "  sogmm view frame0.sogmm                # writes frame0.html\n"
-      "  sogmm view map.sogmm -o map.html");
+      "  sogmm view map.sogmm -o map.html\n"
+      "  sogmm view map.sogmm --serve          # http://127.0.0.1:PORT/ until Ctrl-C");
   app->add_option("model", s->model, "model to show (.sogmm)")->required();
   app->add_option("-o,--output", s->output, "output page (.html; default: the model's name with .html)");
   app->add_flag("--embed-invalid", s->embed_invalid,
                 "write the page even when the file is rejected (the page shows the reader's reason)");
+  app->add_flag("--serve", s->serve,
+                "serve the page on http://127.0.0.1:PORT/ (printed) until Ctrl-C instead of writing it "
+                "(it is written too when -o is given)");
+  app->add_option("--port", s->port, "port for --serve (default 0: a free one)")
+      ->check(CLI::Range(0, 65535))
+      ->needs(app->get_option("--serve"));
   return {app, [s]() {
+            const bool write = !s->serve || !s->output.empty();
             const std::string out = s->output.empty() ? default_output(s->model) : s->output;
-            check_output_path(out);
+            if (write) check_output_path(out);
             const std::string bytes = read_bytes(s->model);
             if (!s->embed_invalid) {
               try {
@@ -76,8 +87,11 @@ Command add_view_command(CLI::App& root) {
               }
             }
             const std::string page = viewer_page(bytes, base_name(s->model));
-            write_file_atomic(out, page.data(), page.size());
-            std::printf("wrote %s (%zu bytes)\n", out.c_str(), page.size());
+            if (write) {
+              write_file_atomic(out, page.data(), page.size());
+              std::printf("wrote %s (%zu bytes)\n", out.c_str(), page.size());
+            }
+            if (s->serve) serve_page(page, s->port);
             return static_cast<int>(kExitOk);
           }};
 }

@@ -12,8 +12,9 @@ function numeric(reason, message) {
 
 // 19d: the Cholesky factorisation of the spec, in its order of operations.
 // `a` is row-major 4x4; only entries on and below the diagonal are read.
+// One scratch factor for all components: no allocation per component.
+const l = new Float64Array(16);
 function choleskyOk(a) {
-  const l = new Float64Array(16);
   for (let j = 0; j < 4; j++) {
     let d = a[4 * j + j];
     for (let k = 0; k < j; k++) d -= l[4 * j + k] * l[4 * j + k];
@@ -34,7 +35,8 @@ function choleskyOk(a) {
  */
 export function checkValues(weights, means, stored, M, packed) {
   for (const arr of [weights, means, stored]) {
-    for (let i = 0; i < arr.length; i++) if (!Number.isFinite(arr[i])) numeric('non_finite', 'NaN or infinity in the arrays');
+    // x - x is 0 for a finite x and NaN for NaN or infinity.
+    for (let i = 0; i < arr.length; i++) if (arr[i] - arr[i] !== 0) numeric('non_finite', 'NaN or infinity in the arrays');
   }
   let sum = 0;
   for (let i = 0; i < M; i++) {

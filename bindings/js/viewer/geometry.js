@@ -1,7 +1,7 @@
 // Small dense linear algebra for the viewer: symmetric eigen-decomposition
 // (cyclic Jacobi, n <= 4) for the picked component's eigenvalues, Cholesky
-// factors for sampling and for the instance transform that maps the unit
-// sphere onto a component's k-sigma ellipsoid.
+// factors for sampling (ellipsoids.js maps the unit sphere with its own
+// 3 x 3 factor, written into the vertices directly).
 
 /** Eigenvalues (ascending) and eigenvectors (columns of v, row-major n x n) of symmetric a. */
 export function symmetricEigen(a, n) {
@@ -46,31 +46,6 @@ export function symmetricEigen(a, n) {
   const vectors = new Float64Array(n * n);
   order.forEach((src, dst) => { for (let k = 0; k < n; k++) vectors[k * n + dst] = v[k * n + src]; });
   return { values, vectors };
-}
-
-/**
- * Column-major 4x4 (three.js Matrix4.elements order) mapping the unit sphere
- * onto the k-sigma ellipsoid of component c: x = mean + k L u with L L^T the
- * spatial covariance (Cholesky), so {x : (x - mean)^T S^-1 (x - mean) = k^2}.
- * No eigen-decomposition: L maps the sphere onto the same ellipsoid.
- */
-export function ellipsoidMatrix(cov, means, c, sigmas, out, offset) {
-  const o = 16 * c;
-  const a = cov[o];
-  const b = cov[o + 4];
-  const d = cov[o + 5];
-  const e = cov[o + 8];
-  const f = cov[o + 9];
-  const g = cov[o + 10];
-  const l00 = Math.sqrt(Math.max(a, 0));
-  const l10 = l00 > 0 ? b / l00 : 0;
-  const l20 = l00 > 0 ? e / l00 : 0;
-  const l11 = Math.sqrt(Math.max(d - l10 * l10, 0));
-  const l21 = l11 > 0 ? (f - l20 * l10) / l11 : 0;
-  const l22 = Math.sqrt(Math.max(g - l20 * l20 - l21 * l21, 0));
-  // Columns of k L (column-major: out[4 j + i] = row i of column j).
-  out.set([sigmas * l00, sigmas * l10, sigmas * l20, 0, 0, sigmas * l11, sigmas * l21, 0, 0, 0, sigmas * l22, 0,
-    means[4 * c], means[4 * c + 1], means[4 * c + 2], 1], offset);
 }
 
 /** Lower Cholesky factor (row-major 4x4) of a positive definite 4x4. */

@@ -1,17 +1,27 @@
 // The viewer of `sogmm view`: reads the .sogmm embedded in the page (or one
 // dropped on it) with the independent JavaScript reader, and draws it with
-// three.js: instanced ellipsoids, sampled points, a map's cameras with a
+// three.js: ellipsoids (one mesh), sampled points, a map's cameras with a
 // slider over its frames, a picked component's numbers and the metadata.
 // window.sogmmViewer exposes the state for the browser test.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { read, getValue, SogmmError } from '../src/reader.js';
-import { ellipsoidMatrix, symmetricEigen, cholesky4 } from './geometry.js';
+import { symmetricEigen, cholesky4 } from './geometry.js';
+import { ellipsoidMesh, placeEllipsoids, colourEllipsoids, showFirst, componentOf } from './ellipsoids.js';
 import { parseMapFrames } from './provenance.js';
 
 const BACKGROUND = 0x101418;
 const SAMPLE_COUNT = 100000;
-const LARGE = 20000; // components above which drawing is coarser
+// Components above which drawing is coarser: about 400,000 triangles at most
+// (80 per ellipsoid up to DETAILED, 20 up to LARGE, 8 beyond).
+const DETAILED = 5000;
+const LARGE = 20000;
+// The page's cap on decoded arrays (spec/format.md section 8: applications
+// may choose their own): 128 MiB, about 2.2 million float32 components, whose
+// mesh already takes some 450 MB. The reference cap (1 GiB) would let a
+// valid but huge file keep the tab busy for minutes and then run it out of
+// memory; this one answers at once with the reason `limit`.
+const MAX_DECODED_BYTES = 2 ** 27;
 const $ = (id) => document.getElementById(id);
 const state = { status: 'loading', reason: null, drawn: 0, frame: null, frames: 0, timings: {} };
 window.sogmmViewer = state;
@@ -32,6 +42,9 @@ function useRenderer(antialias) {
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   renderer.setSize(window.innerWidth, window.innerHeight);
   renderer.setClearColor(BACKGROUND, 1);
+  // Opaque objects only: sorting them by depth would cost a bounding sphere
+  // (a pass over every vertex) before the first frame, for nothing.
+  renderer.sortObjects = false;
   $('view').appendChild(renderer.domElement);
 }
 const scene = new THREE.Scene();
@@ -79,9 +92,8 @@ function weightColour(t, out) { // t in [0, 1]: dark blue -> teal -> yellow
   return out;
 }
 
-function colourInstances(mesh, model, by) {
+function colourComponents(mesh, model, by) {
   const M = Number(model.n_components);
-  const c = new THREE.Color();
   let lo = Infinity;
   let hi = -Infinity;
   for (let k = 0; k < M; k++) {
@@ -89,24 +101,12 @@ function colourInstances(mesh, model, by) {
     lo = Math.min(lo, w);
     hi = Math.max(hi, w);
   }
-  for (let k = 0; k < M; k++) {
-    if (by === 'weight') {
-      weightColour(hi > lo ? (Math.log(Math.max(model.weights[k], 1e-12)) - lo) / (hi - lo) : 1, c);
-    } else {
+  colourEllipsoids(mesh, by === 'weight'
+    ? (k, c) => weightColour(hi > lo ? (Math.log(Math.max(model.weights[k], 1e-12)) - lo) / (hi - lo) : 1, c)
+    : (k, c) => {
       const g = Math.min(Math.max(model.means[4 * k + 3], 0), 1);
       c.setRGB(g, g, g, THREE.SRGBColorSpace);
-    }
-    mesh.setColorAt(k, c);
-  }
-  mesh.instanceColor.needsUpdate = true;
-}
-
-function placeInstances(mesh, model, sigmas) {
-  const M = Number(model.n_components);
-  const m = mesh.instanceMatrix.array;
-  for (let k = 0; k < M; k++) ellipsoidMatrix(model.covariances, model.means, k, sigmas, m, 16 * k);
-  mesh.instanceMatrix.needsUpdate = true;
-  mesh.computeBoundingSphere();
+    });
 }
 
 // --- samples ---------------------------------------------------------------
@@ -234,8 +234,8 @@ function setFrame(f) {
   if (!current || !current.frames.length) return;
   const fr = current.frames[f];
   const M = Number(current.model.n_components);
-  current.mesh.count = fr.nComponents === null ? M : Math.min(fr.nComponents, M);
-  state.drawn = current.mesh.count;
+  state.drawn = fr.nComponents === null ? M : Math.min(fr.nComponents, M);
+  showFirst(current.mesh, state.drawn);
   state.frame = f;
   $('frame').value = String(f);
   $('frame-label').textContent = `after frame ${f} of ${current.frames.length - 1}: ${state.drawn} components ` +
@@ -269,7 +269,7 @@ function load(bytes, name) {
   state.status = 'loading';
   let model;
   try {
-    model = read(bytes);
+    model = read(bytes, { maxDecodedBytes: MAX_DECODED_BYTES });
   } catch (e) {
     showError(e);
     return;
@@ -277,16 +277,17 @@ function load(bytes, name) {
   const t1 = performance.now();
   clearScene();
   const M = Number(model.n_components);
-  // 80 triangles an ellipsoid; a large map (software rendering must draw it
-  // within a second) gets octahedra, 8 triangles, still shaded ellipsoids.
-  const shape = M > LARGE ? new THREE.OctahedronGeometry(1, 0) : new THREE.IcosahedronGeometry(1, 1);
-  const mesh = new THREE.InstancedMesh(shape, new THREE.MeshLambertMaterial({ flatShading: M > LARGE }), M);
-  placeInstances(mesh, model, Number(document.querySelector('input[name=sigma]:checked').value));
-  colourInstances(mesh, model, document.querySelector('input[name=colour]:checked').value);
+  useRenderer(M <= LARGE);
+  const mesh = ellipsoidMesh(M, M <= DETAILED ? 2 : M <= LARGE ? 1 : 0);
   world.add(mesh);
   const frames = parseMapFrames(getValue(model, 'map_frames'));
   const cameras = frames.length ? frustums(frames, model.camera) : null;
   if (cameras) world.add(cameras);
+  // The shaders compile in the GPU process while the vertices are written
+  // here (the programs are checked at their first use, in the first frame).
+  renderer.compile(scene, camera);
+  placeEllipsoids(mesh, model.covariances, model.means, Number(document.querySelector('input[name=sigma]:checked').value));
+  colourComponents(mesh, model, document.querySelector('input[name=colour]:checked').value);
   current = { model, mesh, points: null, cameras, frames, name };
   state.frames = frames.length;
   state.nComponents = M;
@@ -306,13 +307,14 @@ function load(bytes, name) {
     $('frames').style.display = 'none';
   }
   frameCamera(model, frames.length > 0);
-  useRenderer(M <= LARGE);
   const tScene = performance.now();
   renderer.render(scene, camera);
   // Reading one pixel waits for the GPU: the first frame is really drawn.
   renderer.getContext().readPixels(0, 0, 1, 1, 0x1908, 0x1401, new Uint8Array(4));
   const t2 = performance.now();
-  state.timings = { parseMs: t1 - t0, sceneMs: tScene - t1, renderMs: t2 - tScene, firstFrameMs: t2 - t1, totalMs: t2 - t0 };
+  // sinceNavigationMs: from the start of navigation (performance's time
+  // origin) to the first frame, script compilation and base64 included.
+  state.timings = { parseMs: t1 - t0, sceneMs: tScene - t1, renderMs: t2 - tScene, firstFrameMs: t2 - t1, totalMs: t2 - t0, sinceNavigationMs: t2 };
   state.status = 'ready';
 }
 
@@ -328,10 +330,10 @@ function toggleSamples() {
 
 // --- interaction -------------------------------------------------------------
 document.querySelectorAll('input[name=sigma]').forEach((el) => el.addEventListener('change', () => {
-  if (current) { placeInstances(current.mesh, current.model, Number(el.value)); draw(); }
+  if (current) { placeEllipsoids(current.mesh, current.model.covariances, current.model.means, Number(el.value)); draw(); }
 }));
 document.querySelectorAll('input[name=colour]').forEach((el) => el.addEventListener('change', () => {
-  if (current) { colourInstances(current.mesh, current.model, el.value); draw(); }
+  if (current) { colourComponents(current.mesh, current.model, el.value); draw(); }
 }));
 $('show-ellipsoids').addEventListener('change', (e) => { if (current) { current.mesh.visible = e.target.checked; draw(); } });
 $('show-cameras').addEventListener('change', (e) => { if (current && current.cameras) { current.cameras.visible = e.target.checked; draw(); } });
@@ -345,8 +347,8 @@ $('view').addEventListener('pointerup', (e) => {
   if (!current || !downAt || Math.hypot(e.clientX - downAt[0], e.clientY - downAt[1]) > 4) return;
   const r = $('view').getBoundingClientRect();
   raycaster.setFromCamera(new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1), camera);
-  const hit = raycaster.intersectObject(current.mesh, false).find((h) => h.instanceId < current.mesh.count);
-  if (hit) showComponent(current.model, hit.instanceId);
+  const hit = raycaster.intersectObject(current.mesh, false)[0];
+  if (hit) showComponent(current.model, componentOf(current.mesh, hit));
 });
 
 window.addEventListener('dragover', (e) => { e.preventDefault(); $('drop').style.display = 'block'; });
@@ -362,14 +364,21 @@ state.load = load;
 state.setFrame = setFrame;
 state.showComponent = (k) => current && showComponent(current.model, k);
 
+// Native where the browser has it (Chromium 140+, Firefox 133+): a 2 MB
+// model's base64 took 70-100 ms to decode with atob and a loop.
+function fromBase64(text) {
+  if (typeof Uint8Array.fromBase64 === 'function') return Uint8Array.fromBase64(text);
+  const bin = atob(text);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+  return bytes;
+}
+
 // The model embedded by `sogmm view` (base64); a page without one waits for a drop.
 const embedded = $('sogmm-model');
 const text = embedded ? embedded.textContent.trim() : '';
 if (/^[A-Za-z0-9+/=]+$/.test(text) && text.length > 0) {
-  const bin = atob(text);
-  const bytes = new Uint8Array(bin.length);
-  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-  load(bytes, embedded.dataset.name || 'model.sogmm');
+  load(fromBase64(text), embedded.dataset.name || 'model.sogmm');
 } else {
   useRenderer(true);
   state.status = 'empty';
