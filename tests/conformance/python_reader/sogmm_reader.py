@@ -21,6 +21,7 @@ END_MAGIC = b"SGMM"
 HEADER_SIZE = 32
 TRAILER_SIZE = 4
 KNOWN_FEATURES = 0
+MAP_DELTA_FEATURE = 1  # features_required bit 0: a map delta (section 2.5), known to a delta reader only
 DEFAULT_MAX_DECODED_BYTES = 1 << 30
 MAX_DEPTH = 64
 MAX_TABLES = 100000
@@ -481,7 +482,11 @@ def _cholesky_ok(a):
 
 
 # ---------------------------------------------------------------- the procedure of section 9
-def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=True, metadata_only=False):
+def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=True, metadata_only=False,
+         delta=False):
+    """Section 9's procedure; with delta=True a map delta reader's (section 2.5):
+    bit 0 known and required, M = 0 allowed, weights only >= 0, FULL
+    covariances returned as stored."""
     data = bytes(data)
     size = len(data)
     # 1-2
@@ -519,8 +524,11 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
     # 10
-    if md["features_required"] & ~KNOWN_FEATURES:
+    known = KNOWN_FEATURES | (MAP_DELTA_FEATURE if delta else 0)
+    if md["features_required"] & ~known:
         _format("unsupported_feature", hex(md["features_required"]))
+    if delta and not md["features_required"] & MAP_DELTA_FEATURE:
+        _format("not_a_delta", "features_required bit 0 is not set")
     # 11
     if md["dims"] != 4:
         _format("bad_metadata", "dims != 4")
@@ -551,7 +559,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
             _format("unsupported_encoding", "unknown enum value")
     # 13
     m = md["n_components"]
-    if m == 0:
+    if m == 0 and not delta:
         _fail("invalid_data", "empty", "M = 0")
     # 14-15
     packed = md["covariance_layout"] == 0
@@ -615,7 +623,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     s = 0.0
     for x in weights:
         s += x
-    if abs(s - 1.0) > 1e-4:
+    if abs(s - 1.0) > 1e-4 and not delta:
         _fail("numeric", "bad_weights", f"weights sum to {s}")
     mats = []
     for k in range(m):
@@ -629,8 +637,15 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
             asym = max(abs(a[i][j] - a[j][i]) for i in range(4) for j in range(4))
             if asym > 1e-5 * scale:
                 _fail("numeric", "not_symmetric", f"component {k}")
-            # Section 5.1: a reader returns (and tests) the symmetric part.
-            a = [[_round_f32((a[i][j] + a[j][i]) / 2) for j in range(4)] for i in range(4)]
+            # Section 5.1: a reader returns (and tests) the symmetric part;
+            # a delta's receiver must reproduce the sender's bits (2.5).
+            sym = [[_round_f32((a[i][j] + a[j][i]) / 2) for j in range(4)] for i in range(4)]
+            if not _cholesky_ok(sym):
+                _fail("numeric", "not_spd", f"component {k}")
+            if not delta:
+                a = sym
+            mats.append([list(row) for row in a])
+            continue
         if not _cholesky_ok(a):
             _fail("numeric", "not_spd", f"component {k}")
         mats.append(a)
