@@ -39,7 +39,7 @@ const SPRITES = {
 };
 // The page's cap on decoded arrays (spec/format.md section 8: applications
 // may choose their own): 128 MiB, about 2.2 million float32 components, whose
-// mesh already takes some 450 MB. The reference cap (1 GiB) would let a
+// point sprites take another 100 MB. The reference cap (1 GiB) would let a
 // valid but huge file keep the tab busy for minutes and then run it out of
 // memory; this one answers at once with the reason `limit`.
 const MAX_DECODED_BYTES = 2 ** 27;
