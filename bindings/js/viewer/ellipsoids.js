@@ -3,6 +3,8 @@
 // software WebGL (SwiftShader, what headless Chromium has without a GPU)
 // pays a fixed cost per instance, so a 52,497-component map of octahedra took
 // 1.65 s to draw instanced and 0.4 s as one mesh of the same triangles.
+// Beyond 20,000 components even that is too many triangles: impostors.js
+// draws one point sprite per component instead.
 // Component k owns vertices [V k, V (k + 1)) and triangles [T k, T (k + 1)),
 // in file order: a draw range shows the first n components (a map's state
 // after a frame) and a hit triangle names its component.
@@ -10,8 +12,7 @@ import * as THREE from 'three';
 import { mergeVertices } from 'three/examples/jsm/utils/BufferGeometryUtils.js';
 
 // The unit sphere as a polyhedron: positions (also its normals) and triangles.
-const SPHERES = [() => new THREE.OctahedronGeometry(1, 0), () => new THREE.IcosahedronGeometry(1, 0),
-  () => new THREE.IcosahedronGeometry(1, 1)];
+const SPHERES = [() => new THREE.IcosahedronGeometry(1, 0), () => new THREE.IcosahedronGeometry(1, 1)];
 function unitSphere(level) {
   const g = SPHERES[level]();
   g.deleteAttribute('normal');
@@ -21,13 +22,11 @@ function unitSphere(level) {
 }
 
 /**
- * A mesh for M components at a level of detail: 2, an 80-triangle icosphere;
- * 1, an icosahedron (20 triangles); both smooth-shaded; 0, an octahedron
- * (8 triangles, flat-shaded: a large map must draw within a second in
- * software). Place and colour it before drawing.
+ * A mesh for M components at a level of detail: 1, an 80-triangle icosphere;
+ * 0, an icosahedron (20 triangles); smooth-shaded. Place and colour it
+ * before drawing.
  */
 export function ellipsoidMesh(M, level) {
-  const detailed = level > 0;
   const unit = unitSphere(level);
   const V = unit.position.length / 3;
   const I = unit.index.length;
@@ -39,8 +38,8 @@ export function ellipsoidMesh(M, level) {
   // Colours as 16-bit fractions: half the bytes a first frame uploads, and no
   // banding in dark grays (8 bits would band: the colours are linear).
   geo.setAttribute('color', new THREE.BufferAttribute(new Uint16Array(3 * V * M), 3, true));
-  if (detailed) geo.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * V * M), 3));
-  const mesh = new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: !detailed }));
+  geo.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * V * M), 3));
+  const mesh = new THREE.Mesh(geo, new THREE.MeshLambertMaterial({ vertexColors: true }));
   // The model is framed whole: culling would only cost a pass over the
   // vertices (the bounding sphere) before the first frame; a raycast
   // computes the sphere when it first needs it.
@@ -59,7 +58,7 @@ export function ellipsoidMesh(M, level) {
 export function placeEllipsoids(mesh, cov, means, sigmas) {
   const { unit, V, M } = mesh.userData;
   const pos = mesh.geometry.attributes.position.array;
-  const nor = mesh.geometry.attributes.normal ? mesh.geometry.attributes.normal.array : null;
+  const nor = mesh.geometry.attributes.normal.array;
   for (let k = 0; k < M; k++) {
     const o = 16 * k;
     const l00 = Math.sqrt(Math.max(cov[o], 0));
@@ -80,28 +79,26 @@ export function placeEllipsoids(mesh, cov, means, sigmas) {
       pos[p + 1] = my + sigmas * (l10 * x + l11 * y);
       pos[p + 2] = mz + sigmas * (l20 * x + l21 * y + l22 * z);
     }
-    if (nor) {
-      // L^-1 (lower triangular) by substitution; a zero pivot (a flat
-      // ellipsoid, which a valid file does not have) leaves that axis out.
-      const i00 = l00 > 0 ? 1 / l00 : 0;
-      const i11 = l11 > 0 ? 1 / l11 : 0;
-      const i22 = l22 > 0 ? 1 / l22 : 0;
-      const i10 = -l10 * i00 * i11;
-      const i21 = -l21 * i11 * i22;
-      const i20 = -(l20 * i00 + l21 * i10) * i22;
-      p = 3 * V * k;
-      for (let v = 0; v < V; v++, p += 3) {
-        const x = unit[3 * v];
-        const y = unit[3 * v + 1];
-        const z = unit[3 * v + 2];
-        nor[p] = i00 * x + i10 * y + i20 * z; // (L^-T u): column i of L^-1 dotted with u
-        nor[p + 1] = i11 * y + i21 * z;
-        nor[p + 2] = i22 * z;
-      }
+    // L^-1 (lower triangular) by substitution; a zero pivot (a flat
+    // ellipsoid, which a valid file does not have) leaves that axis out.
+    const i00 = l00 > 0 ? 1 / l00 : 0;
+    const i11 = l11 > 0 ? 1 / l11 : 0;
+    const i22 = l22 > 0 ? 1 / l22 : 0;
+    const i10 = -l10 * i00 * i11;
+    const i21 = -l21 * i11 * i22;
+    const i20 = -(l20 * i00 + l21 * i10) * i22;
+    p = 3 * V * k;
+    for (let v = 0; v < V; v++, p += 3) {
+      const x = unit[3 * v];
+      const y = unit[3 * v + 1];
+      const z = unit[3 * v + 2];
+      nor[p] = i00 * x + i10 * y + i20 * z; // (L^-T u): column i of L^-1 dotted with u
+      nor[p + 1] = i11 * y + i21 * z;
+      nor[p + 2] = i22 * z;
     }
   }
   mesh.geometry.attributes.position.needsUpdate = true;
-  if (nor) mesh.geometry.attributes.normal.needsUpdate = true;
+  mesh.geometry.attributes.normal.needsUpdate = true;
   mesh.geometry.boundingSphere = null;
 }
 

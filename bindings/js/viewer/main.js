@@ -1,6 +1,6 @@
 // The viewer of `sogmm view`: reads the .sogmm embedded in the page (or one
 // dropped on it) with the independent JavaScript reader, and draws it with
-// three.js: ellipsoids (one mesh), sampled points, a map's cameras with a
+// three.js: ellipsoids (one mesh, or one point sprite each in a large model), sampled points, a map's cameras with a
 // slider over its frames, a picked component's numbers and the metadata.
 // window.sogmmViewer exposes the state for the browser test.
 import * as THREE from 'three';
@@ -8,17 +8,38 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { read, getValue, SogmmError } from '../src/reader.js';
 import { symmetricEigen, cholesky4 } from './geometry.js';
 import { ellipsoidMesh, placeEllipsoids, colourEllipsoids, showFirst, componentOf } from './ellipsoids.js';
+import { impostorCloud, placeImpostors, colourImpostors, showFirstImpostors, pickImpostor } from './impostors.js';
 import { parseMapFrames } from './provenance.js';
 
 const BACKGROUND = 0x101418;
 const SAMPLE_COUNT = 100000;
-// Components above which drawing is coarser: about 400,000 triangles at most
-// (80 per ellipsoid up to DETAILED, 20 up to LARGE, 8 beyond).
+// Components above which drawing is coarser: 80 triangles per ellipsoid up
+// to DETAILED, 20 up to LARGE (400,000 at most), one point sprite each beyond
+// (impostors.js: software WebGL pays per vertex and triangle).
 const DETAILED = 5000;
 const LARGE = 20000;
+// The two ways to draw the ellipsoids, with the same operations.
+const MESHES = {
+  create: (M) => ellipsoidMesh(M, M <= DETAILED ? 1 : 0),
+  place: placeEllipsoids,
+  colour: colourEllipsoids,
+  showFirst,
+  pick(mesh, ndc) {
+    raycaster.setFromCamera(ndc, camera);
+    const hit = raycaster.intersectObject(mesh, false)[0];
+    return hit ? componentOf(mesh, hit) : null;
+  },
+};
+const SPRITES = {
+  create: impostorCloud,
+  place: placeImpostors,
+  colour: colourImpostors,
+  showFirst: showFirstImpostors,
+  pick: (points, ndc) => pickImpostor(points, ndc, camera, renderer.getDrawingBufferSize(new THREE.Vector2())),
+};
 // The page's cap on decoded arrays (spec/format.md section 8: applications
 // may choose their own): 128 MiB, about 2.2 million float32 components, whose
-// mesh already takes some 450 MB. The reference cap (1 GiB) would let a
+// point sprites take another 100 MB. The reference cap (1 GiB) would let a
 // valid but huge file keep the tab busy for minutes and then run it out of
 // memory; this one answers at once with the reason `limit`.
 const MAX_DECODED_BYTES = 2 ** 27;
@@ -73,7 +94,7 @@ window.addEventListener('resize', () => {
   draw();
 });
 
-let current = null; // {model, mesh, points, cameras, frames}
+let current = null; // {model, mesh, drawing (MESHES or SPRITES), points, cameras, frames}
 
 function clearScene() {
   if (!current) return;
@@ -92,7 +113,7 @@ function weightColour(t, out) { // t in [0, 1]: dark blue -> teal -> yellow
   return out;
 }
 
-function colourComponents(mesh, model, by) {
+function colourComponents(mesh, model, by) { // current.drawing set
   const M = Number(model.n_components);
   let lo = Infinity;
   let hi = -Infinity;
@@ -101,7 +122,7 @@ function colourComponents(mesh, model, by) {
     lo = Math.min(lo, w);
     hi = Math.max(hi, w);
   }
-  colourEllipsoids(mesh, by === 'weight'
+  current.drawing.colour(mesh, by === 'weight'
     ? (k, c) => weightColour(hi > lo ? (Math.log(Math.max(model.weights[k], 1e-12)) - lo) / (hi - lo) : 1, c)
     : (k, c) => {
       const g = Math.min(Math.max(model.means[4 * k + 3], 0), 1);
@@ -235,7 +256,7 @@ function setFrame(f) {
   const fr = current.frames[f];
   const M = Number(current.model.n_components);
   state.drawn = fr.nComponents === null ? M : Math.min(fr.nComponents, M);
-  showFirst(current.mesh, state.drawn);
+  current.drawing.showFirst(current.mesh, state.drawn);
   state.frame = f;
   $('frame').value = String(f);
   $('frame-label').textContent = `after frame ${f} of ${current.frames.length - 1}: ${state.drawn} components ` +
@@ -262,7 +283,9 @@ function frameCamera(model, overhead) {
   controls.update();
 }
 
-function load(bytes, name) {
+// options.spritesAbove: the component count above which the ellipsoids are
+// point sprites (default LARGE; the browser test lowers it to check them).
+function load(bytes, name, options = {}) {
   const t0 = performance.now();
   $('error').style.display = 'none';
   $('pick').style.display = 'none';
@@ -278,7 +301,8 @@ function load(bytes, name) {
   clearScene();
   const M = Number(model.n_components);
   useRenderer(M <= LARGE);
-  const mesh = ellipsoidMesh(M, M <= DETAILED ? 2 : M <= LARGE ? 1 : 0);
+  const drawing = M > (options.spritesAbove ?? LARGE) ? SPRITES : MESHES;
+  const mesh = drawing.create(M);
   world.add(mesh);
   const frames = parseMapFrames(getValue(model, 'map_frames'));
   const cameras = frames.length ? frustums(frames, model.camera) : null;
@@ -286,11 +310,12 @@ function load(bytes, name) {
   // The shaders compile in the GPU process while the vertices are written
   // here (the programs are checked at their first use, in the first frame).
   renderer.compile(scene, camera);
-  placeEllipsoids(mesh, model.covariances, model.means, Number(document.querySelector('input[name=sigma]:checked').value));
+  drawing.place(mesh, model.covariances, model.means, Number(document.querySelector('input[name=sigma]:checked').value));
+  current = { model, mesh, drawing, points: null, cameras, frames, name };
   colourComponents(mesh, model, document.querySelector('input[name=colour]:checked').value);
-  current = { model, mesh, points: null, cameras, frames, name };
   state.frames = frames.length;
   state.nComponents = M;
+  state.sprites = drawing === SPRITES;
   state.drawn = M;
   state.frame = null;
   mesh.visible = $('show-ellipsoids').checked;
@@ -330,7 +355,7 @@ function toggleSamples() {
 
 // --- interaction -------------------------------------------------------------
 document.querySelectorAll('input[name=sigma]').forEach((el) => el.addEventListener('change', () => {
-  if (current) { placeEllipsoids(current.mesh, current.model.covariances, current.model.means, Number(el.value)); draw(); }
+  if (current) { current.drawing.place(current.mesh, current.model.covariances, current.model.means, Number(el.value)); draw(); }
 }));
 document.querySelectorAll('input[name=colour]').forEach((el) => el.addEventListener('change', () => {
   if (current) { colourComponents(current.mesh, current.model, el.value); draw(); }
@@ -346,9 +371,8 @@ $('view').addEventListener('pointerdown', (e) => { downAt = [e.clientX, e.client
 $('view').addEventListener('pointerup', (e) => {
   if (!current || !downAt || Math.hypot(e.clientX - downAt[0], e.clientY - downAt[1]) > 4) return;
   const r = $('view').getBoundingClientRect();
-  raycaster.setFromCamera(new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1), camera);
-  const hit = raycaster.intersectObject(current.mesh, false)[0];
-  if (hit) showComponent(current.model, componentOf(current.mesh, hit));
+  const k = current.drawing.pick(current.mesh, new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1));
+  if (k !== null) showComponent(current.model, k);
 });
 
 window.addEventListener('dragover', (e) => { e.preventDefault(); $('drop').style.display = 'block'; });
