@@ -28,3 +28,25 @@ def test_case(case):
         with pytest.raises(sogmm.SogmmError):
             receiver.apply_delta((DIR / case["then"]).read_bytes())
         assert (receiver.revision, receiver.n_components_, len(receiver)) == before
+
+
+def test_a_receiver_of_the_livingroom_map_is_bitwise_equal_after_every_delta(livingroom):
+    # Issue 33: the shared livingroom frames 0-2 (their trajectory, d = 5),
+    # read by the library's frame reader; after each insert the receiver
+    # applies the delta and holds the sender's components bit for bit.
+    _, _, cam, folder = livingroom
+    _, poses = sogmm.read_trajectory(folder / "trajectory.log")
+    with sogmm.Map(decimate=5, n_threads=2) as sender, sogmm.Map() as receiver:
+        for k in range(3):
+            depth, color = sogmm.read_frame(folder / "depth" / f"{k:05d}.png", folder / "color" / f"{k:05d}.jpg")
+            since = sender.revision
+            sender.insert_rgbd(depth, color, cam, poses[k])
+            if k == 2:
+                sender.flush()
+            receiver.apply_delta(sender.export_delta(since))
+            assert (receiver.revision, len(receiver)) == (sender.revision, len(sender))
+            if sender.n_components_:
+                a, b = sender.export(), receiver.export()
+                for x, y in ((a.weights_, b.weights_), (a.means_, b.means_), (a.covariances_, b.covariances_)):
+                    assert x.tobytes() == y.tobytes()
+        assert receiver.n_components_ > 0
