@@ -10,6 +10,9 @@
 //
 // Usage: sogmm-occupancy-octomap --sequence DIR [--map-frames 0:2] [--ray-frames 2]
 //          [--decimate 5] [--octomap-decimate 1] [--resolutions 0.02,0.05] [--threads 2] [--repeats 3]
+//          [--save-map FILE] [--map FILE]
+// --map answers with a map saved by an earlier run's --save-map (no build;
+// the loop's map takes minutes); --resolutions none skips OctoMap.
 // Frame selections as `sogmm map --frames`: I, A:B or A:B:STEP. The synthetic
 // loop of the issue: `sogmm demo --write-frame DIR --loop`, then
 // --map-frames 0:300:3 --ray-frames 1:300:30.
@@ -115,7 +118,7 @@ void report(const char* name, double auc, std::size_t bytes, double build_s, std
 
 int main(int argc, char** argv) {
   CLI::App app{"Occupancy of a SOGMM map against OctoMap on the rays of a held-out frame"};
-  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05";
+  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05", save_map, load_map;
   int decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
   app.add_option("--sequence", dir, "Redwood folder: depth/, color/, intrinsics.json, trajectory.log")->required();
   app.add_option("--map-frames", map_frames, "frames the maps are built from (I, A:B or A:B:STEP)")
@@ -127,6 +130,8 @@ int main(int argc, char** argv) {
   app.add_option("--resolutions", resolutions, "OctoMap resolutions (m, comma-separated)")->capture_default_str();
   app.add_option("--threads", threads, "query threads")->capture_default_str();
   app.add_option("--repeats", repeats, "timed repeats (median)")->capture_default_str();
+  app.add_option("--save-map", save_map, "write the SOGMM map built from --map-frames here");
+  app.add_option("--map", load_map, "answer with this saved map instead of building one (build time 0)");
   CLI11_PARSE(app, argc, argv);
   try {
     using namespace sogmm;
@@ -153,9 +158,14 @@ int main(int argc, char** argv) {
 
     auto t0 = Clock::now();
     Map map(mo);
-    for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(frame(k).view(cam), poses[k]);
-    map.flush();
-    const double map_build = seconds_since(t0);
+    if (!load_map.empty()) {
+      map = Map::from_model(format::load(load_map), mo);
+    } else {
+      for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(frame(k).view(cam), poses[k]);
+      map.flush();
+    }
+    const double map_build = load_map.empty() ? seconds_since(t0) : 0.0;
+    if (!save_map.empty()) format::save(save_map, map.to_model());
     const std::size_t map_bytes = format::to_bytes(map.to_model()).size();
     std::vector<double> p(n);
     occupancy(map, xyz.data(), n, p.data(), nullptr, {}, threads);  // renders, kept until the map changes
@@ -165,7 +175,7 @@ int main(int argc, char** argv) {
     report(name, roc_auc(p, label), map_bytes, map_build, n, map_query);
 
 #ifdef SOGMM_HAVE_OCTOMAP
-    std::stringstream res_list(resolutions);
+    std::stringstream res_list(resolutions == "none" ? std::string() : resolutions);
     for (std::string item; std::getline(res_list, item, ',');) {
       const double res = std::stod(item);
       t0 = Clock::now();
