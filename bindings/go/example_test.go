@@ -1,6 +1,7 @@
 package sogmm_test
 
 import (
+	"context"
 	"fmt"
 	"log"
 	"os"
@@ -32,7 +33,7 @@ func Example() {
 		log.Fatal(err)
 	}
 	defer opts.Close()
-	model, err := sogmm.FitRGBD(sogmm.Frame{Depth: depth, Gray8: gray, Width: w, Height: h,
+	model, err := sogmm.FitRGBD(context.Background(), sogmm.Frame{Depth: depth, Gray8: gray, Width: w, Height: h,
 		Fx: 140, Fy: 140, Cx: 79.5, Cy: 59.5}, opts)
 	if err != nil {
 		log.Fatal(err)
@@ -41,9 +42,9 @@ func Example() {
 	n, _ := model.NComponents()
 	fmt.Println("components:", n)
 
-	samples, _ := model.Sample(1000, 42, 4, nil)
+	samples, _ := model.Sample(context.Background(), 1000, 42, 4, nil)
 	fmt.Println("samples:", len(samples)/4)
-	g, _, _ := model.RegressGray([]float32{-0.4516, 0, 1.0625, 0.6207, 0, 1.4375})
+	g, _, _ := model.RegressGray(context.Background(), []float32{-0.4516, 0, 1.0625, 0.6207, 0, 1.4375}, nil)
 	fmt.Printf("gray: %.2f %.2f\n", g[0], g[1])
 
 	dir, _ := os.MkdirTemp("", "sogmm-example")

@@ -4,6 +4,7 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"runtime"
 	"unsafe"
 )
@@ -71,15 +72,18 @@ func (f *Frame) handle() (*C.sogmm_frame, error) {
 	return h, nil
 }
 
-// FitRGBD fits one frame; decimation and depth range come from o.
-func FitRGBD(f Frame, o *Options) (*Model, error) {
+// FitRGBD fits one frame; decimation and depth range come from o; ctx and
+// the progress func of o as Fit.
+func FitRGBD(ctx context.Context, f Frame, o *Options) (*Model, error) {
 	h, err := f.handle()
 	if err != nil {
 		return nil, err
 	}
 	defer C.sogmm_frame_free(h)
-	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_frame(out, h, op)
+	return withProgress(ctx, o, func(o *Options) (*Model, error) {
+		return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_fit_frame(out, h, op)
+		})
 	})
 }
 

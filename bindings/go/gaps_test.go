@@ -205,20 +205,20 @@ func culled(t *testing.T, nats float64, threads int64) *Options {
 func TestCulledQueriesWithinTheBound(t *testing.T) {
 	m := farCluster(t)
 	const M = 10.0
-	exact, err := m.ScoreSamples(cullQuery, 4)
+	exact, err := m.ScoreSamples(context.Background(), cullQuery, 4, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
-	mean, variance, err := m.RegressGray(cullQueryXYZ)
+	mean, variance, err := m.RegressGray(context.Background(), cullQueryXYZ, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
 	for _, nats := range []float64{2, 6} {
-		c, err := m.ScoreSamplesWith(cullQuery, 4, culled(t, nats, 1))
+		c, err := m.ScoreSamples(context.Background(), cullQuery, 4, culled(t, nats, 1))
 		if err != nil {
 			t.Fatal(err)
 		}
-		c2, err := m.ScoreSamplesWith(cullQuery, 4, culled(t, nats, 2))
+		c2, err := m.ScoreSamples(context.Background(), cullQuery, 4, culled(t, nats, 2))
 		if err != nil || !slices.Equal(c, c2) {
 			t.Fatalf("thread count changed bits: %v %v %v", c, c2, err)
 		}
@@ -234,7 +234,7 @@ func TestCulledQueriesWithinTheBound(t *testing.T) {
 		// Dropped components hold a share <= (M - 1) e^-nats at a point and
 		// every conditional gray is in [0.25, 0.75]: the mean moves by at
 		// most 0.5 times that share.
-		cm, cv, err := m.RegressGrayWith(cullQueryXYZ, culled(t, nats, 2))
+		cm, cv, err := m.RegressGray(context.Background(), cullQueryXYZ, culled(t, nats, 2))
 		if err != nil {
 			t.Fatal(err)
 		}
@@ -249,11 +249,11 @@ func TestCulledQueriesWithinTheBound(t *testing.T) {
 		}
 	}
 	// Far above every gap: nothing is culled, the exact bits.
-	c, err := m.ScoreSamplesWith(cullQuery, 4, culled(t, 40, 2))
+	c, err := m.ScoreSamples(context.Background(), cullQuery, 4, culled(t, 40, 2))
 	if err != nil || !slices.Equal(c, exact) {
 		t.Fatalf("40 nats: %v %v", c, err)
 	}
-	cm, cv, err := m.RegressGrayWith(cullQueryXYZ, culled(t, 40, 1))
+	cm, cv, err := m.RegressGray(context.Background(), cullQueryXYZ, culled(t, 40, 1))
 	if err != nil || !slices.Equal(cm, mean) || !slices.Equal(cv, variance) {
 		t.Fatalf("40 nats regression: %v %v %v", cm, cv, err)
 	}
@@ -274,31 +274,31 @@ func TestMapQueriesTakeTheSameOptions(t *testing.T) {
 	}
 	defer mp.Close()
 	o := culled(t, 2, 2)
-	c, err := mp.ScoreSamplesWith(cullQuery, 4, o)
+	c, err := mp.ScoreSamples(context.Background(), cullQuery, 4, o)
 	if err != nil {
 		t.Fatal(err)
 	}
-	want, _ := m.ScoreSamplesWith(cullQuery, 4, o)
-	exact, _ := mp.ScoreSamples(cullQuery, 4)
+	want, _ := m.ScoreSamples(context.Background(), cullQuery, 4, o)
+	exact, _ := mp.ScoreSamples(context.Background(), cullQuery, 4, nil)
 	if !slices.Equal(c, want) || slices.Equal(c, exact) {
 		t.Fatalf("map %v, model %v, exact %v", c, want, exact)
 	}
-	cm, _, err := mp.RegressGrayWith(cullQueryXYZ, o)
+	cm, _, err := mp.RegressGray(context.Background(), cullQueryXYZ, o)
 	if err != nil {
 		t.Fatal(err)
 	}
-	wm, _, _ := m.RegressGrayWith(cullQueryXYZ, o)
-	em, _, _ := mp.RegressGray(cullQueryXYZ)
+	wm, _, _ := m.RegressGray(context.Background(), cullQueryXYZ, o)
+	em, _, _ := mp.RegressGray(context.Background(), cullQueryXYZ, nil)
 	if !slices.Equal(cm, wm) || slices.Equal(cm, em) {
 		t.Fatalf("map %v, model %v, exact %v", cm, wm, em)
 	}
 	// The context variants take the same options, and report every point.
 	for name, score := range map[string]func(*Options, ProgressFunc) ([]float64, error){
 		"map": func(o *Options, fn ProgressFunc) ([]float64, error) {
-			return mp.ScoreSamplesContext(context.Background(), cullQuery, 4, o, fn)
+			return mp.ScoreSamples(context.Background(), cullQuery, 4, reporting(o, fn))
 		},
 		"model": func(o *Options, fn ProgressFunc) ([]float64, error) {
-			return m.ScoreSamplesContext(context.Background(), cullQuery, 4, o, fn)
+			return m.ScoreSamples(context.Background(), cullQuery, 4, reporting(o, fn))
 		},
 	} {
 		var last Progress
@@ -309,10 +309,10 @@ func TestMapQueriesTakeTheSameOptions(t *testing.T) {
 	}
 	for name, regress := range map[string]func(*Options) ([]float32, []float32, error){
 		"map": func(o *Options) ([]float32, []float32, error) {
-			return mp.RegressGrayContext(context.Background(), cullQueryXYZ, o, nil)
+			return mp.RegressGray(context.Background(), cullQueryXYZ, o)
 		},
 		"model": func(o *Options) ([]float32, []float32, error) {
-			return m.RegressGrayContext(context.Background(), cullQueryXYZ, o, nil)
+			return m.RegressGray(context.Background(), cullQueryXYZ, o)
 		},
 	} {
 		if got, _, err := regress(o); err != nil || !slices.Equal(got, cm) {

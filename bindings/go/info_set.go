@@ -3,9 +3,22 @@ package sogmm
 // #include "sogmm/sogmm.h"
 import "C"
 
-// More information keys (the rest of the fit record and camera .sogmm files
-// store), for InfoF64 / InfoI64 and SetInfoF64 / SetInfoI64.
+// Information keys of a model (SOGMM_INFO_*): read with InfoF64 / InfoI64;
+// those .sogmm files store (the fit record and the camera) are also set
+// with SetInfoF64 / SetInfoI64.
 const (
+	InfoSupportSize             Key = C.SOGMM_INFO_SUPPORT_SIZE
+	InfoCreatedUnixMs           Key = C.SOGMM_INFO_CREATED_UNIX_MS
+	InfoFitIterations           Key = C.SOGMM_INFO_FIT_ITERATIONS
+	InfoFitConverged            Key = C.SOGMM_INFO_FIT_CONVERGED
+	InfoFitLogLik               Key = C.SOGMM_INFO_FIT_LOG_LIKELIHOOD
+	InfoFitBandwidth            Key = C.SOGMM_INFO_FIT_BANDWIDTH
+	InfoFitSeed                 Key = C.SOGMM_INFO_FIT_SEED
+	InfoFitNPoints              Key = C.SOGMM_INFO_FIT_N_POINTS
+	InfoFitSecondsTot           Key = C.SOGMM_INFO_FIT_SECONDS_TOTAL
+	InfoCameraWidth             Key = C.SOGMM_INFO_CAMERA_WIDTH
+	InfoCameraHeight            Key = C.SOGMM_INFO_CAMERA_HEIGHT
+	InfoCameraDecimate          Key = C.SOGMM_INFO_CAMERA_DECIMATION
 	InfoFitNComponentsRequested Key = C.SOGMM_INFO_FIT_N_COMPONENTS_REQUESTED
 	InfoFitTol                  Key = C.SOGMM_INFO_FIT_TOL
 	InfoFitRegCovar             Key = C.SOGMM_INFO_FIT_REG_COVAR

@@ -5,31 +5,16 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"runtime"
 	"unsafe"
 )
 
-// Map option keys (sogmm.h): novelty test, batch size and fusion of an
-// incremental map; a map also uses the fit and RGB-D keys.
+// The values of OptMapFusionMethod (a map's keys are OptMap*; a map also
+// uses the fit and RGB-D keys).
 const (
-	OptMapNovelty          Key = C.SOGMM_OPT_MAP_NOVELTY
-	OptMapNoveltyThreshold Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
-	// OptMapNoveltyBandwidthScale (f64, (0, 1], default 0.7): with novelty on,
-	// the batches of novel points are fitted with OptBandwidth times this.
-	OptMapNoveltyBandwidthScale Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
-	// OptMapRevisitRefitRatio (f64, 0 = off or >= 1, default 1.25): an RGB-D
-	// insert whose explained points have at least this many times as many
-	// modes as the map has components on its surfaces replaces those
-	// components by a fit of its points plus samples of their unseen mass
-	// (not with a fixed K or OptMapWarmStart).
-	OptMapRevisitRefitRatio Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
-	OptMapBatchSize         Key = C.SOGMM_OPT_MAP_BATCH_SIZE
-	OptMapFusion            Key = C.SOGMM_OPT_MAP_FUSION
-	OptMapFusionMethod      Key = C.SOGMM_OPT_MAP_FUSION_METHOD
-	OptMapFusionThreshold   Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
-	OptMapWarmStart         Key = C.SOGMM_OPT_MAP_WARM_START
-	FusionHellinger             = C.SOGMM_FUSION_HELLINGER
-	FusionKL                    = C.SOGMM_FUSION_KL
+	FusionHellinger = C.SOGMM_FUSION_HELLINGER
+	FusionKL        = C.SOGMM_FUSION_KL
 )
 
 // Map is an owned sogmm_map: an incremental world map that fits only the
@@ -42,8 +27,9 @@ const (
 // returns an error with ErrBusy ("map busy: ...") and changes nothing; Close
 // then leaves the map open (close it after that call returns).
 type Map struct {
-	ptr   *C.sogmm_map
-	guard mapGuard
+	ptr      *C.sogmm_map
+	guard    mapGuard
+	progress ProgressFunc // of the options the map was created with (OnProgress)
 }
 
 // MapStats are the totals of a map.
@@ -65,25 +51,30 @@ func wrapMap(o *Options, f func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Map{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if o != nil {
+		m.progress = o.progress
+	}
+	// The handle comes out in a local: cgo refuses a pointer into a struct
+	// that holds Go pointers (the progress func).
+	var ptr *C.sogmm_map
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&ptr, op) }); err != nil {
 		return nil, err
 	}
+	m.ptr = ptr
 	runtime.SetFinalizer(m, (*Map).Close)
 	return m, nil
 }
 
-// NewMap creates an empty map with the map, fit and RGB-D keys of o (nil = defaults).
+// NewMap creates an empty map with the map, fit and RGB-D keys of o (nil =
+// defaults) and its progress func (OnProgress), to which the map's inserts
+// and flushes report.
 func NewMap(o *Options) (*Map, error) {
 	return wrapMap(o, func(out **C.sogmm_map, op *C.sogmm_options) C.sogmm_status { return C.sogmm_map_create(out, op) })
 }
 
-// LoadMap reads a map file (or any world-frame model); o's keys govern later inserts.
+// LoadMap reads a map file (or any world-frame model); o's keys and progress
+// func govern later inserts.
 func LoadMap(path string, o *Options) (*Map, error) {
 	cp := C.CString(path)
 	defer C.free(unsafe.Pointer(cp))
@@ -116,22 +107,15 @@ func (m *Map) doWith(o *Options, f func(p *C.sogmm_map, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // InsertPoints inserts N rows (x, y, z, gray) in the camera frame with the
-// frame's camera-to-world pose.
-func (m *Map) InsertPoints(points []float32, pose [16]float64) error {
-	return m.insertPoints(points, pose, nil)
-}
-
-func (m *Map) insertPoints(points []float32, pose [16]float64, progress *mapProgress) error {
+// frame's camera-to-world pose. ctx cancels the fit the insert may run (as
+// Fit), which the progress func of the map's options (OnProgress) reports; a
+// cancelled or failed insert leaves the map as it was.
+func (m *Map) InsertPoints(ctx context.Context, points []float32, pose [16]float64) error {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return err
@@ -139,33 +123,29 @@ func (m *Map) insertPoints(points []float32, pose [16]float64, progress *mapProg
 	if n == 0 { // C sees a nil slice as a NULL pointer; the problem is the empty frame
 		return &Error{Status: ErrInvalidData, Message: "points: an empty frame (no point)"}
 	}
-	return m.change("InsertPoints", progress, func(p *C.sogmm_map) C.sogmm_status {
+	return m.change(ctx, "InsertPoints", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_points_f32(p, floats(points), C.size_t(n), (*C.double)(&pose[0]))
 	})
 }
 
 // InsertRGBD inserts an RGB-D frame (decimation and depth range from the
-// options the map was created with) with its camera-to-world pose.
-func (m *Map) InsertRGBD(f Frame, pose [16]float64) error {
-	return m.insertRGBD(f, pose, nil)
-}
-
-func (m *Map) insertRGBD(f Frame, pose [16]float64, progress *mapProgress) error {
+// options the map was created with) with its camera-to-world pose; ctx and
+// progress as InsertPoints.
+func (m *Map) InsertRGBD(ctx context.Context, f Frame, pose [16]float64) error {
 	h, err := f.handle()
 	if err != nil {
 		return err
 	}
 	defer C.sogmm_frame_free(h)
-	return m.change("InsertRGBD", progress, func(p *C.sogmm_map) C.sogmm_status {
+	return m.change(ctx, "InsertRGBD", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_insert_frame(p, h, (*C.double)(&pose[0]))
 	})
 }
 
-// Flush fits the pending novel points now.
-func (m *Map) Flush() error { return m.flush(nil) }
-
-func (m *Map) flush(progress *mapProgress) error {
-	return m.change("Flush", progress, func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
+// Flush fits the pending novel points now; ctx and progress as InsertPoints
+// (a cancelled flush keeps the pending points).
+func (m *Map) Flush(ctx context.Context) error {
+	return m.change(ctx, "Flush", func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_flush(p) })
 }
 
 // DiscardPending drops the points pending for a fit (they never become
@@ -173,7 +153,7 @@ func (m *Map) flush(progress *mapProgress) error {
 // way out when a flush keeps failing and the map cannot be saved.
 func (m *Map) DiscardPending() (uint64, error) {
 	var dropped C.uint64_t
-	err := m.change("DiscardPending", nil, func(p *C.sogmm_map) C.sogmm_status {
+	err := m.change(context.Background(), "DiscardPending", func(p *C.sogmm_map) C.sogmm_status {
 		return C.sogmm_map_discard_pending(p, &dropped)
 	})
 	return uint64(dropped), err
@@ -201,6 +181,27 @@ func (m *Map) Stats() (MapStats, error) {
 		})
 	})
 	return s, err
+}
+
+// Origin returns the map's origin (anchor; world x, y, z in metres): the map
+// holds its components relative to it, so that far from the world origin
+// (geo-referenced poses) they keep room-scale resolution. By default the first
+// frame's translation rounded to 1 km per axis (0 near the world origin); a
+// loaded map's comes from its file (sogmm_map_get_origin).
+func (m *Map) Origin() ([3]float64, error) {
+	var o [3]C.double
+	err := m.read("Origin", func() error {
+		return m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_get_origin(p, &o[0]) })
+	})
+	return [3]float64{float64(o[0]), float64(o[1]), float64(o[2])}, err
+}
+
+// SetOrigin declares the origin (finite, within float32 range) instead of the
+// first frame's; only before the first insert, else an error with
+// StatusInvalidArg (sogmm_map_set_origin).
+func (m *Map) SetOrigin(origin [3]float64) error {
+	o := [3]C.double{C.double(origin[0]), C.double(origin[1]), C.double(origin[2])}
+	return m.change(context.Background(), "SetOrigin", func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_origin(p, &o[0]) })
 }
 
 // FrameStats returns what the insert of frame i (insertion order) did (read

@@ -3,16 +3,18 @@ package sogmm
 // #include "sogmm/sogmm.h"
 import "C"
 
-import "sync"
+import (
+	"context"
+	"sync"
+)
 
 // mapGuard is the Go side of the map's use guard (sogmm.h, "Use guard"): a
-// call changing the map (InsertPoints, InsertRGBD, Flush, their Context
-// forms, Close) needs it alone, reading calls share it, and a call that finds
+// call changing the map (InsertPoints, InsertRGBD, Flush, Close) needs it alone, reading calls share it, and a call that finds
 // it otherwise taken fails at once with ErrBusy ("map busy: ..."), never
 // waits (a progress func calling into its own map would deadlock). The C
 // library checks the same inside its calls; this also covers what Go does
-// around them: the handle Close frees, and the progress callback a Context
-// insert installs and removes.
+// around them: the handle Close frees, and the progress callback an insert
+// installs and removes.
 type mapGuard struct {
 	mu    sync.Mutex
 	users int // > 0: reading calls; -1: the one changing call
@@ -50,19 +52,22 @@ func busy(what, conflict string) error {
 		" (on another goroutine, or the call whose progress func is running); a map is changed by one call at a time"}
 }
 
-// change runs f on m's handle holding m alone; with a progress func or
-// context (fn != nil or ctx != nil) the callback is installed for f and
-// removed after it (withMapProgress).
-func (m *Map) change(what string, p *mapProgress, f func(p *C.sogmm_map) C.sogmm_status) error {
+// change runs f on m's handle holding m alone; when ctx can be cancelled or
+// the map has a progress func, the callback is installed for f and removed
+// after it (withMapProgress).
+func (m *Map) change(ctx context.Context, what string, f func(p *C.sogmm_map) C.sogmm_status) error {
 	if m == nil {
 		return ErrClosed
+	}
+	if ctx == nil {
+		return invalidArg("nil context (pass context.Background())")
 	}
 	if err := m.guard.take(true, what); err != nil {
 		return err
 	}
 	defer m.guard.release(true)
-	if p != nil {
-		return withMapProgress(p, m, f)
+	if ctx.Done() != nil || m.progress != nil {
+		return withMapProgress(ctx, m, f)
 	}
 	return m.doWith(nil, func(h *C.sogmm_map, _ *C.sogmm_options) C.sogmm_status { return f(h) })
 }

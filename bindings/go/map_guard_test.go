@@ -34,15 +34,15 @@ func TestMapCallsFromItsProgressFuncAreBusy(t *testing.T) {
 	defer m.Close()
 	pts := twoBlobs(400)
 	var nested []error
-	err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 0, 0, 0), func(Progress) error {
+	err := setProgress(m, func(Progress) error {
 		if nested == nil {
-			nested = append(nested, m.InsertPoints(pts, yawPose(0, 0, 0, 0)), m.Flush())
+			nested = append(nested, m.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)), m.Flush(context.Background()))
 			_, err := m.Stats()
 			nested = append(nested, err)
 			m.Close() // does nothing: the map is in use
 		}
 		return nil
-	})
+	}).InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0))
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -71,14 +71,14 @@ func TestMapCallsFromAnotherGoroutineAreBusy(t *testing.T) {
 		<-inside
 		_, e1 := m.Stats()
 		_, e2 := m.Export(nil)
-		errs = []error{m.InsertPoints(pts, yawPose(0, 0, 0, 0)), e1, e2}
+		errs = []error{m.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)), e1, e2}
 		m.Close()
 		close(tried)
 	}()
-	err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 0, 0, 0), func(Progress) error {
+	err := setProgress(m, func(Progress) error {
 		once.Do(func() { close(inside); <-tried })
 		return nil
-	})
+	}).InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0))
 	if err != nil {
 		t.Fatal(err)
 	}

@@ -49,11 +49,11 @@ func twoFrameMap(t *testing.T) *Map {
 	m := newTestMap(t, I64(OptMapBatchSize, 100000))
 	pts := twoBlobs(600)
 	for _, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(0, 3, 0, 0)} {
-		if err := m.InsertPoints(pts, pose); err != nil {
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
 			t.Fatal(err)
 		}
 	}
-	if err := m.Flush(); err != nil {
+	if err := m.Flush(context.Background()); err != nil {
 		t.Fatal(err)
 	}
 	return m
@@ -75,49 +75,49 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 		q    []float32
 		dims int
 	}{{q3, 3}, {q4, 4}} {
-		want, err := model.ScoreSamples(c.q, c.dims)
+		want, err := model.ScoreSamples(context.Background(), c.q, c.dims, nil)
 		if err != nil {
 			t.Fatal(err)
 		}
-		got, err := m.ScoreSamples(c.q, c.dims)
+		got, err := m.ScoreSamples(context.Background(), c.q, c.dims, nil)
 		if err != nil || !slices.Equal(got, want) {
 			t.Fatalf("dims %d: map score differs from the model's (err %v)", c.dims, err)
 		}
 		var last Progress
-		got, err = m.ScoreSamplesContext(context.Background(), c.q, c.dims, nil, func(p Progress) error { last = p; return nil })
+		got, err = m.ScoreSamples(context.Background(), c.q, c.dims, reporting(nil, func(p Progress) error { last = p; return nil }))
 		if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
 			t.Fatalf("dims %d: with progress: err %v, last %+v", c.dims, err, last)
 		}
 	}
-	wm, wv, err := model.RegressGray(q3)
+	wm, wv, err := model.RegressGray(context.Background(), q3, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
-	gm, gv, err := m.RegressGray(q3)
+	gm, gv, err := m.RegressGray(context.Background(), q3, nil)
 	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
 		t.Fatalf("regress differs (err %v)", err)
 	}
-	gm, gv, err = m.RegressGrayContext(context.Background(), q3, nil, nil)
+	gm, gv, err = m.RegressGray(context.Background(), q3, nil)
 	if err != nil || !slices.Equal(gm, wm) || !slices.Equal(gv, wv) {
 		t.Fatalf("regress with context differs (err %v)", err)
 	}
-	ws, _ := model.Sample(3000, 4, 4, nil)
-	gs, err := m.Sample(3000, 4, 4, nil)
+	ws, _ := model.Sample(context.Background(), 3000, 4, 4, nil)
+	gs, err := m.Sample(context.Background(), 3000, 4, 4, nil)
 	if err != nil || !slices.Equal(gs, ws) {
 		t.Fatalf("sample differs (err %v)", err)
 	}
-	gs, err = m.SampleContext(context.Background(), 3000, 4, 4, nil, nil)
+	gs, err = m.Sample(context.Background(), 3000, 4, 4, nil)
 	if err != nil || !slices.Equal(gs, ws) {
 		t.Fatalf("sample with context differs (err %v)", err)
 	}
 
 	ctx, cancel := context.WithCancel(context.Background())
 	cancel()
-	_, _, err = m.RegressGrayContext(ctx, q3, nil, nil)
+	_, _, err = m.RegressGray(ctx, q3, nil)
 	if !errors.Is(err, ErrCancelled) || !errors.Is(err, context.Canceled) {
 		t.Fatalf("cancelled regress: %v", err)
 	}
-	if _, err := m.ScoreSamples(q3, 5); !errors.Is(err, ErrInvalidArg) {
+	if _, err := m.ScoreSamples(context.Background(), q3, 5, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("dims 5: %v", err)
 	}
 	empty, err := NewMap(nil)
@@ -125,21 +125,21 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer empty.Close()
-	if _, err := empty.Sample(10, 1, 4, nil); !errors.Is(err, ErrInvalidData) {
+	if _, err := empty.Sample(context.Background(), 10, 1, 4, nil); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty map: %v", err)
 	}
 }
 
 // A cancelled insert or flush leaves the map as it was.
 func TestMapInsertCancelLeavesTheMapUnchanged(t *testing.T) {
-	m := newTestMap(t, I64(OptMapNovelty, 0))
-	defer m.Close()
-	pts := twoBlobs(400)
 	var stages []Stage
-	if err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 0, 0, 0), func(p Progress) error {
+	m := newTestMap(t, I64(OptMapNovelty, 0), OnProgress(func(p Progress) error {
 		stages = append(stages, p.Stage)
 		return nil
-	}); err != nil {
+	}))
+	defer m.Close()
+	pts := twoBlobs(400)
+	if err := m.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)); err != nil {
 		t.Fatal(err)
 	}
 	if len(stages) == 0 || stages[len(stages)-1] != StageEM {
@@ -147,31 +147,33 @@ func TestMapInsertCancelLeavesTheMapUnchanged(t *testing.T) {
 	}
 	before, _ := m.Stats()
 	stop := errors.New("stop")
-	err := m.InsertPointsContext(context.Background(), pts, yawPose(0, 3, 0, 0), func(Progress) error { return stop })
+	err := setProgress(m, func(Progress) error { return stop }).InsertPoints(context.Background(), pts, yawPose(0, 3, 0, 0))
 	if !errors.Is(err, ErrCancelled) || !errors.Is(err, stop) {
 		t.Fatalf("cancelled insert: %v", err)
 	}
 	if after, _ := m.Stats(); after != before {
 		t.Fatalf("a cancelled insert changed the map: %+v -> %+v", before, after)
 	}
-	if err := m.InsertPoints(pts, yawPose(0, 3, 0, 0)); err != nil { // the callback is gone
+	// Without a progress func (and an uncancellable ctx) nothing is installed;
+	// the cancelled insert's C callback was removed after it.
+	if err := setProgress(m, nil).InsertPoints(context.Background(), pts, yawPose(0, 3, 0, 0)); err != nil {
 		t.Fatal(err)
 	}
 
 	p := newTestMap(t, I64(OptMapBatchSize, 100000))
 	defer p.Close()
-	if err := p.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
+	if err := p.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)); err != nil {
 		t.Fatal(err)
 	}
 	ctx, cancel := context.WithCancel(context.Background())
 	cancel()
-	if err := p.FlushContext(ctx, nil); !errors.Is(err, context.Canceled) {
+	if err := p.Flush(ctx); !errors.Is(err, context.Canceled) {
 		t.Fatalf("cancelled flush: %v", err)
 	}
 	if s, _ := p.Stats(); s.Pending != 400 || s.Components != 0 {
 		t.Fatalf("a cancelled flush changed the map: %+v", s)
 	}
-	if err := p.FlushContext(context.Background(), nil); err != nil {
+	if err := p.Flush(context.Background()); err != nil {
 		t.Fatal(err)
 	}
 }
@@ -182,18 +184,18 @@ func TestFitWarm(t *testing.T) {
 	pts := twoBlobs(2000)
 	o, _ := NewOptions(NComponents(2), Seed(1), Threads(2))
 	defer o.Close()
-	cold, err := Fit(pts, o)
+	cold, err := Fit(context.Background(), pts, o)
 	if err != nil {
 		t.Fatal(err)
 	}
 	defer cold.Close()
-	warm, err := FitWarmContext(context.Background(), pts, cold, o, nil)
+	warm, err := FitWarm(context.Background(), pts, cold, o)
 	if err != nil {
 		t.Fatal(err)
 	}
 	defer warm.Close()
 	mean := func(m *Model) float64 {
-		s, _ := m.ScoreSamples(pts, 4)
+		s, _ := m.ScoreSamples(context.Background(), pts, 4, nil)
 		var sum float64
 		for _, v := range s {
 			sum += v
@@ -203,7 +205,7 @@ func TestFitWarm(t *testing.T) {
 	if k, _ := warm.NComponents(); k != 2 || mean(warm) < mean(cold)-1e-6 {
 		t.Fatalf("warm: K %d, mean log-likelihood %v < cold %v", k, mean(warm), mean(cold))
 	}
-	plain, err := FitWarm(pts, cold, o)
+	plain, err := FitWarm(context.Background(), pts, cold, o)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -215,10 +217,10 @@ func TestFitWarm(t *testing.T) {
 	}
 	k3, _ := NewOptions(NComponents(3))
 	defer k3.Close()
-	if _, err := FitWarm(pts, cold, k3); !errors.Is(err, ErrInvalidArg) {
+	if _, err := FitWarm(context.Background(), pts, cold, k3); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("K mismatch: %v", err)
 	}
-	if _, err := FitWarm(pts, nil, nil); !errors.Is(err, ErrClosed) {
+	if _, err := FitWarm(context.Background(), pts, nil, nil); !errors.Is(err, ErrClosed) {
 		t.Fatalf("nil initial: %v", err)
 	}
 }
@@ -227,9 +229,9 @@ func TestFitWarm(t *testing.T) {
 func TestModelQueryContexts(t *testing.T) {
 	_, model := twoFrameMapAndExport(t)
 	q := twoBlobs(5000)
-	want, _ := model.ScoreSamples(q, 4)
+	want, _ := model.ScoreSamples(context.Background(), q, 4, nil)
 	var last Progress
-	got, err := model.ScoreSamplesContext(context.Background(), q, 4, nil, func(p Progress) error { last = p; return nil })
+	got, err := model.ScoreSamples(context.Background(), q, 4, reporting(nil, func(p Progress) error { last = p; return nil }))
 	if err != nil || !slices.Equal(got, want) || last.Stage != StageScoring || last.Step != 5000 {
 		t.Fatalf("score with context: err %v, last %+v", err, last)
 	}
@@ -237,13 +239,13 @@ func TestModelQueryContexts(t *testing.T) {
 	for i := 0; i < len(q); i += 4 {
 		xyz = append(xyz, q[i:i+3]...)
 	}
-	wm, _, _ := model.RegressGray(xyz)
-	gm, _, err := model.RegressGrayContext(context.Background(), xyz, nil, func(p Progress) error { last = p; return nil })
+	wm, _, _ := model.RegressGray(context.Background(), xyz, nil)
+	gm, _, err := model.RegressGray(context.Background(), xyz, reporting(nil, func(p Progress) error { last = p; return nil }))
 	if err != nil || !slices.Equal(gm, wm) || last.Stage != StageRegression {
 		t.Fatalf("regress with context: err %v, last %+v", err, last)
 	}
 	stop := errors.New("stop")
-	if _, err := model.ScoreSamplesContext(context.Background(), q, 4, nil, func(Progress) error { return stop }); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
+	if _, err := model.ScoreSamples(context.Background(), q, 4, reporting(nil, func(Progress) error { return stop })); !errors.Is(err, stop) || !errors.Is(err, ErrCancelled) {
 		t.Fatalf("cancelled score: %v", err)
 	}
 }
@@ -259,10 +261,10 @@ func TestNoveltyBandwidthScale(t *testing.T) {
 	count := func(scale float64) uint64 {
 		m := newTestMap(t, Bandwidth(0.05), I64(OptMapBatchSize, 100000), F64(OptMapNoveltyBandwidthScale, scale))
 		defer m.Close()
-		if err := m.InsertPoints(twoBlobs(600), yawPose(0, 0, 0, 0)); err != nil {
+		if err := m.InsertPoints(context.Background(), twoBlobs(600), yawPose(0, 0, 0, 0)); err != nil {
 			t.Fatal(err)
 		}
-		if err := m.Flush(); err != nil {
+		if err := m.Flush(context.Background()); err != nil {
 			t.Fatal(err)
 		}
 		st, err := m.Stats()
@@ -300,7 +302,7 @@ func TestRevisitRefitRatio(t *testing.T) {
 		defer m.Close()
 		for _, gray := range [][]uint8{plain, striped} {
 			f := Frame{Depth: depth, Gray8: gray, Width: w, Height: h, Fx: 60, Fy: 60, Cx: 32, Cy: 24}
-			if err := m.InsertRGBD(f, yawPose(0, 0, 0, 0)); err != nil {
+			if err := m.InsertRGBD(context.Background(), f, yawPose(0, 0, 0, 0)); err != nil {
 				t.Fatal(err)
 			}
 		}

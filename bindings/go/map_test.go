@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"math"
 	"path/filepath"
@@ -26,10 +27,10 @@ func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 	var want *Model
 	for k, pose := range poses {
 		pts := twoBlobs(200 + 50*k)
-		if err := m.InsertPoints(pts, pose); err != nil {
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
 			t.Fatal(err)
 		}
-		f, err := Fit(pts, o)
+		f, err := Fit(context.Background(), pts, o)
 		if err != nil {
 			t.Fatal(err)
 		}
@@ -80,21 +81,21 @@ func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
 	defer m.Close()
 	scaled := yawPose(0, 0, 0, 0)
 	scaled[0] = 2
-	if err := m.InsertPoints(twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
+	if err := m.InsertPoints(context.Background(), twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("scaled pose: %v", err)
 	}
 	nan := yawPose(0, math.NaN(), 0, 0)
-	if err := m.InsertPoints(twoBlobs(50), nan); !errors.Is(err, ErrInvalidArg) {
+	if err := m.InsertPoints(context.Background(), twoBlobs(50), nan); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("NaN pose: %v", err)
 	}
-	if err := m.InsertPoints(nil, yawPose(0, 0, 0, 0)); !errors.Is(err, ErrInvalidData) {
+	if err := m.InsertPoints(context.Background(), nil, yawPose(0, 0, 0, 0)); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty frame: %v", err)
 	}
 	if s, err := m.Stats(); err != nil || s.Frames != 0 || s.Pending != 0 {
 		t.Fatalf("a failed insert changed the map: %+v (%v)", s, err)
 	}
 	m.Close()
-	if err := m.Flush(); !errors.Is(err, ErrClosed) {
+	if err := m.Flush(context.Background()); !errors.Is(err, ErrClosed) {
 		t.Fatalf("closed map: %v", err)
 	}
 }
@@ -104,7 +105,7 @@ func TestMapDiscardPendingUnlocksSave(t *testing.T) {
 	m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
 	defer m.Close()
 	pts := twoBlobs(200)
-	if err := m.InsertPoints(pts, yawPose(0, 0, 0, 0)); err != nil {
+	if err := m.InsertPoints(context.Background(), pts, yawPose(0, 0, 0, 0)); err != nil {
 		t.Fatal(err)
 	}
 	path := filepath.Join(t.TempDir(), "pending.sogmm")
@@ -121,5 +122,68 @@ func TestMapDiscardPendingUnlocksSave(t *testing.T) {
 	}
 	if got, err := m.DiscardPending(); err != nil || got != 0 {
 		t.Fatalf("second DiscardPending = %d (%v), want 0", got, err)
+	}
+}
+
+// Issue 36: a map 1000 km out holds its components relative to its origin
+// (the first frame's translation rounded to 1 km), finds in a mapped frame the
+// novel points it finds at the world origin, and keeps the origin through save
+// and load; it is declared only before the first insert.
+func TestMapFarFromTheOriginKeepsItsOrigin(t *testing.T) {
+	pts := twoBlobs(200)
+	path := filepath.Join(t.TempDir(), "far.sogmm")
+	var novel []uint64
+	for _, km := range []float64{0, 1000} {
+		m := newTestMap(t, Threads(1), I64(OptMapBatchSize, 100000))
+		pose := yawPose(20, 1000*km+3.37, -1000*km, 0)
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
+			t.Fatal(err)
+		}
+		if err := m.Flush(context.Background()); err != nil {
+			t.Fatal(err)
+		}
+		if o, err := m.Origin(); err != nil || o != [3]float64{1000 * km, -1000 * km, 0} {
+			t.Fatalf("origin %v (%v) at %v km", o, err, km)
+		}
+		if err := m.InsertPoints(context.Background(), pts, pose); err != nil {
+			t.Fatal(err)
+		}
+		f, err := m.FrameStats(1)
+		if err != nil {
+			t.Fatal(err)
+		}
+		novel = append(novel, f.Novel)
+		if _, err := m.DiscardPending(); err != nil {
+			t.Fatal(err)
+		}
+		if err := m.Save(path, nil); err != nil {
+			t.Fatal(err)
+		}
+		m.Close()
+	}
+	if novel[1] != novel[0] {
+		t.Fatalf("novel points of a mapped frame: %d at 1000 km, %d at 0 km", novel[1], novel[0])
+	}
+	loaded, err := LoadMap(path, nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer loaded.Close()
+	if o, err := loaded.Origin(); err != nil || o != [3]float64{1e6, -1e6, 0} {
+		t.Fatalf("loaded origin %v (%v)", o, err)
+	}
+	if err := loaded.SetOrigin([3]float64{}); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("SetOrigin after inserts: %v, want ErrInvalidArg", err)
+	}
+	fresh := newTestMap(t, Threads(1))
+	defer fresh.Close()
+	if err := fresh.SetOrigin([3]float64{math.NaN(), 0, 0}); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("SetOrigin(NaN): %v, want ErrInvalidArg", err)
+	}
+	if err := fresh.SetOrigin([3]float64{5e5, 0.5, 0}); err != nil {
+		t.Fatal(err)
+	}
+	if o, err := fresh.Origin(); err != nil || o != [3]float64{5e5, 0.5, 0} {
+		t.Fatalf("declared origin %v (%v)", o, err)
 	}
 }

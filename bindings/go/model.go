@@ -5,25 +5,10 @@ package sogmm
 import "C"
 
 import (
+	"context"
 	"fmt"
 	"runtime"
 	"unsafe"
-)
-
-// Information keys of a model (SOGMM_INFO_*); read with InfoF64 / InfoI64.
-const (
-	InfoSupportSize    Key = C.SOGMM_INFO_SUPPORT_SIZE
-	InfoCreatedUnixMs  Key = C.SOGMM_INFO_CREATED_UNIX_MS
-	InfoFitIterations  Key = C.SOGMM_INFO_FIT_ITERATIONS
-	InfoFitConverged   Key = C.SOGMM_INFO_FIT_CONVERGED
-	InfoFitLogLik      Key = C.SOGMM_INFO_FIT_LOG_LIKELIHOOD
-	InfoFitBandwidth   Key = C.SOGMM_INFO_FIT_BANDWIDTH
-	InfoFitSeed        Key = C.SOGMM_INFO_FIT_SEED
-	InfoFitNPoints     Key = C.SOGMM_INFO_FIT_N_POINTS
-	InfoFitSecondsTot  Key = C.SOGMM_INFO_FIT_SECONDS_TOTAL
-	InfoCameraWidth    Key = C.SOGMM_INFO_CAMERA_WIDTH
-	InfoCameraHeight   Key = C.SOGMM_INFO_CAMERA_HEIGHT
-	InfoCameraDecimate Key = C.SOGMM_INFO_CAMERA_DECIMATION
 )
 
 // Model is an owned sogmm_model: a fitted 4-D GMM (x, y, z, gray) with its
@@ -42,13 +27,8 @@ func newModel(o *Options, f func(out **C.sogmm_model, op *C.sogmm_options) C.sog
 	if err := abiOnce(); err != nil {
 		return nil, err
 	}
-	op, err := o.raw()
-	if err != nil {
-		return nil, err
-	}
-	defer runtime.KeepAlive(o)
 	m := &Model{}
-	if err := call(func() C.sogmm_status { return f(&m.ptr, op) }); err != nil {
+	if err := callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(&m.ptr, op) }); err != nil {
 		return nil, err
 	}
 	runtime.SetFinalizer(m, func(m *Model) {
@@ -64,13 +44,8 @@ func (m *Model) do(o *Options, f func(p *C.sogmm_model, op *C.sogmm_options) C.s
 	if m == nil || m.ptr == nil {
 		return ErrClosed
 	}
-	op, err := o.raw()
-	if err != nil {
-		return err
-	}
 	defer runtime.KeepAlive(m)
-	defer runtime.KeepAlive(o)
-	return call(func() C.sogmm_status { return f(m.ptr, op) })
+	return callWith(o, func(op *C.sogmm_options) C.sogmm_status { return f(m.ptr, op) })
 }
 
 // derive creates a new model from m (clone, merge, transform).
@@ -110,38 +85,21 @@ func rowsOf(data []float32, cols int, what string) (int, error) {
 	return len(data) / cols, nil
 }
 
-// Fit fits a model to n points: points holds n rows (x, y, z, gray). o may be nil.
-func Fit(points []float32, o *Options) (*Model, error) {
+// Fit fits a model to n points: points holds n rows (x, y, z, gray). o may
+// be nil (defaults; OptNComponents fixes K). ctx cancels: the call stops
+// within about 50 ms once ctx is done (the error then satisfies
+// errors.Is(err, ErrCancelled) and errors.Is(err, ctx.Err())); the progress
+// func of o (OnProgress) gets the reports.
+func Fit(ctx context.Context, points []float32, o *Options) (*Model, error) {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return nil, err
 	}
-	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), nil, op)
+	return withProgress(ctx, o, func(o *Options) (*Model, error) {
+		return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), nil, op)
+		})
 	})
-}
-
-// FitFixedK fits exactly k components (1 <= k <= n): Fit with
-// OptNComponents = k on a copy of o (o may be nil).
-func FitFixedK(points []float32, k int, o *Options) (*Model, error) {
-	if k < 1 {
-		return nil, invalidArg("k must be >= 1, got %d", k)
-	}
-	var fixed *Options
-	var err error
-	if o != nil {
-		fixed, err = o.Clone()
-	} else {
-		fixed, err = NewOptions()
-	}
-	if err != nil {
-		return nil, err
-	}
-	defer fixed.Close()
-	if err := fixed.SetI64(OptNComponents, int64(k)); err != nil {
-		return nil, err
-	}
-	return Fit(points, fixed)
 }
 
 // FromArrays builds a model from M weights, M x 4 means and M x 4 x 4

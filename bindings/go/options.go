@@ -8,37 +8,64 @@ import "runtime"
 // Key names an option (SOGMM_OPT_*) or a model information value (SOGMM_INFO_*).
 type Key int32
 
-// Option keys (types and ranges: sogmm.h and spec/api.md).
+// BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp)
+
+// Option keys: the C macros by their Go names (types, ranges, defaults and
+// meaning: sogmm.h, spec/api.md, or OptionInfoOf at run time).
 const (
-	OptBandwidth        Key = C.SOGMM_OPT_BANDWIDTH
-	OptNComponents      Key = C.SOGMM_OPT_N_COMPONENTS
-	OptTol              Key = C.SOGMM_OPT_TOL
-	OptRegCovar         Key = C.SOGMM_OPT_REG_COVAR
-	OptMaxIter          Key = C.SOGMM_OPT_MAX_ITER
-	OptSeed             Key = C.SOGMM_OPT_SEED
-	OptThreads          Key = C.SOGMM_OPT_THREADS
-	OptModeCounter      Key = C.SOGMM_OPT_MODE_COUNTER
-	OptTruncationNats   Key = C.SOGMM_OPT_TRUNCATION_NATS
-	OptNInit            Key = C.SOGMM_OPT_N_INIT
-	OptDequantiseDepth  Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
-	OptDepthScale       Key = C.SOGMM_OPT_DEPTH_SCALE
-	OptDepthMin         Key = C.SOGMM_OPT_DEPTH_MIN
-	OptDepthMax         Key = C.SOGMM_OPT_DEPTH_MAX
-	OptDecimation       Key = C.SOGMM_OPT_DECIMATION
-	OptZstdLevel        Key = C.SOGMM_OPT_ZSTD_LEVEL
-	OptFloat64          Key = C.SOGMM_OPT_FLOAT64
-	OptCompress         Key = C.SOGMM_OPT_COMPRESS
-	OptMaxDecodedBytes  Key = C.SOGMM_OPT_MAX_DECODED_BYTES
-	OptVerifyChecksums  Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
-	OptSampleTruncation Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
-	// OptQueryTruncationNats culls the queries given these options (see QueryTruncationNats).
-	OptQueryTruncationNats Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
+	OptBandwidth                   Key = C.SOGMM_OPT_BANDWIDTH
+	OptNComponents                 Key = C.SOGMM_OPT_N_COMPONENTS
+	OptTol                         Key = C.SOGMM_OPT_TOL
+	OptRegCovar                    Key = C.SOGMM_OPT_REG_COVAR
+	OptMaxIter                     Key = C.SOGMM_OPT_MAX_ITER
+	OptSeed                        Key = C.SOGMM_OPT_SEED
+	OptThreads                     Key = C.SOGMM_OPT_THREADS
+	OptModeCounter                 Key = C.SOGMM_OPT_MODE_COUNTER
+	OptTruncationNats              Key = C.SOGMM_OPT_TRUNCATION_NATS
+	OptNInit                       Key = C.SOGMM_OPT_N_INIT
+	OptDequantiseDepth             Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
+	OptEmAcceleration              Key = C.SOGMM_OPT_EM_ACCELERATION
+	OptDepthScale                  Key = C.SOGMM_OPT_DEPTH_SCALE
+	OptDepthMin                    Key = C.SOGMM_OPT_DEPTH_MIN
+	OptDepthMax                    Key = C.SOGMM_OPT_DEPTH_MAX
+	OptDecimation                  Key = C.SOGMM_OPT_DECIMATION
+	OptZstdLevel                   Key = C.SOGMM_OPT_ZSTD_LEVEL
+	OptFloat64                     Key = C.SOGMM_OPT_FLOAT64
+	OptCompress                    Key = C.SOGMM_OPT_COMPRESS
+	OptMaxDecodedBytes             Key = C.SOGMM_OPT_MAX_DECODED_BYTES
+	OptVerifyChecksums             Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
+	OptSampleTruncation            Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
+	OptQueryTruncationNats         Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
+	OptMapNovelty                  Key = C.SOGMM_OPT_MAP_NOVELTY
+	OptMapNoveltyThreshold         Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
+	OptMapBatchSize                Key = C.SOGMM_OPT_MAP_BATCH_SIZE
+	OptMapFusion                   Key = C.SOGMM_OPT_MAP_FUSION
+	OptMapFusionMethod             Key = C.SOGMM_OPT_MAP_FUSION_METHOD
+	OptMapFusionThreshold          Key = C.SOGMM_OPT_MAP_FUSION_THRESHOLD
+	OptMapWarmStart                Key = C.SOGMM_OPT_MAP_WARM_START
+	OptMapNoveltyBandwidthScale    Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
+	OptMapRevisitRefitRatio        Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
+	OptOccupancySigma              Key = C.SOGMM_OPT_OCCUPANCY_SIGMA
+	OptOccupancyThickness          Key = C.SOGMM_OPT_OCCUPANCY_THICKNESS
+	OptSurfaceDiscSigmas           Key = C.SOGMM_OPT_SURFACE_DISC_SIGMAS
+	OptRegistrationMaxIter         Key = C.SOGMM_OPT_REGISTRATION_MAX_ITER
+	OptRegistrationTol             Key = C.SOGMM_OPT_REGISTRATION_TOL
+	OptRegistrationOutlierRatio    Key = C.SOGMM_OPT_REGISTRATION_OUTLIER_RATIO
+	OptRegistrationUseGray         Key = C.SOGMM_OPT_REGISTRATION_USE_GRAY
+	OptRegistrationLevels          Key = C.SOGMM_OPT_REGISTRATION_LEVELS
+	OptRegistrationCoarseSigma     Key = C.SOGMM_OPT_REGISTRATION_COARSE_SIGMA
+	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
+	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
+	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
 )
+
+// END GENERATED option keys
 
 // Options is an owned sogmm_options handle: parameters for fit, save, load
 // and sample. A nil *Options passed to any function means "all defaults".
 type Options struct {
-	ptr *C.sogmm_options
+	ptr      *C.sogmm_options
+	progress ProgressFunc // OnProgress; Go-side, installed per call (withProgress)
 }
 
 // Option sets one value; the library checks its range (ErrInvalidArg with a
@@ -51,9 +78,13 @@ func NewOptions(opts ...Option) (*Options, error) {
 		return nil, err
 	}
 	o := &Options{}
-	if err := call(func() C.sogmm_status { return C.sogmm_options_create(&o.ptr) }); err != nil {
+	// Out through a local: cgo refuses a pointer into a struct that holds Go
+	// pointers (the progress func).
+	var ptr *C.sogmm_options
+	if err := call(func() C.sogmm_status { return C.sogmm_options_create(&ptr) }); err != nil {
 		return nil, err
 	}
+	o.ptr = ptr
 	runtime.SetFinalizer(o, (*Options).Close)
 	if err := o.Set(opts...); err != nil {
 		o.Close()
@@ -90,6 +121,17 @@ func (o *Options) raw() (*C.sogmm_options, error) {
 		return nil, ErrClosed
 	}
 	return o.ptr, nil
+}
+
+// callWith runs one C call with o's handle (nil o = NULL = defaults), keeping
+// o alive until it returns; a closed o gives ErrClosed.
+func callWith(o *Options, f func(op *C.sogmm_options) C.sogmm_status) error {
+	op, err := o.raw()
+	if err != nil {
+		return err
+	}
+	defer runtime.KeepAlive(o)
+	return call(func() C.sogmm_status { return f(op) })
 }
 
 // do runs one C call on o's handle, keeping o alive until it returns.
@@ -132,11 +174,35 @@ func (o *Options) GetI64(key Key) (int64, error) {
 // Clone is a deep copy.
 func (o *Options) Clone() (*Options, error) {
 	c := &Options{}
-	if err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_clone(&c.ptr, p) }); err != nil {
+	var ptr *C.sogmm_options // a local, as in NewOptions
+	if err := o.do(func(p *C.sogmm_options) C.sogmm_status { return C.sogmm_options_clone(&ptr, p) }); err != nil {
 		return nil, err
 	}
+	c.ptr = ptr
+	c.progress = o.progress
 	runtime.SetFinalizer(c, (*Options).Close)
 	return c, nil
+}
+
+// copyOrDefaults is a new handle: a Clone of o, or the defaults for a nil o.
+func (o *Options) copyOrDefaults() (*Options, error) {
+	if o == nil {
+		return NewOptions()
+	}
+	return o.Clone()
+}
+
+// OnProgress makes every call given these options report to fn (see
+// ProgressFunc); nil removes it. A map keeps the one of the options it was
+// created with for its inserts and flushes.
+func OnProgress(fn ProgressFunc) Option {
+	return func(o *Options) error {
+		if o == nil || o.ptr == nil {
+			return ErrClosed
+		}
+		o.progress = fn
+		return nil
+	}
 }
 
 // F64 sets any f64 key (e.g. an experimental one).
@@ -192,6 +258,15 @@ func DequantiseDepth(on bool) Option {
 		return I64(OptDequantiseDepth, 1)
 	}
 	return I64(OptDequantiseDepth, 0)
+}
+
+// Squarem turns SQUAREM-accelerated EM on (1) or off (0: plain EM, the
+// default); see SOGMM_OPT_EM_ACCELERATION in sogmm.h.
+func Squarem(on bool) Option {
+	if on {
+		return I64(OptEmAcceleration, 1)
+	}
+	return I64(OptEmAcceleration, 0)
 }
 
 // DequantiseAuto is OptDequantiseDepth's default value (see sogmm.h).

@@ -83,19 +83,24 @@ func sogmmGoProgress(stage C.int32_t, step, total C.uint64_t, ll C.double, handl
 	return 0
 }
 
-// withProgress runs create with a private copy of o (nil = defaults) that
-// reports to fn and watches ctx; ctx's error or fn's becomes the Cause of
-// the ErrCancelled error, and a panic in fn is raised again here.
-func withProgress[T any](ctx context.Context, o *Options, fn ProgressFunc,
-	create func(private *Options) (T, error)) (T, error) {
+// withProgress runs create with o, or, when ctx can be cancelled or o has
+// a progress func (OnProgress), with a private copy of o (nil = defaults)
+// that reports to it and watches ctx; ctx's error or the func's becomes the
+// Cause of the ErrCancelled error, and a panic in the func is raised again
+// here. Progress never changes a result: both paths give the same bits.
+func withProgress[T any](ctx context.Context, o *Options, create func(o *Options) (T, error)) (T, error) {
 	var zero T
-	var private *Options
-	var err error
-	if o == nil {
-		private, err = NewOptions()
-	} else {
-		private, err = o.Clone()
+	var fn ProgressFunc
+	if o != nil {
+		fn = o.progress
 	}
+	if ctx == nil {
+		return zero, invalidArg("nil context (pass context.Background())")
+	}
+	if ctx.Done() == nil && fn == nil { // nothing can cancel, nobody listens
+		return create(o)
+	}
+	private, err := o.copyOrDefaults()
 	if err != nil {
 		return zero, err
 	}
@@ -124,12 +129,12 @@ func (s *progressState) finish(err error) error {
 	return err
 }
 
-// withMapProgress runs f on m's handle with the progress callback of m set to report to
-// fn and watch ctx (sogmm_map_set_progress) and removed again afterwards;
-// errors and panics as withProgress. The caller must have exclusive use of
-// m, as for any insert.
-func withMapProgress(mp *mapProgress, m *Map, f func(p *C.sogmm_map) C.sogmm_status) error {
-	state := &progressState{ctx: mp.ctx, fn: mp.fn}
+// withMapProgress runs f on m's handle with the progress callback of m set
+// to report to m's progress func and watch ctx (sogmm_map_set_progress), and
+// removed again afterwards; errors and panics as withProgress. The caller
+// must have exclusive use of m, as for any insert.
+func withMapProgress(ctx context.Context, m *Map, f func(p *C.sogmm_map) C.sogmm_status) error {
+	state := &progressState{ctx: ctx, fn: m.progress}
 	h := cgo.NewHandle(state)
 	defer h.Delete()
 	if err := m.do(func(p *C.sogmm_map) C.sogmm_status {
@@ -141,40 +146,4 @@ func withMapProgress(mp *mapProgress, m *Map, f func(p *C.sogmm_map) C.sogmm_sta
 	// open map that this call holds alone (Map.change).
 	defer m.do(func(p *C.sogmm_map) C.sogmm_status { return C.sogmm_map_set_progress(p, nil, nil) })
 	return state.finish(m.do(f))
-}
-
-// mapProgress is the context and progress func of a map insert or flush.
-type mapProgress struct {
-	ctx context.Context
-	fn  ProgressFunc
-}
-
-// FitContext is Fit with cancellation: it stops within about 50 ms once ctx
-// is done (the error then satisfies errors.Is(err, ErrCancelled) and
-// errors.Is(err, ctx.Err())) and reports progress to fn (may be nil).
-func FitContext(ctx context.Context, points []float32, o *Options, fn ProgressFunc) (*Model, error) {
-	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return Fit(points, p) })
-}
-
-// ScoreSamplesContext is ScoreSamplesWith (the Threads and
-// QueryTruncationNats of o; nil = exact, all cores) with cancellation and
-// progress (StageScoring) as FitContext; the same values.
-func (m *Model) ScoreSamplesContext(ctx context.Context, points []float32, dims int, o *Options, fn ProgressFunc) ([]float64, error) {
-	return withProgress(ctx, o, fn, func(p *Options) ([]float64, error) { return m.scoreSamples(points, dims, p) })
-}
-
-// RegressGrayContext is RegressGrayWith (options as ScoreSamplesContext)
-// with cancellation and progress (StageRegression) as FitContext; the same
-// values.
-func (m *Model) RegressGrayContext(ctx context.Context, xyz []float32, o *Options, fn ProgressFunc) (mean, variance []float32, err error) {
-	both, err := withProgress(ctx, o, fn, func(p *Options) ([2][]float32, error) {
-		mean, variance, err := m.regressGray(xyz, p)
-		return [2][]float32{mean, variance}, err
-	})
-	return both[0], both[1], err
-}
-
-// FitRGBDContext is FitRGBD with cancellation and progress as FitContext.
-func FitRGBDContext(ctx context.Context, f Frame, o *Options, fn ProgressFunc) (*Model, error) {
-	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return FitRGBD(f, p) })
 }

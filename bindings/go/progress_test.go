@@ -32,15 +32,15 @@ func emOptions(t *testing.T) *Options {
 func TestProgressReportsEMInOrderAndChangesNothing(t *testing.T) {
 	pts := cube(3000)
 	var seen []Progress
-	m, err := FitContext(context.Background(), pts, emOptions(t), func(p Progress) error {
+	m, err := Fit(context.Background(), pts, reporting(emOptions(t), func(p Progress) error {
 		seen = append(seen, p)
 		return nil
-	})
+	}))
 	if err != nil {
 		t.Fatal(err)
 	}
 	defer m.Close()
-	plain, err := Fit(pts, emOptions(t))
+	plain, err := Fit(context.Background(), pts, emOptions(t))
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -78,12 +78,12 @@ func TestProgressReportsEMInOrderAndChangesNothing(t *testing.T) {
 
 func TestProgressErrorCancelsWithNoModel(t *testing.T) {
 	stop := errors.New("stop at EM 2")
-	m, err := FitContext(context.Background(), cube(3000), emOptions(t), func(p Progress) error {
+	m, err := Fit(context.Background(), cube(3000), reporting(emOptions(t), func(p Progress) error {
 		if p.Stage == StageEM && p.Step == 2 {
 			return stop
 		}
 		return nil
-	})
+	}))
 	if m != nil {
 		t.Fatal("a cancelled fit returned a model")
 	}
@@ -98,18 +98,18 @@ func TestProgressErrorCancelsWithNoModel(t *testing.T) {
 func TestCancelledContextStopsTheFit(t *testing.T) {
 	ctx, cancel := context.WithCancel(context.Background())
 	reports := 0
-	m, err := FitContext(ctx, cube(3000), emOptions(t), func(p Progress) error {
+	m, err := Fit(ctx, cube(3000), reporting(emOptions(t), func(p Progress) error {
 		reports++
 		if p.Stage == StageEM && p.Step == 1 {
 			cancel() // as another goroutine would; seen at the next report
 		}
 		return nil
-	})
+	}))
 	if m != nil || !errors.Is(err, ErrCancelled) || !errors.Is(err, context.Canceled) {
 		t.Fatalf("want ErrCancelled and context.Canceled, got model %v, err %v", m, err)
 	}
 	// A context done before the call: nothing runs past the first report.
-	m, err = FitContext(ctx, cube(3000), emOptions(t), nil)
+	m, err = Fit(ctx, cube(3000), emOptions(t))
 	if m != nil || !errors.Is(err, context.Canceled) {
 		t.Fatalf("done context: got %v, %v", m, err)
 	}
@@ -125,12 +125,12 @@ func TestPanicInProgressIsRaisedAfterTheCall(t *testing.T) {
 			t.Fatalf("callback called %d times after panicking", calls)
 		}
 	}()
-	_, _ = FitContext(context.Background(), cube(3000), emOptions(t), func(p Progress) error {
+	_, _ = Fit(context.Background(), cube(3000), reporting(emOptions(t), func(p Progress) error {
 		if p.Stage == StageEM {
 			calls++
 			panic("boom")
 		}
 		return nil
-	})
+	}))
 	t.Fatal("no panic")
 }

@@ -3,23 +3,16 @@ package sogmm
 // #include "sogmm/sogmm.h"
 import "C"
 
-import "unsafe"
+import (
+	"context"
+	"unsafe"
+)
 
 // Rigid registration of a point cloud to a model (issue 32; sogmm.h,
 // sogmm_register_points_f32). Options (nil = defaults): OptRegistration*,
 // Threads; progress StageRegistration.
 
 const (
-	OptRegistrationMaxIter         Key = C.SOGMM_OPT_REGISTRATION_MAX_ITER
-	OptRegistrationTol             Key = C.SOGMM_OPT_REGISTRATION_TOL
-	OptRegistrationOutlierRatio    Key = C.SOGMM_OPT_REGISTRATION_OUTLIER_RATIO
-	OptRegistrationUseGray         Key = C.SOGMM_OPT_REGISTRATION_USE_GRAY
-	OptRegistrationLevels          Key = C.SOGMM_OPT_REGISTRATION_LEVELS
-	OptRegistrationCoarseSigma     Key = C.SOGMM_OPT_REGISTRATION_COARSE_SIGMA
-	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
-	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
-	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
-
 	RegistrationConverged    = C.SOGMM_REGISTRATION_CONVERGED     // the pose is an estimate
 	RegistrationNotConverged = C.SOGMM_REGISTRATION_NOT_CONVERGED // iterations ran out, or no point near the target
 	RegistrationLowFitness   = C.SOGMM_REGISTRATION_LOW_FITNESS   // too few points explained by the target
@@ -41,29 +34,42 @@ type Registration struct {
 
 // RegisterPoints gives the rigid pose that best explains points (rows of x,
 // y, z, gray in their own frame) under the model, from init (nil = identity).
-func (m *Model) RegisterPoints(points []float32, init *[16]float64, o *Options) (*Registration, error) {
+// ctx and the progress func of o (StageRegistration) as Fit.
+func (m *Model) RegisterPoints(ctx context.Context, points []float32, init *[16]float64, o *Options) (*Registration, error) {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return nil, err
 	}
 	var pose [16]float64
-	info := C.sogmm_registration_info{struct_size: C.size_t(unsafe.Sizeof(C.sogmm_registration_info{}))}
+	info := newRegistrationInfo()
 	var initPtr *C.double
 	if init != nil {
 		initPtr = (*C.double)(unsafe.Pointer(&init[0]))
 	}
-	err = m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
-			(*C.double)(unsafe.Pointer(&pose[0])), &info)
+	_, err = withProgress(ctx, o, func(o *Options) (struct{}, error) {
+		return struct{}{}, m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
+				(*C.double)(unsafe.Pointer(&pose[0])), &info)
+		})
 	})
 	if err != nil {
 		return nil, err
 	}
+	return registrationOf(pose, &info), nil
+}
+
+// newRegistrationInfo is a sogmm_registration_info sized for this binding.
+func newRegistrationInfo() C.sogmm_registration_info {
+	return C.sogmm_registration_info{struct_size: C.size_t(unsafe.Sizeof(C.sogmm_registration_info{}))}
+}
+
+// registrationOf is what a call wrote into info, with its pose.
+func registrationOf(pose [16]float64, info *C.sogmm_registration_info) *Registration {
 	r := &Registration{Pose: pose, Status: int(info.status), Iterations: int(info.iterations),
 		LogLikelihood: float64(info.log_likelihood), InlierRatio: float64(info.inlier_ratio), RMSE: float64(info.rmse),
 		Unobservable: int(info.unobservable), EigenRatio: float64(info.eigen_ratio)}
 	for i := range r.Information {
 		r.Information[i] = float64(info.information[i])
 	}
-	return r, nil
+	return r
 }

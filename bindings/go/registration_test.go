@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"math"
 	"testing"
@@ -30,7 +31,7 @@ func TestRegisterPointsRecoversATranslation(t *testing.T) {
 	}
 	defer model.Close()
 	shift := []float32{0.02, -0.01, 0.03}
-	pts, err := model.Sample(3000, 1, 4, nil)
+	pts, err := model.Sample(context.Background(), 3000, 1, 4, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -39,7 +40,7 @@ func TestRegisterPointsRecoversATranslation(t *testing.T) {
 			pts[i+k] -= shift[k]
 		}
 	}
-	r, err := model.RegisterPoints(pts, nil, nil)
+	r, err := model.RegisterPoints(context.Background(), pts, nil, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -53,7 +54,7 @@ func TestRegisterPointsRecoversATranslation(t *testing.T) {
 		}
 	}
 	nan := [16]float64{1, 0, 0, math.NaN(), 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}
-	if _, err := model.RegisterPoints(pts, &nan, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := model.RegisterPoints(context.Background(), pts, &nan, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("NaN init: %v", err)
 	}
 }

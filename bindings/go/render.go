@@ -3,10 +3,7 @@ package sogmm
 // #include "sogmm/sogmm.h"
 import "C"
 
-import (
-	"context"
-	"fmt"
-)
+import "fmt"
 
 // Camera holds the pinhole intrinsics of a rendered image: pixel (u, v)
 // looks along ((u - Cx) / Fx, (v - Cy) / Fy, 1) in the camera's frame.
@@ -48,41 +45,4 @@ func posePtr(pose *[16]float64) *C.double {
 		return nil
 	}
 	return (*C.double)(&pose[0])
-}
-
-// Render is what the model shows from cam at pose (camera-to-world; nil =
-// identity, the model in the camera's frame): per pixel the first surface
-// along its ray, its depth, the gray regressed there and its variance. o
-// (may be nil) gives DepthMin / DepthMax (the depths that count as surfaces)
-// and Threads (the same bits for any count).
-func (m *Model) Render(cam Camera, pose *[16]float64, o *Options) (*Rendered, error) {
-	return renderInto(cam, func(depth, gray, variance *C.float) error {
-		return m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-			return C.sogmm_model_render_f32(p, C.uint32_t(cam.Width), C.uint32_t(cam.Height), C.double(cam.Fx),
-				C.double(cam.Fy), C.double(cam.Cx), C.double(cam.Cy), posePtr(pose), op, depth, gray, variance)
-		})
-	})
-}
-
-// RenderContext is Render with cancellation and progress (StageRendering:
-// rows done) as FitContext.
-func (m *Model) RenderContext(ctx context.Context, cam Camera, pose *[16]float64, o *Options, fn ProgressFunc) (*Rendered, error) {
-	return withProgress(ctx, o, fn, func(p *Options) (*Rendered, error) { return m.Render(cam, pose, p) })
-}
-
-// Render is the map seen from cam at the camera-to-world pose: the same bits
-// as m.Export(nil) rendered (see Model.Render). A map without components
-// gives ErrInvalidData.
-func (m *Map) Render(cam Camera, pose *[16]float64, o *Options) (*Rendered, error) {
-	return renderInto(cam, func(depth, gray, variance *C.float) error {
-		return m.doWith(o, func(p *C.sogmm_map, op *C.sogmm_options) C.sogmm_status {
-			return C.sogmm_map_render_f32(p, C.uint32_t(cam.Width), C.uint32_t(cam.Height), C.double(cam.Fx),
-				C.double(cam.Fy), C.double(cam.Cx), C.double(cam.Cy), posePtr(pose), op, depth, gray, variance)
-		})
-	})
-}
-
-// RenderContext is Render with cancellation and progress as Model.RenderContext.
-func (m *Map) RenderContext(ctx context.Context, cam Camera, pose *[16]float64, o *Options, fn ProgressFunc) (*Rendered, error) {
-	return withProgress(ctx, o, fn, func(p *Options) (*Rendered, error) { return m.Render(cam, pose, p) })
 }

@@ -28,7 +28,7 @@ func onAxis(t *testing.T) *Model {
 func TestRenderSingleComponentClosedForm(t *testing.T) {
 	m := onAxis(t)
 	defer m.Close()
-	r, err := m.Render(renderCam, nil, nil)
+	r, err := m.Render(context.Background(), renderCam, nil, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -50,7 +50,7 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer moved.Close()
-	b, err := moved.Render(renderCam, &pose, nil)
+	b, err := moved.Render(context.Background(), renderCam, &pose, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -65,13 +65,13 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 	}
 	// Bad input.
 	scaled := [16]float64{2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}
-	if _, err := m.Render(renderCam, &scaled, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := m.Render(context.Background(), renderCam, &scaled, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("scaled pose: %v", err)
 	}
-	if _, err := m.Render(Camera{Width: 0, Height: 7, Fx: 10, Fy: 10}, nil, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := m.Render(context.Background(), Camera{Width: 0, Height: 7, Fx: 10, Fy: 10}, nil, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("width 0: %v", err)
 	}
-	if _, err := m.Render(Camera{Width: 20000, Height: 20000, Fx: 1, Fy: 1}, nil, nil); !errors.Is(err, ErrLimit) {
+	if _, err := m.Render(context.Background(), Camera{Width: 20000, Height: 20000, Fx: 1, Fy: 1}, nil, nil); !errors.Is(err, ErrLimit) {
 		t.Fatalf("2^28 pixels: %v", err)
 	}
 	o, err := NewOptions(DepthRange(0.1, 1.4))
@@ -79,7 +79,7 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer o.Close()
-	near, err := m.Render(renderCam, nil, o)
+	near, err := m.Render(context.Background(), renderCam, nil, o)
 	if err != nil || !math.IsNaN(float64(near.Depth[renderCentre])) {
 		t.Fatalf("depth max 1.4: %v (err %v)", near.Depth[renderCentre], err)
 	}
@@ -89,12 +89,12 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 func TestMapRenderEqualsTheExport(t *testing.T) {
 	m, model := twoFrameMapAndExport(t)
 	cam := Camera{Width: 40, Height: 30, Fx: 30, Fy: 30, Cx: 19.5, Cy: 14.5}
-	a, err := m.Render(cam, nil, nil)
+	a, err := m.Render(context.Background(), cam, nil, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
 	var last Progress
-	b, err := model.RenderContext(context.Background(), cam, nil, nil, func(p Progress) error { last = p; return nil })
+	b, err := model.Render(context.Background(), cam, nil, reporting(nil, func(p Progress) error { last = p; return nil }))
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -119,7 +119,7 @@ func TestMapRenderEqualsTheExport(t *testing.T) {
 	}
 	ctx, cancel := context.WithCancel(context.Background())
 	cancel()
-	if _, err := m.RenderContext(ctx, cam, nil, nil, nil); !errors.Is(err, ErrCancelled) {
+	if _, err := m.Render(ctx, cam, nil, nil); !errors.Is(err, ErrCancelled) {
 		t.Fatalf("cancelled render: %v", err)
 	}
 	empty, err := NewMap(nil)
@@ -127,7 +127,7 @@ func TestMapRenderEqualsTheExport(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer empty.Close()
-	if _, err := empty.Render(cam, nil, nil); !errors.Is(err, ErrInvalidData) {
+	if _, err := empty.Render(context.Background(), cam, nil, nil); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty map: %v", err)
 	}
 }

@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"fmt"
 	"math"
@@ -69,7 +70,7 @@ func TestRegressionAndScoreClosedForm(t *testing.T) {
 	m := oneGaussian(t)
 	// Both points are within 2.3 sigma: far out (beyond ~6.5 sigma) the answer
 	// blends towards the prior on purpose (sogmm.h, sogmm_model_regress_gray).
-	mean, v, err := m.RegressGray([]float32{1, 0, 0, -2, 0.5, 1})
+	mean, v, err := m.RegressGray(context.Background(), []float32{1, 0, 0, -2, 0.5, 1}, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -78,7 +79,7 @@ func TestRegressionAndScoreClosedForm(t *testing.T) {
 		math.Abs(float64(v[0])-0.46) > 1e-6 || math.Abs(float64(v[1])-0.46) > 1e-6 {
 		t.Fatalf("mean %v variance %v", mean, v)
 	}
-	got, err := m.ScoreSamples([]float32{0, 0, 0, 0.5}, 4)
+	got, err := m.ScoreSamples(context.Background(), []float32{0, 0, 0, 0.5}, 4, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -89,12 +90,12 @@ func TestRegressionAndScoreClosedForm(t *testing.T) {
 }
 
 func TestFixedKFit(t *testing.T) {
-	o, err := NewOptions(Seed(7), Threads(1))
+	o, err := NewOptions(Seed(7), Threads(1), NComponents(2))
 	if err != nil {
 		t.Fatal(err)
 	}
 	defer o.Close()
-	m, err := FitFixedK(twoBlobs(400), 2, o)
+	m, err := Fit(context.Background(), twoBlobs(400), o)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -112,7 +113,7 @@ func TestFixedKFit(t *testing.T) {
 }
 
 func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
-	o, err := NewOptions(Seed(1), Threads(1))
+	o, err := NewOptions(Seed(1), Threads(1), NComponents(2))
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -125,7 +126,7 @@ func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
 		for i := 0; i < len(pts); i += 4 {
 			pts[i], pts[i+1], pts[i+2] = scale*pts[i], scale*pts[i+1], scale*pts[i+2]
 		}
-		m, err := FitFixedK(pts, 2, o)
+		m, err := Fit(context.Background(), pts, o)
 		if err != nil {
 			t.Fatal(err)
 		}
@@ -163,25 +164,25 @@ func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
 func TestSeedsAreReproducible(t *testing.T) {
 	o, _ := NewOptions(Bandwidth(0.5), Seed(3), Threads(1))
 	defer o.Close()
-	a, err := Fit(twoBlobs(200), o)
+	a, err := Fit(context.Background(), twoBlobs(200), o)
 	if err != nil {
 		t.Fatal(err)
 	}
 	defer a.Close()
-	b, _ := Fit(twoBlobs(200), o)
+	b, _ := Fit(context.Background(), twoBlobs(200), o)
 	defer b.Close()
 	ma, _ := a.Means()
 	mb, _ := b.Means()
-	sa, _ := a.Sample(100, 9, 4, nil)
-	sb, _ := b.Sample(100, 9, 4, nil)
-	sc, _ := a.Sample(100, 10, 4, nil)
+	sa, _ := a.Sample(context.Background(), 100, 9, 4, nil)
+	sb, _ := b.Sample(context.Background(), 100, 9, 4, nil)
+	sc, _ := a.Sample(context.Background(), 100, 10, 4, nil)
 	if !slices.Equal(ma, mb) || !slices.Equal(sa, sb) || slices.Equal(sa, sc) {
 		t.Fatal("same seed must give the same fit and samples, another seed other samples")
 	}
 }
 
 func TestErrorsWorkWithErrorsIs(t *testing.T) {
-	_, err := Fit([]float32{float32(math.NaN()), 0, 0, 0}, nil)
+	_, err := Fit(context.Background(), []float32{float32(math.NaN()), 0, 0, 0}, nil)
 	var e *Error
 	if !errors.Is(err, ErrInvalidData) || !errors.As(err, &e) || e.Message == "" || errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("NaN fit: %v", err)
@@ -190,7 +191,7 @@ func TestErrorsWorkWithErrorsIs(t *testing.T) {
 	if !errors.Is(err, ErrInvalidArg) || !strings.Contains(strings.ToLower(err.Error()), "bandwidth") {
 		t.Fatalf("bad bandwidth: %v", err)
 	}
-	if _, err = Fit(make([]float32, 5), nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err = Fit(context.Background(), make([]float32, 5), nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("ragged points: %v", err)
 	}
 	if _, err = FromBytes([]byte("not a model"), nil); !errors.Is(err, ErrFormat) {
@@ -203,10 +204,10 @@ func TestErrorsWorkWithErrorsIs(t *testing.T) {
 		t.Fatalf("missing file: %v", err)
 	}
 	m := oneGaussian(t)
-	if _, err = m.Sample(1, 0, 5, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err = m.Sample(context.Background(), 1, 0, 5, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("dims 5: %v", err)
 	}
-	if _, err = m.Sample(math.MaxInt/2, 0, 4, nil); !errors.Is(err, ErrLimit) {
+	if _, err = m.Sample(context.Background(), math.MaxInt/2, 0, 4, nil); !errors.Is(err, ErrLimit) {
 		t.Fatalf("huge n: %v", err)
 	}
 }
@@ -302,7 +303,7 @@ func TestRGBDChecksSliceLengths(t *testing.T) {
 	f := Frame{Depth: depth, Gray8: gray, Width: w, Height: h, Fx: 30, Fy: 30, Cx: 15.5, Cy: 11.5}
 	o, _ := NewOptions(Bandwidth(0.1), Threads(1))
 	defer o.Close()
-	m, err := FitRGBD(f, o)
+	m, err := FitRGBD(context.Background(), f, o)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -312,12 +313,12 @@ func TestRGBDChecksSliceLengths(t *testing.T) {
 	}
 	short := f
 	short.Depth = depth[1:]
-	if _, err := FitRGBD(short, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := FitRGBD(context.Background(), short, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("short depth: %v", err)
 	}
 	both := f
 	both.RGB8 = gray
-	if _, err := FitRGBD(both, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := FitRGBD(context.Background(), both, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("two color images: %v", err)
 	}
 }
@@ -357,7 +358,7 @@ func TestSharedModelAcrossGoroutines(t *testing.T) {
 	m := oneGaussian(t)
 	serial := make([][]float32, 8)
 	for s := range serial {
-		serial[s], _ = m.Sample(300, uint64(s), 4, nil)
+		serial[s], _ = m.Sample(context.Background(), 300, uint64(s), 4, nil)
 	}
 	var wg sync.WaitGroup
 	errs := make(chan error, 16)
@@ -365,14 +366,14 @@ func TestSharedModelAcrossGoroutines(t *testing.T) {
 		wg.Add(2)
 		go func(s int) {
 			defer wg.Done()
-			got, err := m.Sample(300, uint64(s), 4, nil)
+			got, err := m.Sample(context.Background(), 300, uint64(s), 4, nil)
 			if err != nil || !slices.Equal(got, serial[s]) {
 				errs <- errors.New("concurrent sample differs from the serial one")
 			}
 		}(s)
 		go func() {
 			defer wg.Done()
-			bad, err := Fit([]float32{float32(math.Inf(1)), 0, 0, 0}, nil)
+			bad, err := Fit(context.Background(), []float32{float32(math.Inf(1)), 0, 0, 0}, nil)
 			if bad != nil {
 				bad.Close()
 			}
@@ -460,7 +461,7 @@ func TestTheDepthFloorIsTheDefaultForFrames(t *testing.T) {
 			t.Fatal(err)
 		}
 		defer o.Close()
-		m, err := FitRGBD(staircaseFrame(), o)
+		m, err := FitRGBD(context.Background(), staircaseFrame(), o)
 		if err != nil {
 			t.Fatal(err)
 		}

@@ -1,6 +1,7 @@
 package sogmm
 
 import (
+	"context"
 	"errors"
 	"math"
 	"testing"
@@ -15,10 +16,10 @@ func planeMap(t *testing.T) *Map {
 	for i := range f.Depth {
 		f.Depth[i], f.Gray8[i] = 2000, 128
 	}
-	if err := m.InsertRGBD(f, [16]float64{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}); err != nil {
+	if err := m.InsertRGBD(context.Background(), f, [16]float64{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}); err != nil {
 		t.Fatal(err)
 	}
-	if err := m.Flush(); err != nil {
+	if err := m.Flush(context.Background()); err != nil {
 		t.Fatal(err)
 	}
 	return m
@@ -27,7 +28,7 @@ func planeMap(t *testing.T) *Map {
 func TestPlaneOccupancyDistanceCollision(t *testing.T) {
 	m := planeMap(t)
 	defer m.Close()
-	p, s, err := m.Occupancy([]float32{0, 0, 1, 0, 0, 2, 0, 0, 3, 5, 0, 2}, nil)
+	p, s, err := m.Occupancy(context.Background(), []float32{0, 0, 1, 0, 0, 2, 0, 0, 3, 5, 0, 2}, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -37,7 +38,7 @@ func TestPlaneOccupancyDistanceCollision(t *testing.T) {
 	if !(p[0] < 1e-6 && p[1] > 0.9 && p[2] == 0.5 && p[3] == 0.5) {
 		t.Fatalf("probabilities %v", p)
 	}
-	d, g, err := m.SurfaceDistance([]float32{0.2, -0.1, 1.7, 0.2, -0.1, 2.05}, nil)
+	d, g, err := m.SurfaceDistance(context.Background(), []float32{0.2, -0.1, 1.7, 0.2, -0.1, 2.05}, nil)
 	if err != nil {
 		t.Fatal(err)
 	}
@@ -49,19 +50,19 @@ func TestPlaneOccupancyDistanceCollision(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer model.Close()
-	d2, _, err := model.SurfaceDistance([]float32{0.2, -0.1, 1.7, 0.2, -0.1, 2.05}, nil)
+	d2, _, err := model.SurfaceDistance(context.Background(), []float32{0.2, -0.1, 1.7, 0.2, -0.1, 2.05}, nil)
 	if err != nil || d2[0] != d[0] || d2[1] != d[1] {
 		t.Fatalf("model distance %v (%v), map %v", d2, err, d)
 	}
 	sphere := []float64{0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01}
-	c, err := m.CollisionProbability([]float64{0.1, 0.05, 2.0, 0.1, 0.05, 1.8}, append(sphere, sphere...), nil)
+	c, err := m.CollisionProbability(context.Background(), []float64{0.1, 0.05, 2.0, 0.1, 0.05, 1.8}, append(sphere, sphere...), nil)
 	if err != nil || c[0] < 0.99 || c[1] > 0.01 {
 		t.Fatalf("collision %v (%v)", c, err)
 	}
-	if _, err := model.CollisionProbability([]float64{0, 0, 1}, []float64{-0.01, 0, 0, 0, -0.01, 0, 0, 0, -0.01}, nil); !errors.Is(err, ErrInvalidArg) {
+	if _, err := model.CollisionProbability(context.Background(), []float64{0, 0, 1}, []float64{-0.01, 0, 0, 0, -0.01, 0, 0, 0, -0.01}, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("a negative radius: %v", err)
 	}
-	if _, _, err := m.Occupancy([]float32{0, float32(math.NaN()), 1}, nil); !errors.Is(err, ErrInvalidData) {
+	if _, _, err := m.Occupancy(context.Background(), []float32{0, float32(math.NaN()), 1}, nil); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("a NaN point: %v", err)
 	}
 }

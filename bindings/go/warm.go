@@ -15,7 +15,9 @@ import (
 // and new ones are added for the novel points; with OptNComponents = K, EM
 // runs from initial as given (K must be its size). Needs OptNInit 1; initial
 // is not changed.
-func FitWarm(points []float32, initial *Model, o *Options) (*Model, error) {
+//
+// ctx and the progress func of o as Fit.
+func FitWarm(ctx context.Context, points []float32, initial *Model, o *Options) (*Model, error) {
 	n, err := rowsOf(points, 4, "points")
 	if err != nil {
 		return nil, err
@@ -24,12 +26,9 @@ func FitWarm(points []float32, initial *Model, o *Options) (*Model, error) {
 		return nil, ErrClosed
 	}
 	defer runtime.KeepAlive(initial)
-	return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
-		return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), initial.ptr, op)
+	return withProgress(ctx, o, func(o *Options) (*Model, error) {
+		return newModel(o, func(out **C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_fit_points_f32(out, floats(points), C.size_t(n), initial.ptr, op)
+		})
 	})
-}
-
-// FitWarmContext is FitWarm with cancellation and progress as FitContext.
-func FitWarmContext(ctx context.Context, points []float32, initial *Model, o *Options, fn ProgressFunc) (*Model, error) {
-	return withProgress(ctx, o, fn, func(p *Options) (*Model, error) { return FitWarm(points, initial, p) })
 }

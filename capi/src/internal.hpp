@@ -95,6 +95,13 @@ void require_finite(const float* values, std::size_t count, const char* what);
 /// sogmm::rigid_pose_error accepts them (the one pose rule of the library).
 std::array<double, 16> require_rigid(const double* pose, const char* what);
 
+/// SOGMM_E_INVALID_ARG when info_out->struct_size is smaller than this
+/// library's sogmm_registration_info (info_out not NULL).
+void require_registration_info_size(const sogmm_registration_info* info_out);
+/// Writes `r`'s figures into the caller-sized struct (only its first
+/// struct_size bytes: later versions append fields).
+void write_registration_info(const sogmm::RegistrationResult& r, sogmm_registration_info* info_out);
+
 /// An RGB-D frame checked and back-projected as sogmm_fit_frame,
 /// sogmm_map_insert_frame and sogmm_frame_to_points_f32 take it.
 struct RgbdPoints {

@@ -11,6 +11,13 @@ sogmm_status unavailable() {
 
 extern "C" {
 
+SOGMM_API sogmm_status sogmm_map_export_delta(const sogmm_map*, uint64_t, const sogmm_options*, void*, size_t,
+                                              size_t*) {
+  return unavailable();
+}
+SOGMM_API sogmm_status sogmm_map_apply_delta(sogmm_map*, const void*, size_t, const sogmm_options*) {
+  return unavailable();
+}
 SOGMM_API sogmm_status sogmm_model_save(const sogmm_model*, const char*, const sogmm_options*) {
   return unavailable();
 }

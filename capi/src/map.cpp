@@ -1,4 +1,5 @@
 // sogmm_map_*: the incremental world map (sogmm::Map) behind a handle.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -92,6 +93,27 @@ SOGMM_API sogmm_status sogmm_map_discard_pending(sogmm_map* map, uint64_t* dropp
   SOGMM_CATCH
 }
 
+SOGMM_API sogmm_status sogmm_map_get_origin(const sogmm_map* map, double* origin_out) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapReader use(map, "sogmm_map_get_origin");
+    require_nonnull(origin_out, "origin_out");
+    const sogmm::Origin& o = map->map.origin();
+    std::copy(o.begin(), o.end(), origin_out);
+  }
+  SOGMM_CATCH
+}
+
+SOGMM_API sogmm_status sogmm_map_set_origin(sogmm_map* map, const double* origin) {
+  SOGMM_TRY {
+    require_nonnull(map, "map");
+    const sogmm_capi::MapWriter use(map, "sogmm_map_set_origin");
+    require_nonnull(origin, "origin");
+    map->map.set_origin({origin[0], origin[1], origin[2]});
+  }
+  SOGMM_CATCH
+}
+
 SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn fn, void* user_data) {
   SOGMM_TRY {
     require_nonnull(map, "map");
@@ -116,6 +138,7 @@ SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, in
       case SOGMM_MAP_N_FLUSHES: *out = count(s.n_flushes); break;
       case SOGMM_MAP_N_FUSED: *out = count(s.n_fused); break;
       case SOGMM_MAP_N_REFITS: *out = count(s.n_refits); break;
+      case SOGMM_MAP_REVISION: *out = count(map->map.revision()); break;
       default: fail(SOGMM_E_INTERNAL, "map key table out of sync");
     }
   }

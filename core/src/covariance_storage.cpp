@@ -171,7 +171,12 @@ double store_covariance(const double* cov, float* out, int* factorisations_out) 
     }
   } report{factorisations, factorisations_out};
   Mat4 s = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(cov);
-  s = 0.5 * (s + s.transpose());
+  // The symmetric part into a new matrix: assigned to `s` itself, Eigen
+  // evaluates it in place, column by column, and reads entries above the
+  // diagonal after it overwrote their mirrors (s(0,1) became 0.75 s01 +
+  // 0.25 s10). No bit changes for a symmetric input (every caller's today:
+  // (a + a) / 2 is exact), only for an asymmetric one.
+  s = (0.5 * (s + s.transpose())).eval();
   require(s.allFinite(), ErrorCode::Numeric, "EM: a covariance to store is not finite");
   // float32 storage: an entry beyond its range has no float32 value (and the
   // conversion would be undefined), so such a component cannot be stored.

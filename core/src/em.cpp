@@ -11,8 +11,10 @@
 #include <Eigen/Core>
 
 #include "covariance_storage.hpp"
+#include "em_acceleration.hpp"
 #include "em_kernel.hpp"
 #include "em_truncation.hpp"
+#include "em_working.hpp"
 #include "sogmm/options.hpp"
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
@@ -44,6 +46,7 @@ void check_options(const EmOptions& o) {
   require_option(OptionKey::MAX_ITER, std::int64_t{o.max_iter}, "EM max_iter");
   require_option(OptionKey::THREADS, std::int64_t{o.threads}, "EM threads");
   require_option(OptionKey::TRUNCATION_NATS, o.truncation_nats, "EM truncation_nats");
+  require_option(OptionKey::EM_ACCELERATION, static_cast<std::int64_t>(o.acceleration), "EM acceleration");
 }
 
 // The frame the fit works in: the midpoint of the data's bounding box per
@@ -144,17 +147,7 @@ struct SoaPoints {
   }
 };
 
-// The fit's working model, in double and relative to the frame's origin:
-// float32 means would round every update to the float grid at the data's
-// offset (1 mm at 10 km), and float32 covariances cannot hold a thin
-// component of a large scene. float32 is only the kernels' and the storage's
-// type.
-struct Working {
-  std::vector<double> mean;        // M x 4, relative to Frame::origin
-  std::vector<double> covariance;  // M x 16, row-major
-  std::vector<double> log_weight;  // M
-  std::size_t size() const { return log_weight.size(); }
-};
+using detail::Working;
 
 // Whether float32 arithmetic would lose component k's thin directions. The
 // kernels compute y_j = sum_i U_ij d_i with d about the size of the
@@ -334,13 +327,16 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
 
   EmReport rep;
   double pairs_evaluated = 0.0;
-  double previous = -std::numeric_limits<double>::infinity();
-  // The first model's kernel parameters; each iteration packs the next.
+  // The first model's kernel parameters; each pass packs the next.
   double shift = pack_all(w, reg, data_scale2, params, exact);  // of the log-densities in params
   double next_shift = 0.0;
   std::vector<float> next_params;
   std::vector<double> next_exact;
-  for (int iter = 1; iter <= options.max_iter; ++iter) {
+  int passes = 0;
+  // One E+M pass (detail::EmPass): the E-step of the packed model, the M-step
+  // into `cur`, which is packed for the next pass.
+  const detail::EmPass pass = [&](Working& cur) {
+    ++passes;
     if (truncated) bounds.load(params);
     double mean_ll = 0.0, iteration_pairs = 0.0;
     bool promoted = false;
@@ -393,7 +389,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       }
       mean_ll = total_ll / static_cast<double>(n) + shift;
       require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
-                                                              std::to_string(iter));
+                                                              std::to_string(passes));
 
       // M-step.
       double weight_sum = 0.0;
@@ -401,15 +397,15 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         const float* packed = &params[k * kParamStride];
         double centre[4];
         for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
-        nk[k] = m_step_component(&stats[k * kStatStride], reg, centre, &w.mean[4 * k], &w.covariance[16 * k]);
+        nk[k] = m_step_component(&stats[k * kStatStride], reg, centre, &cur.mean[4 * k], &cur.covariance[16 * k]);
         if (!options.quantisation.empty()) {
           double mean[4];
-          for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + w.mean[4 * k + i];
-          options.quantisation.floor_covariance_at(mean, &w.covariance[16 * k]);
+          for (int i = 0; i < 4; ++i) mean[i] = frame.origin[i] + cur.mean[4 * k + i];
+          options.quantisation.floor_covariance_at(mean, &cur.covariance[16 * k]);
         }
         weight_sum += nk[k];
       }
-      for (std::size_t k = 0; k < m; ++k) w.log_weight[k] = std::log(nk[k] / weight_sum);
+      for (std::size_t k = 0; k < m; ++k) cur.log_weight[k] = std::log(nk[k] / weight_sum);
 
       // The next model's parameters. A component evaluated in float32 whose
       // new covariance is too elongated for float32 (needs_double) got
@@ -419,7 +415,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       // components evaluated in double (e.g. the first step of a large
       // scene, from point-sized seeds; never on the shared room-sized
       // frames, whose components stay below a third of the threshold).
-      next_shift = pack_all(w, reg, data_scale2, next_params, next_exact);
+      next_shift = pack_all(cur, reg, data_scale2, next_params, next_exact);
       promoted = false;
       for (std::size_t k = 0; k < m; ++k)
         if (params[k * kParamStride + 15] == 0.0f && next_params[k * kParamStride + 15] != 0.0f) {
@@ -432,15 +428,40 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
     params.swap(next_params);
     exact.swap(next_exact);
     shift = next_shift;
+    return mean_ll;
+  };
 
-    rep.iterations = iter;
-    rep.log_likelihood = mean_ll;
-    if (on_iteration) on_iteration(iter, mean_ll);
-    if (std::fabs(mean_ll - previous) < options.tol) {
-      rep.converged = true;
-      break;
+  if (options.acceleration == EmAcceleration::Squarem) {
+    // Makes a model current (detail::EmLoad): only when every component
+    // packs as it is, so pack_all then changes nothing in it, and an
+    // extrapolated one only when it keeps its reg_covar floors.
+    std::vector<float> one(kParamStride);
+    std::vector<double> one_exact(kParamStride);
+    const detail::EmLoad load = [&](Working& cur, bool extrapolated) {
+      for (std::size_t k = 0; k < m; ++k) {
+        if (!pack_component(cur, k, one.data(), one_exact.data())) return false;
+        if (!extrapolated) continue;
+        Eigen::Matrix4d above = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&cur.covariance[16 * k]);
+        for (int i = 0; i < 4; ++i) above(i, i) -= reg[i];
+        if (Eigen::LLT<Eigen::Matrix4d>(above).info() != Eigen::Success) return false;
+      }
+      shift = pack_all(cur, reg, data_scale2, params, exact);
+      return true;
+    };
+    detail::run_squarem(w, options, pass, load, rep, on_iteration);
+  } else {
+    double previous = -std::numeric_limits<double>::infinity();
+    for (int iter = 1; iter <= options.max_iter; ++iter) {
+      const double mean_ll = pass(w);
+      rep.iterations = iter;
+      rep.log_likelihood = mean_ll;
+      if (on_iteration) on_iteration(iter, mean_ll);
+      if (std::fabs(mean_ll - previous) < options.tol) {
+        rep.converged = true;
+        break;
+      }
+      previous = mean_ll;
     }
-    previous = mean_ll;
   }
   rep.kernel = kernels.isa;
   rep.reg_covar = floors;

@@ -31,8 +31,9 @@ void require_rigid(const Pose& pose) {
   require(problem.empty(), ErrorCode::InvalidArgument, "map: the camera-to-world pose is not a rigid transform: " + problem);
 }
 
-// x, y, z of each point moved by `pose`, in double.
-std::vector<double> to_world(const PointsView& points, const Pose& pose) {
+// x, y, z of each point moved by `pose` (to the world or the anchored frame),
+// in double.
+std::vector<double> moved_points(const PointsView& points, const Pose& pose) {
   std::vector<double> out(3 * points.size);
   for (std::size_t i = 0; i < points.size; ++i) {
     const float* p = points[i];
@@ -51,9 +52,10 @@ bool same_camera(const Camera& a, const Camera& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy;
 }
 
-// A fit made in the camera frame of `pose` with `bandwidth` as a world-frame
-// model with its fit record (record_fit, as every front end writes it).
-Model world_model(const Map::State& s, const FitResult& r, const Pose& pose, double bandwidth, bool from_rgbd) {
+// A fit made in the camera frame of `pose` (camera to the map's anchored
+// frame) with `bandwidth` as a model of the map's frame with its fit record
+// (record_fit, as every front end writes it).
+Model batch_model(const Map::State& s, const FitResult& r, const Pose& pose, double bandwidth, bool from_rgbd) {
   Model batch;
   batch.gmm = transform(r.gmm, pose);
   FitOptions fo = s.options.fit;
@@ -77,19 +79,28 @@ struct Searchable {
   Model model;
   ComponentIndex index;
   std::vector<detail::Marginal3> marginals;
+  Gmm batch;    // the refit's fit, as merged (what a delta carries)
+  Model world;  // State::world of `model`
 };
+
+// State::world for `model` (empty when the origin is 0).
+Model world_of(const Map::State& s, const Model& model) {
+  return detail::is_zero(s.origin) ? Model{} : detail::world_frame(model, s.origin);
+}
 
 // The map after a revisit refit, built without touching the map: the seen
 // components dropped, the refit's merged in, index and marginals rebuilt.
 Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, const Pose& pose, bool from_rgbd) {
-  Model batch = world_model(s, plan.fit, pose, plan.bandwidth, from_rgbd);
+  Model batch = batch_model(s, plan.fit, pose, plan.bandwidth, from_rgbd);
   Model kept = s.model;
   kept.gmm = detail::without_components(s.model.gmm, plan.replaced);
+  Gmm batch_gmm = batch.gmm;
   Searchable out{kept.gmm.size() == 0 ? std::move(batch) : merge(kept, batch), ComponentIndex(s.options.index_sigmas),
-                 {}};
+                 {}, std::move(batch_gmm), {}};
   out.marginals.reserve(out.model.gmm.size());
   for (std::size_t k = 0; k < out.model.gmm.size(); ++k) out.marginals.push_back(detail::marginal3(out.model.gmm, k));
   out.index.build(out.model.gmm);
+  out.world = world_of(s, out.model);
   return out;
 }
 
@@ -147,11 +158,26 @@ MapStats Map::stats() const {
 
 const Model& Map::model() const {
   require(size() > 0, ErrorCode::InvalidData, "map: the map has no component yet (insert and flush a frame first)");
-  return s_->model;
+  return detail::is_zero(s_->origin) ? s_->model : s_->world;
+}
+
+const Origin& Map::origin() const { return s_->origin; }
+
+void Map::set_origin(const Origin& origin) {
+  State& s = *s_;
+  require(s.frames.empty() && s.model.gmm.size() == 0, ErrorCode::InvalidArgument,
+          "map: the origin is set before the first insert (this map has " + std::to_string(s.frames.size()) +
+              " frames and " + std::to_string(s.model.gmm.size()) + " components)");
+  detail::require_origin(origin);
+  s.origin = origin;
+  s.origin_fixed = true;
 }
 
 void Map::local_log_likelihood(const double* xyz, std::size_t n, double* out) const {
-  detail::local_log_likelihood(s_->index, s_->marginals, s_->options.fit.em.threads, xyz, n, out);
+  const Origin& o = s_->origin;
+  std::vector<double> anchored(xyz, xyz + 3 * n);
+  for (std::size_t i = 0; i < 3 * n; ++i) anchored[i] -= o[i % 3];
+  detail::local_log_likelihood(s_->index, s_->marginals, s_->options.fit.em.threads, anchored.data(), n, out);
 }
 
 namespace {
@@ -165,12 +191,40 @@ void check_frame(const PointsView& points) {
   require_finite_points(points, "map frame");
 }
 
-FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const Pose& pose, bool from_rgbd,
+// The first frame fixes the map's origin (Map::origin); an insert that fails
+// leaves it unfixed again.
+class OriginGuard {
+ public:
+  OriginGuard(Map::State& s, const Pose& pose) : s_(s), fixes_(!s.origin_fixed) {
+    if (!fixes_) return;
+    s.origin = detail::default_origin(pose);
+    s.origin_fixed = true;
+  }
+  ~OriginGuard() {
+    if (!fixes_ || committed_) return;
+    s_.origin = Origin{};
+    s_.origin_fixed = false;
+  }
+  void commit() { committed_ = true; }
+  OriginGuard(const OriginGuard&) = delete;
+  OriginGuard& operator=(const OriginGuard&) = delete;
+
+ private:
+  Map::State& s_;
+  bool fixes_, committed_ = false;
+};
+
+FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const Pose& world_pose, bool from_rgbd,
                         const ProgressSink& progress) {
   check_frame(points);
+  detail::JournalScope journal(s.journal, s.frames.size());
+  OriginGuard origin(s, world_pose);
+  // Everything below works in the map's anchored frame; only the frame's
+  // record keeps the world pose.
+  const Pose pose = detail::anchored(s.origin, world_pose);
   FrameStats f;
   f.index = s.frames.size();
-  f.pose = pose;
+  f.pose = world_pose;
   f.n_points = points.size;
   const auto t0 = std::chrono::steady_clock::now();
   detail::PendingFrame novel;
@@ -179,8 +233,11 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   std::vector<detail::PendingVoxel> novel_voxels;
   std::vector<double> ll;
   std::vector<std::int64_t> dominant;  // each point's dominant map component (revisit refit)
-  const std::vector<double> world = to_world(points, pose);
-  detail::require_float32_world(world, from_rgbd);
+  // The points in the anchored frame, in double. Both frames hold float32
+  // coordinates: the anchored one in the map, the world one in exports.
+  const std::vector<double> xyz = moved_points(points, pose);
+  detail::require_float32_world(xyz, from_rgbd);
+  if (!detail::is_zero(s.origin)) detail::require_float32_world(moved_points(points, world_pose), from_rgbd);
   if (!s.options.novelty) {
     novel.xyzg.assign(points.data, points.data + 4 * points.size);
   } else {
@@ -190,14 +247,14 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     ll.assign(points.size, -std::numeric_limits<double>::infinity());
     dominant.assign(points.size, -1);
     if (s.model.gmm.size() > 0)
-      detail::local_log_likelihood(s.index, s.marginals, s.options.fit.em.threads, world.data(), points.size,
+      detail::local_log_likelihood(s.index, s.marginals, s.options.fit.em.threads, xyz.data(), points.size,
                                    ll.data(), dominant.data());
     // Per point: 0 explained (or near a pending point), 1 novel.
     std::vector<std::uint8_t> state(points.size, 0);
     std::vector<detail::PendingVoxel> voxels(points.size);
     detail::parallel_for(points.size, detail::team_size(s.options.fit.em.threads), 1024, [&](std::size_t i, int) {
       if (ll[i] >= s.options.novelty_threshold) return;
-      voxels[i] = detail::pending_voxel(world.data() + 3 * i);
+      voxels[i] = detail::pending_voxel(xyz.data() + 3 * i);
       if (!detail::near_pending(s.pending_voxels, voxels[i])) state[i] = 1;
     });
     for (std::size_t i = 0; i < points.size; ++i) {
@@ -224,10 +281,14 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       f.ms_fit += ms_since(t1);
       const auto t2 = std::chrono::steady_clock::now();
       Searchable next = after_refit(s, *plan, pose, from_rgbd);
-      before_refit = Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals)};
+      s.journal.remove(plan->replaced);
+      s.journal.merge(next.batch);
+      before_refit =
+          Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals), {}, std::move(s.world)};
       s.model = std::move(next.model);
       s.index = std::move(next.index);
       s.marginals = std::move(next.marginals);
+      s.world = std::move(next.world);
       ++s.n_flushes;
       ++s.n_refits;
       ++s.revision;
@@ -242,6 +303,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     s.model = std::move(before_refit->model);
     s.index = std::move(before_refit->index);
     s.marginals = std::move(before_refit->marginals);
+    s.world = std::move(before_refit->world);
     --s.n_flushes;
     --s.n_refits;
     ++s.revision;  // the components changed back: never reuse what the refit's were
@@ -275,6 +337,8 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     throw;
   }
   s.frames.back().n_components = s.model.gmm.size();
+  journal.commit(s.frames.size());
+  origin.commit();
   return s.frames.back();
 }
 
@@ -335,6 +399,7 @@ std::size_t Map::discard_pending() {
 std::size_t Map::flush(const ProgressSink& progress) {
   State& s = *s_;
   if (s.n_pending == 0) return 0;
+  detail::JournalScope journal(s.journal, s.frames.size());
   const auto t0 = std::chrono::steady_clock::now();
   // The batch is fitted in the camera frame of its latest frame: a batch of
   // one frame is then fitted exactly on that frame's points, as `sogmm fit
@@ -357,11 +422,17 @@ std::size_t Map::flush(const ProgressSink& progress) {
   const double ms_fit = ms_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
 
-  Model batch = world_model(s, r, last, batch_options.bandwidth, from_rgbd);
+  Model batch = batch_model(s, r, last, batch_options.bandwidth, from_rgbd);
   const std::size_t first = s.model.gmm.size();
+  s.journal.merge(batch.gmm);
   Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);
   std::vector<std::size_t> changed;
-  if (s.options.fusion && first > 0) changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
+  if (s.options.fusion && first > 0) {
+    const Gmm appended = detail::tail(merged.gmm, first);
+    changed = detail::fuse_new_components(merged.gmm, first, s.index, s.options);
+    s.journal.set(merged.gmm, changed);
+    s.journal.drop(detail::dropped_positions(appended, merged.gmm, first));
+  }
   const std::size_t added = merged.gmm.size() - first;
   const std::size_t fused = r.gmm.size() - added;
   // The marginals and index of the merged map, built on copies before
@@ -375,11 +446,13 @@ std::size_t Map::flush(const ProgressSink& progress) {
   }
   for (std::size_t k = first; k < merged.gmm.size(); ++k) marginals.push_back(detail::marginal3(merged.gmm, k));
   index.add(merged.gmm, first);
+  Model world = world_of(s, merged);
 
   // Commit.
   s.model = std::move(merged);
   s.marginals = std::move(marginals);
   s.index = std::move(index);
+  s.world = std::move(world);
   s.pending.clear();
   s.n_pending = 0;
   s.pending_voxels.clear();
@@ -397,6 +470,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
     f.ms_merge += ms_since(t1);
     f.n_components = s.model.gmm.size();
   }
+  journal.commit(s.frames.size());
   return added;
 }
 
@@ -408,7 +482,12 @@ Model Map::extract(const Box3& box) const {
                 checked::exact(box.hi[i]) + "], not finite with min <= max");
   const Model& all = model();
   std::vector<std::uint32_t> ids;
-  s_->index.query_box(box, ids);
+  Box3 anchored = box;  // the index is in the anchored frame
+  for (int i = 0; i < 3; ++i) {
+    anchored.lo[i] -= s_->origin[i];
+    anchored.hi[i] -= s_->origin[i];
+  }
+  s_->index.query_box(anchored, ids);
   require(!ids.empty(), ErrorCode::InvalidData, "map: no component meets the box");
   Model out;
   out.fit = all.fit;

@@ -13,15 +13,16 @@
 #include "sogmm/inference.hpp"
 
 namespace sogmm {
-namespace {
+namespace detail {
 
 // One line per frame: index, points, novel points, then the 12 entries of the
 // pose's first three rows (the last row of a rigid pose is 0 0 0 1), each at
 // round-trip precision, then the map's components after the frame.
-std::string frames_text(const std::vector<FrameStats>& frames) {
+std::string frames_text(const std::vector<FrameStats>& frames, std::size_t first) {
   std::string text;
   char buf[64];
-  for (const FrameStats& f : frames) {
+  for (std::size_t k = first; k < frames.size(); ++k) {
+    const FrameStats& f = frames[k];
     std::snprintf(buf, sizeof buf, "%" PRIu64 " %zu %zu", f.index, f.n_points, f.n_novel);
     text += buf;
     for (int i = 0; i < 12; ++i) text += " " + checked::exact(f.pose[i]);
@@ -29,6 +30,10 @@ std::string frames_text(const std::vector<FrameStats>& frames) {
   }
   return text;
 }
+
+}  // namespace detail
+
+namespace {
 
 std::string options_text(const MapOptions& o) {
   return "novelty=" + std::to_string(o.novelty ? 1 : 0) + " novelty_threshold=" + checked::exact(o.novelty_threshold) +
@@ -50,7 +55,11 @@ bool read_count(std::istream& in, T& out) {
   return static_cast<bool>(digits >> out) && digits.eof();
 }
 
-std::vector<FrameStats> parse_frames(const std::string& text) {
+}  // namespace
+
+namespace detail {
+
+std::vector<FrameStats> parse_frames(const std::string& text, std::uint64_t first_index, const char* key) {
   std::vector<FrameStats> frames;
   std::istringstream in(text);
   std::string line;
@@ -58,7 +67,7 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
   while (std::getline(in, line)) {
     ++line_no;
     auto bad = [&](const std::string& why) {
-      return Error(ErrorCode::Format, std::string("map: key ") + kMapFramesKey + ", line " + std::to_string(line_no) +
+      return Error(ErrorCode::Format, std::string("map: key ") + key + ", line " + std::to_string(line_no) +
                                           ": " + why);
     };
     std::istringstream row(line);
@@ -66,7 +75,8 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
     std::size_t n_points = 0, n_novel = 0;
     if (!(read_count(row, index) && read_count(row, n_points) && read_count(row, n_novel)))
       throw bad("expected 'index points novel' (unsigned integers) and 12 pose entries");
-    if (index != frames.size()) throw bad("frame index " + std::to_string(index) + ", expected " + std::to_string(frames.size()));
+    if (index != first_index + frames.size())
+      throw bad("frame index " + std::to_string(index) + ", expected " + std::to_string(first_index + frames.size()));
     if (n_novel > n_points) throw bad("more novel points than points");
     FrameStats f;
     f.index = index;
@@ -90,6 +100,10 @@ std::vector<FrameStats> parse_frames(const std::string& text) {
   }
   return frames;
 }
+
+}  // namespace detail
+
+namespace {
 
 // With options.warm_start, the loaded map's first flush warm-starts like any
 // later one: from the last flush's fit in its camera. That fit is the block of
@@ -121,7 +135,7 @@ void restore_warm_start(Map::State& s) {
     std::copy_n(s.model.gmm.covariance(k), 16, block.covariances.data() + 16 * (k - before));
   }
   block.support_size = std::max<std::uint64_t>(1, f[camera].n_novel);
-  s.previous_pose = f[camera].pose;
+  s.previous_pose = detail::anchored(s.origin, f[camera].pose);
   s.previous_fit = transform(block, inverse_rigid(s.previous_pose));
 }
 
@@ -130,11 +144,21 @@ void restore_warm_start(Map::State& s) {
 Model Map::to_model() const {
   require(s_->n_pending == 0, ErrorCode::InvalidArgument,
           "map: " + std::to_string(s_->n_pending) + " points are pending; flush first (a map file holds components only)");
-  Model m = model();
+  (void)model();  // Error(InvalidData) for an empty map
+  // The components as the map holds them, with the origin as their pose
+  // (spec/format.md 2.3): a world-frame file would round them to float32
+  // world coordinates (6.25 cm steps at 1000 km).
+  Model m = s_->model;
+  if (!detail::is_zero(s_->origin)) {
+    Pose pose = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int i = 0; i < 3; ++i) pose[4 * i + 3] = s_->origin[i];
+    m.pose = pose;
+  }
   erase_value(m, kMapFramesKey);
   erase_value(m, kMapOptionsKey);
-  m.key_values.emplace_back(kMapFramesKey, frames_text(s_->frames));
+  m.key_values.emplace_back(kMapFramesKey, detail::frames_text(s_->frames));
   m.key_values.emplace_back(kMapOptionsKey, options_text(s_->options));
+  detail::write_identity(m, s_->journal);
   return m;
 }
 
@@ -148,15 +172,20 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   Map map(options);
   State& s = *map.s_;
   s.model = model;
-  if (const std::string* frames = find_value(model, kMapFramesKey)) s.frames = parse_frames(*frames);
+  s.origin = detail::split_origin(s.model);
+  detail::require_origin(s.origin);
+  s.origin_fixed = true;
+  if (!detail::is_zero(s.origin)) s.world = detail::world_frame(s.model, s.origin);
+  if (const std::string* frames = find_value(model, kMapFramesKey)) s.frames = detail::parse_frames(*frames);
   // The provenance lives in s.frames now; to_model() writes it afresh.
   erase_value(s.model, kMapFramesKey);
   erase_value(s.model, kMapOptionsKey);
+  detail::read_identity(s.model, s.journal);
   if (model.camera.known) s.camera = model.camera.camera;
   restore_warm_start(s);
-  s.marginals.reserve(model.gmm.size());
-  for (std::size_t k = 0; k < model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(model.gmm, k));
-  s.index.build(model.gmm);
+  s.marginals.reserve(s.model.gmm.size());
+  for (std::size_t k = 0; k < s.model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(s.model.gmm, k));
+  s.index.build(s.model.gmm);
   return map;
 }
 

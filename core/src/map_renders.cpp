@@ -40,7 +40,10 @@ std::shared_ptr<const std::vector<float>> Map::frame_depth(std::size_t frame, in
   require(frame < s.frames.size(), ErrorCode::InvalidArgument,
           "map: frame " + std::to_string(frame) + " is not recorded (the map has " + std::to_string(s.frames.size()) +
               " frames)");
-  const Model& m = model();
+  (void)model();  // Error(InvalidData) for an empty map
+  // The map's own components from the frame's pose in the anchored frame:
+  // the world-frame model would render float32 world coordinates.
+  const Model& m = s.model;
   require(m.camera.known, ErrorCode::InvalidData, "map: no camera is recorded (points-only inserts), nothing to render");
   if (auto kept = s.renders.find(s.revision, frame)) return kept;
   RenderOptions ro;
@@ -48,7 +51,8 @@ std::shared_ptr<const std::vector<float>> Map::frame_depth(std::size_t frame, in
   ro.depth_max = m.camera.depth_max;
   ro.threads = threads;
   auto depth = std::make_shared<const std::vector<float>>(
-      render(m.gmm, decimated(m.camera.camera, m.camera.decimation), s.frames[frame].pose, ro).depth);
+      render(m.gmm, decimated(m.camera.camera, m.camera.decimation), detail::anchored(s.origin, s.frames[frame].pose), ro)
+          .depth);
   s.renders.keep(s.revision, frame, depth);
   return depth;
 }

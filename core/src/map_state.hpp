@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "map_journal.hpp"
 #include "map_renders.hpp"
 #include "sogmm/map.hpp"
 
@@ -84,6 +85,37 @@ PendingVoxel pending_voxel(const double xyz[3]);
 /// Whether a pending point lies in the voxel or one of its 26 neighbours.
 bool near_pending(const PendingVoxelSet& voxels, const PendingVoxel& voxel);
 
+/// The provenance lines (kMapFramesKey format) of frames [first, end).
+std::string frames_text(const std::vector<FrameStats>& frames, std::size_t first = 0);
+/// Frames from provenance lines whose indices run from first_index; a
+/// malformed line -> Error(Format) naming `key` and the line.
+std::vector<FrameStats> parse_frames(const std::string& text, std::uint64_t first_index = 0,
+                                     const char* key = kMapFramesKey);
+
+/// Grid (m) of the default origin: the first frame's translation rounded to
+/// a multiple of it per axis. A map whose first frame is within 500 m of the
+/// world origin keeps the origin 0 (components, files and results as before
+/// anchors existed); 500 m from its origin a float32 coordinate still moves
+/// in steps of 30 um.
+inline constexpr double kOriginGrid = 1000.0;
+
+/// The origin a map takes from its first frame's pose (map_anchor.cpp).
+Origin default_origin(const Pose& first_pose);
+bool is_zero(const Origin& origin);
+/// `camera_to_world` as a camera-to-anchored-frame pose: translation minus
+/// the origin, in double.
+Pose anchored(const Origin& origin, const Pose& camera_to_world);
+/// The world-frame model of a map held relative to `origin` (means moved by
+/// it, rounded to float32; no pose). Error(InvalidArgument) for a mean beyond
+/// float32.
+Model world_frame(const Model& anchored_model, const Origin& origin);
+/// Takes the pose off a world-frame model: its translation is returned as the
+/// origin, its rotation (if any) applied to the components.
+Origin split_origin(Model& model);
+/// Error(InvalidArgument) naming the axis unless every entry is finite and
+/// within float32 range.
+void require_origin(const Origin& origin);
+
 /// A revisit refit worked out but not committed (map_revisit.cpp).
 struct RevisitRefit {
   std::vector<std::size_t> replaced;  ///< map components the frame sees (ascending), to be replaced
@@ -120,7 +152,14 @@ namespace sogmm {
 
 struct Map::State {
   MapOptions options;
-  Model model;                 ///< world-frame map; gmm empty until the first flush
+  Model model;                 ///< the map relative to `origin`; gmm empty until the first flush
+  /// The anchor: components, index, marginals, pending frames (their poses
+  /// too) and the previous fit are all relative to it (map_anchor.cpp).
+  Origin origin{};
+  bool origin_fixed = false;   ///< by the first frame, set_origin or a load
+  /// model moved to the world frame (Map::model), kept only when the origin
+  /// is not 0 (else model is the world-frame model itself).
+  Model world;
   ComponentIndex index;
   std::vector<detail::Marginal3> marginals;  ///< one per component of model.gmm
   std::vector<detail::PendingFrame> pending;
@@ -141,7 +180,10 @@ struct Map::State {
   /// undo): what is kept about them (renders) is valid for one revision.
   std::uint64_t revision = 0;
   mutable detail::FrameRenders renders;  // filled by const queries (Map::frame_depth)
-  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) {}
+  /// The public revision and the changes deltas are cut from
+  /// (sogmm/map_delta.hpp); unlike `revision` it also counts frames.
+  detail::Journal journal;
+  explicit State(const MapOptions& o) : options(o), index(o.index_sigmas) { journal.map_id = detail::new_map_id(); }
 };
 
 }  // namespace sogmm

@@ -42,18 +42,24 @@ std::vector<OptionSpec> make_table() {
       // ---- fit ----
       SOGMM_F64_ROW(
           BANDWIDTH, fit.bandwidth, 0.0, kInf, bandwidth_is_usable,
-          "> 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero", "",
+          "> 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero (about 5.3e-155 to 4.4e153)", "",
           "mean-shift bandwidth over the (range, gray) features: the one SOGMM parameter; it sets the number of components"),
       SOGMM_I64_ROW(N_COMPONENTS, fit.n_components, 0, kI64Max, ">= 0", "components",
-                    "0: self-organizing (the mode count picks K); K > 0: a fixed-K fit without the mode count"),
+                    "0: self-organizing (the mode count picks K); K > 0: a fit of exactly K components (1 <= K <= the number "
+                    "of points) without the mode count"),
       SOGMM_F64_ROW(TOL, fit.em.tol, 0.0, kInf, finite, ">= 0, finite", "nats per point",
-                    "EM stops when the mean log-likelihood per point changes by less than this; 0 runs max_iter iterations"),
+                    "EM stops when the mean log-likelihood per point changes by less than this; 0 runs MAX_ITER iterations"),
       // reg_covar: unset (automatic floors) is SOGMM_REG_COVAR_AUTO (-1).
       OptionSpec{OptionKey::REG_COVAR, "SOGMM_OPT_REG_COVAR", OptionType::F64, -1.0,
-                 std::numeric_limits<float>::max(), 0, 0, ">= 0, finite in float32, or SOGMM_REG_COVAR_AUTO (-1)",
+                 std::numeric_limits<float>::max(), 0, 0, ">= 0, finite in float32 (<= 3.4e38: covariances are float32), or SOGMM_REG_COVAR_AUTO (-1)",
                  "data units squared",
-                 "added to every covariance diagonal in each M-step; AUTO derives a spatial and a gray floor from "
-                 "the data's scales",
+                 "a value is added to all four covariance diagonals in each M-step. SOGMM_REG_COVAR_AUTO (-1, the "
+                 "default; get returns it while no value is set): one floor on x, y, z and one on gray, derived "
+                 "from the data: 1e-6 x 100^k, with 10^k the power of ten nearest the median distance of the points "
+                 "from their coordinate-wise median, resp. the smallest one not below the gray range; 1e-6 and 1e-6 "
+                 "for a room-sized frame with gray in [0, 1], 1 m^2 for a 1 km scene. The model's fit record holds "
+                 "the floors used (FIT_REG_COVAR: the spatial one; key_values reg_covar_gray and reg_covar_source). "
+                 "Any other negative value, NaN or inf is refused",
                  [](double v) { return v == -1.0 || (std::isfinite(static_cast<float>(v)) && v >= 0); }, nullptr,
                  [](const Settings& s) { return s.fit.em.reg_covar.value_or(-1.0); },
                  [](Settings& s, double v) {
@@ -63,32 +69,43 @@ std::vector<OptionSpec> make_table() {
                  nullptr, nullptr},
       SOGMM_I64_ROW(MAX_ITER, fit.em.max_iter, 1, kInt32Max, "[1, 2^31-1]", "iterations",
                     "at most this many EM iterations"),
-      SOGMM_I64_ROW(SEED, fit.seed, kI64Min, kI64Max, "any (as a 64-bit unsigned seed)", "",
-                    "seeds k-means++: the same seed gives the same model; run r of n_init uses seed + r"),
+      SOGMM_I64_ROW(SEED, fit.seed, kI64Min, kI64Max, "any (the bits of a uint64 seed, cast)", "",
+                    "seeds k-means++: the same seed gives the same model; run r of N_INIT uses SEED + r"),
       // THREADS also sets the queries' team (score, regress, render, map queries).
       OptionSpec{OptionKey::THREADS, "SOGMM_OPT_THREADS", OptionType::I64, 0.0, 4096.0, 0, 4096, "[0, 4096]",
-                 "threads", "worker threads of fits and queries; 0 = all available cores; results do not depend on it",
+                 "threads",
+                 "worker threads of fits and queries; 0 = all available cores; a request is capped at 4 x the cores "
+                 "(libgomp aborts when it cannot start a thread); results do not depend on it",
                  nullptr, always_i64, nullptr, nullptr,
                  [](const Settings& s) { return static_cast<std::int64_t>(s.fit.em.threads); },
                  [](Settings& s, std::int64_t v) { s.fit.em.threads = s.query.threads = static_cast<int>(v); }},
       SOGMM_I64_ROW(MODE_COUNTER, fit.mode_counter, 0, 1, "a SOGMM_MODE_COUNTER_* value (0 or 1)", "",
-                    "how K is counted: 0 the authors' flat binned mean shift, 1 the paper's Gaussian blurring mean shift"),
+                    "how K is counted: SOGMM_MODE_COUNTER_FLAT_BINNED (0) the authors' flat mean shift with bin seeding, "
+                    "SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING (1) the paper's Gaussian blurring mean shift"),
       SOGMM_F64_ROW(TRUNCATION_NATS, fit.em.truncation_nats, 0.0, kInf, finite, ">= 0, finite", "nats",
-                    "0: exact E-step; > 0: a point skips a component only when its term is provably this far below "
-                    "the point's largest"),
+                    "0: exact E-step; > 0: a truncated E-step that skips a component only when it is provably more than "
+                    "this many nats below every point's best in a block (25: each skipped term < 1.4e-11)"),
       SOGMM_I64_ROW(N_INIT, fit.n_init, 1, kMaxRuns, "[1, 1000]", "runs",
-                    "runs of k-means++ then EM (seeds seed + r); the best final likelihood is kept"),
+                    "runs of k-means++ then EM: run r (from 0) is seeded with SEED + r and the run with the highest final "
+                    "mean log-likelihood is kept (ties: the earliest); the cost grows linearly"),
       SOGMM_I64_ROW(DEQUANTISE_DEPTH, fit.dequantise_depth, -1, 1, "SOGMM_DEQUANTISE_AUTO (-1), 0 or 1", "",
-                    "the depth-quantisation floor: AUTO is on for points from a depth image, off for arrays"),
+                    "1: when the camera-frame depth sits on discrete levels (a 16-bit depth image), floor each component's "
+                    "variance along its viewing ray at the level's bin variance, so that components do not collapse "
+                    "onto single levels (every seed converges; higher likelihood of held-out pixels spread in their "
+                    "bins, lower training likelihood); 0: the paper's plain EM; SOGMM_DEQUANTISE_AUTO (-1): 1 for "
+                    "the points of sogmm_fit_frame, 0 for points given as arrays"),
+      SOGMM_I64_ROW(EM_ACCELERATION, fit.em.acceleration, 0, 1, "0 (plain EM) or 1 (SQUAREM)", "",
+                    "0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the "
+                    "log-likelihood would fall), fewer iterations to the same tol"),
       // ---- RGB-D back-projection ----
       SOGMM_F64_ROW(DEPTH_SCALE, depth.depth_scale, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v) && std::isfinite(1.0 / v); },
                     "> 0, finite, 1 / value finite", "raw units per metre",
                     "depth = raw / depth_scale (1000: millimetres; TUM uses 5000)"),
       SOGMM_F64_ROW(DEPTH_MIN, depth.depth_min, 0.0, kInf, finite, ">= 0, finite", "m",
-                    "pixels at or nearer than this are invalid (exclusive); must be below DEPTH_MAX"),
+                    "pixels at or nearer than this are invalid (exclusive); must be below DEPTH_MAX at fit time"),
       SOGMM_F64_ROW(DEPTH_MAX, depth.depth_max, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
-                    "> 0, finite", "m", "pixels farther than this are invalid (inclusive)"),
-      SOGMM_I64_ROW(DECIMATION, depth.decimate, 1, 1024, "[1, 1024]", "pixels", "integer decimation factor d of the image"),
+                    "> 0, finite", "m", "pixels farther than this are invalid (inclusive); must exceed DEPTH_MIN at fit time"),
+      SOGMM_I64_ROW(DECIMATION, depth.decimate, 1, 1024, "[1, 1024]", "pixels", "integer decimation factor d of the image; at fit time d <= width and d <= height"),
       // ---- writing .sogmm ----
       SOGMM_I64_ROW(ZSTD_LEVEL, write.zstd_level, 1, 22, "[1, 22]", "", "zstd compression level of the arrays"),
       SOGMM_I64_ROW(FLOAT64, write.float64, 0, 1, "0 or 1", "", "1: store the arrays as float64"),
@@ -97,7 +114,8 @@ std::vector<OptionSpec> make_table() {
       // 0 restores the format library's default cap (kDefaultMaxDecodedBytes).
       OptionSpec{OptionKey::MAX_DECODED_BYTES, "SOGMM_OPT_MAX_DECODED_BYTES", OptionType::I64, 0.0,
                  static_cast<double>(kI64Max), 0, kI64Max, ">= 0; 0 = the default cap (1 GiB)", "bytes",
-                 "cap on the arrays' decoded bytes: load refuses a file above it and save a model above it",
+                 "cap on the arrays' decoded bytes: load refuses a file above it and save a model above it (what a "
+                 "reader with the default cap would refuse)",
                  nullptr, always_i64, nullptr, nullptr,
                  [](const Settings& s) { return static_cast<std::int64_t>(s.read.max_decoded_bytes); },
                  [](Settings& s, std::int64_t v) {
@@ -111,29 +129,37 @@ std::vector<OptionSpec> make_table() {
                     "> 0 (+inf = untruncated)", "standard deviations",
                     "each standard-normal coordinate of a sample is truncated to (-value, value)"),
       SOGMM_F64_ROW(QUERY_TRUNCATION_NATS, query.truncation_nats, 0.0, kInf, finite, ">= 0, finite", "nats",
-                    "0: exact score and regression; > 0: a component is skipped at a point only when its term is "
-                    "provably this far below the point's largest"),
+                    "0: exact score and regression; > 0: culled ones, which skip a component at a point only when its "
+                    "term is provably more than this many nats below the point's largest (as TRUNCATION_NATS for "
+                    "the E-step): a score is then at most log(1 + M exp(-nats)) below the exact one"),
       // ---- incremental map ----
       SOGMM_I64_ROW(MAP_NOVELTY, map.novelty, 0, 1, "0 or 1", "",
-                    "1: only points the map does not explain are fitted; 0: every point (append everything)"),
+                    "1: only points the map does not explain are fitted; 0: every point is novel and each insert fits its "
+                    "whole frame (append everything)"),
       SOGMM_F64_ROW(MAP_NOVELTY_THRESHOLD, map.novelty_threshold, -kInf, kInf, finite, "finite", "nats (log per m^3)",
-                    "a point is novel when its neighbourhood's 3-D log-density is below this"),
+                    "a point is novel when its 3-D log-likelihood under the local submap is below this"),
       SOGMM_I64_ROW(MAP_BATCH_SIZE, map.batch_size, 1, std::int64_t{1} << 26, "[1, 2^26]", "points",
                     "pending novel points that trigger a fit"),
       SOGMM_I64_ROW(MAP_FUSION, map.fusion, 0, 1, "0 or 1", "", "1: fuse new components into close map components"),
       SOGMM_I64_ROW(MAP_FUSION_METHOD, map.fusion_method, 0, 1, "a SOGMM_FUSION_* value (0 or 1)", "",
-                    "the distance of fusion: 0 Hellinger, 1 symmetric KL"),
+                    "the distance of fusion: SOGMM_FUSION_HELLINGER (0) the Hellinger distance of the 4-D Gaussians, in "
+                    "[0, 1]; SOGMM_FUSION_KL (1) the symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, in nats"),
       SOGMM_F64_ROW(MAP_FUSION_THRESHOLD, map.fusion_threshold, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "the method's unit", "fuse when the distance is below this"),
       SOGMM_I64_ROW(MAP_WARM_START, map.warm_start, 0, 1, "0 or 1", "",
-                    "1: each flush's fit starts from the previous flush's model (needs n_init = 1)"),
+                    "1: each batch's fit starts from the previous batch's model moved into its camera (as a warm "
+                    "sogmm_fit_points_f32); meant for MAP_NOVELTY 0; needs N_INIT 1"),
       SOGMM_F64_ROW(MAP_NOVELTY_BANDWIDTH_SCALE, map.novelty_bandwidth_scale, 0.0, 1.0,
                     [](double v) { return v > 0; }, "in (0, 1]", "",
-                    "with novelty on, batches are fitted with the bandwidth times this"),
+                    "with MAP_NOVELTY 1 the batches of novel points are fitted with BANDWIDTH times this (with MAP_NOVELTY "
+                    "0 each frame with the bandwidth itself; why: MapOptions::novelty_bandwidth_scale)"),
       SOGMM_F64_ROW(MAP_REVISIT_REFIT_RATIO, map.revisit_refit_ratio, 0.0, kInf,
                     [](double v) { return v == 0 || (std::isfinite(v) && v >= 1); }, "0 (off) or >= 1, finite", "",
-                    "a revisited surface is refitted when its points have this many times as many modes as it has "
-                    "components"),
+                    "with MAP_NOVELTY 1, an RGB-D insert refits the map components on its surfaces when its explained "
+                    "points they dominate have at least this many times as many modes as they are components: they "
+                    "are replaced by a fit of those points plus samples of their mass it does not see (details and "
+                    "why: MapOptions::revisit_refit_ratio); 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START "
+                    "1; a refit counts as a fit (flushed, n_flushes)"),
       // ---- occupancy and distance to the surface ----
       SOGMM_F64_ROW(OCCUPANCY_SIGMA, occupancy.surface_sigma, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "m",
@@ -142,30 +168,33 @@ std::vector<OptionSpec> make_table() {
                     "> 0, finite", "m", "a point within this distance of the surface along a ray is occupied"),
       SOGMM_F64_ROW(SURFACE_DISC_SIGMAS, surface.disc_sigmas, 0.0, 10.0, [](double v) { return v > 0; }, "in (0, 10]",
                     "standard deviations",
-                    "distance to the surface: each component is the disc of its two largest axes out to this many "
-                    "standard deviations"),
+                    "distance to the surface: each component is the disc of its two largest principal axes out to this "
+                    "many standard deviations"),
       SOGMM_I64_ROW(REGISTRATION_MAX_ITER, registration.max_iter, 1, kInt32Max, "[1, 2^31-1]", "iterations",
                     "registration: EM / Gauss-Newton iterations per coarse-to-fine level"),
       SOGMM_F64_ROW(REGISTRATION_TOL, registration.tol, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "m",
-                    "registration: a level ends when a step moves the source by less than this"),
+                    "registration: a level ends when a step moves the source by less than this (|t| + |rotation| x RMS "
+                    "radius)"),
       SOGMM_F64_ROW(REGISTRATION_OUTLIER_RATIO, registration.outlier_ratio, 0.0, 1.0, [](double v) { return v < 1; },
-                    "in [0, 1)", "", "registration: prior weight of the uniform outlier term"),
+                    "in [0, 1)", "", "registration: prior weight of the uniform outlier term (over the target's 3-sigma box)"),
       SOGMM_I64_ROW(REGISTRATION_USE_GRAY, registration.use_gray, 0, 1, "0 or 1", "",
-                    "registration: 1 scores gray too (the 4-D joint density), 0 the 3-D marginal"),
+                    "registration: 1 scores gray too (the 4-D joint density: gray marginal times the conditional x | "
+                    "gray), 0 the 3-D marginal"),
       SOGMM_I64_ROW(REGISTRATION_LEVELS, registration.levels, 1, 16, "[1, 16]", "levels",
-                    "registration: coarse-to-fine levels; the last uses the model unsmoothed"),
+                    "registration: coarse-to-fine levels; level l smooths the target by COARSE_SIGMA / 2^l, the last not "
+                    "at all"),
       SOGMM_F64_ROW(REGISTRATION_COARSE_SIGMA, registration.coarse_sigma, 0.0, kInf,
                     [](double v) { return v > 0 && std::isfinite(v); }, "> 0, finite", "m",
                     "registration: smoothing standard deviation of the coarsest level (halved per level)"),
       SOGMM_F64_ROW(REGISTRATION_MIN_INLIER_RATIO, registration.min_inlier_ratio, 0.0, 1.0, finite, "in [0, 1]", "",
-                    "registration: below this inlier ratio the status is low fitness"),
+                    "registration: below this inlier ratio the status is SOGMM_REGISTRATION_LOW_FITNESS"),
       SOGMM_F64_ROW(REGISTRATION_DEGENERACY_RATIO, registration.degeneracy_ratio, 0.0, 1.0,
                     [](double v) { return v < 1; }, "in [0, 1)", "",
                     "registration: directions whose scaled information is below this fraction of the largest are "
                     "unobservable"),
       SOGMM_I64_ROW(REGISTRATION_MIN_POINTS, registration.min_points, 6, kI64Max, ">= 6", "points",
-                    "registration: fewer finite source points are an error"),
+                    "registration: fewer finite source points are SOGMM_E_INVALID_DATA"),
   };
   return t;
 }

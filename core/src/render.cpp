@@ -69,10 +69,24 @@ void regress_at_depths(const Gmm& gmm, const Camera& camera, int threads, Render
   }
 }
 
-// One component's 1-D Gaussian along a ray: centre t, precision a, log scale.
+// One component's 1-D Gaussian along a ray: centre t, precision a, log scale,
+// and r, the squared Mahalanobis distance of the ray to the component's mean.
 struct RayTerm {
-  double t, a, log_c;
+  double t, a, log_c, r;
 };
+
+// RenderOptions::surface_sigma: the evidence sum_i exp(-D_i^2 / 2) at the
+// mode's 3-D point (D_i its Mahalanobis distance to component i, so each
+// component counts 1 at its mean whatever its weight). A flat component
+// fitted to a uniform patch of surface points has the patch's edge at 2 sigma
+// (a disc; sqrt(3) sigma for a square): a ray that only grazes its tail past
+// the silhouette of the surface it models sees no point of it, while inside a
+// surface tiled by components the evidences add up.
+double surface_evidence(const std::vector<RayTerm>& terms, double t) {
+  double e = 0;
+  for (const RayTerm& q : terms) e += std::exp(-0.5 * (q.r + q.a * (t - q.t) * (t - q.t)));
+  return e;
+}
 
 // Components within this squared Mahalanobis distance of a ray shape its 1-D
 // mixture: those within max_mahalanobis, and at least those within 8 sigma.
@@ -95,10 +109,11 @@ float first_surface(const std::vector<RayComponent>& comps, const std::vector<st
     const double t = b / a;
     const double r = c.mpm - b * b / a;  // squared Mahalanobis distance of the ray to the mean
     if (r > r_use || t <= 0) continue;
-    terms.push_back({t, a, c.log_amp - 0.5 * r});
+    terms.push_back({t, a, c.log_amp - 0.5 * r, r});
     if (r <= r_show && t > o.depth_min && t <= o.depth_max) starts.push_back(t);
   }
   if (starts.empty()) return kEmpty;
+  const double min_evidence = o.surface_sigma > 0 ? std::exp(-0.5 * o.surface_sigma * o.surface_sigma) : 0.0;
   double max_log_c = -std::numeric_limits<double>::infinity();
   for (const RayTerm& q : terms) max_log_c = std::max(max_log_c, q.log_c);
   // The climbs in order of their starts. An ascent in 1-D cannot cross a
@@ -130,6 +145,7 @@ float first_surface(const std::vector<RayComponent>& comps, const std::vector<st
       if (done) break;
     }
     if (!supported || !(t > o.depth_min && t <= o.depth_max)) continue;
+    if (min_evidence > 0 && surface_evidence(terms, t) < min_evidence) continue;  // a graze, not a surface
     if (best_t < 0 || t < best_t) best_t = t;
   }
   return best_t > 0 ? static_cast<float>(best_t) : kEmpty;
@@ -144,6 +160,8 @@ void validate(const RenderOptions& o) {
               std::to_string(o.depth_max) + ")");
   require(std::isfinite(o.max_mahalanobis) && o.max_mahalanobis > 0, ErrorCode::InvalidArgument,
           "render: max_mahalanobis must be finite and > 0 (got " + std::to_string(o.max_mahalanobis) + ")");
+  require(std::isfinite(o.surface_sigma) && o.surface_sigma >= 0, ErrorCode::InvalidArgument,
+          "render: surface_sigma must be finite and >= 0 (got " + std::to_string(o.surface_sigma) + ")");
   require(o.threads >= 0, ErrorCode::InvalidArgument, "render: threads must be >= 0 (got " + std::to_string(o.threads) + ")");
 }
 

@@ -22,7 +22,10 @@ inline constexpr double kSymmetryTolerance = 1e-5;
 /// an F64 file are checked after rounding to float32, as the model holds them,
 /// and the model must also pass sogmm::validate (what every C API handle
 /// keeps), so that every entry point gives a file one verdict.
-void check_values(const Gmm& gmm);
+/// `delta`: the explicit components of a map delta (spec/format.md section
+/// 2.5), whose weights need not sum to 1 (and M may be 0): the sum test and
+/// sogmm::validate (which holds it too) are left out.
+void check_values(const Gmm& gmm, bool delta = false);
 
 /// Replaces every covariance of a model that passed check_values by its
 /// symmetric part (spec/format.md section 5.1: a reader returns symmetric

@@ -25,6 +25,9 @@ inline constexpr std::size_t kMinFileSize = kHeaderSize + kTrailerSize;
 inline constexpr std::uint64_t kMetadataLengthLimit = (std::uint64_t{1} << 31) - 1;
 /// Feature bits this reader knows (format 1.0 defines none).
 inline constexpr std::uint64_t kKnownFeatures = 0;
+/// features_required bit of a map delta (spec/format.md sections 2.5 and 7):
+/// known only to the delta reader, so a model reader refuses a delta.
+inline constexpr std::uint64_t kFeatureMapDelta = 1;
 
 /// The fixed header fields.
 struct Header {

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "container.hpp"
+#include "source.hpp"
 #include "sogmm/format.hpp"
 
 namespace sogmm::format::detail {
@@ -33,6 +35,19 @@ struct Tweaks {
   bool unknown_optional_fields = false;  ///< appends fields with ids unknown to format 1.0
   bool share_strings = false;  ///< key/value strings stored once and shared (FlatBuffers CreateSharedString)
 };
+
+/// The version and feature bit of a map delta (spec/format.md section 2.5):
+/// written as format 1.1 with features_required bit 0, checked as a delta.
+inline Tweaks map_delta_tweaks() {
+  Tweaks t;
+  t.minor = 1;
+  t.features_required = kFeatureMapDelta;
+  return t;
+}
+
+/// The reading procedure on `src`; *info (if not null) as load(). `delta`:
+/// the file must be a map delta, read by the delta rules (section 2.5).
+Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, bool delta);
 
 /// to_bytes() with tweaks.
 std::vector<std::uint8_t> encode(const Model& model, const WriteOptions& options, const Tweaks& tweaks);

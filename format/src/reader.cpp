@@ -25,7 +25,8 @@ const char* const kNames[3] = {"weights", "means", "covariances"};
 
 // Steps 1-16: the header and the trailer first, then the metadata block, read
 // only once its length is known to fit the file.
-ParsedMetadata read_metadata(const Source& src, const ReadOptions& options) {
+ParsedMetadata read_metadata(const Source& src, const ReadOptions& options,
+                             std::uint64_t known_features = kKnownFeatures) {
   const std::uint64_t size = src.size();
   std::uint8_t prefix[kHeaderSize] = {};
   const std::size_t prefix_size = size < kHeaderSize ? static_cast<std::size_t>(size) : kHeaderSize;
@@ -38,7 +39,7 @@ ParsedMetadata read_metadata(const Source& src, const ReadOptions& options) {
   auto* bytes = reinterpret_cast<std::uint8_t*>(block.data());
   src.read(kHeaderSize, bytes, h.metadata_length);
   if (options.verify_checksums) check_metadata_crc(bytes, h);
-  return parse_metadata(bytes, h, options);
+  return parse_metadata(bytes, h, options, known_features);
 }
 
 // Steps 17-18 for one array: its values as float32 at `out` (rows x cols, in
@@ -88,10 +89,17 @@ void expand_upper_in_place(float* cov, std::uint64_t m) {
   }
 }
 
+}  // namespace
+
 // The whole procedure. *info (if not null) gets the file information, with
-// its `metadata` left default: the returned model holds the metadata.
-Model read_model(const Source& src, const ReadOptions& options, FileInfo* info) {
-  ParsedMetadata meta = read_metadata(src, options);
+// its `metadata` left default: the returned model holds the metadata. With
+// `delta`, the file must be a map delta (spec/format.md section 2.5): its
+// components are checked as a delta's and returned as stored (a symmetric
+// part would change the bits the receiver must reproduce).
+Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, bool delta) {
+  ParsedMetadata meta = read_metadata(src, options, delta ? kKnownFeatures | kFeatureMapDelta : kKnownFeatures);
+  if (delta && (meta.info.features_required & kFeatureMapDelta) == 0)
+    fail(ErrorCode::Format, "not_a_delta", "the file is a model, not a map delta (feature bit 0 is not set)");
   const std::uint64_t m = meta.info.n_components;  // its arrays fit the cap (step 15)
   Model model = std::move(meta.info.metadata);
   Gmm& g = model.gmm;
@@ -101,14 +109,16 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info) 
     read_array(src, meta.arrays[i], m, columns(i, meta.packed), options.verify_checksums, kNames[i], dest[i]);
   }
   if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
-  check_values(g);  // 19
-  if (!meta.packed) symmetrize(g);
+  check_values(g, delta);  // 19
+  if (!meta.packed && !delta) symmetrize(g);
   if (info != nullptr) {
     *info = std::move(meta.info);
     info->metadata = Model{};
   }
   return model;
 }
+
+namespace {
 
 const std::uint8_t* bytes_of(const void* data, std::size_t size, const char* who) {
   if (data == nullptr && size != 0) throw Error(ErrorCode::InvalidArgument, std::string(who) + ": null data");
@@ -120,24 +130,24 @@ const std::uint8_t* bytes_of(const void* data, std::size_t size, const char* who
 
 Model from_bytes(const void* data, std::size_t size, const ReadOptions& options) {
   const detail::MemorySource src(detail::bytes_of(data, size, "from_bytes"), size);
-  return detail::read_model(src, options, nullptr);
+  return detail::read_model(src, options, nullptr, false);
 }
 
 FileInfo read_info(const void* data, std::size_t size, const ReadOptions& options) {
   const detail::MemorySource src(detail::bytes_of(data, size, "read_info"), size);
-  return detail::read_metadata(src, options).info;
+  return detail::read_metadata(src, options, detail::kKnownFeatures | detail::kFeatureMapDelta).info;
 }
 
 Model load(const std::string& path, const ReadOptions& options) { return load(path, options, nullptr); }
 
 Model load(const std::string& path, const ReadOptions& options, FileInfo* info) {
   const detail::FileSource src(path);
-  return detail::read_model(src, options, info);
+  return detail::read_model(src, options, info, false);
 }
 
 FileInfo read_info_file(const std::string& path, const ReadOptions& options) {
   const detail::FileSource src(path);
-  return detail::read_metadata(src, options).info;
+  return detail::read_metadata(src, options, detail::kKnownFeatures | detail::kFeatureMapDelta).info;
 }
 
 }  // namespace sogmm::format

@@ -188,7 +188,8 @@ void set_array_offsets(std::uint8_t* metadata, const std::uint64_t (&offsets)[3]
   }
 }
 
-ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const ReadOptions& options) {
+ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const ReadOptions& options,
+                              std::uint64_t known_features) {
   // 9. The wire rules of section 4.3 decide. FlatBuffers' own verifier, whose
   // rules are weaker, then only guards the generated accessors used below.
   verify_wire(buf, h.metadata_length);
@@ -197,7 +198,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
   const fb::SogmmFile* root = fb::GetSogmmFile(buf);
 
   // 10. required features
-  const std::uint64_t unknown = root->features_required() & ~kKnownFeatures;
+  const std::uint64_t unknown = root->features_required() & ~known_features;
   if (unknown != 0) {
     fail(F, "unsupported_feature", "file requires feature bits 0x" + [&] {
       char hex[32];
@@ -275,7 +276,9 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
 
   // 13. M
   const std::uint64_t m = root->n_components();
-  if (m == 0) fail(ErrorCode::InvalidData, "empty", "model has no components (M = 0)");
+  // A map delta may carry no component (a frame that only added provenance).
+  if (m == 0 && (root->features_required() & kFeatureMapDelta) == 0)
+    fail(ErrorCode::InvalidData, "empty", "model has no components (M = 0)");
 
   // 14. declared lengths agree with M
   std::uint64_t total = 0;

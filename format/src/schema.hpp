@@ -51,7 +51,10 @@ struct ParsedMetadata {
 /// and the buffer layout; then decodes the metadata. `metadata` holds the
 /// header.metadata_length bytes of the block and is 8-byte aligned (so every
 /// FlatBuffers scalar read is aligned).
-ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& header, const ReadOptions& options);
+/// `known_features`: the features_required bits this reading accepts (a map
+/// delta's reader adds kFeatureMapDelta, which also allows M = 0).
+ParsedMetadata parse_metadata(const std::uint8_t* metadata, const Header& header, const ReadOptions& options,
+                              std::uint64_t known_features = kKnownFeatures);
 
 /// Number of columns C of array `which` (1, 4, 10 or 16).
 inline std::uint64_t columns(int which, bool packed) {

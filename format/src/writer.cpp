@@ -67,10 +67,10 @@ std::vector<float> pack_upper(const std::vector<float>& cov, std::size_t m) {
 }
 
 // The writer's checks: what a reader would reject, a writer refuses.
-void validate_for_write(const Model& model) {
+void validate_for_write(const Model& model, bool delta) {
   const Gmm& g = model.gmm;
   const std::size_t m = g.weights.size();
-  if (m == 0) fail(ErrorCode::InvalidData, "empty", "model has no components (M = 0)");
+  if (m == 0 && !delta) fail(ErrorCode::InvalidData, "empty", "model has no components (M = 0)");
   if (g.means.size() != 4 * m || g.covariances.size() != 16 * m) {
     fail(ErrorCode::InvalidData, "length_mismatch",
          "array lengths disagree with M = " + std::to_string(m) + ": " + std::to_string(g.means.size()) +
@@ -79,7 +79,7 @@ void validate_for_write(const Model& model) {
   check_strings(model, ErrorCode::InvalidData);
   check_metadata_numbers(model, ErrorCode::InvalidData);
   if (model.pose) check_pose(*model.pose);
-  check_values(g);
+  check_values(g, delta);
 }
 
 // The producer version a file records: the model's, or this library's.
@@ -178,7 +178,7 @@ class EncodedFile {
   EncodedFile(const Model& model, const WriteOptions& options, const Tweaks& t) {
     MetadataBounds bounds;
     if (t.validate) {
-      validate_for_write(model);
+      validate_for_write(model, (t.features_required & kFeatureMapDelta) != 0);
       bounds = check_metadata_limits(model);
     } else {
       bounds = metadata_bounds(model);

@@ -72,6 +72,10 @@ static void test_options(void) {
   EXPECT_TRUE(i == 1);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_MODE_COUNTER, &i));
   EXPECT_TRUE(i == SOGMM_MODE_COUNTER_FLAT_BINNED);
+  EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_EM_ACCELERATION, &i));
+  EXPECT_TRUE(i == 0);
+  EXPECT_STATUS(sogmm_options_set_i64(o, SOGMM_OPT_EM_ACCELERATION, 2), SOGMM_E_INVALID_ARG);
+  EXPECT_STATUS(sogmm_options_set_i64(o, SOGMM_OPT_EM_ACCELERATION, -1), SOGMM_E_INVALID_ARG);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_DECIMATION, &i));
   EXPECT_TRUE(i == 1);
   EXPECT_OK(sogmm_options_get_i64(o, SOGMM_OPT_ZSTD_LEVEL, &i));

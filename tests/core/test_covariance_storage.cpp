@@ -134,4 +134,18 @@ TEST(CovarianceStorage, NeverWorseThanAPositiveDefiniteNearestRounding) {
   EXPECT_GT(compared, 1000);  // the case is common among near-singular targets
 }
 
+// An asymmetric input is stored as its symmetric part (issue 36 follow-up:
+// the symmetrisation ran in place through Eigen's aliasing and stored
+// s(0,1) = 0.75 s01 + 0.25 s10 against s(1,0) = (s01 + s10) / 2).
+TEST(CovarianceStorage, AnAsymmetricInputIsStoredAsItsSymmetricPart) {
+  const Mat4 s = rotated(Eigen::Vector4d(2.5e-3, 9e-4, 4e-6, 1e-4));
+  Mat4 skewed = s;
+  skewed(0, 1) += 2e-7;
+  skewed(2, 3) -= 1e-7;
+  const Mat4 symmetric = (0.5 * (skewed + skewed.transpose())).eval();
+  const Stored a = store(skewed), b = store(symmetric);
+  EXPECT_EQ(a.c, b.c);
+  EXPECT_EQ(a.c, a.c.transpose());
+}
+
 }  // namespace

@@ -1,6 +1,7 @@
 // The renderer (sogmm/render.hpp, issue 29 part 3) against independent
 // truth: the closed-form mode and regression of one component along a ray,
-// the first-surface rule on a hand-built scene, a fitted plane, the
+// the first-surface rule on a hand-built scene, the surface-evidence rule
+// (where a component's surface ends, evidence adding up, a graze), a fitted plane, the
 // invariance under moving model and pose together, threads, progress and
 // bad input; score_render on a hand-computed case.
 #include <gtest/gtest.h>
@@ -126,6 +127,74 @@ TEST(Render, RemovingTheFrontSurfaceShowsTheOneBehind) {
   EXPECT_NEAR(r.gray[at(kSmall, 4, 4)], 0.9, 1e-3);
 }
 
+// The surface-evidence rule (RenderOptions::surface_sigma = 2): a mode is a
+// surface only where sum_k exp(-D_k^2 / 2) at its point reaches exp(-2), one
+// component at 2 sigma.
+// Ground truth from the closed form of one thin disc at z = 1 m (sigma 5 cm
+// in x and y, 1 mm in z): a ray of slope s = x / z passes at Mahalanobis
+// distance r = s / sqrt(sx^2 + s^2 sz^2) from its mean (the minimum over t of
+// t^2 s^2 / sx^2 + (t - 1)^2 / sz^2), and its 1-D mode is that minimiser, so
+// D = r there: the pixel shows the disc iff r <= 2.
+TEST(Render, AComponentShowsASurfaceOutToTwoSigma) {
+  const double sx = 0.05, sz = 0.001;
+  sogmm::Gmm g;
+  g.resize(1);
+  set_component(g, 0, 1.0, Eigen::Vector4d(0, 0, 1.0, 0.5), diag(sx * sx, sx * sx, sz * sz, 0.01));
+  const sogmm::Camera cam{61, 1, 200.0, 200.0, 0.0, 0.0};  // pixel u: slope u / 200, 0 to 0.3
+  sogmm::RenderOptions o;
+  o.surface_sigma = 2.0;
+  const sogmm::RenderedImages r = sogmm::render_expected_surface(g, cam, o);
+  const sogmm::RenderedImages every = sogmm::render_expected_surface(g, cam);  // surface_sigma 0
+  int shown = 0, hidden = 0;
+  for (int u = 0; u < cam.width; ++u) {
+    const double s = u / cam.fx, dist = s / std::sqrt(sx * sx + s * s * sz * sz);
+    if (std::abs(dist - 2.0) < 0.01) continue;  // at the threshold itself rounding decides
+    SCOPED_TRACE(testing::Message() << "pixel " << u << ", ray at " << dist << " sigma");
+    if (dist < 2.0) {
+      ASSERT_FALSE(std::isnan(r.depth[at(cam, u, 0)]));
+      const double t = 1.0 / (1.0 + s * s * sz * sz / (sx * sx));  // the minimiser above
+      EXPECT_NEAR(r.depth[at(cam, u, 0)], t, 1e-5);
+      ++shown;
+    } else {
+      EXPECT_TRUE(std::isnan(r.depth[at(cam, u, 0)]));
+      EXPECT_EQ(std::isnan(every.depth[at(cam, u, 0)]), dist > 3.0);  // without the rule: out to max_mahalanobis
+      ++hidden;
+    }
+  }
+  EXPECT_EQ(shown, 20);   // u = 0..19: r < 1.9
+  EXPECT_EQ(hidden, 40);  // u = 21..60 (u = 20 sits on the threshold)
+}
+
+// Beside the silhouette of a near patch, a ray 2.5 sigma off the patch's mean
+// (evidence exp(-3.125) = 0.044) passes on to the wall behind it; two
+// components 2.1 sigma either side of a ray (each 0.110 alone, 0.220
+// together) show a surface that neither shows alone.
+TEST(Render, EvidenceAddsUpAndAGrazeIsNoSurface) {
+  const double s = 0.02, sz = 0.001;
+  const sogmm::Camera cam{1, 1, 100.0, 100.0, 0.0, 0.0};  // one ray, along z
+  sogmm::Gmm g;
+  g.resize(2);
+  set_component(g, 0, 0.5, Eigen::Vector4d(2.5 * s, 0, 1.0, 0.2), diag(s * s, s * s, sz * sz, 0.01));
+  set_component(g, 1, 0.5, Eigen::Vector4d(0, 0, 2.0, 0.9), diag(0.5, 0.5, sz * sz, 0.01));
+  sogmm::RenderOptions o;
+  o.surface_sigma = 2.0;
+  sogmm::RenderedImages r = sogmm::render_expected_surface(g, cam, o);
+  EXPECT_NEAR(r.depth[0], 2.0, 1e-4);
+  EXPECT_NEAR(sogmm::render_expected_surface(g, cam).depth[0], 1.0, 1e-4);  // surface_sigma 0: the patch
+  EXPECT_NEAR(r.gray[0], 0.9, 1e-3);
+  sogmm::Gmm pair;
+  pair.resize(2);
+  set_component(pair, 0, 0.5, Eigen::Vector4d(2.1 * s, 0, 1.0, 0.2), diag(s * s, s * s, sz * sz, 0.01));
+  set_component(pair, 1, 0.5, Eigen::Vector4d(-2.1 * s, 0, 1.0, 0.2), diag(s * s, s * s, sz * sz, 0.01));
+  r = sogmm::render_expected_surface(pair, cam, o);
+  EXPECT_NEAR(r.depth[0], 1.0, 1e-5);
+  sogmm::Gmm one;
+  one.resize(1);
+  set_component(one, 0, 1.0, Eigen::Vector4d(2.1 * s, 0, 1.0, 0.2), diag(s * s, s * s, sz * sz, 0.01));
+  r = sogmm::render_expected_surface(one, cam, o);
+  EXPECT_TRUE(std::isnan(r.depth[0]));
+}
+
 TEST(Render, FittedPlaneIsRenderedAtThePlane) {
   // A regular grid of points on the plane z = 1.5 + 0.2 x (no randomness),
   // gray a ramp in y; fitted, then rendered from the origin.
@@ -249,6 +318,12 @@ TEST(Render, BadInputIsAClearError) {
   o.max_mahalanobis = 0;
   sogmm_test::expect_error_codes([&] { sogmm::render_expected_surface(g, kSmall, o); },
                                  {sogmm::ErrorCode::InvalidArgument}, {"max_mahalanobis"}, "max_mahalanobis 0");
+  for (double bad : {-1.0, std::nan("")}) {
+    o = {};
+    o.surface_sigma = bad;
+    sogmm_test::expect_error_codes([&] { sogmm::render_expected_surface(g, kSmall, o); },
+                                   {sogmm::ErrorCode::InvalidArgument}, {"surface_sigma"}, "surface_sigma < 0 or NaN");
+  }
   sogmm_test::expect_error_codes([&] { sogmm::render_expected_surface(g, sogmm::Camera{0, 9, 1, 1, 0, 0}); },
                                  {sogmm::ErrorCode::InvalidArgument}, {"size"}, "a camera without pixels");
   sogmm_test::expect_error_codes(

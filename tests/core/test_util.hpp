@@ -204,6 +204,28 @@ inline std::vector<float> draw_mixture(const std::vector<Eigen::Vector4d>& mus,
   return out;
 }
 
+// A room-like frame: 8 rotated planar patches (about 1 m, 3 mm thick) with
+// gray gradients, 4000 points in the camera frame.
+inline std::vector<float> frame_points() {
+  TestRng r(2024);
+  std::vector<float> pts;
+  for (int patch = 0; patch < 8; ++patch) {
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a(i, j) = r.normal();
+    const Eigen::Matrix3d q = Eigen::HouseholderQR<Eigen::Matrix3d>(a).householderQ();
+    const Eigen::Vector3d centre(r.uniform() * 2 - 1, r.uniform() - 0.5, 1.5 + 1.5 * r.uniform());
+    const double g0 = r.uniform();
+    for (int i = 0; i < 500; ++i) {
+      const double u = r.uniform() - 0.5, v = 0.6 * (r.uniform() - 0.5);
+      const Eigen::Vector3d p = centre + q * Eigen::Vector3d(u, v, 0.003 * r.normal());
+      pts.insert(pts.end(), {static_cast<float>(p(0)), static_cast<float>(p(1)), static_cast<float>(p(2)),
+                             static_cast<float>(g0 + 0.3 * u + 0.02 * r.normal())});
+    }
+  }
+  return pts;
+}
+
 inline bool bit_identical(const sogmm::Gmm& a, const sogmm::Gmm& b) {
   auto same = [](const std::vector<float>& x, const std::vector<float>& y) {
     return x.size() == y.size() &&

@@ -24,6 +24,11 @@
 // - save -> load -> save writes the same bytes (but the creation time);
 // - never locked (issue 36): at the end of every input, each map's pending
 //   points flush, or are discarded, and the map then saves (or is empty).
+// - a declared origin is taken only by an empty map and only when every axis
+//   is a finite float32; tracking records a frame exactly when it says it
+//   inserted one, at a finite pose; a delta (exported since any revision,
+//   sometimes with a flipped byte) brings the receiver to the sender's
+//   revision and component count, or is refused with the receiver unchanged.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -669,6 +674,109 @@ void step_misc(State& st, Reader& in) {
   }
 }
 
+std::int64_t revision(const sogmm_map* m) {
+  int64_t r = -1;
+  FUZZ_CHECK(sogmm_map_get_i64(m, SOGMM_MAP_REVISION, &r) == SOGMM_OK && r >= 0);
+  return r;
+}
+
+// A declared origin: accepted only on a map with no frame and no component,
+// and only when every axis is finite and within float32 range; a refused
+// call leaves the origin as it was.
+void step_origin(State& st, Reader& in) {
+  Slot& slot = st.maps[in.take<std::uint8_t>() % kMaps];
+  double origin[3];
+  for (double& v : origin) v = (in.take<std::uint8_t>() & 1) ? take_special(in) : take_double(in);
+  if (!slot.map) return;
+  double before[3], after[3];
+  FUZZ_CHECK(sogmm_map_get_origin(slot.map, before) == SOGMM_OK);
+  const Counts c = counts(slot.map);
+  const sogmm_status s = sogmm_map_set_origin(slot.map, origin);
+  check_status(s);
+  FUZZ_CHECK(sogmm_map_get_origin(slot.map, after) == SOGMM_OK);
+  bool representable = true;
+  for (double v : origin) representable = representable && std::isfinite(v) && std::fabs(v) <= 3.4028234663852886e38;
+  if (s == SOGMM_OK) {
+    FUZZ_CHECK(c.frames == 0 && c.components == 0 && representable);
+    FUZZ_CHECK(std::memcmp(after, origin, sizeof origin) == 0);
+  } else {
+    FUZZ_CHECK(std::memcmp(after, before, sizeof before) == 0);
+  }
+}
+
+// Tracking (issue 32) on the current frame, from a hostile guess or the
+// constant-velocity prediction: a frame is recorded exactly when the call
+// says it was inserted, at a finite rigid pose; an error records nothing.
+void step_track(State& st, Reader& in) {
+  Slot& slot = st.maps[in.take<std::uint8_t>() % kMaps];
+  const std::uint8_t how = in.take<std::uint8_t>();
+  const std::array<double, 16> guess = take_map_pose(in);
+  if (!slot.map || !st.frame) return;
+  const std::size_t n = sogmm_frame_width(st.frame) * std::size_t{sogmm_frame_height(st.frame)};
+  if (st.points_used + n > kMaxPointsPerInput) return;
+  st.points_used += n;
+  const Counts before = counts(slot.map);
+  double pose[16];
+  std::int32_t inserted = -1;
+  sogmm_registration_info info{};
+  info.struct_size = (how & 2) ? sizeof info : in.take<std::uint8_t>();
+  arm(slot, true);
+  const sogmm_status s =
+      sogmm_map_track_frame(slot.map, st.frame, (how & 1) ? guess.data() : nullptr, pose, &inserted, &info);
+  check_status(s);
+  FUZZ_CHECK(s != SOGMM_E_BUSY);
+  const Counts after = counts(slot.map);
+  if (s != SOGMM_OK) {
+    FUZZ_CHECK(after.frames == before.frames);
+    FUZZ_CHECK(s != SOGMM_E_CANCELLED || slot.has_progress);
+    return;
+  }
+  FUZZ_CHECK(inserted == 0 || inserted == 1);
+  FUZZ_CHECK(after.frames == before.frames + static_cast<std::uint64_t>(inserted));
+  if (inserted)
+    for (double v : pose) FUZZ_CHECK(std::isfinite(v));
+}
+
+// A delta of one slot since a revision (its first, its last, or any),
+// applied to the other slot (or itself): the receiver either reaches the
+// sender's revision with the sender's component count, or refuses and is
+// unchanged.
+void step_delta(State& st, Reader& in) {
+  const std::uint8_t what = in.take<std::uint8_t>();
+  Slot& from = st.maps[what % kMaps];
+  Slot& to = st.maps[(what >> 1) % kMaps];
+  const std::uint64_t pick = in.take<std::uint8_t>();
+  if (!from.map) return;
+  const std::int64_t head = revision(from.map);
+  const std::uint64_t since = pick < 0x80 ? 0 : pick < 0xC0 ? static_cast<std::uint64_t>(head) : pick - 0xC0;
+  std::size_t size = 0;
+  const sogmm_status q = sogmm_map_export_delta(from.map, since, nullptr, nullptr, 0, &size);
+  check_status(q);
+  if (q != SOGMM_OK) {
+    FUZZ_CHECK(q == SOGMM_E_INVALID_ARG || q == SOGMM_E_LIMIT);
+    return;
+  }
+  FUZZ_CHECK(size > 0 && size < (std::size_t{64} << 20));
+  std::vector<std::uint8_t> bytes(size);
+  std::size_t written = 0;
+  FUZZ_CHECK(sogmm_map_export_delta(from.map, since, nullptr, bytes.data(), bytes.size(), &written) == SOGMM_OK);
+  FUZZ_CHECK(written == size);
+  if (what & 4) bytes[in.take<std::uint16_t>() % bytes.size()] ^= static_cast<std::uint8_t>(1 + in.take<std::uint8_t>() % 255);
+  if (!to.map) return;
+  const Counts before = counts(to.map);
+  const std::int64_t to_revision = revision(to.map);
+  arm(to, true);
+  const sogmm_status s = sogmm_map_apply_delta(to.map, bytes.data(), bytes.size(), nullptr);
+  check_status(s);
+  FUZZ_CHECK(s != SOGMM_E_BUSY);
+  if (s == SOGMM_OK) {
+    FUZZ_CHECK(revision(to.map) == head);
+    FUZZ_CHECK(counts(to.map).components == counts(from.map).components);
+  } else {
+    FUZZ_CHECK(counts(to.map) == before && revision(to.map) == to_revision);
+  }
+}
+
 // Issue 36's rule: whatever came before, a map's pending points either flush
 // or are discarded, and then the map saves (or is empty and says so).
 void check_never_locked(Slot& slot) {
@@ -713,7 +821,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       {"set_option", step_set_option}, {"create", step_create},       {"insert_points", step_insert_points},
       {"frame", step_frame},           {"insert_frame", step_insert_frame}, {"flush", step_flush},
       {"discard", step_discard},       {"progress", step_progress},   {"save_load", step_save_load},
-      {"load_bytes", step_load_bytes}, {"query", step_query},         {"misc", step_misc}};
+      {"load_bytes", step_load_bytes}, {"query", step_query},         {"misc", step_misc},
+      {"origin", step_origin},         {"track", step_track},         {"delta", step_delta}};
   Reader in(data, size);
   State st;
   sogmm_fuzz::run_program(in, st, kMaxSteps, steps, check_stats);

@@ -13,9 +13,9 @@ from make_api_seeds import tame, write_seeds  # the same reader layouts (fuzz_in
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "seeds", "map")
 
-# Opcodes (LLVMFuzzerTestOneInput's switch, modulo 12).
+# Opcodes (LLVMFuzzerTestOneInput's step table, modulo 15).
 (SET_OPTION, CREATE, INSERT_POINTS, FRAME, INSERT_FRAME, FLUSH, DISCARD, PROGRESS, SAVE_LOAD, LOAD_BYTES, QUERY,
- MISC) = range(12)
+ MISC, ORIGIN, TRACK, DELTA) = range(15)
 # Query kinds (step_query: what % 8).
 EXPORT, SCORE, REGRESS, SAMPLE, RENDER, OCCUPANCY, SURFACE, COLLISION = range(8)
 # Indices into take_special's table.
@@ -48,6 +48,21 @@ def frame(w, h, f, salt=0, gray=True, special_f=None):
     return out + (bytes([SPECIAL[special_f]]) if special_f is not None else bytes([f - 4]))
 
 
+def origin(slot, x, y, z):
+    """step_origin: each axis a double (flag byte 0, then the value)."""
+    return bytes([ORIGIN, slot]) + b"".join(bytes([0]) + tame(v) for v in (x, y, z))
+
+
+def track(slot, guess=None):
+    """step_track: the full info struct; the constant-velocity guess, or `guess`."""
+    return bytes([TRACK, slot, 3 if guess is not None else 2]) + (guess or pose())
+
+
+def delta(sender, receiver, since_first=True):
+    """step_delta: the sender's delta since its first (or last) revision, applied to the receiver."""
+    return bytes([DELTA, sender | (receiver << 1), 0 if since_first else 0x80])
+
+
 def query(slot, kind, n, extra=b"", flags=0):
     return bytes([QUERY, slot, kind | flags, n]) + extra
 
@@ -78,6 +93,9 @@ def main():
         + bytes([LOAD_BYTES, 1, 1]) + struct.pack("<HB", 40, 0x10) + bytes([LOAD_BYTES, 0, 0, 8]) + b"\x89SOG\r\n\x1a\n",
         "fixed_k_above_pending": set_map_i64(N_COMPONENTS, 8) + create(0) + insert_points(0, 5) + bytes([FLUSH, 0])
         + insert_points(0, 40, salt=9),
+        "origin_track_then_delta": create(0) + origin(0, 5e5, 0.0, 0.0) + frame(10, 10, 10) + track(0, pose(5e5))
+        + track(0) + track(0, pose(5e5 + 0.02)) + bytes([FLUSH, 0]) + create(1) + delta(0, 1) + delta(0, 1, False)
+        + query(1, SCORE, 20, points_bytes(20)),
         "first_frame_tiny_focal": create(0) + frame(8, 8, 0, special_f=1e-30) + bytes([INSERT_FRAME, 0]) + pose()
         + frame(8, 8, 10, salt=3) + bytes([INSERT_FRAME, 0]) + pose() + bytes([FLUSH, 0]),
     }

@@ -65,7 +65,10 @@ for i in "${!TARGETS[@]}"; do
 done
 
 if [ "$DO_BUILD" = 1 ]; then
+  # -O1 with line tables, libFuzzer's advice (and tools/test.sh's other
+  # sanitizer builds): the instrumented core compiles about 2x faster than at -O2 -g.
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
     -DSOGMM_SANITIZE=ON -DSOGMM_FUZZ=ON -DSOGMM_BUILD_TOOLS=OFF >/dev/null
   cmake --build "$BUILD" --parallel "$(nproc)" --target "${TARGETS[@]/#/sogmm_fuzz_}"
 fi

@@ -206,4 +206,70 @@ TEST(CapiMapValidity, LoadRefusesUnknownSupportAndSignedCounts) {
   sogmm::test::remove_scratch_dir(dir);
 }
 
+// The map's origin (anchor) through the C API: the first frame's translation
+// rounded to 1 km, or declared before the first insert; a map saved 1000 km
+// out stores it as its pose (spec/format.md 2.3.1) and loads it back, and its
+// export is in world coordinates.
+TEST(CapiMapValidity, AFarMapKeepsItsOriginThroughSaveAndLoad) {
+  const std::vector<float> a = wall(300, 5);
+  double origin[3] = {7, 7, 7};
+  {
+    MapHandle m;
+    EXPECT_EQ(sogmm_map_get_origin(m.map, origin), SOGMM_OK);
+    EXPECT_EQ(origin[0], 0.0);  // nothing inserted, nothing declared
+    const double declared[3] = {1.0e6 + 0.5, 2, 3};
+    EXPECT_EQ(sogmm_map_set_origin(m.map, declared), SOGMM_OK);
+    ASSERT_EQ(m.insert(a, translated(1.0e6 + 12.25)), SOGMM_OK);
+    EXPECT_EQ(sogmm_map_get_origin(m.map, origin), SOGMM_OK);
+    EXPECT_EQ(origin[0], 1.0e6 + 0.5);
+    EXPECT_EQ(origin[2], 3.0);
+    EXPECT_EQ(sogmm_map_set_origin(m.map, declared), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(has(last_error(), "before the first insert")) << last_error();
+  }
+  MapHandle m;
+  const double bad[3] = {0, NAN, 0};
+  EXPECT_EQ(sogmm_map_set_origin(m.map, bad), SOGMM_E_INVALID_ARG);
+  EXPECT_TRUE(has(last_error(), "origin axis 1")) << last_error();
+  EXPECT_EQ(sogmm_map_set_origin(m.map, nullptr), SOGMM_E_NULL_ARG);
+  EXPECT_EQ(sogmm_map_get_origin(m.map, nullptr), SOGMM_E_NULL_ARG);
+  EXPECT_EQ(sogmm_map_get_origin(nullptr, origin), SOGMM_E_NULL_ARG);
+  ASSERT_EQ(m.insert(a, translated(1.0e6 + 12.25)), SOGMM_OK);
+  ASSERT_EQ(sogmm_map_flush(m.map), SOGMM_OK);
+  EXPECT_EQ(sogmm_map_get_origin(m.map, origin), SOGMM_OK);
+  EXPECT_EQ(origin[0], 1.0e6);
+  EXPECT_EQ(origin[1], 0.0);
+
+  const std::string dir = sogmm::test::make_scratch_dir("sogmm-origin");
+  const std::string path = dir + "/far.sogmm";
+  ASSERT_EQ(sogmm_map_save(m.map, path.c_str(), nullptr), SOGMM_OK) << last_error();
+  sogmm_model* file = nullptr;
+  ASSERT_EQ(sogmm_model_load(&file, path.c_str(), nullptr), SOGMM_OK);
+  double pose[16] = {};
+  ASSERT_EQ(sogmm_model_get_pose(file, pose), SOGMM_OK);  // the origin, as a translation
+  EXPECT_EQ(pose[3], 1.0e6);
+  EXPECT_EQ(pose[0], 1.0);
+  sogmm_map* loaded = nullptr;
+  ASSERT_EQ(sogmm_map_load(&loaded, path.c_str(), nullptr), SOGMM_OK) << last_error();
+  double loaded_origin[3] = {};
+  EXPECT_EQ(sogmm_map_get_origin(loaded, loaded_origin), SOGMM_OK);
+  EXPECT_EQ(loaded_origin[0], 1.0e6);
+  // The export is world-frame: the file's means moved by the origin.
+  sogmm_model* world = nullptr;
+  ASSERT_EQ(sogmm_map_export(&world, loaded, nullptr), SOGMM_OK);
+  size_t n = 0;
+  ASSERT_EQ(sogmm_model_n_components(file, &n), SOGMM_OK);
+  std::vector<float> file_mean(4 * n), world_mean(4 * n);
+  ASSERT_EQ(sogmm_model_get_means_f32(file, file_mean.data(), file_mean.size()), SOGMM_OK);
+  ASSERT_EQ(sogmm_model_get_means_f32(world, world_mean.data(), world_mean.size()), SOGMM_OK);
+  for (size_t k = 0; k < n; ++k) {
+    EXPECT_EQ(world_mean[4 * k], static_cast<float>(static_cast<double>(file_mean[4 * k]) + 1.0e6));
+    EXPECT_EQ(world_mean[4 * k + 2], file_mean[4 * k + 2]);
+    EXPECT_LT(std::fabs(file_mean[4 * k] - 12.25f), 1.0f);  // the file's means are near the origin
+  }
+  sogmm_model_free(world);
+  sogmm_model_free(file);
+  sogmm_map_free(loaded);
+  sogmm::test::remove_scratch_dir(dir);
+}
+
 }  // namespace

@@ -2,34 +2,25 @@
 """Every layer's option keys and defaults against the library's registry.
 
 The option registry (core/include/sogmm/options.hpp) is the one source of
-each option's key, type, range and default; the C API reports it through
-sogmm_option_keys / sogmm_option_get_info. This check reads the registry
-from the built library and fails on any copy that disagrees with it:
+each option's key, type, range, default and documentation; the C API
+reports it through sogmm_option_keys / sogmm_option_get_info. This check
+fails when a copy of it disagrees:
 
-- sogmm.h: every SOGMM_OPT_* macro is a registry key with that name and
-  number, and the "default X" of its comment is the registry's default;
-- spec/api.md: the option table's key, type and default columns;
-- Rust (sogmm-sys) and Python (_ffi.py) key constants: names and numbers
-  (Go takes the header's macros through cgo: nothing to compare);
-- Python: every keyword of the public API that names an option has the
-  registry's default (the package reads them from the library).
+- the generated blocks (the SOGMM_OPT_* macros and their documentation in
+  sogmm.h, spec/api.md's option tables, the Rust, Python and Go key
+  constants) differ from what tools/options/regenerate.py writes from the
+  registry; the message names the command that rewrites them;
+- a keyword of Python's public API that names an option has a default other
+  than the registry's (the package reads them from the library).
 
-Usage: check_options.py LIBSOGMM_PATH REPO_ROOT
+Usage: check_options.py LIBSOGMM_PATH REPO_ROOT SOGMM_OPTION_MIRRORS_PATH
 """
 import ctypes
 import inspect
 import math
-import re
+import subprocess
 import sys
 from pathlib import Path
-
-SENTINELS = {
-    "SOGMM_REG_COVAR_AUTO": -1.0,
-    "SOGMM_DEQUANTISE_AUTO": -1.0,
-    "SOGMM_MODE_COUNTER_FLAT_BINNED": 0.0,
-    "SOGMM_FUSION_HELLINGER": 0.0,
-}
-
 
 class Info(ctypes.Structure):
     _fields_ = [
@@ -68,72 +59,8 @@ def registry(lib_path):
     return rows
 
 
-def number(text):
-    """The value a default cell or comment states: a number or a sentinel."""
-    text = text.strip().strip("`").rstrip(".,;:")
-    if text in SENTINELS:
-        return SENTINELS[text]
-    m = re.match(r"^([-+]?[0-9.]+(?:e[-+]?[0-9]+)?)", text)
-    return float(m.group(1)) if m else None
-
-
 def same(a, b):
     return a == b or (math.isnan(a) and math.isnan(b)) or math.isclose(a, b, rel_tol=1e-12)
-
-
-def check_header(rows, root, problems):
-    text = (root / "capi/include/sogmm/sogmm.h").read_text()
-    seen = set()
-    for m in re.finditer(r"#define (SOGMM_OPT_\w+) (\d+)\s*/\*(.*?)\*/", text, re.S):
-        name, key, comment = m.group(1), int(m.group(2)), m.group(3)
-        seen.add(name)
-        row = rows.get(name)
-        if row is None:
-            problems.append(f"sogmm.h: {name} = {key} is not in the registry")
-            continue
-        if row["key"] != key:
-            problems.append(f"sogmm.h: {name} = {key}, registry {row['key']}")
-        if not comment.strip().startswith(row["type"]):
-            problems.append(f"sogmm.h: {name}'s comment does not start with its type {row['type']}")
-        d = re.search(r"default ([^\s:;,]+)", comment)
-        if not d or number(d.group(1)) is None or not same(number(d.group(1)), row["default"]):
-            problems.append(f"sogmm.h: {name}'s comment states default "
-                            f"{d.group(1) if d else '(none)'}, registry {row['default']}")
-    for name in rows.keys() - seen:
-        problems.append(f"sogmm.h: no #define for {name}")
-
-
-def check_spec(rows, root, problems):
-    seen = set()
-    for line in (root / "spec/api.md").read_text().splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) < 5 or not re.fullmatch(r"`SOGMM_OPT_\w+`", cells[0]):
-            continue
-        name = cells[0].strip("`")
-        seen.add(name)
-        row = rows.get(name)
-        if row is None:
-            problems.append(f"spec/api.md: {name} is not in the registry")
-            continue
-        if int(cells[1]) != row["key"] or cells[2] != row["type"]:
-            problems.append(f"spec/api.md: {name} is {cells[1]} {cells[2]}, registry {row['key']} {row['type']}")
-        d = number(cells[4].split(":")[0].split(" ")[0])
-        if d is None or not same(d, row["default"]):
-            problems.append(f"spec/api.md: {name} default '{cells[4][:40]}', registry {row['default']}")
-    for name in rows.keys() - seen:
-        problems.append(f"spec/api.md: the option table has no row for {name}")
-
-
-def check_constants(rows, path, pattern, prefix, problems):
-    text = path.read_text()
-    found = {prefix + m.group(1): int(m.group(2)) for m in re.finditer(pattern, text)}
-    for name, row in rows.items():
-        if name not in found:
-            problems.append(f"{path}: no constant for {name}")
-        elif found[name] != row["key"]:
-            problems.append(f"{path}: {name} = {found[name]}, registry {row['key']}")
-    for name in found.keys() - rows.keys():
-        problems.append(f"{path}: {name} is not in the registry")
 
 
 def check_python_defaults(rows, root, problems):
@@ -170,21 +97,16 @@ def check_python_defaults(rows, root, problems):
 
 
 def main():
-    lib_path, root = sys.argv[1], Path(sys.argv[2])
+    lib_path, root, generator = sys.argv[1], Path(sys.argv[2]), sys.argv[3]
+    stale = subprocess.run([sys.executable, str(root / "tools/options/regenerate.py"), "--check",
+                            "--generator", generator, "--root", str(root)])
     rows = registry(lib_path)
     problems = []
-    check_header(rows, root, problems)
-    check_spec(rows, root, problems)
-    check_constants(rows, root / "bindings/rust/sogmm-sys/src/lib.rs",
-                    r"pub const SOGMM_OPT_(\w+): sogmm_key = (\d+);", "SOGMM_OPT_", problems)
-    check_constants(rows, root / "bindings/python/src/sogmm/_ffi.py", r"(?m)^OPT_(\w+) = (\d+)$", "SOGMM_OPT_",
-                    problems)
     n_python = check_python_defaults(rows, root, problems)
     for p in problems:
         print("MISMATCH", p)
-    print(f"{len(rows)} options; header, spec/api.md, Rust and Python keys, {n_python} Python keyword defaults "
-          f"checked: {len(problems)} mismatches")
-    return 1 if problems else 0
+    print(f"{len(rows)} options; {n_python} Python keyword defaults checked: {len(problems)} mismatches")
+    return 1 if problems or stale.returncode != 0 else 0
 
 
 if __name__ == "__main__":

@@ -252,6 +252,16 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
     check(ev.get("psnr_data_range") == 1 and ev2.get("psnr_data_range") == 2, "eval --data-range: %s" % ev2)
     check(abs(ev2.get("psnr", 0) - ev.get("psnr", 0) - 20 * math.log10(2)) < 1e-9 and
           ev2.get("psnr_paper") == ev.get("psnr_paper"), "eval --data-range 2: %s vs %s" % (ev2, ev))
+    # --surface-sigma S only rejects modes (a pixel shown at S = 2 shows a mode that S = 0 also
+    # finds, and a pixel empty at S = 0 has no mode at all): never fewer empty pixels, the same
+    # observed pixels, the mass-weighted figures untouched; S < 0 is a usage error.
+    ev3 = run_json(["eval", model] + fargs + ["--surface-sigma", 2])
+    for key in ("", "_heldout"):
+        check(ev3.get("empty_share" + key, -1) >= ev.get("empty_share" + key, 2) and
+              ev3.get("n_pixels" + key) == ev.get("n_pixels" + key), "eval --surface-sigma 2%s: %s vs %s" % (key, ev3, ev))
+    check(ev3.get("psnr") == ev.get("psnr") and ev3.get("mre") == ev.get("mre"), "eval --surface-sigma 2 moved MRE/PSNR")
+    p = run(["eval", model] + fargs + ["--surface-sigma", -1], expect=2)
+    check("--surface-sigma" in p.stderr, "eval --surface-sigma -1: %r" % p.stderr)
     # --n-init: the kept run is the best, and a single fit with its seed is the same model.
     best = run_json(["eval"] + fargs + extra_camera + ["--decimate", dec, "--bandwidth", bandwidth, "--seed", 5,
                                                        "--n-init", 3])
@@ -270,6 +280,11 @@ def exercise_frame(tmp, d, ext, dec, bandwidth, extra_camera, expect_w, expect_h
     img = read_png(out)
     check(img.shape == (expect_h, expect_w), "render: %s, expected %dx%d" % (img.shape, expect_w, expect_h))
     check((img > 0).mean() > 0.6, "render: only %.2f of the pixels show the surface" % (img > 0).mean())
+    run(["render", model, "-o", out, "--surface-sigma", 2])
+    strict = read_png(out)
+    # Empty pixels are black; S = 2 only rejects modes, so it shows no more pixels than S = 0.
+    check(strict.shape == img.shape and 0 < (strict > 0).sum() <= (img > 0).sum(),
+          "render --surface-sigma 2: %d shown pixels against %d at S = 0" % ((strict > 0).sum(), (img > 0).sum()))
     run(["render", model, "-o", out, "--scale", "2"])
     check(png_size(out)[:2] == (2 * expect_w, 2 * expect_h), "render --scale 2 size %s" % (png_size(out),))
     run(["render", model, "-o", out, "--depth", fargs[1]])
@@ -423,7 +438,8 @@ def mode_map(tmp):
     summary, progress = run_json(["map", d] + base + ["-o", out, "--progress"], with_stderr=True)
     check(progress.count("novel") >= n, "map --progress: one line per frame expected: %r" % progress[-500:])
     rows = open(os.path.join(tmp, "loop.csv")).read().strip().split("\n")
-    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced",
+    check(rows[0] == "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced,"
+          "pose,inlier_ratio,registration_ll",
           "map CSV header: %r" % rows[0])
     check(len(rows) == n + 1, "map CSV: %d rows for %d frames" % (len(rows) - 1, n))
     table = [r.split(",") for r in rows[1:]]
@@ -509,6 +525,41 @@ def mode_map(tmp):
     err(["map", bad, "--trajectory", traj] + badargs, 3, "color")  # 3 depth images, 2 color
     check(not os.path.exists(m), "a failed map run wrote %s" % m)
     no_temp_files(tmp)
+
+
+def mode_deltas(tmp):
+    """sogmm map --deltas writes one delta per fitting insert, names that
+    sort; sogmm apply-deltas rebuilds the map bit for bit (sogmm-inspect
+    --components of both) and refuses a gap with one line naming the file."""
+    d = os.path.join(tmp, "loop")
+    run(["demo", "--write-frame", d, "--loop", "--frames", 6])
+    base = ["--trajectory", os.path.join(d, "trajectory.log"), "--decimate", 10, "--bandwidth", 0.05, "--batch", 400]
+    out, deltas = os.path.join(tmp, "loop.sogmm"), os.path.join(tmp, "deltas")
+    summary = run_json(["map", d] + base + ["-o", out, "--deltas", deltas])
+    names = sorted(os.listdir(deltas))
+    check(len(names) == summary.get("n_deltas") and len(names) >= 2, "map --deltas: %s for %s" % (names, summary))
+    revisions = [int(n[len("delta-"):-len(".sogmm")]) for n in names]
+    check(revisions == sorted(revisions) and revisions[-1] >= 6, "delta names do not sort by revision: %s" % names)
+    rebuilt = os.path.join(tmp, "rebuilt.sogmm")
+    r = run_json(["apply-deltas", deltas, "-o", rebuilt])
+    check(r.get("n_deltas") == len(names) and r.get("n_components") == summary.get("n_components"),
+          "apply-deltas: %s vs map %s" % (r, summary))
+    inspect = os.path.join(os.path.dirname(SOGMM), "..", "sogmm-inspect", "sogmm-inspect")
+    if os.path.exists(inspect):
+        comps = [subprocess.run([inspect, "--components", f], stdout=subprocess.PIPE, text=True).stdout
+                 for f in (out, rebuilt)]
+        check(comps[0] == comps[1] and comps[0].count("component") == summary.get("n_components"),
+              "apply-deltas: the rebuilt components differ from the map's")
+        v = subprocess.run([inspect, "--verify", os.path.join(deltas, names[0])], stdout=subprocess.PIPE, text=True)
+        check(v.returncode == 0 and "map delta" in v.stdout, "sogmm-inspect --verify on a delta: %r" % v.stdout)
+    # From a base map: the sender's final map already holds every delta.
+    p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "none.sogmm"), "--base", out], expect=2)
+    check("no delta after revision %d" % revisions[-1] in p.stderr, "apply-deltas --base: %r" % p.stderr)
+    # A gap: the second delta missing. Nothing is written.
+    os.remove(os.path.join(deltas, names[1]))
+    p = run(["apply-deltas", deltas, "-o", os.path.join(tmp, "gap.sogmm")], expect=3)
+    check(names[2 if len(names) > 2 else 1] in p.stderr or "missing" in p.stderr, "apply-deltas gap: %r" % p.stderr)
+    check(not os.path.exists(os.path.join(tmp, "gap.sogmm")), "apply-deltas wrote a map after a gap")
 
 
 def query_map(tmp, d, map_path, traj_lines):
@@ -679,7 +730,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sogmm", required=True)
     ap.add_argument("--data", required=True)
-    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "shared"])
+    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "deltas", "shared"])
     a = ap.parse_args()
     SOGMM = a.sogmm
     with tempfile.TemporaryDirectory(prefix="sogmm_cli_test_") as tmp:
@@ -693,6 +744,8 @@ def main():
             mode_sequence(tmp)
         elif a.mode == "map":
             mode_map(tmp)
+        elif a.mode == "deltas":
+            mode_deltas(tmp)
         elif mode_shared(tmp, a.data) == "skip":
             return 0
     if FAILURES:

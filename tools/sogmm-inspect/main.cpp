@@ -20,6 +20,8 @@
 #include <Eigen/Eigenvalues>
 
 #include "sogmm/format.hpp"
+#include "sogmm/map_delta.hpp"
+#include "sogmm/map_delta_file.hpp"
 
 namespace {
 
@@ -238,10 +240,27 @@ int main(int argc, char** argv) {
       std::printf("checksums           metadata verified; arrays not read\n");
       return 0;
     }
+    // A map delta (spec/format.md 2.5: bit 0 and its keys) is verified by
+    // the delta rules and shown as the model form it is stored in (delta
+    // keys included). Bit 0 without the keys is no delta: read as a model,
+    // it is refused as such (unsupported_feature). The probe's metadata is
+    // freed before the full read (section 8's memory bound).
+    bool delta = false;
+    {
+      const fmt::FileInfo probe = fmt::read_info_file(path);
+      delta = (probe.features_required & 1u) != 0 && sogmm::find_value(probe.metadata, sogmm::kDeltaOpsKey) != nullptr;
+    }
     fmt::FileInfo info;
-    const sogmm::Model model = fmt::load(path, {}, &info);  // full verification, checksums included
+    sogmm::Model model;
+    if (delta) {
+      model = sogmm::delta_to_model(fmt::load_delta(path));
+      info = fmt::read_info_file(path);
+      info.metadata = sogmm::Model{};
+    } else {
+      model = fmt::load(path, {}, &info);
+    }
     if (mode == "verify") {
-      std::printf("ok\n");
+      std::printf(delta ? "ok (map delta)\n" : "ok\n");
       return 0;
     }
     if (mode == "json") {
@@ -266,6 +285,13 @@ int main(int argc, char** argv) {
       return 0;
     }
     print_metadata(info, model);
+    if (delta) {
+      std::printf("map delta           revision %s -> %s, %zu explicit components\n",
+                  sogmm::find_value(model, sogmm::kDeltaBaseRevisionKey)->c_str(),
+                  sogmm::find_value(model, sogmm::kDeltaRevisionKey)->c_str(), model.gmm.size());
+      std::printf("checksums           all verified (metadata and %d arrays); steps checked by a receiver\n", 3);
+      return 0;
+    }
     print_statistics(model);
     std::printf("checksums           all verified (metadata and %d arrays)\n", 3);
     return 0;

@@ -30,6 +30,7 @@ Prints a table and one JSON line per sequence.
 Usage (from the repository root):
     python3 tools/sogmm-perf/map_loop.py [--sogmm build/tools/sogmm/sogmm] [--loop-dir /tmp/sogmm_loop]
         [--frames 300] [--decimate 5] [--bandwidth 0.02] [--accuracy-step 10] [--heldout-decimate 4] [--timing-runs 5]
+        [--surface-sigma S]
         [-- MAP FLAGS...]
 Anything after `--` goes to `sogmm map` (e.g. -- --fusion hellinger --threshold 3).
 """
@@ -44,8 +45,12 @@ import sys
 import tempfile
 
 
+EVAL_FLAGS = []  # --surface-sigma S: given to every `sogmm eval` (its per-pixel renders)
+
+
 def run_json(sogmm, args):
-    p = subprocess.run([sogmm] + [str(a) for a in args] + ["--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    extra = EVAL_FLAGS if args and args[0] == "eval" else []
+    p = subprocess.run([sogmm] + [str(a) for a in args] + extra + ["--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                        text=True)
     if p.returncode != 0:
         sys.exit("sogmm %s failed (%d): %s" % (" ".join(map(str, args)), p.returncode, p.stderr.strip()))
@@ -173,7 +178,11 @@ def main():
     ap.add_argument("--accuracy-step", type=int, default=10, help="evaluate every N-th frame against its own fit")
     ap.add_argument("--heldout-decimate", type=int, default=None,
                     help="decimation of the held-out pixel grid (default: --decimate minus 1)")
+    ap.add_argument("--surface-sigma", type=float, default=None,
+                    help="eval's per-pixel renders: a mode is a surface only with one component's evidence at S sigma")
     a = ap.parse_args(argv)
+    if a.surface_sigma is not None:
+        EVAL_FLAGS.extend(["--surface-sigma", str(a.surface_sigma)])
     if a.heldout_decimate is None:
         a.heldout_decimate = max(1, a.decimate - 1)
     if a.heldout_decimate % a.decimate == 0:
@@ -192,7 +201,7 @@ def main():
             results.append(measure("livingroom_0_3", a.sogmm, room, "0:3", a, map_flags, work))
         else:
             print("SKIP livingroom: %s is absent" % room)
-    print("map flags: %s" % (" ".join(map_flags) or "(defaults)"))
+    print("map flags: %s; eval flags: %s" % (" ".join(map_flags) or "(defaults)", " ".join(EVAL_FLAGS) or "(defaults)"))
     print("| sequence | frames | M append | M map | ratio (<=0.30) | novel | worst PSNR loss dB vs own fit (<=0.5) "
           "/ vs append / held-out d=%d | worst MRE +mm vs own fit (<=1) / vs append / held-out | insert ms 10-20 "
           "| 290-300 | ratio (<=1.5) |" % a.heldout_decimate)

@@ -93,6 +93,7 @@ Command add_demo_command(CLI::App& root);
 Command add_eval_command(CLI::App& root);
 Command add_fit_command(CLI::App& root);
 Command add_map_command(CLI::App& root);
+Command add_apply_deltas_command(CLI::App& root);
 Command add_render_command(CLI::App& root);
 Command add_sample_command(CLI::App& root);
 Command add_query_command(CLI::App& root);

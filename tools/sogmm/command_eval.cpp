@@ -28,6 +28,7 @@ struct EvalState {
   DepthOptions depth_options;
   FitOptions fit;
   double data_range = 1.0;  // honest PSNR's peak (--data-range)
+  double surface_sigma = 0.0;  // per-pixel renders: RenderOptions::surface_sigma (--surface-sigma)
   int frame = -1;           // --frame I of --trajectory (one frame of a world-frame model)
   bool json = false;
 };
@@ -131,7 +132,7 @@ int run_fit_and_eval(const EvalState& s) {
   const Camera camera = resolve_camera(s.camera, frame);
   const PointCloud cloud = backproject_nonempty(frame, camera, s.depth_options, s.src.depth);
   FitResult fitted = fit(cloud.view(), s.fit);
-  const PixelFigures pixels = pixel_figures(fitted.gmm, frame, camera, s.depth_options, s.data_range);
+  const PixelFigures pixels = pixel_figures(fitted.gmm, frame, camera, s.depth_options, s.data_range, s.surface_sigma);
   const Evaluation e =
       evaluate(std::move(fitted), cloud.view(), decimated(camera, s.depth_options.decimate), s.fit.seed, s.data_range);
   nlohmann::json extra;
@@ -148,7 +149,7 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
     const std::vector<Pose> poses = read_trajectory(s.src.trajectory);
     require(static_cast<std::size_t>(s.frame) < poses.size(), ErrorCode::InvalidArgument,
             "eval: --frame must be in [0, " + std::to_string(poses.size()) + ") for " + s.src.trajectory);
-    gmm = transform(gmm, inverse_rigid(poses[static_cast<std::size_t>(s.frame)]));
+    gmm = in_camera(model, poses[static_cast<std::size_t>(s.frame)]);
   } else {
     // A world-frame model seen from the world origin scores nothing the
     // frame saw: refuse instead of printing meaningless figures.
@@ -176,7 +177,7 @@ int run_model_frame(const EvalState& s, const CLI::App& app) {
   f.psnr = psnr(gmm, cloud.view(), dc, s.data_range);
   f.rec = reconstruction_metrics(gmm, cloud.view(), 0.01, s.fit.seed);
   f.n_samples = cloud.size();
-  f.pixels = pixel_figures(gmm, frame, camera, d, s.data_range);
+  f.pixels = pixel_figures(gmm, frame, camera, d, s.data_range, s.surface_sigma);
   nlohmann::json j = to_json(f);
   j.erase("frame");
   describe_model(s.model, model, s.json, j);
@@ -237,13 +238,13 @@ int run_model_sequence(const EvalState& s, const CLI::App& app) {
             f.depth + ": image size differs from the camera (give --intrinsics)");
     const PointCloud cloud = backproject_nonempty(frame, camera, d, f.depth);
     const Camera dc = decimated(camera, d.decimate);
-    const Gmm local = transform(model.gmm, inverse_rigid(poses[k]));
+    const Gmm local = in_camera(model, poses[k]);
     FrameScore sc;
     sc.frame = i;
     sc.depth = f.depth;
     sc.n_points = cloud.size();
     sc.psnr = psnr(local, cloud.view(), dc, s.data_range);
-    sc.pixels = pixel_figures(local, frame, camera, d, s.data_range);
+    sc.pixels = pixel_figures(local, frame, camera, d, s.data_range, s.surface_sigma);
     // As many samples as the model was fitted on, kept where this camera sees.
     const std::size_t n = static_cast<std::size_t>(
         std::min<std::uint64_t>(std::max<std::uint64_t>(model.gmm.support_size, cloud.size()), 4000000));
@@ -333,11 +334,16 @@ Command add_eval_command(CLI::App& root) {
   add_camera_flags(*app, s->camera, s->depth_options);
   add_fit_flags(*app, s->fit);
   add_data_range_flag(*app, s->data_range);
+  app->add_option("--surface-sigma", s->surface_sigma,
+                  "per-pixel figures: render with sogmm render's --surface-sigma (0 = every mode is a surface)")
+      ->capture_default_str();
   app->add_option("--frame", s->frame,
                   "with MODEL, --depth/--color and --trajectory: the pose index of the frame (world-frame model)");
   app->add_flag("--json", s->json, "print one JSON object");
   CLI::App* a = app;
   return {app, [s, a]() {
+            require(std::isfinite(s->surface_sigma) && s->surface_sigma >= 0, ErrorCode::InvalidArgument,
+                    "eval: --surface-sigma must be finite and >= 0");
             if (s->model.empty()) {
               require(s->src.sequence.empty() && s->src.trajectory.empty() && s->src.frames.empty(), ErrorCode::InvalidArgument,
                       "eval: --sequence needs a MODEL (fit one with: sogmm fit --sequence DIR --trajectory FILE -o M)");
@@ -346,9 +352,9 @@ Command add_eval_command(CLI::App& root) {
               return run_fit_and_eval(*s);
             }
             require(!any_given(*a, {"--bandwidth", "--components", "--tol", "--max-iter", "--reg-covar", "--n-init",
-                                     "--truncate"}),
+                                     "--truncate", "--em-acceleration"}),
                     ErrorCode::InvalidArgument,
-                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate apply only "
+                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate/--em-acceleration apply only "
                     "without MODEL");
             if (!s->src.sequence.empty()) {
               require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");

@@ -151,7 +151,7 @@ int run_sequence(const FitState& s) {
   Totals t;
   nlohmann::json frames_json = nlohmann::json::array();
   std::size_t before = 0;
-  run_map_over_sequence(map, in, s.depth_options, progress, [&](const MapRunFrame& f) {
+  run_map_over_sequence(map, in, progress, [&](const MapRunFrame& f) {
     const std::size_t m = f.stats.n_components - before;
     before = f.stats.n_components;
     t.add(f.stats.n_points, f.fit, f.stats.ms_fit / 1000.0);

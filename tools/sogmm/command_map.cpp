@@ -11,6 +11,7 @@
 
 #include "cli_common.hpp"
 #include "file_util.hpp"
+#include "map_deltas.hpp"
 #include "map_run.hpp"
 #include "model_io.hpp"
 #include "sogmm/error.hpp"
@@ -22,9 +23,10 @@ namespace {
 
 struct MapState {
   FrameSource src;
-  std::string output, csv, plot, trajectory_out;
+  std::string output, csv, plot, trajectory_out, deltas;
   CameraFlags camera;
   MapOptions options;
+  RegistrationOptions registration;  // tracking, without --trajectory
   std::string fusion = "off";
   bool no_novelty = false;
   bool json = false, progress = false, quiet = false;
@@ -40,15 +42,30 @@ struct Row {
   bool flushed;
   double ms_novelty, ms_fit, ms_merge;
   std::size_t replaced;  // components a revisit refit replaced
+  // How the pose came: "given" (--trajectory), "first" (the map's first
+  // frame, at the identity) or "registered" (tracking), with the
+  // registration's fitness (empty when not registered).
+  const char* pose_source;
+  double inlier_ratio, registration_ll;
 };
 
 std::string csv_text(const std::vector<Row>& rows) {
-  std::string out = "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced\n";
-  char buf[256];
+  std::string out =
+      "frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced,pose,inlier_ratio,"
+      "registration_ll\n";
+  char buf[320];
   for (const Row& r : rows) {
-    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%zu,%zu,%d,%.3f,%.3f,%.3f,%zu\n", r.frame, r.points, r.novel,
-                  r.components, r.pending, r.flushed ? 1 : 0, r.ms_novelty, r.ms_fit, r.ms_merge, r.replaced);
+    std::snprintf(buf, sizeof buf, "%zu,%zu,%zu,%zu,%zu,%d,%.3f,%.3f,%.3f,%zu,%s,", r.frame, r.points, r.novel,
+                  r.components, r.pending, r.flushed ? 1 : 0, r.ms_novelty, r.ms_fit, r.ms_merge, r.replaced,
+                  r.pose_source);
     out += buf;
+    if (std::string(r.pose_source) == "registered") {
+      std::snprintf(buf, sizeof buf, "%.4f,%.4f", r.inlier_ratio, r.registration_ll);
+      out += buf;
+    } else {
+      out += ",";
+    }
+    out += "\n";
   }
   return out;
 }
@@ -90,16 +107,23 @@ int run_map(MapState& s) {
   double ms_novelty = 0, ms_fit = 0, ms_merge = 0;
   std::vector<Pose> poses_used;
   std::size_t skipped = 0;
-  run_map_over_sequence(map, in, s.options.depth, progress, [&](const MapRunFrame& f) {
+  DeltaWriter deltas(s.deltas);
+  run_map_over_sequence(
+      map, in, progress,
+      [&](const MapRunFrame& f) {
     if (f.skipped) {
       ++skipped;
       return;
     }
     poses_used.push_back(f.pose);
     const FrameStats& st = f.stats;
+    if (st.flushed) deltas.write(map);
     const std::size_t pending = map.pending();
+    const bool given = !in.poses.empty();
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
-                    st.ms_fit, st.ms_merge, st.n_replaced});
+                    st.ms_fit, st.ms_merge, st.n_replaced,
+                    given ? "given" : (f.registered ? "registered" : "first"), f.registration.inlier_ratio,
+                    f.registration.log_likelihood});
     points += st.n_points;
     novel += st.n_novel;
     ms_novelty += st.ms_novelty;
@@ -112,10 +136,12 @@ int run_map(MapState& s) {
                   f.label.c_str(), st.n_points, st.n_novel, pending, st.n_components, st.ms_novelty, st.ms_fit,
                   st.ms_merge);
     progress.status(buf);
-  });
+      },
+      s.registration);
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t added = map.flush(progress.fit_callback("final flush"));
   const double ms_flush = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  deltas.write(map);  // the final flush and the frames since the last delta
   progress.finish();
   if (!s.trajectory_out.empty()) write_trajectory_log(s.trajectory_out, poses_used);
   const Model model = with_sequence_metadata(map.to_model(), in);
@@ -146,6 +172,10 @@ int run_map(MapState& s) {
     j["ms_merge"] = ms_merge;
     j["ms_final_flush"] = ms_flush;
     j["file_bytes"] = bytes;
+    if (!s.deltas.empty()) {
+      j["n_deltas"] = deltas.count();
+      j["delta_bytes"] = deltas.bytes();
+    }
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
@@ -178,7 +208,8 @@ Command add_map_command(CLI::App& root) {
       "components close to existing ones (Hellinger or symmetric KL distance below --fusion-threshold) are\n"
       "merged into them. --no-novelty fits every frame whole (the append-everything map of sogmm fit\n"
       "--sequence). Progress goes to stderr (a live line on a terminal, lines with --progress); the per-frame\n"
-      "CSV (frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced) and an SVG plot\n"
+      "CSV (frame,points,novel_points,components,pending,flushed,ms_novelty,ms_fit,ms_merge,replaced,pose,\n"
+      "inlier_ratio,registration_ll) and an SVG plot\n"
       "of components and time against frame go next to the map unless --csv/--plot say where.\n"
       "Evaluate the result with sogmm eval MAP --sequence DIR --trajectory LOG.\n\n"
       "Examples:\n"
@@ -193,6 +224,9 @@ Command add_map_command(CLI::App& root) {
                   "map from a constant-velocity guess; frames that fail are skipped with a warning)");
   app->add_option("--trajectory-out", s->trajectory_out,
                   "write the poses of the inserted frames (given or estimated) as a Redwood .log");
+  app->add_flag("--registration-gray", s->registration.use_gray,
+                "without --trajectory: register with gray too (the 4-D density; SOGMM_OPT_REGISTRATION_USE_GRAY),\n"
+                "which holds the pose where the geometry alone lets a frame slide (a wall, a floor)");
   app->add_option("--frames", s->src.frames, "I, A:B (B excluded) or A:B:STEP; default all");
   add_pair_by_order_flag(*app, s->src.pair_by_order);
   add_camera_flags(*app, s->camera, s->options.depth);
@@ -216,6 +250,9 @@ Command add_map_command(CLI::App& root) {
                   "fuse below this distance (Hellinger in [0, 1]; KL in nats)")
       ->capture_default_str();
   app->add_option("-o,--output", s->output, "output map file (.sogmm, world frame)")->required();
+  app->add_option("--deltas", s->deltas,
+                  "write a map delta (spec/format.md 2.5) into this folder after every insert that fitted and at "
+                  "the end, named by revision so that they sort (rebuild with sogmm apply-deltas)");
   app->add_option("--csv", s->csv, "per-frame CSV (default: OUTPUT with .csv)");
   app->add_option("--plot", s->plot, "SVG plot of components and time per frame (default: OUTPUT with .svg)");
   app->add_flag("--progress", s->progress, "print progress lines on stderr even when it is not a terminal");

@@ -30,7 +30,7 @@ struct RenderState {
   bool compare = false, uncertainty = false, occupancy = false;
   SliceFlags slice;
   int scale = 0;
-  double error_max = 0.25, std_max = 0.0, max_mahalanobis = 3.0;
+  double error_max = 0.25, std_max = 0.0, max_mahalanobis = 3.0, surface_sigma = 0.0;
   double data_range = 1.0;  // honest PSNR's peak (--data-range, with --compare)
 };
 
@@ -70,7 +70,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     const std::vector<Pose> poses = read_trajectory(s.trajectory);
     require(s.frame >= 0 && static_cast<std::size_t>(s.frame) < poses.size(), ErrorCode::InvalidArgument,
             "render: --frame must be in [0, " + std::to_string(poses.size()) + ") for " + s.trajectory);
-    gmm = transform(gmm, inverse_rigid(poses[s.frame]));
+    gmm = in_camera(model, poses[s.frame]);
     view_note = " seen from pose " + std::to_string(s.frame) + " of " + s.trajectory;
   } else if (key_value(model, "coordinate_frame") == "world") {
     std::fprintf(stderr,
@@ -128,6 +128,7 @@ int run_render(const RenderState& s, const CLI::App& app) {
     o.depth_min = d.depth_min;
     o.depth_max = d.depth_max;
     o.max_mahalanobis = s.max_mahalanobis;
+    o.surface_sigma = s.surface_sigma;
     view = panel_view(render_expected_surface(gmm, dc, o));
     where = "at the model's expected surface (first surface along each ray)";
   }
@@ -163,7 +164,9 @@ Command add_render_command(CLI::App& root) {
       "(E[gray | xyz], the paper's conditional) at the 3-D point of each pixel: the ground-truth point with\n"
       "--depth, else the model's expected surface: the nearest mode of the mixture's marginal density along\n"
       "the pixel's ray, the first surface a camera sees (1-D mean shift from every component peak on the\n"
-      "ray; pixels whose ray passes outside every component's 3-sigma ellipsoid stay empty/black).\n"
+      "ray; pixels whose ray passes outside every component's 3-sigma ellipsoid stay empty/black; with\n"
+      "--surface-sigma S only modes where the components' evidence sum exp(-D^2/2) reaches that of one\n"
+      "component at S sigma are surfaces, so a ray grazing a tail beyond a silhouette passes on).\n"
       "--compare writes original gray | regressed gray | |error| heat map with colour bar and the PSNR.\n"
       "--uncertainty writes the conditional standard deviation of gray as a heat map with colour bar.\n\n"
       "Examples:\n"
@@ -195,6 +198,10 @@ Command add_render_command(CLI::App& root) {
   app->add_option("--max-mahalanobis", s->max_mahalanobis,
                   "expected surface: empty where the ray is farther than this many sigmas from every component")
       ->capture_default_str();
+  app->add_option("--surface-sigma", s->surface_sigma,
+                  "expected surface: a mode counts only where the components' evidence reaches one component's at "
+                  "this many sigmas (0 = every mode; 2 = the edge of a flat component's disc)")
+      ->capture_default_str();
   CLI::App* a = app;
   return {app, [s, a]() {
             require(!(s->compare && s->uncertainty), ErrorCode::InvalidArgument,
@@ -209,8 +216,9 @@ Command add_render_command(CLI::App& root) {
                     "render: --occupancy draws a map from its own frames; it takes none of --compare, --uncertainty, "
                     "--trajectory, --depth");
             require(s->scale >= 0 && s->scale <= 16, ErrorCode::InvalidArgument, "render: --scale must be in 1..16");
-            require(s->error_max > 0 && s->std_max >= 0 && s->max_mahalanobis > 0, ErrorCode::InvalidArgument,
-                    "render: --error-max and --max-mahalanobis must be > 0, --std-max >= 0");
+            require(s->error_max > 0 && s->std_max >= 0 && s->max_mahalanobis > 0 && s->surface_sigma >= 0,
+                    ErrorCode::InvalidArgument,
+                    "render: --error-max and --max-mahalanobis must be > 0, --std-max and --surface-sigma >= 0");
             return run_render(*s, *a);
           }};
 }

@@ -54,8 +54,10 @@ Grid observe(const LoadedFrame& frame, const Camera& camera, const DepthOptions&
   return g;
 }
 
-RenderScores compare(const Gmm& gmm, const Grid& g, const DepthOptions& depth, double data_range) {
+RenderScores compare(const Gmm& gmm, const Grid& g, const DepthOptions& depth, double data_range,
+                     double surface_sigma) {
   RenderOptions o;
+  o.surface_sigma = surface_sigma;
   o.depth_min = depth.depth_min;
   o.depth_max = depth.depth_max;
   return score_render(render_expected_surface(gmm, g.camera, o), g.depth, g.gray, g.mask, data_range);
@@ -69,13 +71,13 @@ double mean_ll(const Gmm& gmm, const std::vector<float>& points) {
 }  // namespace
 
 PixelFigures pixel_figures(const Gmm& gmm, const LoadedFrame& frame, const Camera& camera, const DepthOptions& depth,
-                           double data_range) {
+                           double data_range, double surface_sigma) {
   PixelFigures p;
   p.decimate = depth.decimate;
   const Grid fit = observe(frame, camera, depth, depth.decimate, 0);
   const Grid held = observe(frame, camera, depth, depth.decimate + 1, depth.decimate);
-  p.fit_grid = compare(gmm, fit, depth, data_range);
-  p.heldout = compare(gmm, held, depth, data_range);
+  p.fit_grid = compare(gmm, fit, depth, data_range, surface_sigma);
+  p.heldout = compare(gmm, held, depth, data_range, surface_sigma);
   p.log_likelihood = mean_ll(gmm, fit.points);
   p.log_likelihood_heldout = mean_ll(gmm, held.points);
   p.n_points_heldout = held.points.size() / 4;

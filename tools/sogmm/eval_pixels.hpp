@@ -30,9 +30,10 @@ struct PixelFigures {
 
 /// The figures of `gmm` (in the frame's camera coordinates) against `frame`
 /// (full-size `camera`; decimation and depth range from `depth`);
-/// `data_range` is the PSNR's peak (psnr_images).
+/// `data_range` is the PSNR's peak (psnr_images); `surface_sigma` the
+/// renders' RenderOptions::surface_sigma.
 PixelFigures pixel_figures(const Gmm& gmm, const LoadedFrame& frame, const Camera& camera, const DepthOptions& depth,
-                           double data_range);
+                           double data_range, double surface_sigma);
 
 /// Adds the figures to an `eval --json` object: depth_mae, empty_share,
 /// pixel_psnr (fitting grid) and the same with _heldout, n_pixels and

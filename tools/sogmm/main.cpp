@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
       "  sogmm sample frame0.sogmm -n 100000 -o samples.ply --ellipsoids ellipsoids.ply\n"
       "  sogmm query room.sogmm --points probes.csv --occupancy --distance -o answers.csv");
   std::vector<Command> commands = {add_demo_command(app),   add_eval_command(app),  add_fit_command(app),
-                                   add_map_command(app),    add_render_command(app), add_sample_command(app),
+                                   add_map_command(app),    add_apply_deltas_command(app),    add_render_command(app), add_sample_command(app),
                                    add_query_command(app),  add_view_command(app),  add_bench_command(app)};
   try {
     app.parse(argc, argv);

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "sogmm/error.hpp"
+#include "sogmm/map_tracking.hpp"
 #include "sogmm/model.hpp"
 
 namespace sogmm::tools {
@@ -73,11 +74,10 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
   return out;
 }
 
-Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
-                             const std::function<void(const MapRunFrame&)>& after) {
+Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter& progress,
+                             const std::function<void(const MapRunFrame&)>& after,
+                             const RegistrationOptions& registration) {
   Camera camera;
-  constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  std::vector<Pose> used;  // the poses of the frames inserted so far
   for (std::size_t k = 0; k < in.selected.size(); ++k) {
     MapRunFrame r;
     r.file = in.frames[in.selected[k]];
@@ -90,34 +90,23 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptio
       rethrow_naming(e, r.file.depth);
     }
     // The tool's check first: its message names the file and the depth range.
-    const PointCloud points = backproject_nonempty(frame, camera, depth, r.file.depth);
-    if (!in.poses.empty()) {
-      r.pose = in.poses[k];
-    } else if (used.empty()) {
-      r.pose = kIdentity;
-    } else {
-      // Constant velocity: the last motion (in the camera) once more.
-      const Pose last = used.back();
-      const Pose motion = used.size() > 1 ? compose_poses(inverse_rigid(used[used.size() - 2]), last) : kIdentity;
-      if (map.pending() > 0) map.flush(progress.fit_callback(r.label + " flush"));
-      const Pose guess = compose_poses(last, motion);
-      const std::string bad = rigid_pose_error(guess);
-      require(bad.empty(), ErrorCode::Numeric, r.file.depth + ": the constant-velocity guess " + bad);
-      r.registration = register_points(map.model().gmm, points.view().data, points.size(), guess);
-      r.registered = r.registration.status == RegistrationStatus::Converged;
-      r.skipped = !r.registered;
-      if (r.skipped) {
-        std::fprintf(stderr, "warning: %s not inserted: its registration to the map ended %s (inliers %.2f)\n",
-                     r.file.depth.c_str(), status_name(r.registration.status), r.registration.inlier_ratio);
-        if (after) after(r);
-        continue;
-      }
-      r.pose = r.registration.pose;
-    }
-    used.push_back(r.pose);
+    const PointCloud points = backproject_nonempty(frame, camera, map.options().depth, r.file.depth);
     try {
-      r.stats = map.insert_rgbd(frame.view(camera), r.pose,
-                                recording(progress.fit_callback(r.label), r.fit));
+      if (!in.poses.empty()) {
+        r.pose = in.poses[k];
+        r.stats = map.insert_backprojected(points.view(), camera, r.pose, recording(progress.fit_callback(r.label), r.fit));
+      } else {  // the core's tracking: registered to the map from a constant-velocity guess
+        const TrackedFrame t = track_backprojected(map, points.view(), camera, predict_constant_velocity(map),
+                                                   registration, 0, recording(progress.fit_callback(r.label), r.fit));
+        r.registration = t.registration;
+        r.registered = t.registered;
+        r.skipped = !t.inserted;
+        r.pose = t.registration.pose;
+        r.stats = t.stats;
+        if (r.skipped)
+          std::fprintf(stderr, "warning: %s not inserted: its registration to the map ended %s (inliers %.2f)\n",
+                       r.file.depth.c_str(), status_name(r.registration.status), r.registration.inlier_ratio);
+      }
     } catch (const Error& e) {
       rethrow_naming(e, r.file.depth);
     }

@@ -57,16 +57,19 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
 
 /// Inserts every selected frame into `map` in order: loads it (a missing or
 /// unreadable file -> Error(Io) naming it), checks the camera against the
-/// frame size (another size -> Error(InvalidData)), back-projects it (no valid
+/// frame size (another size -> Error(InvalidData)), back-projects it with the
+/// map's depth options (no valid
 /// pixel -> Error(InvalidData) naming the file) and inserts it with its pose.
-/// Without poses each frame's pose is estimated: the first is the identity,
-/// the others are registered to the map (flushed first, so that everything
-/// seen is a target) from a constant-velocity prediction; a frame whose
-/// registration does not converge is skipped with a warning on stderr.
+/// Without poses each frame's pose is estimated by the core's tracking
+/// (track_backprojected of sogmm/map_tracking.hpp, with `registration`): the
+/// first is the identity, the others are registered to the map from a
+/// constant-velocity prediction; a frame whose registration does not
+/// converge is skipped with a warning on stderr.
 /// `progress` shows each fit's stages; `after` is called after each insert.
 /// Returns the camera of the frames.
-Camera run_map_over_sequence(Map& map, const SequenceInput& in, const DepthOptions& depth, ProgressPrinter& progress,
-                             const std::function<void(const MapRunFrame&)>& after);
+Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter& progress,
+                             const std::function<void(const MapRunFrame&)>& after,
+                             const RegistrationOptions& registration = {});
 
 /// Comma-separated frame indices of the selection ("0,1,2").
 std::string frame_list(const SequenceInput& in);

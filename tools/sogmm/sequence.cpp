@@ -8,6 +8,7 @@
 
 #include "file_util.hpp"
 #include "sogmm/error.hpp"
+#include "sogmm/inference.hpp"
 #include "sogmm/model.hpp"
 
 namespace sogmm::tools {
@@ -124,6 +125,12 @@ std::vector<std::size_t> parse_frame_range(const std::string& text, std::size_t 
 }
 
 std::vector<Pose> read_trajectory(const std::string& path) { return read_trajectory_log(path).poses; }
+
+Gmm in_camera(const Model& model, const Pose& camera_to_world) {
+  const Pose to_camera = inverse_rigid(camera_to_world);
+  const bool posed_world = model.pose && coordinate_frame(model) == "world";
+  return transform(model.gmm, posed_world ? compose_poses(to_camera, *model.pose) : to_camera);
+}
 
 std::vector<Pose> poses_of_frames(const Trajectory& trajectory, const std::string& path,
                                   const std::vector<SequenceFrame>& frames, const std::vector<std::size_t>& selected,

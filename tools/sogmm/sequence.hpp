@@ -44,6 +44,12 @@ using format::read_trajectory_log;
 /// The poses of read_trajectory_log in file order (entry k = block k).
 std::vector<Pose> read_trajectory(const std::string& path);
 
+/// A model's components in the camera of `camera_to_world`, the model taken
+/// as world-frame. A "world" model's pose maps its frame to the world
+/// (spec/format.md 2.1; a map far from the world origin stores its origin so,
+/// 2.3.1): composed in double before the one float32 transform.
+Gmm in_camera(const Model& model, const Pose& camera_to_world);
+
 /// The pose of each selected frame (entry k for frames[selected[k]]): the
 /// pose whose id is the frame's number, or with `pair_by_order` the pose of
 /// the frame's position in name order. A frame without its pose, or a

@@ -261,3 +261,55 @@ def test_a_frame_far_from_the_pending_ones_fails_at_its_insert():
         assert len(m) == 1 and m.n_pending_ == len(pts)
         m.flush()
         assert m.n_components_ > 0
+
+
+def test_deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused():
+    with sogmm.Map(novelty=False, **FIT) as sender, sogmm.Map() as receiver:
+        deltas = []
+        for pts, pose in zip(frames(), POSES):
+            since = sender.revision
+            sender.insert_points(pts, pose)
+            deltas.append(sender.export_delta(since))
+        assert sender.revision == 2
+        with pytest.raises(sogmm.InvalidArgumentError, match="revision"):
+            receiver.apply_delta(deltas[1])  # a gap
+        assert receiver.revision == 0
+        with pytest.raises(sogmm.FormatError):
+            receiver.apply_delta(deltas[0][:-3])  # truncated
+        for d in deltas:
+            receiver.apply_delta(d)
+        assert receiver.revision == sender.revision
+        a, b = sender.export(), receiver.export()
+        for x, y in ((a.weights_, b.weights_), (a.means_, b.means_), (a.covariances_, b.covariances_)):
+            assert x.tobytes() == y.tobytes()
+        with pytest.raises(sogmm.InvalidArgumentError, match="already applied"):
+            receiver.apply_delta(deltas[1])  # a duplicate
+
+
+def test_a_far_map_keeps_its_origin(tmp_path):
+    # Issue 36: a map 1000 km out holds its components relative to its origin
+    # (the first frame's translation rounded to 1 km) and finds in a mapped
+    # frame the novel points it finds at the world origin.
+    pts = blobs(n_per=50)
+    novel = []
+    for km in (0.0, 1000.0):
+        pose = rigid(20.0, (1000.0 * km + 3.37, -1000.0 * km, 1.0))
+        with sogmm.Map(batch_size=10_000, **FIT) as m:
+            m.insert_points(pts, pose)
+            m.flush()
+            assert list(m.origin) == [1000.0 * km, -1000.0 * km, 0.0]
+            novel.append(m.insert_points(pts, pose)["n_novel"])
+            m.discard_pending()
+            m.save(tmp_path / "far.sogmm")
+    assert novel[1] == novel[0]
+    with sogmm.Map.load(tmp_path / "far.sogmm") as loaded:
+        assert list(loaded.origin) == [1.0e6, -1.0e6, 0.0]
+        with pytest.raises(sogmm.InvalidArgumentError, match="before the first insert"):
+            loaded.set_origin([0.0, 0.0, 0.0])
+    with sogmm.Map(**FIT) as m:
+        with pytest.raises(sogmm.InvalidArgumentError, match="origin"):
+            m.set_origin([0.0, math.nan, 0.0])
+        with pytest.raises(sogmm.InvalidArgumentError, match="3 values"):
+            m.set_origin([1.0, 2.0])
+        m.set_origin([5.0e5, 0.5, 0.0])
+        assert list(m.origin) == [5.0e5, 0.5, 0.0]

@@ -117,3 +117,21 @@ def test_gmm_queries_take_progress(two_frames):
     assert seen[-1][0] == STAGE_REGRESSION
     with pytest.raises(sogmm.CancelledError):
         g.regress_gray(q, progress=lambda *_: True)
+
+
+def test_gmm_and_map_share_one_query_implementation(two_frames):
+    # One mixin, one method object per query: the map runs the same code on its handle kind.
+    from sogmm.queryable import Queryable
+
+    for name in ("score_samples", "score", "regress_gray", "sample", "render", "surface_distance",
+                 "collision_probability"):
+        assert getattr(sogmm.GMM, name) is getattr(Queryable, name) is getattr(sogmm.Map, name), name
+    # The model's sample now reports too (stage STAGE_SAMPLING, of 3000 points; at least the
+    # stage start), with the same draws, and a truthy return cancels it.
+    g = two_frames.export()
+    seen = []
+    np.testing.assert_array_equal(g.sample(3000, seed=4, progress=lambda *r: seen.append(r)),
+                                  g.sample(3000, seed=4))
+    assert seen and all(r[0] == STAGE_SAMPLING and r[2] == 3000 for r in seen), seen
+    with pytest.raises(sogmm.CancelledError):
+        g.sample(3000, seed=4, progress=lambda *_: True)

@@ -354,3 +354,22 @@ def test_the_depth_floor_is_the_default_for_frames_and_not_for_arrays():
     np.testing.assert_array_equal(array_default.covariances_, off.covariances_)
     np.testing.assert_array_equal(sogmm.SOGMM(dequantise_depth=True, **params).fit(pts).covariances_,
                                   on.covariances_)
+
+
+def test_em_acceleration_reaches_the_fit():
+    # Three overlapping clusters along x: plain EM creeps to its fixed point
+    # (tol 1e-7); SQUAREM gets there in fewer passes, no lower.
+    rng = np.random.default_rng(35)
+    k = np.arange(3000) % 3
+    pts = np.column_stack([0.8 * k + 0.5 * rng.standard_normal(3000), 0.2 * rng.standard_normal(3000),
+                           1.0 + 0.1 * rng.standard_normal(3000), 0.3 + 0.1 * rng.standard_normal(3000)])
+    params = dict(n_components=3, seed=1, n_threads=1, tol=1e-7, max_iter=3000)
+    assert sogmm.SOGMM().get_params()["em_acceleration"] == "none"
+    plain = sogmm.SOGMM(**params).fit(pts)
+    again = sogmm.SOGMM(em_acceleration="none", **params).fit(pts)
+    fast = sogmm.SOGMM(em_acceleration="squarem", **params).fit(pts)
+    np.testing.assert_array_equal(plain.means_, again.means_)
+    assert fast.info()["fit_iterations"] < plain.info()["fit_iterations"]
+    assert fast.info()["fit_log_likelihood"] >= plain.info()["fit_log_likelihood"] - 1e-5
+    with pytest.raises(sogmm.InvalidArgumentError, match="em_acceleration"):
+        sogmm.SOGMM(em_acceleration="fast", **params).fit(pts)

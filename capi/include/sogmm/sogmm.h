@@ -150,125 +150,208 @@ typedef struct sogmm_trajectory sogmm_trajectory; /* camera poses read from a Re
  * `const sogmm_options*` is expected means "all defaults". */
 typedef int32_t sogmm_key;
 
-/* Fit (mode count + k-means++ + EM). */
-#define SOGMM_OPT_BANDWIDTH 100    /* f64, > 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero
-                                    * (about 5.3e-155 to 4.4e153); default 0.02: mean-shift bandwidth */
-#define SOGMM_OPT_N_COMPONENTS 101 /* i64, >= 0; default 0 = self-organizing, K > 0 = fixed K */
-#define SOGMM_OPT_TOL 102          /* f64, >= 0, finite; default 1e-3: EM stop tolerance (0: run max_iter iterations) */
-#define SOGMM_OPT_REG_COVAR 103    /* f64, >= 0, finite in float32 (<= 3.4e38: covariances are float32),
-                                    * or SOGMM_REG_COVAR_AUTO; default SOGMM_REG_COVAR_AUTO. A value:
-                                    * added to all four covariance diagonals in each M-step, as before.
-                                    * AUTO: one floor on x, y, z and one on gray, derived from the data
-                                    * (1e-6 x 100^k; 10^k is the power of ten nearest the median distance
-                                    * of the points from their coordinate-wise median, resp. the smallest
-                                    * one not below the gray range): 1e-6 and 1e-6 for a room-sized frame
-                                    * with gray in [0, 1] (the former default), 1 m^2 for a 1 km scene.
-                                    * The model's fit record holds the floors used (FIT_REG_COVAR: the
-                                    * spatial one; key_values reg_covar_gray and reg_covar_source).
-                                    * Any other negative value, NaN or inf: SOGMM_E_INVALID_ARG. */
-#define SOGMM_REG_COVAR_AUTO (-1.0) /* SOGMM_OPT_REG_COVAR: floors from the data's scales (see above);
-                                     * get returns it while no value is set */
-#define SOGMM_OPT_MAX_ITER 104     /* i64, [1, 2^31-1]; default 100: EM iterations at most */
-#define SOGMM_OPT_SEED 105         /* i64, any; default 0: the uint64 seed's bits (cast) */
-#define SOGMM_OPT_THREADS 106      /* i64, [0, 4096]; default 0 = all cores; a request is capped at
-                                    * 4 x the cores (libgomp aborts when it cannot start a thread) */
-#define SOGMM_OPT_MODE_COUNTER 107 /* i64, a SOGMM_MODE_COUNTER_* value; default SOGMM_MODE_COUNTER_FLAT_BINNED */
-#define SOGMM_OPT_TRUNCATION_NATS 108 /* f64, >= 0, finite; default 0 = exact E-step. > 0: truncated E-step
-                                       * that skips components provably more than this many nats below
-                                       * every point's best in a block (25: each skipped term < 1.4e-11) */
-#define SOGMM_OPT_N_INIT 109       /* i64, [1, 1000]; default 1: runs of k-means++ + EM. Run r (from 0)
-                                    * is seeded with SEED + r; the run with the highest final mean
-                                    * log-likelihood is kept (ties: the earliest). Cost grows linearly. */
-#define SOGMM_OPT_DEQUANTISE_DEPTH 110 /* i64, SOGMM_DEQUANTISE_AUTO (-1), 0 or 1; default SOGMM_DEQUANTISE_AUTO. 1: when the
-                                        * camera-frame depth sits on discrete levels (a 16-bit depth image),
-                                        * floor each component's variance along its viewing ray at the
-                                        * level's bin variance, so components do not collapse onto single
-                                        * levels (every seed converges; higher likelihood of held-out pixels spread in their bins; lower
-                                        * training likelihood). 0: the paper's plain EM. AUTO: 1 for the
-                                        * points of sogmm_fit_frame, 0 for points given as arrays */
+/* BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp) */
+/* Fit (mode count + k-means++ + EM). Read by sogmm_fit_points_f32, sogmm_fit_frame and each
+ * batch of a map. */
+/* Mean-shift bandwidth over the (range, gray) features: the one SOGMM parameter; it sets the
+ * number of components.
+ * f64, > 0, finite, with bw^2, (3 bw)^2 and 1 / (2 bw^2) finite and nonzero (about 5.3e-155 to
+ * 4.4e153); default 0.02. */
+#define SOGMM_OPT_BANDWIDTH 100
+/* 0: self-organizing (the mode count picks K); K > 0: a fit of exactly K components (1 <= K <=
+ * the number of points) without the mode count.
+ * i64 (components), >= 0; default 0. */
+#define SOGMM_OPT_N_COMPONENTS 101
+/* EM stops when the mean log-likelihood per point changes by less than this; 0 runs MAX_ITER
+ * iterations.
+ * f64 (nats per point), >= 0, finite; default 0.001. */
+#define SOGMM_OPT_TOL 102
+/* A value is added to all four covariance diagonals in each M-step. SOGMM_REG_COVAR_AUTO (-1,
+ * the default; get returns it while no value is set): one floor on x, y, z and one on gray,
+ * derived from the data: 1e-6 x 100^k, with 10^k the power of ten nearest the median distance of
+ * the points from their coordinate-wise median, resp. the smallest one not below the gray range;
+ * 1e-6 and 1e-6 for a room-sized frame with gray in [0, 1], 1 m^2 for a 1 km scene. The model's
+ * fit record holds the floors used (FIT_REG_COVAR: the spatial one; key_values reg_covar_gray
+ * and reg_covar_source). Any other negative value, NaN or inf is refused.
+ * f64 (data units squared), >= 0, finite in float32 (<= 3.4e38: covariances are float32), or
+ * SOGMM_REG_COVAR_AUTO (-1); default -1. */
+#define SOGMM_OPT_REG_COVAR 103
+/* At most this many EM iterations.
+ * i64 (iterations), [1, 2^31-1]; default 100. */
+#define SOGMM_OPT_MAX_ITER 104
+/* Seeds k-means++: the same seed gives the same model; run r of N_INIT uses SEED + r.
+ * i64, any (the bits of a uint64 seed, cast); default 0. */
+#define SOGMM_OPT_SEED 105
+/* Worker threads of fits and queries; 0 = all available cores; a request is capped at 4 x the
+ * cores (libgomp aborts when it cannot start a thread); results do not depend on it.
+ * i64 (threads), [0, 4096]; default 0. */
+#define SOGMM_OPT_THREADS 106
+/* How K is counted: SOGMM_MODE_COUNTER_FLAT_BINNED (0) the authors' flat mean shift with bin
+ * seeding, SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING (1) the paper's Gaussian blurring mean shift.
+ * i64, a SOGMM_MODE_COUNTER_* value (0 or 1); default 0. */
+#define SOGMM_OPT_MODE_COUNTER 107
+/* 0: exact E-step; > 0: a truncated E-step that skips a component only when it is provably more
+ * than this many nats below every point's best in a block (25: each skipped term < 1.4e-11).
+ * f64 (nats), >= 0, finite; default 0. */
+#define SOGMM_OPT_TRUNCATION_NATS 108
+/* Runs of k-means++ then EM: run r (from 0) is seeded with SEED + r and the run with the highest
+ * final mean log-likelihood is kept (ties: the earliest); the cost grows linearly.
+ * i64 (runs), [1, 1000]; default 1. */
+#define SOGMM_OPT_N_INIT 109
+/* 1: when the camera-frame depth sits on discrete levels (a 16-bit depth image), floor each
+ * component's variance along its viewing ray at the level's bin variance, so that components do
+ * not collapse onto single levels (every seed converges; higher likelihood of held-out pixels
+ * spread in their bins, lower training likelihood); 0: the paper's plain EM;
+ * SOGMM_DEQUANTISE_AUTO (-1): 1 for the points of sogmm_fit_frame, 0 for points given as arrays.
+ * i64, SOGMM_DEQUANTISE_AUTO (-1), 0 or 1; default -1. */
+#define SOGMM_OPT_DEQUANTISE_DEPTH 110
+/* 0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the
+ * log-likelihood would fall), fewer iterations to the same tol.
+ * i64, 0 (plain EM) or 1 (SQUAREM); default 0. */
+#define SOGMM_OPT_EM_ACCELERATION 111
+
+/* RGB-D back-projection. Read by sogmm_fit_frame, sogmm_map_insert_frame,
+ * sogmm_frame_to_points_f32. */
+/* Depth = raw / depth_scale (1000: millimetres; TUM uses 5000).
+ * f64 (raw units per metre), > 0, finite, 1 / value finite; default 1000. */
+#define SOGMM_OPT_DEPTH_SCALE 200
+/* Pixels at or nearer than this are invalid (exclusive); must be below DEPTH_MAX at fit time.
+ * f64 (m), >= 0, finite; default 0.1. */
+#define SOGMM_OPT_DEPTH_MIN 201
+/* Pixels farther than this are invalid (inclusive); must exceed DEPTH_MIN at fit time.
+ * f64 (m), > 0, finite; default 3. */
+#define SOGMM_OPT_DEPTH_MAX 202
+/* Integer decimation factor d of the image; at fit time d <= width and d <= height.
+ * i64 (pixels), [1, 1024]; default 1. */
+#define SOGMM_OPT_DECIMATION 203
+
+/* Writing .sogmm. Read by sogmm_model_save, sogmm_model_save_to_memory, sogmm_map_save. */
+/* Zstd compression level of the arrays.
+ * i64, [1, 22]; default 19. */
+#define SOGMM_OPT_ZSTD_LEVEL 300
+/* 1: store the arrays as float64.
+ * i64, 0 or 1; default 0. */
+#define SOGMM_OPT_FLOAT64 301
+/* 1: zstd-compress the arrays.
+ * i64, 0 or 1; default 1. */
+#define SOGMM_OPT_COMPRESS 302
+
+/* Reading .sogmm. Read by sogmm_model_load, sogmm_model_load_from_memory, sogmm_map_load;
+ * MAX_DECODED_BYTES also the saves. */
+/* Cap on the arrays' decoded bytes: load refuses a file above it and save a model above it (what
+ * a reader with the default cap would refuse).
+ * i64 (bytes), >= 0; 0 = the default cap (1 GiB); default 1073741824. */
+#define SOGMM_OPT_MAX_DECODED_BYTES 400
+/* 1: check the CRC-32C of the metadata and of every array.
+ * i64, 0 or 1; default 1. */
+#define SOGMM_OPT_VERIFY_CHECKSUMS 401
+
+/* Sampling and queries. Read by sogmm_model_sample_f32 (SAMPLE_TRUNCATION); the model's score
+ * and regression and the map queries (QUERY_TRUNCATION_NATS, and THREADS for the team). */
+/* Each standard-normal coordinate of a sample is truncated to (-value, value).
+ * f64 (standard deviations), > 0 (+inf = untruncated); default 2.5. */
+#define SOGMM_OPT_SAMPLE_TRUNCATION 500
+/* 0: exact score and regression; > 0: culled ones, which skip a component at a point only when
+ * its term is provably more than this many nats below the point's largest (as TRUNCATION_NATS
+ * for the E-step): a score is then at most log(1 + M exp(-nats)) below the exact one.
+ * f64 (nats), >= 0, finite; default 0. */
+#define SOGMM_OPT_QUERY_TRUNCATION_NATS 501
+
+/* Incremental map. Read by sogmm_map_create, sogmm_map_load; a map also reads the fit keys (each
+ * batch's fit; THREADS also runs the novelty test) and the RGB-D keys (sogmm_map_insert_frame). */
+/* 1: only points the map does not explain are fitted; 0: every point is novel and each insert
+ * fits its whole frame (append everything).
+ * i64, 0 or 1; default 1. */
+#define SOGMM_OPT_MAP_NOVELTY 600
+/* A point is novel when its 3-D log-likelihood under the local submap is below this.
+ * f64 (nats (log per m^3)), finite; default 3. */
+#define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601
+/* Pending novel points that trigger a fit.
+ * i64 (points), [1, 2^26]; default 12288. */
+#define SOGMM_OPT_MAP_BATCH_SIZE 602
+/* 1: fuse new components into close map components.
+ * i64, 0 or 1; default 0. */
+#define SOGMM_OPT_MAP_FUSION 603
+/* The distance of fusion: SOGMM_FUSION_HELLINGER (0) the Hellinger distance of the 4-D
+ * Gaussians, in [0, 1]; SOGMM_FUSION_KL (1) the symmetric KL divergence (KL(a||b) + KL(b||a)) /
+ * 2, in nats.
+ * i64, a SOGMM_FUSION_* value (0 or 1); default 0. */
+#define SOGMM_OPT_MAP_FUSION_METHOD 604
+/* Fuse when the distance is below this.
+ * f64 (the method's unit), > 0, finite; default 0.3. */
+#define SOGMM_OPT_MAP_FUSION_THRESHOLD 605
+/* 1: each batch's fit starts from the previous batch's model moved into its camera (as a warm
+ * sogmm_fit_points_f32); meant for MAP_NOVELTY 0; needs N_INIT 1.
+ * i64, 0 or 1; default 0. */
+#define SOGMM_OPT_MAP_WARM_START 606
+/* With MAP_NOVELTY 1 the batches of novel points are fitted with BANDWIDTH times this (with
+ * MAP_NOVELTY 0 each frame with the bandwidth itself; why: MapOptions::novelty_bandwidth_scale).
+ * f64, in (0, 1]; default 0.7. */
+#define SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE 607
+/* With MAP_NOVELTY 1, an RGB-D insert refits the map components on its surfaces when its
+ * explained points they dominate have at least this many times as many modes as they are
+ * components: they are replaced by a fit of those points plus samples of their mass it does not
+ * see (details and why: MapOptions::revisit_refit_ratio); 0: off; no refit with N_COMPONENTS > 0
+ * or MAP_WARM_START 1; a refit counts as a fit (flushed, n_flushes).
+ * f64, 0 (off) or >= 1, finite; default 1.25. */
+#define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608
+
+/* Occupancy and distance to the surface. Read by sogmm_map_occupancy_f32,
+ * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32. */
+/* Standard deviation of the true surface along a ray about the depth the map renders there.
+ * f64 (m), > 0, finite; default 0.01. */
+#define SOGMM_OPT_OCCUPANCY_SIGMA 700
+/* A point within this distance of the surface along a ray is occupied.
+ * f64 (m), > 0, finite; default 0.02. */
+#define SOGMM_OPT_OCCUPANCY_THICKNESS 701
+/* Distance to the surface: each component is the disc of its two largest principal axes out to
+ * this many standard deviations.
+ * f64 (standard deviations), in (0, 10]; default 2. */
+#define SOGMM_OPT_SURFACE_DISC_SIGMAS 702
+
+/* Registration. Read by sogmm_register_points_f32. */
+/* Registration: EM / Gauss-Newton iterations per coarse-to-fine level.
+ * i64 (iterations), [1, 2^31-1]; default 30. */
+#define SOGMM_OPT_REGISTRATION_MAX_ITER 800
+/* Registration: a level ends when a step moves the source by less than this (|t| + |rotation| x
+ * RMS radius).
+ * f64 (m), > 0, finite; default 0.0001. */
+#define SOGMM_OPT_REGISTRATION_TOL 801
+/* Registration: prior weight of the uniform outlier term (over the target's 3-sigma box).
+ * f64, in [0, 1); default 0.1. */
+#define SOGMM_OPT_REGISTRATION_OUTLIER_RATIO 802
+/* Registration: 1 scores gray too (the 4-D joint density: gray marginal times the conditional x
+ * | gray), 0 the 3-D marginal.
+ * i64, 0 or 1; default 0. */
+#define SOGMM_OPT_REGISTRATION_USE_GRAY 803
+/* Registration: coarse-to-fine levels; level l smooths the target by COARSE_SIGMA / 2^l, the
+ * last not at all.
+ * i64 (levels), [1, 16]; default 3. */
+#define SOGMM_OPT_REGISTRATION_LEVELS 804
+/* Registration: smoothing standard deviation of the coarsest level (halved per level).
+ * f64 (m), > 0, finite; default 0.04. */
+#define SOGMM_OPT_REGISTRATION_COARSE_SIGMA 805
+/* Registration: below this inlier ratio the status is SOGMM_REGISTRATION_LOW_FITNESS.
+ * f64, in [0, 1]; default 0.5. */
+#define SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO 806
+/* Registration: directions whose scaled information is below this fraction of the largest are
+ * unobservable.
+ * f64, in [0, 1); default 0.001. */
+#define SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO 807
+/* Registration: fewer finite source points are SOGMM_E_INVALID_DATA.
+ * i64 (points), >= 6; default 100. */
+#define SOGMM_OPT_REGISTRATION_MIN_POINTS 808
+/* END GENERATED option keys */
+
+/* Named values of option keys. */
+/* SOGMM_OPT_REG_COVAR: floors from the data's scales; get returns it while no value is set. */
+#define SOGMM_REG_COVAR_AUTO (-1.0)
+/* SOGMM_OPT_DEQUANTISE_DEPTH: on for the points of an RGB-D frame, off for arrays. */
 #define SOGMM_DEQUANTISE_AUTO (-1)
-#define SOGMM_MODE_COUNTER_FLAT_BINNED 0      /* authors' flat mean shift with bin seeding */
+/* SOGMM_OPT_MODE_COUNTER: */
+#define SOGMM_MODE_COUNTER_FLAT_BINNED 0       /* the authors' flat mean shift with bin seeding */
 #define SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING 1 /* the paper's Gaussian blurring mean shift */
-
-/* RGB-D back-projection (sogmm_fit_frame, sogmm_map_insert_frame, sogmm_frame_to_points_f32). */
-#define SOGMM_OPT_DEPTH_SCALE 200 /* f64, > 0, finite, 1 / value finite; default 1000: raw depth units per metre */
-#define SOGMM_OPT_DEPTH_MIN 201   /* f64, >= 0, finite; default 0.1 m (exclusive) */
-#define SOGMM_OPT_DEPTH_MAX 202   /* f64, > 0, finite; default 3.0 m (inclusive); must exceed DEPTH_MIN at fit time */
-#define SOGMM_OPT_DECIMATION 203  /* i64, [1, 1024]; default 1: integer decimation factor */
-
-/* Writing .sogmm (save, save_to_memory). */
-#define SOGMM_OPT_ZSTD_LEVEL 300 /* i64, [1, 22]; default 19 */
-#define SOGMM_OPT_FLOAT64 301    /* i64, 0 or 1; default 0: store arrays as float64 */
-#define SOGMM_OPT_COMPRESS 302   /* i64, 0 or 1; default 1: zstd-compress the arrays */
-
-/* Reading .sogmm (load, load_from_memory); MAX_DECODED_BYTES also for writing (save, save_to_memory). */
-#define SOGMM_OPT_MAX_DECODED_BYTES 400 /* i64, >= 0; default 1073741824 (1 GiB, the format library's cap); 0 sets that default again. The cap
-                                         * on the arrays' decoded bytes: load refuses a file above it and
-                                         * save a model above it (what a default reader would refuse) */
-#define SOGMM_OPT_VERIFY_CHECKSUMS 401  /* i64, 0 or 1; default 1 */
-
-/* Sampling (sogmm_model_sample_f32) and queries (the model score and
- * regression and the map queries, which also use SOGMM_OPT_THREADS). */
-#define SOGMM_OPT_SAMPLE_TRUNCATION 500 /* f64, > 0 (may be +Inf = untruncated); default 2.5 */
-#define SOGMM_OPT_QUERY_TRUNCATION_NATS 501 /* f64, >= 0, finite; default 0 = exact queries. > 0: culled score
-                                             * and regression that skip a component at a point only when its
-                                             * term is provably more than this many nats below the point's
-                                             * largest (as SOGMM_OPT_TRUNCATION_NATS for the E-step): a score is
-                                             * then at most log(1 + M exp(-nats)) below the exact one */
-
-/* Incremental map (sogmm_map_create, sogmm_map_load). The map also uses the
- * fit keys (each batch's fit; SOGMM_OPT_THREADS also runs the novelty test)
- * and the RGB-D keys (sogmm_map_insert_frame). */
-#define SOGMM_OPT_MAP_NOVELTY 600           /* i64, 0 or 1; default 1. 0: every point is novel and each
-                                             * insert fits its whole frame (append everything) */
-#define SOGMM_OPT_MAP_NOVELTY_THRESHOLD 601 /* f64, finite; default 3.0 nats: points whose 3-D log-likelihood
-                                             * under the local submap is below it are novel */
-#define SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE 607 /* f64, (0, 1]; default 0.7: with MAP_NOVELTY 1 the batches
-                                                   * of novel points are fitted with SOGMM_OPT_BANDWIDTH times
-                                                   * this (with MAP_NOVELTY 0 each frame with the bandwidth) */
-#define SOGMM_OPT_MAP_REVISIT_REFIT_RATIO 608 /* f64, 0 or >= 1, finite; default 1.25: with MAP_NOVELTY 1, an
-                                               * RGB-D insert refits the map components on its surfaces when
-                                               * its explained points they dominate have at least this many
-                                               * times as many modes as they are components: they are replaced
-                                               * by a fit of those points plus samples of their mass it does
-                                               * not see (MapOptions::revisit_refit_ratio: details and why).
-                                               * 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START 1.
-                                               * A refit counts as a fit (flushed, n_flushes) */
-/* Occupancy and distance to the surface (sogmm_map_occupancy_f32,
- * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32). */
-#define SOGMM_OPT_OCCUPANCY_SIGMA 700     /* f64, > 0, finite; default 0.01 m: standard deviation of the
-                                           * true surface along a ray about the depth the map renders */
-#define SOGMM_OPT_OCCUPANCY_THICKNESS 701 /* f64, > 0, finite; default 0.02 m: a point within this distance
-                                           * of the surface along a ray is occupied */
-#define SOGMM_OPT_SURFACE_DISC_SIGMAS 702 /* f64, (0, 10]; default 2.0: each component is the disc of its two
-                                           * largest principal axes out to this many standard deviations */
-/* Registration (sogmm_register_points_f32). */
-#define SOGMM_OPT_REGISTRATION_MAX_ITER 800 /* i64, [1, 2^31-1]; default 30: EM / Gauss-Newton iterations
-                                             * per coarse-to-fine level */
-#define SOGMM_OPT_REGISTRATION_TOL 801 /* f64, > 0, finite; default 0.0001 m: a level ends when a step moves
-                                        * the source by less than this (|t| + |rotation| x RMS radius) */
-#define SOGMM_OPT_REGISTRATION_OUTLIER_RATIO 802 /* f64, [0, 1); default 0.1: prior weight of the uniform
-                                                  * outlier term (over the target's 3-sigma box) */
-#define SOGMM_OPT_REGISTRATION_USE_GRAY 803 /* i64, 0 or 1; default 0. 1: score gray too (the 4-D joint
-                                             * density: gray marginal times the conditional x | gray) */
-#define SOGMM_OPT_REGISTRATION_LEVELS 804 /* i64, [1, 16]; default 3: coarse-to-fine levels; level l smooths
-                                           * the target by COARSE_SIGMA / 2^l, the last not at all */
-#define SOGMM_OPT_REGISTRATION_COARSE_SIGMA 805 /* f64, > 0, finite; default 0.04 m: smoothing standard
-                                                 * deviation of the coarsest level */
-#define SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO 806 /* f64, [0, 1]; default 0.5: below this inlier ratio the
-                                                     * status is SOGMM_REGISTRATION_LOW_FITNESS */
-#define SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO 807 /* f64, [0, 1); default 0.001: a direction whose scaled
-                                                     * information eigenvalue is below this fraction of the
-                                                     * largest is unobservable */
-#define SOGMM_OPT_REGISTRATION_MIN_POINTS 808 /* i64, >= 6; default 100: fewer source points are
-                                               * SOGMM_E_INVALID_DATA */
-#define SOGMM_OPT_MAP_BATCH_SIZE 602        /* i64, [1, 2^26]; default 12288: pending points that trigger a fit */
-#define SOGMM_OPT_MAP_FUSION 603            /* i64, 0 or 1; default 0: fuse new components into close ones */
-#define SOGMM_OPT_MAP_FUSION_METHOD 604     /* i64, a SOGMM_FUSION_* value; default SOGMM_FUSION_HELLINGER */
-#define SOGMM_OPT_MAP_FUSION_THRESHOLD 605  /* f64, > 0, finite; default 0.3: fuse below this distance */
-#define SOGMM_OPT_MAP_WARM_START 606        /* i64, 0 or 1; default 0. 1: each batch's fit starts from the
-                                             * previous batch's model moved into its camera (as
-                                             * a warm sogmm_fit_points_f32); for MAP_NOVELTY 0; needs N_INIT 1 */
+/* SOGMM_OPT_MAP_FUSION_METHOD: */
 #define SOGMM_FUSION_HELLINGER 0 /* Hellinger distance of the 4-D Gaussians, in [0, 1] */
 #define SOGMM_FUSION_KL 1        /* symmetric KL divergence (KL(a||b) + KL(b||a)) / 2, nats */
 
@@ -309,7 +392,7 @@ typedef struct sogmm_option_info {
   const char* range;   /* the whole rule in words, e.g. "> 0, finite" (the bounds are its hull:
                         * a value inside them may still be refused, as a sentinel outside them accepted) */
   const char* unit;    /* e.g. "m", "nats"; "" when dimensionless */
-  const char* doc;     /* one sentence: what the option does */
+  const char* doc;     /* what the option does (the text this header documents the key with) */
 } sogmm_option_info;
 
 /* Fills `*out` for `key`. SOGMM_E_INVALID_ARG for an unknown key (info keys
@@ -835,6 +918,9 @@ SOGMM_API sogmm_status sogmm_map_set_progress(sogmm_map* map, sogmm_progress_fn 
 #define SOGMM_MAP_N_FLUSHES 20003    /* i64: fits run by this handle (batches and revisit refits) */
 #define SOGMM_MAP_N_FUSED 20004      /* i64: new components fused into existing ones instead of appended */
 #define SOGMM_MAP_N_REFITS 20005     /* i64: revisit refits run by this handle (also in N_FLUSHES) */
+#define SOGMM_MAP_REVISION 20006     /* i64: the map's revision: 0 when created, +1 for every insert, flush
+                                      * that fitted or delta that changed it (a delta sets the sender's);
+                                      * a failed call keeps it. Saved with the map (spec/format.md 2.3) */
 SOGMM_API sogmm_status sogmm_map_get_i64(const sogmm_map* map, sogmm_key key, int64_t* out);
 
 /* What the insert of frame `frame` did (insertion order, from 0;
@@ -854,6 +940,25 @@ SOGMM_API sogmm_status sogmm_map_frame_get_f64(const sogmm_map* map, uint64_t fr
 /* The camera-to-world pose given with frame `frame` into `pose_out` (16
  * doubles, row-major). frame >= SOGMM_MAP_N_FRAMES -> SOGMM_E_INVALID_ARG. */
 SOGMM_API sogmm_status sogmm_map_frame_get_pose(const sogmm_map* map, uint64_t frame, double* pose_out);
+
+/* The map's origin (anchor) into origin_out (3 doubles: x, y, z in the world
+ * frame, metres). The map holds its components relative to it, so that far
+ * from the world origin (geo-referenced poses: 1000 km out a float32
+ * coordinate moves in steps of 6.25 cm) they keep room-scale resolution;
+ * every computation with a pose is in double relative to it. By default the
+ * first frame's translation rounded to a multiple of 1 km per axis (0 for a
+ * map that starts within 500 m of the world origin, which is held and saved
+ * as before origins existed); a loaded map's comes from its file's pose
+ * (spec/format.md 2.3.1). World-frame exports and queries convert at the
+ * boundary. 0 0 0 for a map before its first insert unless set. */
+SOGMM_API sogmm_status sogmm_map_get_origin(const sogmm_map* map, double* origin_out);
+/* Declares the map's origin (3 doubles, world frame, metres; e.g. a site's
+ * surveyed point, so that the maps of one site share it) instead of the
+ * first frame's. Only before the first insert: a map with a frame or a
+ * component -> SOGMM_E_INVALID_ARG; a NaN/Inf entry or one beyond float32
+ * range -> SOGMM_E_INVALID_ARG naming the axis. Needs exclusive use of the
+ * map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_set_origin(sogmm_map* map, const double* origin);
 
 /* New world-frame model (key "coordinate_frame" = "world") of the whole map
  * (`box` NULL) or of the components whose 3-sigma box meets `box` (6 floats:
@@ -918,6 +1023,37 @@ SOGMM_API sogmm_status sogmm_map_save(const sogmm_map* map, const char* path, co
  * SOGMM_E_INVALID_ARG; malformed "map_frames" (a count with a sign
  * included) -> SOGMM_E_FORMAT. */
 SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const sogmm_options* options);
+
+/* Map deltas (spec/format.md section 2.5): what changed in a map since one
+ * of its revisions (SOGMM_MAP_REVISION), so that a receiver that applies
+ * them in order holds a bitwise equal map (weights, means, covariances,
+ * support size, frame provenance) without the whole map being resent.
+ *
+ * Writes the delta file from revision `since_revision` to the map's current
+ * one into `out` (room for `capacity` bytes) and its size to *size. out =
+ * NULL with capacity 0 only queries the size; capacity below the size ->
+ * SOGMM_E_BUFFER_TOO_SMALL with *size set (nothing written). Pending points
+ * are not in a delta. Write keys of `options` apply (NULL = defaults). A
+ * revision the map holds no changes from (before it was created or loaded,
+ * after its current one, or, for a receiver, inside a delta it received) ->
+ * SOGMM_E_INVALID_ARG naming the range. The map keeps every explicit
+ * component it ever fitted (the cost of exporting from any revision). */
+SOGMM_API sogmm_status sogmm_map_export_delta(const sogmm_map* map, uint64_t since_revision,
+                                              const sogmm_options* options, void* out, size_t capacity,
+                                              size_t* size);
+/* Applies a delta of `size` bytes from `data` (read keys of `options`
+ * apply). Refused with the map unchanged (its revision included): a file
+ * that is not a valid delta (SOGMM_E_FORMAT and the other errors of
+ * sogmm_model_load_from_memory; a model file -> SOGMM_E_FORMAT
+ * "not_a_delta"); another map's delta, unless `map` is new (revision 0, no
+ * frame, no component: it then takes the sender's identity) ->
+ * SOGMM_E_INVALID_ARG; a delta that does not start at the map's revision (a
+ * gap, a duplicate, out of order) -> SOGMM_E_INVALID_ARG naming both
+ * revisions; points pending -> SOGMM_E_INVALID_ARG; steps that do not fit
+ * the map or a result that differs from the sender's digest ->
+ * SOGMM_E_FORMAT. Needs exclusive use of the map, like an insert. */
+SOGMM_API sogmm_status sogmm_map_apply_delta(sogmm_map* map, const void* data, size_t size,
+                                             const sogmm_options* options);
 
 /* ---- trajectories (Redwood .log) -------------------------------------- */
 /* A .log file holds, per frame, a header line "i j n" and four lines of a
@@ -1062,6 +1198,33 @@ typedef struct sogmm_registration_info {
 SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, const float* points, size_t n,
                                                  const double* init, const sogmm_options* options,
                                                  double* pose_out, sogmm_registration_info* info_out);
+
+/* Tracking: inserts an RGB-D `frame` into `map` at the camera-to-world pose
+ * that registration to the map finds (sogmm_register_points_f32's method,
+ * with the map's creation options: SOGMM_OPT_REGISTRATION_*,
+ * SOGMM_OPT_THREADS; progress and cancel through the map's callback), so
+ * that a stream without poses still gives a map. Start: `guess` (a rigid
+ * row-major 4 x 4 camera-to-world pose), or with NULL the constant-velocity
+ * prediction from the map's last two frames (frames assumed evenly spaced:
+ * a caller that skips frames passes its own guess). The map's first frame
+ * (no component, nothing pending) is inserted at the guess (NULL: the
+ * identity) without registration. The target is the map's components;
+ * pending points are flushed first when the map has none, or when the
+ * registration to the components alone does not converge (then it runs
+ * again). The frame is inserted only when the registration's status is
+ * SOGMM_REGISTRATION_CONVERGED: otherwise the call still returns SOGMM_OK,
+ * *inserted_out is 0, info_out says why, and the map keeps only the flush
+ * it may have run. Outputs (each may be NULL): pose_out (16 doubles) the
+ * pose used or the registration's last iterate, inserted_out 1/0,
+ * info_out the registration's figures (struct_size set by the caller; for
+ * the first frame status CONVERGED and iterations 0). Errors: NULL map or
+ * frame -> SOGMM_E_NULL_ARG; a non-rigid guess, info_out->struct_size too
+ * small -> SOGMM_E_INVALID_ARG; fewer than REGISTRATION_MIN_POINTS valid
+ * pixels -> SOGMM_E_INVALID_DATA; a busy map -> SOGMM_E_BUSY; otherwise as
+ * sogmm_map_insert_frame and sogmm_map_flush. */
+SOGMM_API sogmm_status sogmm_map_track_frame(sogmm_map* map, const sogmm_frame* frame, const double* guess,
+                                             double* pose_out, int32_t* inserted_out,
+                                             sogmm_registration_info* info_out);
 
 /* ---- buffers ---------------------------------------------------------- */
 /* Bytes of a buffer: owned by the buffer, valid until sogmm_buffer_free.

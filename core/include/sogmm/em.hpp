@@ -14,6 +14,13 @@
 
 namespace sogmm {
 
+/// How the EM moves from one model to the next (EmOptions::acceleration).
+/// The values are the C API's (SOGMM_OPT_EM_ACCELERATION).
+enum class EmAcceleration : int {
+  None = 0,     ///< plain EM: each model is the M-step of the last
+  Squarem = 1,  ///< SQUAREM (Varadhan & Roland 2008, S3) with a monotone safeguard
+};
+
 /// Parameters of the EM. Defaults are the paper's.
 struct EmOptions {
   double tol = 1e-3;        ///< stop when |change of mean log-likelihood| < tol
@@ -52,6 +59,22 @@ struct EmOptions {
   /// component collapses onto one depth level. fit() detects it for
   /// camera-frame clouds.
   DepthQuantisation quantisation;
+  /// None (default): plain EM. Squarem: after every two EM steps t1 =
+  /// F(t0), t2 = F(t1), the model is extrapolated along them (t0 + 2a r +
+  /// a^2 v, r = t1 - t0, v = t2 - 2 t1 + t0, a = |r| / |v| in t0's Fisher
+  /// metric, capped by a schedule that grows while steps succeed) and one EM
+  /// step is taken from there. An extrapolation that is not a model (a
+  /// covariance not positive definite, or not above its reg_covar floors)
+  /// is pulled back towards t2, and one
+  /// whose log-likelihood is below t1's is rejected, the run continuing from
+  /// t2 as plain EM would. The model returned is an M-step's. Limit: the EM
+  /// step after a kept extrapolation is not an ascent step (the M-step adds
+  /// the reg_covar floors back), so the reported log-likelihood can fall
+  /// there (measured: up to 2.5e-4 nats/point on a synthetic scene, where
+  /// plain EM never falls; test_em_acceleration.cpp).
+  /// Iterations (max_iter, EmReport::iterations) count E+M passes, rejected
+  /// ones included; tol applies between consecutive reported passes.
+  EmAcceleration acceleration = EmAcceleration::None;
 };
 
 /// What the EM did.
@@ -68,6 +91,10 @@ struct EmReport {
   const char* kernel = "";
   /// The regulariser the fit used (EmOptions::reg_covar resolved).
   RegCovarFloors reg_covar;
+  /// EmAcceleration::Squarem: extrapolations kept and rejected (each costs
+  /// one pass; 0 and 0 for plain EM).
+  int extrapolations_kept = 0;
+  int extrapolations_rejected = 0;
 };
 
 /// Called after each EM iteration with the iteration number (from 1) and the

@@ -60,8 +60,12 @@
 
 namespace sogmm {
 
+struct MapDelta;  // sogmm/map_delta.hpp
+
 /// Row-major 4 x 4 rigid transform [R t; 0 0 0 1] (camera-to-world).
 using Pose = std::array<double, 16>;
+/// A point of the world frame (x, y, z in metres), in double.
+using Origin = std::array<double, 3>;
 
 /// How fusion measures the distance of two components (full 4-D Gaussians).
 enum class FusionMethod {
@@ -248,9 +252,29 @@ class Map {
   /// The index over the map's components (ids are component indices of model()).
   const ComponentIndex& index() const;
 
-  /// The whole map as a world-frame model (key coordinate_frame "world").
-  /// Pending points are not in it. Throws Error(InvalidData) when the map
-  /// has no component yet.
+  /// The map's origin (anchor, world frame, metres): the map holds its
+  /// components relative to it, so that they keep room-scale float32
+  /// resolution however far from the world origin the frames are (1000 km
+  /// out a world float32 coordinate moves in steps of 6.25 cm). By default
+  /// the first frame's translation rounded to a multiple of 1 km per axis: 0
+  /// for a map that starts within 500 m of the world origin, which is then
+  /// held, saved and answered exactly as before anchors existed. Everything
+  /// that meets a pose (novelty, pending voxels, fits, renders) is computed
+  /// in double relative to it; model(), extract() and the queries convert at
+  /// the boundary; a map file records it (to_model()).
+  const Origin& origin() const;
+  /// Declares the origin (e.g. a site's surveyed point, so that maps of one
+  /// site share it) instead of the first frame's. Only before the first
+  /// insert (no frame recorded, no component) -> else
+  /// Error(InvalidArgument); every axis finite and within float32 range ->
+  /// else Error(InvalidArgument).
+  void set_origin(const Origin& origin);
+
+  /// The whole map as a world-frame model (key coordinate_frame "world", no
+  /// pose): the components moved by origin() and rounded to float32, so far
+  /// from the world origin they have the world float32 resolution there (use
+  /// to_model() for the exact map). Pending points are not in it. Throws
+  /// Error(InvalidData) when the map has no component yet.
   const Model& model() const;
   /// The components whose index box meets `box`, weights renormalised over
   /// them and support size the map's times their weight share (rounded, at
@@ -261,7 +285,8 @@ class Map {
 
   /// log p(x) of each point's 3-D marginal under its neighbourhood in the
   /// map, as the novelty test computes it (see the header comment): `xyz`
-  /// holds n world points (3 doubles each), `out` receives n values, each
+  /// holds n world points (3 doubles each; taken relative to origin() in
+  /// double), `out` receives n values, each
   /// independent of the other points; -inf where no component's box holds
   /// the point. Uses fit.em.threads threads.
   void local_log_likelihood(const double* xyz, std::size_t n, double* out) const;
@@ -277,18 +302,51 @@ class Map {
   /// Error(InvalidArgument); as model() and render().
   std::shared_ptr<const std::vector<float>> frame_depth(std::size_t frame, int threads = 0) const;
 
-  /// model() with the provenance keys kMapFramesKey and kMapOptionsKey added
-  /// (what a map file stores). Throws Error(InvalidArgument) when points are
-  /// pending (flush first: a file holds components only) and as model().
+  /// What a map file stores: the components relative to origin() with the
+  /// origin as the model's pose (a translation; spec/format.md 2.3; no pose
+  /// when the origin is 0, so that such a model is model() itself) and the
+  /// provenance keys kMapFramesKey and kMapOptionsKey. Throws
+  /// Error(InvalidArgument) when points are pending (flush first: a file
+  /// holds components only) and as model().
   Model to_model() const;
   /// A map holding `model`'s components (which must be a world-frame model,
   /// else Error(InvalidArgument)) and, when present, the frame provenance of
   /// kMapFramesKey (malformed, or a number with a sign -> Error(Format)
-  /// naming the line). A model of support size 0 (unknown) ->
+  /// naming the line). A pose, when present, maps the components to the
+  /// world (spec/format.md 2.1): its translation becomes origin() and its
+  /// rotation, if any, is applied to the components. A model of support size 0 (unknown) ->
   /// Error(InvalidArgument): every flush merges by support size and would
   /// have to guess its weight against the new points' (merge() refuses it).
   /// `options` govern later inserts.
   static Map from_model(const Model& model, const MapOptions& options = {});
+
+  /// The map's revision: 0 when built, +1 for every call that changed the
+  /// components or the frame provenance (an insert, a flush that fitted, a
+  /// delta applied: a delta sets the sender's revision). A failed call
+  /// changes nothing, the revision included. Kept in a saved map
+  /// (kMapRevisionKey), with id() (kMapIdKey).
+  std::uint64_t revision() const;
+  /// The map's identity, 32 lowercase hex digits, random when the map is
+  /// built (a receiver takes its sender's with its first delta).
+  const std::string& id() const;
+  /// What changed from revision `since` to revision() (sogmm/map_delta.hpp),
+  /// pending points left out. Error(InvalidArgument) naming the range unless
+  /// `since` is a revision this map recorded the changes after: from the
+  /// revision it was built or loaded at, up to revision(); a receiver can
+  /// relay from the revisions its deltas started at. Memory: the map keeps
+  /// every explicit component it ever received (batches, fusion results).
+  MapDelta delta_since(std::uint64_t since) const;
+  /// Applies a delta of the sender (the map id()). Refused, nothing changed:
+  /// another map's delta (unless this map is new: revision 0, no frame, no
+  /// component, then it takes the sender's id) -> Error(InvalidArgument); a
+  /// delta that does not start at revision() (a gap, a duplicate, one out of
+  /// order) -> Error(InvalidArgument) naming both revisions; points pending
+  /// -> Error(InvalidArgument); a delta whose steps do not fit this map or
+  /// whose result differs from the sender's digest -> Error(Format). The new
+  /// state is built aside and committed at once: a throw at any point leaves
+  /// the map at its last revision. This map's options are kept (they govern
+  /// later inserts).
+  void apply_delta(const MapDelta& delta);
 
   struct State;  ///< the implementation (core/src/map_state.hpp)
 

@@ -4,12 +4,16 @@
 // name, type, accepted values, unit and meaning. The default of a setting is
 // the value its field is initialised with, read from a default Settings and
 // never written again: the C API's options handle stores a Settings, its
-// introspection call (sogmm_option_info) reports the table, and the bindings
-// and spec/api.md are checked against it (tests/tools/check_options.py).
+// introspection call (sogmm_option_info) reports the table, and the copies
+// that cannot read it at run time (sogmm.h's SOGMM_OPT_* macros and their
+// documentation, spec/api.md's option tables, the Rust, Python and Go key
+// constants) are generated from it (tools/options/regenerate.py; ctest
+// options_registry fails while one is stale).
 //
 // Adding an option: a field in the struct it belongs to (with its default
-// and doc comment), a key below and in sogmm.h, and a row in
-// core/src/option_table.cpp.
+// and doc comment), a key below, and a row in core/src/option_table.cpp;
+// then `cmake --build build --target sogmm-option-mirrors &&
+// python3 tools/options/regenerate.py`.
 #pragma once
 
 #include <cstdint>
@@ -69,6 +73,7 @@ enum class OptionKey : int {
   TRUNCATION_NATS = 108,
   N_INIT = 109,
   DEQUANTISE_DEPTH = 110,
+  EM_ACCELERATION = 111,
   DEPTH_SCALE = 200,
   DEPTH_MIN = 201,
   DEPTH_MAX = 202,
@@ -120,7 +125,7 @@ struct OptionSpec {
   std::int64_t upper_i64;  ///< I64 rows: largest accepted value
   const char* range;  ///< the accepted values in words, e.g. "> 0, finite"
   const char* unit;   ///< e.g. "m", "nats", "" when dimensionless
-  const char* doc;    ///< one sentence: what the setting does
+  const char* doc;    ///< what the setting does, complete: sogmm.h and spec/api.md document the key with it
   bool (*accepts_f64)(double);        ///< F64 rows: the whole rule
   bool (*accepts_i64)(std::int64_t);  ///< I64 rows: the whole rule
   double (*get_f64)(const Settings&);

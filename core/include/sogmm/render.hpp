@@ -25,13 +25,23 @@ struct RenderOptions {
   /// A pixel whose ray passes farther than this many standard deviations
   /// (Mahalanobis distance) from every component's mean shows nothing.
   double max_mahalanobis = 3.0;
+  /// 0 (default): every mode found is a surface. s > 0: a mode is a surface
+  /// only where the evidence sum_k exp(-D_k^2 / 2) at its 3-D point (D_k its
+  /// Mahalanobis distance to component k, weights aside) reaches
+  /// exp(-s^2 / 2), that of one component at s sigma; a ray that grazes the
+  /// tail of a nearer object's components beyond its silhouette then passes
+  /// on to the surface behind. s = 2 is the edge of the uniform disc a flat
+  /// component is fitted to; gaps between components that cover less than
+  /// that show as empty pixels (README, "Per visible pixel").
+  double surface_sigma = 0.0;
   /// Worker threads (0 = OpenMP's default, at most 4 x processors). The
   /// images are bitwise the same for any count.
   int threads = 0;
 };
 
 /// Throws Error(InvalidArgument) unless 0 <= depth_min < depth_max, both
-/// finite, max_mahalanobis finite and > 0 and threads >= 0.
+/// finite, max_mahalanobis finite and > 0, surface_sigma finite and >= 0 and
+/// threads >= 0.
 void validate(const RenderOptions& options);
 
 /// Rendered images, row-major width x height. A pixel with nothing to show
@@ -64,9 +74,10 @@ std::vector<RayComponent> ray_components(const Gmm& gmm);
 /// 1-D mean shift from each component peak on the ray that lies in
 /// (depth_min, depth_max] and within max_mahalanobis of its component climbs
 /// to a mode of the ray's 1-D mixture (components within max(8,
-/// max_mahalanobis) sigma shape it); the pixel's depth is the nearest such
-/// mode in range: the first surface a camera would see, not the densest (a
-/// dense wall behind a sparse object is occluded). Gray and its variance are
+/// max_mahalanobis) sigma shape it); with surface_sigma > 0 only modes with
+/// that much evidence count. The pixel's depth is the nearest such mode in
+/// range: the first surface a camera would see, not the densest (a dense
+/// wall behind a sparse object is occluded). Gray and its variance are
 /// regress_gray at that 3-D point. `progress` (optional) receives
 /// Stage::Rendering reports (step = image rows done, total = height) and may
 /// cancel (Error(Cancelled)). Errors: validate(camera), validate(options),

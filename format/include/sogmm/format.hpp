@@ -108,7 +108,9 @@ struct FileInfo {
 
 /// Reads and verifies the header and the metadata block of a whole file in
 /// memory (steps 1 to 12 of spec/format.md section 9: everything except
-/// decoding the arrays and checking their values). No decompression.
+/// decoding the arrays and checking their values). No decompression. Also
+/// describes a map delta (features_required bit 0, spec/format.md 2.5),
+/// which load() and from_bytes() refuse.
 FileInfo read_info(const void* data, std::size_t size, const ReadOptions& options = {});
 
 /// read_info() on a file, reading only its header, metadata block and last 4

@@ -7,6 +7,7 @@
 package main
 
 import (
+	"context"
 	"fmt"
 	"math"
 	"os"
@@ -46,7 +47,7 @@ func run(path string) error {
 		return err
 	}
 	defer opts.Close()
-	model, err := sogmm.Fit(cubes(), opts)
+	model, err := sogmm.Fit(context.Background(), cubes(), opts)
 	if err != nil {
 		return err
 	}
@@ -67,7 +68,7 @@ func run(path string) error {
 	if err != nil {
 		return err
 	}
-	gray, _, err := loaded.RegressGray([]float32{0.015, 0.015, 1.015, 1.015, 0.015, 1.015})
+	gray, _, err := loaded.RegressGray(context.Background(), []float32{0.015, 0.015, 1.015, 1.015, 0.015, 1.015}, nil)
 	if err != nil {
 		return err
 	}

@@ -56,7 +56,7 @@ func main() {
 			sent.Store(time.Now().UnixNano())
 			cancel()
 		})
-		m, err := sogmm.FitContext(ctx, pts, opts, nil)
+		m, err := sogmm.Fit(ctx, pts, opts)
 		done := time.Now().UnixNano()
 		timer.Stop()
 		cancel()

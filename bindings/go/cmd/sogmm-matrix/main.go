@@ -8,6 +8,7 @@ package main
 
 import (
 	"bufio"
+	"context"
 	"encoding/binary"
 	"fmt"
 	"math"
@@ -38,7 +39,7 @@ func write(pointsPath, outPath string) error {
 		return err
 	}
 	defer o.Close()
-	m, err := sogmm.Fit(pts, o)
+	m, err := sogmm.Fit(context.Background(), pts, o)
 	if err != nil {
 		return err
 	}
@@ -59,7 +60,7 @@ func frame(depthPath, colorPath, outPath string) error {
 		return err
 	}
 	defer o.Close()
-	m, err := sogmm.FitRGBD(f, o)
+	m, err := sogmm.FitRGBD(context.Background(), f, o)
 	if err != nil {
 		return err
 	}
@@ -80,9 +81,9 @@ func read(modelPath, queryPath, outPath string) error {
 	w, err1 := m.Weights()
 	mu, err2 := m.Means()
 	cov, err3 := m.Covariances()
-	s, err4 := m.Sample(256, 2024, 4, nil)
-	mean, variance, err5 := m.RegressGray(q)
-	score, err6 := m.ScoreSamples(q, 3)
+	s, err4 := m.Sample(context.Background(), 256, 2024, 4, nil)
+	mean, variance, err5 := m.RegressGray(context.Background(), q, nil)
+	score, err6 := m.ScoreSamples(context.Background(), q, 3, nil)
 	for _, e := range []error{err1, err2, err3, err4, err5, err6} {
 		if e != nil {
 			return e

@@ -203,7 +203,14 @@ def map_tile(frames: list[Frame], settings: FitSettings, map_settings: MapSettin
         with tempfile.TemporaryDirectory(prefix="sogmm_tile_") as d:
             path = os.path.join(d, "tile.sogmm")
             tile.map.save(path, compress=False)
-            part = _map_partial(GMM.load(path), inserted)
+            saved = GMM.load(path)
+            if saved.pose is not None:
+                # A tile far from the world origin holds its components
+                # relative to its origin, the file's pose (spec/format.md
+                # 2.3.1); the merge tree's rows are world-frame.
+                saved = saved.transform(saved.pose)
+                saved.pose = None
+            part = _map_partial(saved, inserted)
     finally:
         tile.close()
     infos[-1]["seconds"] += time.perf_counter() - start

@@ -33,6 +33,7 @@ ABI_VERSION = 2
 OK = 0
 E_NOT_FOUND = -10
 
+# BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp)
 OPT_BANDWIDTH = 100
 OPT_N_COMPONENTS = 101
 OPT_TOL = 102
@@ -44,9 +45,7 @@ OPT_MODE_COUNTER = 107
 OPT_TRUNCATION_NATS = 108
 OPT_N_INIT = 109
 OPT_DEQUANTISE_DEPTH = 110
-DEQUANTISE_AUTO = -1
-MODE_COUNTER_FLAT_BINNED = 0
-MODE_COUNTER_GAUSSIAN_BLURRING = 1
+OPT_EM_ACCELERATION = 111
 OPT_DEPTH_SCALE = 200
 OPT_DEPTH_MIN = 201
 OPT_DEPTH_MAX = 202
@@ -60,13 +59,13 @@ OPT_SAMPLE_TRUNCATION = 500
 OPT_QUERY_TRUNCATION_NATS = 501
 OPT_MAP_NOVELTY = 600
 OPT_MAP_NOVELTY_THRESHOLD = 601
-OPT_MAP_NOVELTY_BANDWIDTH_SCALE = 607
-OPT_MAP_REVISIT_REFIT_RATIO = 608
 OPT_MAP_BATCH_SIZE = 602
 OPT_MAP_FUSION = 603
 OPT_MAP_FUSION_METHOD = 604
 OPT_MAP_FUSION_THRESHOLD = 605
 OPT_MAP_WARM_START = 606
+OPT_MAP_NOVELTY_BANDWIDTH_SCALE = 607
+OPT_MAP_REVISIT_REFIT_RATIO = 608
 OPT_OCCUPANCY_SIGMA = 700
 OPT_OCCUPANCY_THICKNESS = 701
 OPT_SURFACE_DISC_SIGMAS = 702
@@ -79,6 +78,10 @@ OPT_REGISTRATION_COARSE_SIGMA = 805
 OPT_REGISTRATION_MIN_INLIER_RATIO = 806
 OPT_REGISTRATION_DEGENERACY_RATIO = 807
 OPT_REGISTRATION_MIN_POINTS = 808
+# END GENERATED option keys
+DEQUANTISE_AUTO = -1
+MODE_COUNTER_FLAT_BINNED = 0
+MODE_COUNTER_GAUSSIAN_BLURRING = 1
 REGISTRATION_STATUS = {0: "converged", 1: "not_converged", 2: "low_fitness", 3: "degenerate"}
 OCCUPANCY_FREE = 0
 OCCUPANCY_OCCUPIED = 1
@@ -127,6 +130,7 @@ MAP_N_FRAMES = 20002
 MAP_N_FLUSHES = 20003
 MAP_N_FUSED = 20004
 MAP_N_REFITS = 20005
+MAP_REVISION = 20006
 MAP_FRAME_N_POINTS = 20100
 MAP_FRAME_N_NOVEL = 20101
 MAP_FRAME_N_COMPONENTS = 20102
@@ -215,6 +219,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_free": (None, [HANDLE]),
     "sogmm_map_insert_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, F64_IN]),
     "sogmm_map_insert_frame": (STATUS, [HANDLE, HANDLE, F64_IN]),
+    # guess, inserted_out and info_out may be NULL: c_void_p.
+    "sogmm_map_track_frame": (STATUS, [HANDLE, HANDLE, c_void_p, F64_OUT, c_void_p, c_void_p]),
     "sogmm_map_flush": (STATUS, [HANDLE]),
     "sogmm_map_discard_pending": (STATUS, [HANDLE, POINTER(c_uint64)]),
     "sogmm_map_set_progress": (STATUS, [HANDLE, PROGRESS_FN, c_void_p]),
@@ -222,6 +228,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_frame_get_i64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_int64)]),
     "sogmm_map_frame_get_f64": (STATUS, [HANDLE, c_uint64, KEY, POINTER(c_double)]),
     "sogmm_map_frame_get_pose": (STATUS, [HANDLE, c_uint64, F64_OUT]),
+    "sogmm_map_get_origin": (STATUS, [HANDLE, F64_OUT]),
+    "sogmm_map_set_origin": (STATUS, [HANDLE, F64_IN]),
     "sogmm_map_export": (STATUS, [HANDLE_OUT, HANDLE, c_void_p]),
     "sogmm_map_score_samples_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_int32, HANDLE, F64_OUT]),
     "sogmm_map_regress_gray_f32": (STATUS, [HANDLE, F32_IN, c_size_t, HANDLE, F32_OUT, F32_OUT]),
@@ -239,6 +247,8 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
                                       HANDLE, F32_OUT, F32_OUT, F32_OUT]),
     "sogmm_map_save": (STATUS, [HANDLE, c_char_p, HANDLE]),
     "sogmm_map_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
+    "sogmm_map_export_delta": (STATUS, [HANDLE, c_uint64, HANDLE, c_void_p, c_size_t, POINTER(c_size_t)]),
+    "sogmm_map_apply_delta": (STATUS, [HANDLE, c_void_p, c_size_t, HANDLE]),
     "sogmm_trajectory_read": (STATUS, [HANDLE_OUT, c_char_p]),
     "sogmm_trajectory_free": (None, [HANDLE]),
     "sogmm_trajectory_size": (c_size_t, [HANDLE]),
@@ -439,6 +449,7 @@ OPTION_NAMES = {
     OPT_TRUNCATION_NATS: "truncation_nats",
     OPT_N_INIT: "n_init",
     OPT_DEQUANTISE_DEPTH: "dequantise_depth",
+    OPT_EM_ACCELERATION: "em_acceleration",
     OPT_DEPTH_SCALE: "depth_scale",
     OPT_DEPTH_MIN: "depth_min",
     OPT_DEPTH_MAX: "depth_trunc",

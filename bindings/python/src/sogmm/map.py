@@ -9,11 +9,12 @@ algorithm is documented in core/include/sogmm/map.hpp.
 
 from __future__ import annotations
 
+import ctypes
 import os
 import threading
 import weakref
 from contextlib import contextmanager
-from ctypes import byref, c_double, c_int64, c_uint64, c_void_p
+from ctypes import byref, c_double, c_int64, c_size_t, c_uint64, c_void_p
 
 import numpy as np
 
@@ -21,9 +22,11 @@ from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
 from .errors import InvalidArgumentError, MapBusyError
-from .model import (GMM, SOGMM, _pose, _query_options, _read_options, _rows, _sample_args,
-                    _surface_distance, _write_options, _collision)
+from ._arrays import _pose, _real_array, _rows
+from .model import GMM, SOGMM, _read_options, _write_options
 from .progress import ProgressArg, call_with_progress
+from .queryable import Queryable
+from .registration import RegistrationInfo, info_dict
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
 _D = _ffi.DEFAULTS
@@ -99,7 +102,7 @@ class _UseGuard:
                 self._users -= 1
 
 
-class Map:
+class Map(Queryable):
     """An incremental world map of posed frames.
 
     Args:
@@ -127,6 +130,9 @@ class Map:
             ``novelty=False``, needs ``n_init=1``.
         depth_scale, depth_min, depth_trunc, decimate: back-projection of
             :meth:`insert_rgbd` frames (as :func:`sogmm.rgbd_to_points`).
+        registration_use_gray: :meth:`track_rgbd` registers with gray too (the
+            4-D density, as :func:`sogmm.register`'s ``use_gray``), which holds
+            the pose where geometry alone lets a frame slide (a wall, a floor).
         **fit_params: parameters of each batch's fit, as :class:`sogmm.SOGMM`
             (bandwidth, seed, n_threads, ...).
 
@@ -151,19 +157,20 @@ class Map:
                  revisit_refit_ratio: float = _D.map_revisit_refit_ratio,
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
+                 registration_use_gray: bool = bool(_D.registration_use_gray),
                  **fit_params):
         self._ptr = None
         self._finalizer = None
         self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio) as o:
+                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) as o:
             out = c_void_p()
             check(lib.sogmm_map_create(byref(out), o.ptr))
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
@@ -180,7 +187,8 @@ class Map:
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
-               _ffi.OPT_MAP_WARM_START: int(bool(warm_start))}
+               _ffi.OPT_MAP_WARM_START: int(bool(warm_start)),
+               _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(registration_use_gray))}
         if _FUSION[fusion] is not None:
             i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
         # The fit keys exactly as SOGMM sets them (same checks and messages).
@@ -245,6 +253,32 @@ class Map:
             self._call("insert_rgbd", progress, lambda h: lib.sogmm_map_insert_frame(h, frame, p))
         return self.frame_stats(-1)
 
+    def track_rgbd(self, depth, color, camera: Camera, guess=None,
+                   progress: ProgressArg = None) -> tuple[np.ndarray, dict]:
+        """Inserts an RGB-D frame at the camera-to-world pose that registration
+        to the map finds (``sogmm_map_track_frame``): from ``guess`` (4 x 4),
+        or with None the constant-velocity prediction from the map's last two
+        frames. The map's first frame is inserted at the guess (None: the
+        identity). The frame is inserted only when the registration converged.
+
+        Returns ``(pose, info)``: the pose used (or the registration's last
+        iterate when not inserted) and :func:`sogmm.register`'s figures plus
+        ``inserted`` (bool) and ``registered`` (False for the first frame).
+        Bad input raises as :meth:`insert_rgbd` and :func:`sogmm.register`.
+        """
+        f = prepare_frame(depth, color, camera, *self._depth)
+        start = None if guess is None else np.ascontiguousarray(_pose(guess))
+        pose = np.empty(16, dtype=np.float64)
+        inserted = ctypes.c_int32(0)
+        info = RegistrationInfo(struct_size=ctypes.sizeof(RegistrationInfo))
+        with f.handle() as frame:
+            self._call("track_rgbd", progress, lambda h: lib.sogmm_map_track_frame(
+                h, frame, None if start is None else start.ctypes.data, pose, byref(inserted), byref(info)))
+        out = info_dict(info)
+        out["inserted"] = bool(inserted.value)
+        out["registered"] = out["iterations"] > 0
+        return pose.reshape(4, 4), out
+
     def flush(self, progress: ProgressArg = None) -> int:
         """Fits the pending points now; returns the number of components added."""
         before = self.n_components_
@@ -259,6 +293,28 @@ class Map:
         with self._guard.changing("discard_pending"):
             check(lib.sogmm_map_discard_pending(self._h(), byref(dropped)))
         return int(dropped.value)
+
+    @property
+    def origin(self) -> np.ndarray:
+        """The map's origin (anchor; 3 world coordinates, metres): the map holds
+        its components relative to it, so that far from the world origin
+        (geo-referenced poses) they keep room-scale resolution. By default the
+        first frame's translation rounded to 1 km per axis (0 near the world
+        origin); a loaded map's comes from its file (sogmm_map_get_origin)."""
+        out = np.empty(3, dtype=np.float64)
+        with self._guard.reading("origin"):
+            check(lib.sogmm_map_get_origin(self._h(), out))
+        return out
+
+    def set_origin(self, origin) -> None:
+        """Declares the origin (3 world coordinates, metres, finite within
+        float32 range) instead of the first frame's; only before the first
+        insert, else InvalidArgumentError (sogmm_map_set_origin)."""
+        o = _real_array(origin, np.float64, "origin")
+        if o.shape != (3,):
+            raise InvalidArgumentError(f"origin must hold 3 values, got shape {o.shape}")
+        with self._guard.changing("set_origin"):
+            check(lib.sogmm_map_set_origin(self._h(), o))
 
     # ---- statistics ----------------------------------------------------------
     def stats(self) -> dict:
@@ -326,40 +382,14 @@ class Map:
             check(lib.sogmm_map_export(byref(out), self._h(), None if b is None else b.ctypes.data_as(c_void_p)))
         return GMM._wrap(out)
 
-    # World-frame queries on the map itself (no export, no copy): each answer
-    # is bitwise what the same GMM method gives on export(). A map without
-    # components (nothing flushed yet) raises InvalidDataError. ``progress``
-    # as in SOGMM.fit (stages STAGE_SCORING, STAGE_REGRESSION, STAGE_SAMPLING);
-    # ``truncation_nats`` and ``n_threads`` as in GMM.score_samples.
-    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                      n_threads: int = _D.threads) -> np.ndarray:
-        """Log-density of (n, 3) or (n, 4) world points under the whole map (see GMM.score_samples)."""
-        x = _rows(X, (3, 4), "X")
-        out = np.empty(x.shape[0], dtype=np.float64)
-        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("score_samples"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_score_samples_f32(self._h(), x, x.shape[0],
-                                                                                     x.shape[1], o.ptr, out))
-        return out
+    # The world-frame queries on the map itself (no export, no copy) come from
+    # Queryable: each answer is bitwise what the same GMM method gives on
+    # export(); a map without components (nothing flushed yet) raises
+    # InvalidDataError. Each holds the map's use guard for reading.
+    _C_PREFIX = "sogmm_map"
 
-    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                     n_threads: int = _D.threads) -> tuple[np.ndarray, np.ndarray]:
-        """Expected gray and its variance at (n, 3) world points (see GMM.regress_gray)."""
-        x = _rows(xyz, (3,), "xyz")
-        mean = np.empty(x.shape[0], dtype=np.float32)
-        var = np.empty(x.shape[0], dtype=np.float32)
-        with _query_options(truncation_nats, n_threads) as o, self._guard.reading("regress_gray"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_regress_gray_f32(self._h(), x, x.shape[0], o.ptr,
-                                                                                    mean, var))
-        return mean, var
-
-    def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
-               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The map seen from ``camera`` at the camera-to-world ``pose``: bitwise
-        ``self.export().render(...)`` (see GMM.render). An empty map: InvalidDataError."""
-        from .render import render_images
-
-        return render_images(lib.sogmm_map_render_f32, self._h(), camera, pose, depth_min, depth_trunc, n_threads,
-                             progress)
+    def _reading(self, what: str):
+        return self._guard.reading(what)
 
     def occupancy(self, points, return_state: bool = False, *, surface_sigma: float = _D.occupancy_sigma,
                   thickness: float = _D.occupancy_thickness, n_threads: int = _D.threads,
@@ -377,34 +407,37 @@ class Map:
         state = np.empty(x.shape[0], dtype=np.uint8)
         state_ptr = state.ctypes.data if state.size else None
         f64 = {_ffi.OPT_OCCUPANCY_SIGMA: surface_sigma, _ffi.OPT_OCCUPANCY_THICKNESS: thickness}
-        with _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}) as o, self._guard.reading("occupancy"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_occupancy_f32(self._h(), x, x.shape[0], o.ptr,
-                                                                                 prob, state_ptr))
+        self._query("occupancy", "occupancy_f32", _ffi.Options(f64=f64, i64={_ffi.OPT_THREADS: n_threads}), progress,
+                    lambda o: (x, x.shape[0], o, prob, state_ptr))
         return (prob, state) if return_state else prob
 
-    def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                         n_threads: int = _D.threads, progress: ProgressArg = None):
-        """Distance of (n, 3) world points to the map's surface (see GMM.surface_distance);
-        an empty map: InvalidDataError."""
-        with self._guard.reading("surface_distance"):
-            return _surface_distance(lib.sogmm_map_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
-                                     n_threads, progress)
+    # ---- deltas (spec/format.md section 2.5) ---------------------------------------
+    @property
+    def revision(self) -> int:
+        """The map's revision: 0 when created, +1 for every insert, fitting
+        flush or applied delta that changed it."""
+        v = c_int64()
+        with self._guard.reading("revision"):
+            check(lib.sogmm_map_get_i64(self._h(), _ffi.MAP_REVISION, byref(v)))
+        return int(v.value)
 
-    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
-        """Collision probability of ellipsoidal robots against the map (see
-        GMM.collision_probability); an empty map: InvalidDataError."""
-        with self._guard.reading("collision_probability"):
-            return _collision(lib.sogmm_map_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
-                              progress)
+    def export_delta(self, since_revision: int) -> bytes:
+        """The delta file (bytes) from ``since_revision`` to the current
+        revision; a receiver at that revision applies it with apply_delta."""
+        size = c_size_t()
+        with self._guard.reading("export_delta"):
+            check(lib.sogmm_map_export_delta(self._h(), since_revision, None, None, 0, byref(size)))
+            buf = ctypes.create_string_buffer(size.value)
+            check(lib.sogmm_map_export_delta(self._h(), since_revision, None, buf, size.value, byref(size)))
+        return buf.raw[: size.value]
 
-    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
-               spatial_only: bool = False, progress: ProgressArg = None) -> np.ndarray:
-        """(n, 4) world samples of the map, or (n, 3) with spatial_only (see GMM.sample)."""
-        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
-        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o, self._guard.reading("sample"):
-            call_with_progress(o, progress, lambda: lib.sogmm_map_sample_f32(self._h(), n, seed, dims, o.ptr, out))
-        return out
+    def apply_delta(self, delta: bytes) -> None:
+        """Applies a delta of the sender's map; afterwards this map is bitwise
+        the sender's. A gap, a duplicate, another map's or a damaged delta
+        raises (InvalidArgumentError / FormatError) and changes nothing."""
+        data = bytes(delta)
+        with self._guard.changing("apply_delta"):
+            check(lib.sogmm_map_apply_delta(self._h(), data, len(data), None))
 
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
@@ -430,7 +463,8 @@ class Map:
         map_keys = dict(novelty=bool(d.map_novelty), novelty_threshold=d.map_novelty_threshold,
                         batch_size=d.map_batch_size, fusion=None, fusion_threshold=d.map_fusion_threshold,
                         warm_start=bool(d.map_warm_start), novelty_bandwidth_scale=d.map_novelty_bandwidth_scale,
-                        revisit_refit_ratio=d.map_revisit_refit_ratio)
+                        revisit_refit_ratio=d.map_revisit_refit_ratio,
+                        registration_use_gray=bool(d.registration_use_gray))
         for k in list(map_keys):
             if k in options:
                 map_keys[k] = options.pop(k)

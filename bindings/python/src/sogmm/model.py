@@ -9,7 +9,6 @@ weakref.finalize (or early by ``close()`` / a ``with`` block).
 from __future__ import annotations
 
 import os
-import secrets
 import weakref
 from ctypes import byref, c_char_p, c_double, c_int64, c_size_t, c_void_p
 
@@ -18,57 +17,15 @@ import numpy as np
 from . import _ffi
 from ._ffi import check, lib
 from .camera import Camera, prepare_frame
+from ._arrays import _count, _pose, _real_array, _rows
 from .errors import InvalidArgumentError, NotFittedError, NotFoundError
 from .progress import ProgressArg, call_with_progress
+from .queryable import Queryable
 
 # The library's option defaults (sogmm_option_get_info): keyword defaults read, never copied.
 _D = _ffi.DEFAULTS
 
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
-
-
-# ---- input conversion ----------------------------------------------------
-def _real_array(x, dtype, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x)
-    except (TypeError, ValueError) as e:
-        raise InvalidArgumentError(f"{name} must be a numeric array ({e})") from None
-    if a.dtype.kind not in "biuf":
-        raise InvalidArgumentError(f"{name} must hold real numbers, got dtype {a.dtype}")
-    return np.ascontiguousarray(a, dtype=dtype)
-
-
-def _rows(x, cols: tuple[int, ...], name: str) -> np.ndarray:
-    a = _real_array(x, np.float32, name)
-    if a.ndim != 2 or a.shape[1] not in cols:
-        want = " or ".join(str(c) for c in cols)
-        raise InvalidArgumentError(f"{name} must be a 2-D array with {want} columns, got shape {a.shape}")
-    return a
-
-
-def _pose(pose) -> np.ndarray:
-    p = _real_array(pose, np.float64, "pose")
-    if p.shape != (4, 4):
-        raise InvalidArgumentError(f"pose must be a 4 x 4 matrix, got shape {p.shape}")
-    return p
-
-
-def _count(n, name: str) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
-        raise InvalidArgumentError(f"{name} must be a non-negative integer, got {n!r}")
-    return int(n)
-
-
-def _sample_args(n_samples, seed, spatial_only: bool) -> tuple[int, int, int, np.ndarray]:
-    """Checked (n, seed as uint64 bits, dims, output array) of a sample call;
-    seed=None draws a fresh seed."""
-    n = _count(n_samples, "n_samples")
-    if seed is None:
-        seed = secrets.randbits(64)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise InvalidArgumentError(f"seed must be an int, got {seed!r}")
-    dims = 3 if spatial_only else 4
-    return n, int(seed) & 0xFFFFFFFFFFFFFFFF, dims, np.empty((n, dims), dtype=np.float32)
 
 
 def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = _D.max_decoded_bytes) -> _ffi.Options:
@@ -78,41 +35,13 @@ def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_b
     )
 
 
-def _surface_distance(c_fn, handle, points, gradient: bool, disc_sigmas: float, n_threads: int,
-                      progress: ProgressArg):
-    """The distance query of GMM and Map (sogmm_*_surface_distance_f32)."""
-    x = _rows(points, (3,), "points")
-    dist = np.empty(x.shape[0], dtype=np.float64)
-    grad = np.empty((x.shape[0], 3), dtype=np.float64) if gradient else None
-    grad_ptr = grad.ctypes.data if grad is not None and grad.size else None
-    with _ffi.Options(f64={_ffi.OPT_SURFACE_DISC_SIGMAS: disc_sigmas}, i64={_ffi.OPT_THREADS: n_threads}) as o:
-        call_with_progress(o, progress, lambda: c_fn(handle, x, x.shape[0], o.ptr, dist, grad_ptr))
-    return (dist, grad) if gradient else dist
-
-
-def _collision(c_fn, handle, centers, shapes, disc_sigmas: float, n_threads: int, progress: ProgressArg):
-    """The collision query of GMM and Map (sogmm_*_collision_probability)."""
-    c = np.ascontiguousarray(centers, dtype=np.float64)
-    s = np.ascontiguousarray(shapes, dtype=np.float64)
-    if c.ndim != 2 or c.shape[1] != 3 or s.shape != (c.shape[0], 3, 3):
-        raise InvalidArgumentError(f"centers must be (n, 3) and shapes (n, 3, 3), got {c.shape} and {s.shape}")
-    out = np.empty(c.shape[0], dtype=np.float64)
-    with _ffi.Options(f64={_ffi.OPT_SURFACE_DISC_SIGMAS: disc_sigmas}, i64={_ffi.OPT_THREADS: n_threads}) as o:
-        call_with_progress(o, progress, lambda: c_fn(handle, c, s, c.shape[0], o.ptr, out))
-    return out
-
-
-def _query_options(truncation_nats: float, n_threads: int) -> _ffi.Options:
-    return _ffi.Options(f64={_ffi.OPT_QUERY_TRUNCATION_NATS: truncation_nats}, i64={_ffi.OPT_THREADS: n_threads})
-
-
 def _read_options(verify_checksums: bool, max_decoded_bytes: int) -> _ffi.Options:
     return _ffi.Options(
         i64={_ffi.OPT_VERIFY_CHECKSUMS: int(bool(verify_checksums)), _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
     )
 
 
-class GMM:
+class GMM(Queryable):
     """A 4-D Gaussian mixture over (x, y, z, gray) held by libsogmm.
 
     Create one with :meth:`from_arrays`, :func:`sogmm.load`,
@@ -123,6 +52,7 @@ class GMM:
 
     _ptr: int | None = None
     _finalizer = None
+    _C_PREFIX = "sogmm_model"  # the queries of Queryable
 
     # ---- handle management ----------------------------------------------
     @classmethod
@@ -387,90 +317,6 @@ class GMM:
             raise InvalidArgumentError(f"metadata keys and values must be valid Unicode text: {e}") from None
         check(lib.sogmm_model_set_value(self._h(), k, v))
 
-    # ---- inference -------------------------------------------------------
-    def score_samples(self, X, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                      n_threads: int = _D.threads) -> np.ndarray:
-        """Log-density of each row: (n, 4) rows (x, y, z, gray) -> joint density,
-        (n, 3) rows (x, y, z) -> spatial marginal. Returns float64 (n,).
-
-        ``truncation_nats`` > 0 culls: a component is skipped at a point only
-        when its term is provably more than that many nats below the point's
-        largest, so each score is at most log(1 + M exp(-truncation_nats))
-        below the exact one (0, the default, is exact). ``n_threads``: 0 = all
-        cores; the answers are the same for any count. ``progress`` as in
-        :meth:`SOGMM.fit` (stage STAGE_SCORING, points done)."""
-        h = self._h()
-        x = _rows(X, (3, 4), "X")
-        out = np.empty(x.shape[0], dtype=np.float64)
-        with _query_options(truncation_nats, n_threads) as o:
-            call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_score_samples_f32(h, x, x.shape[0], x.shape[1], o.ptr, out))
-        return out
-
-    def surface_distance(self, points, gradient: bool = False, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                         n_threads: int = _D.threads, progress: ProgressArg = None):
-        """Unsigned distance (metres) of (n, 3) points to the model's surface: an
-        (n,) float64 array, and with ``gradient`` also the (n, 3) gradient (unit
-        vectors pointing away from the nearest surface point). The surface is
-        the union of the components' discs (their two largest principal axes
-        out to ``disc_sigmas`` standard deviations); the search is exact."""
-        return _surface_distance(lib.sogmm_model_surface_distance_f32, self._h(), points, gradient, disc_sigmas,
-                                 n_threads, progress)
-
-    def collision_probability(self, centers, shapes, *, disc_sigmas: float = _D.surface_disc_sigmas,
-                              n_threads: int = _D.threads, progress: ProgressArg = None) -> np.ndarray:
-        """Probability that each ellipsoidal robot touches the surface: ``centers``
-        (n, 3), ``shapes`` (n, 3, 3) symmetric positive definite S (the robot is
-        {x : (x - c)^T S^-1 (x - c) <= 1}; a sphere of radius r is r^2 I).
-        The largest over the components' discs of Phi(-clearance / sigma_k),
-        sigma_k the patch's noise along its normal: 1/2 at contact."""
-        return _collision(lib.sogmm_model_collision_probability, self._h(), centers, shapes, disc_sigmas, n_threads,
-                          progress)
-
-    def score(self, X) -> float:
-        """Mean log-density of the rows of X (see score_samples)."""
-        return float(np.mean(self.score_samples(X)))
-
-    def sample(self, n_samples: int = 1, seed: int | None = None, *, truncation: float = _D.sample_truncation,
-               spatial_only: bool = False) -> np.ndarray:
-        """Draws n_samples points, (n, 4) float32 rows (x, y, z, gray), grouped by
-        component (or (n, 3) with spatial_only). The same seed gives the same
-        samples; seed=None draws a fresh one. ``truncation`` (in standard
-        deviations, may be inf) bounds each draw."""
-        h = self._h()
-        n, seed, dims, out = _sample_args(n_samples, seed, spatial_only)
-        with _ffi.Options(f64={_ffi.OPT_SAMPLE_TRUNCATION: truncation}) as o:
-            check(lib.sogmm_model_sample_f32(h, n, seed, dims, o.ptr, out))
-        return out
-
-    def regress_gray(self, xyz, progress: ProgressArg = None, *, truncation_nats: float = _D.query_truncation_nats,
-                     n_threads: int = _D.threads) -> tuple[np.ndarray, np.ndarray]:
-        """Expected gray and its conditional variance at (n, 3) points: two float32 (n,) arrays.
-        ``truncation_nats`` and ``n_threads`` as for score_samples; ``progress``
-        as in :meth:`SOGMM.fit` (stage STAGE_REGRESSION, points done)."""
-        h = self._h()
-        x = _rows(xyz, (3,), "xyz")
-        mean = np.empty(x.shape[0], dtype=np.float32)
-        var = np.empty(x.shape[0], dtype=np.float32)
-        with _query_options(truncation_nats, n_threads) as o:
-            call_with_progress(o, progress,
-                               lambda: lib.sogmm_model_regress_gray_f32(h, x, x.shape[0], o.ptr, mean, var))
-        return mean, var
-
-    def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
-               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """What the model shows from ``camera`` placed at ``pose`` (4 x 4 camera-to-world rigid
-        transform; None = identity, the model in the camera's frame): per pixel the first surface
-        along its ray (the nearest mode of the model's density along the ray at depth in
-        (depth_min, depth_trunc]), the gray regressed there and its variance. Returns three float32
-        (height, width) arrays: depth (camera z, metres), gray, variance; NaN where the model shows
-        nothing. Bitwise the same for any ``n_threads``; ``progress`` as in :meth:`SOGMM.fit`
-        (stage STAGE_RENDERING, rows done). Bad camera or pose: InvalidArgumentError."""
-        from .render import render_images
-
-        return render_images(lib.sogmm_model_render_f32, self._h(), camera, pose, depth_min, depth_trunc,
-                             n_threads, progress)
-
     def merge(self, other: "GMM") -> "GMM":
         """A new model with the components of both, weighted by support size.
 
@@ -599,6 +445,9 @@ _MODE_COUNTERS = {
     "flat_binned": _ffi.MODE_COUNTER_FLAT_BINNED,
     "gaussian_blurring": _ffi.MODE_COUNTER_GAUSSIAN_BLURRING,
 }
+# SOGMM_OPT_EM_ACCELERATION's values by name; the keyword's default is the library's.
+_EM_ACCELERATIONS = {"none": 0, "squarem": 1}
+_EM_ACCELERATION_DEFAULT = next(k for k, v in _EM_ACCELERATIONS.items() if v == _D.em_acceleration)
 
 
 class SOGMM(GMM):
@@ -633,6 +482,10 @@ class SOGMM(GMM):
         n_init: runs of k-means++ + EM, seeded seed, seed + 1, ...; the run with
             the highest final mean log-likelihood is kept (as scikit-learn's
             GaussianMixture(n_init)). 1 (default) = the paper's single run.
+        em_acceleration: "none" = plain EM, "squarem" = SQUAREM steps
+            (extrapolation along two EM steps, rejected when the likelihood
+            would fall; max_iter counts every E+M pass). The default is the
+            library's (SOGMM_OPT_EM_ACCELERATION).
 
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
@@ -641,7 +494,7 @@ class SOGMM(GMM):
                  reg_covar: float | str = "auto", max_iter: int = _D.max_iter, n_components: int | None = None, n_threads: int = _D.threads,
                  mode_counter: str = "flat_binned", truncation_nats: float = _D.truncation_nats,
                  n_init: int = _D.n_init,
-                 dequantise_depth: bool | None = None):
+                 dequantise_depth: bool | None = None, em_acceleration: str = _EM_ACCELERATION_DEFAULT):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -653,12 +506,13 @@ class SOGMM(GMM):
         self.truncation_nats = truncation_nats
         self.n_init = n_init
         self.dequantise_depth = dequantise_depth
+        self.em_acceleration = em_acceleration
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats", "n_init", "dequantise_depth")
+               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -673,6 +527,9 @@ class SOGMM(GMM):
     def _fit_options(self, extra_f64=None, extra_i64=None) -> _ffi.Options:
         if self.mode_counter not in _MODE_COUNTERS:
             raise InvalidArgumentError(f"mode_counter must be one of {sorted(_MODE_COUNTERS)}, got {self.mode_counter!r}")
+        if self.em_acceleration not in _EM_ACCELERATIONS:
+            raise InvalidArgumentError(
+                f"em_acceleration must be one of {sorted(_EM_ACCELERATIONS)}, got {self.em_acceleration!r}")
         k = self.n_components
         if k is None:
             k = 0
@@ -704,6 +561,7 @@ class SOGMM(GMM):
             _ffi.OPT_DEQUANTISE_DEPTH: (_ffi.DEQUANTISE_AUTO if self.dequantise_depth is None
                                         else int(bool(self.dequantise_depth))),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
+            _ffi.OPT_EM_ACCELERATION: _EM_ACCELERATIONS[self.em_acceleration],
         }
         f64.update(extra_f64 or {})
         i64.update(extra_i64 or {})

@@ -11,7 +11,7 @@ from .model import GMM, _pose, _rows
 from .progress import ProgressArg, call_with_progress
 
 
-class _Info(ctypes.Structure):
+class RegistrationInfo(ctypes.Structure):
     """sogmm_registration_info."""
 
     _fields_ = [
@@ -54,7 +54,7 @@ def register(source_points, target_model: GMM, init=None, *, progress: ProgressA
     x = _rows(source_points, (4,), "source_points")
     start = None if init is None else np.ascontiguousarray(_pose(init))
     pose = np.empty(16, dtype=np.float64)
-    info = _Info(struct_size=ctypes.sizeof(_Info))
+    info = RegistrationInfo(struct_size=ctypes.sizeof(RegistrationInfo))
     f64 = {_ffi.OPT_REGISTRATION_TOL: tol, _ffi.OPT_REGISTRATION_OUTLIER_RATIO: outlier_ratio,
            _ffi.OPT_REGISTRATION_COARSE_SIGMA: coarse_sigma, _ffi.OPT_REGISTRATION_MIN_INLIER_RATIO: min_inlier_ratio,
            _ffi.OPT_REGISTRATION_DEGENERACY_RATIO: degeneracy_ratio}
@@ -65,8 +65,13 @@ def register(source_points, target_model: GMM, init=None, *, progress: ProgressA
         call_with_progress(o, progress, lambda: _ffi.lib.sogmm_register_points_f32(
             target_model._h(), x, x.shape[0], None if start is None else start.ctypes.data, o.ptr, pose,
             ctypes.byref(info)))
+    return pose.reshape(4, 4), info_dict(info)
+
+
+def info_dict(info: RegistrationInfo) -> dict:
+    """The figures of a ``sogmm_registration_info`` as ``register`` returns them."""
     status = _ffi.REGISTRATION_STATUS[info.status]
-    return pose.reshape(4, 4), {
+    return {
         "status": status,
         "converged": status == "converged",
         "iterations": int(info.iterations),

@@ -75,25 +75,19 @@ pub const SOGMM_E_CANCELLED: sogmm_status = -12;
 pub const SOGMM_E_BUSY: sogmm_status = -13;
 
 // ---- option keys ----------------------------------------------------------
+// BEGIN GENERATED option keys (tools/options/regenerate.py, from core/src/option_table.cpp)
 pub const SOGMM_OPT_BANDWIDTH: sogmm_key = 100;
 pub const SOGMM_OPT_N_COMPONENTS: sogmm_key = 101;
 pub const SOGMM_OPT_TOL: sogmm_key = 102;
 pub const SOGMM_OPT_REG_COVAR: sogmm_key = 103;
-/// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).
-pub const SOGMM_REG_COVAR_AUTO: f64 = -1.0;
 pub const SOGMM_OPT_MAX_ITER: sogmm_key = 104;
 pub const SOGMM_OPT_SEED: sogmm_key = 105;
 pub const SOGMM_OPT_THREADS: sogmm_key = 106;
 pub const SOGMM_OPT_MODE_COUNTER: sogmm_key = 107;
 pub const SOGMM_OPT_TRUNCATION_NATS: sogmm_key = 108;
 pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
-/// i64, SOGMM_DEQUANTISE_AUTO (default), 0 or 1: floor variances along viewing rays at the depth
-/// quantisation (see sogmm.h).
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
-/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
-pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
-pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
-pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
+pub const SOGMM_OPT_EM_ACCELERATION: sogmm_key = 111;
 pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;
 pub const SOGMM_OPT_DEPTH_MIN: sogmm_key = 201;
 pub const SOGMM_OPT_DEPTH_MAX: sogmm_key = 202;
@@ -107,13 +101,13 @@ pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
 pub const SOGMM_OPT_QUERY_TRUNCATION_NATS: sogmm_key = 501;
 pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
 pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
-pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
-pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;
 pub const SOGMM_OPT_MAP_FUSION: sogmm_key = 603;
 pub const SOGMM_OPT_MAP_FUSION_METHOD: sogmm_key = 604;
 pub const SOGMM_OPT_MAP_FUSION_THRESHOLD: sogmm_key = 605;
 pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
+pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
+pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
 pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
 pub const SOGMM_OPT_SURFACE_DISC_SIGMAS: sogmm_key = 702;
@@ -126,6 +120,14 @@ pub const SOGMM_OPT_REGISTRATION_COARSE_SIGMA: sogmm_key = 805;
 pub const SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO: sogmm_key = 806;
 pub const SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO: sogmm_key = 807;
 pub const SOGMM_OPT_REGISTRATION_MIN_POINTS: sogmm_key = 808;
+// END GENERATED option keys
+// ---- named values of option keys -------------------------------------------
+/// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).
+pub const SOGMM_REG_COVAR_AUTO: f64 = -1.0;
+/// i64 value of SOGMM_OPT_DEQUANTISE_DEPTH (its default): on for RGB-D frames, off for arrays.
+pub const SOGMM_DEQUANTISE_AUTO: i64 = -1;
+pub const SOGMM_MODE_COUNTER_FLAT_BINNED: i64 = 0;
+pub const SOGMM_MODE_COUNTER_GAUSSIAN_BLURRING: i64 = 1;
 pub const SOGMM_REGISTRATION_CONVERGED: i32 = 0;
 pub const SOGMM_REGISTRATION_NOT_CONVERGED: i32 = 1;
 pub const SOGMM_REGISTRATION_LOW_FITNESS: i32 = 2;
@@ -192,6 +194,7 @@ pub const SOGMM_MAP_N_FRAMES: sogmm_key = 20002;
 pub const SOGMM_MAP_N_FLUSHES: sogmm_key = 20003;
 pub const SOGMM_MAP_N_FUSED: sogmm_key = 20004;
 pub const SOGMM_MAP_N_REFITS: sogmm_key = 20005;
+pub const SOGMM_MAP_REVISION: sogmm_key = 20006;
 pub const SOGMM_MAP_FRAME_N_POINTS: sogmm_key = 20100;
 pub const SOGMM_MAP_FRAME_N_NOVEL: sogmm_key = 20101;
 pub const SOGMM_MAP_FRAME_N_COMPONENTS: sogmm_key = 20102;
@@ -370,6 +373,8 @@ extern "C" {
     pub fn sogmm_map_frame_get_i64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut i64) -> sogmm_status;
     pub fn sogmm_map_frame_get_f64(map: *const sogmm_map, frame: u64, key: sogmm_key, out: *mut f64) -> sogmm_status;
     pub fn sogmm_map_frame_get_pose(map: *const sogmm_map, frame: u64, pose_out: *mut f64) -> sogmm_status;
+    pub fn sogmm_map_get_origin(map: *const sogmm_map, origin_out: *mut f64) -> sogmm_status;
+    pub fn sogmm_map_set_origin(map: *mut sogmm_map, origin: *const f64) -> sogmm_status;
     pub fn sogmm_map_export(out: *mut *mut sogmm_model, map: *const sogmm_map, box_: *const f32) -> sogmm_status;
     pub fn sogmm_map_score_samples_f32(
         map: *const sogmm_map,
@@ -426,6 +431,14 @@ extern "C" {
         pose_out: *mut f64,
         info_out: *mut sogmm_registration_info,
     ) -> sogmm_status;
+    pub fn sogmm_map_track_frame(
+        map: *mut sogmm_map,
+        frame: *const sogmm_frame,
+        guess: *const f64,
+        pose_out: *mut f64,
+        inserted_out: *mut i32,
+        info_out: *mut sogmm_registration_info,
+    ) -> sogmm_status;
     pub fn sogmm_model_surface_distance_f32(
         model: *const sogmm_model,
         xyz: *const f32,
@@ -475,6 +488,20 @@ extern "C" {
     pub fn sogmm_map_save(map: *const sogmm_map, path: *const c_char, options: *const sogmm_options) -> sogmm_status;
     pub fn sogmm_map_load(out: *mut *mut sogmm_map, path: *const c_char, options: *const sogmm_options)
         -> sogmm_status;
+    pub fn sogmm_map_export_delta(
+        map: *const sogmm_map,
+        since_revision: u64,
+        options: *const sogmm_options,
+        out: *mut c_void,
+        capacity: usize,
+        size: *mut usize,
+    ) -> sogmm_status;
+    pub fn sogmm_map_apply_delta(
+        map: *mut sogmm_map,
+        data: *const c_void,
+        size: usize,
+        options: *const sogmm_options,
+    ) -> sogmm_status;
     pub fn sogmm_fit_points_f32(
         out: *mut *mut sogmm_model,
         points: *const f32,

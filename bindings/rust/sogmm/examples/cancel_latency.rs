@@ -1,4 +1,4 @@
-//! Measures how long `Model::fit_with_progress` takes to return once a cancel
+//! Measures how long `Model::fit` with a progress closure takes to return once a cancel
 //! is requested (from another thread) about 1 s into a d = 1 fit (issue 16).
 //! Input: a frame's points as raw float32 rows (x, y, z, gray), as written by
 //! tools/sogmm-perf/cancel_latency.py --dump FILE.
@@ -23,7 +23,7 @@ fn main() -> Result<(), sogmm::Error> {
         .collect();
     let runs: usize = args.get(2).map_or(5, |s| s.parse().unwrap());
     let delay: f64 = args.get(3).map_or(1.0, |s| s.parse().unwrap());
-    let opts = Options::builder().bandwidth(0.02).seed(0).build()?;
+    let base = Options::builder().bandwidth(0.02).seed(0);
     println!(
         "rust: d = 1 fit of {} points, cancel requested after {delay} s",
         pts.len() / 4
@@ -38,13 +38,17 @@ fn main() -> Result<(), sogmm::Error> {
             *sent2.lock().unwrap() = Some(Instant::now());
             stop2.store(true, Ordering::SeqCst);
         });
-        let result = Model::fit_with_progress(&pts, Some(&opts), |_| {
-            if stop.load(Ordering::SeqCst) {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        });
+        let opts = base
+            .clone()
+            .on_progress(move |_| {
+                if stop.load(Ordering::SeqCst) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })
+            .build()?;
+        let result = Model::fit(&pts, Some(&opts));
         let done = Instant::now();
         timer.join().unwrap();
         match result {

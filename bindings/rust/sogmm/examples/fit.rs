@@ -1,7 +1,7 @@
 //! Fits a model to a synthetic frame (a tilted plane with three gray bands),
 //! samples it, regresses gray, and round-trips it through a .sogmm file.
 //! Run: SOGMM_LIB_DIR=<build>/capi cargo run --example fit [scratch-dir]
-use sogmm::{Color, Frame, Model, Options};
+use sogmm::{Color, Frame, Model, Options, Queryable};
 
 fn main() -> Result<(), sogmm::Error> {
     let (w, h) = (160u32, 120u32);
@@ -27,9 +27,9 @@ fn main() -> Result<(), sogmm::Error> {
     let mut model = Model::fit_rgbd(&frame, Some(&opts))?;
     println!("libsogmm {}: {} components", sogmm::version(), model.n_components());
 
-    let samples = model.sample(1000, 42, 4)?;
+    let samples = model.sample(1000, 42, 4, None)?;
     println!("first sample: {:?}", &samples[..4]);
-    let (g, var) = model.regress_gray(&[-0.4516, 0.0, 1.0625, 0.6207, 0.0, 1.4375])?;
+    let (g, var) = model.regress_gray(&[-0.4516, 0.0, 1.0625, 0.6207, 0.0, 1.4375], None)?;
     println!("gray at two points: {g:?} (variance {var:?})");
 
     model.set_value("example", "synthetic plane")?;

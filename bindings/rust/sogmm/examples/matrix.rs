@@ -6,7 +6,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use sogmm::{ImageFrame, Model, Options};
+use sogmm::{ImageFrame, Model, Options, Queryable};
 
 fn floats(path: &str) -> Vec<f32> {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
@@ -32,13 +32,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ["read", model, query, out] => {
             let q = floats(query);
             let m = Model::load(model, None)?;
-            let (mean, var) = m.regress_gray(&q)?;
+            let (mean, var) = m.regress_gray(&q, None)?;
             let mut f = std::io::BufWriter::new(std::fs::File::create(out)?);
             for a in [
                 m.weights()?,
                 m.means()?,
                 m.covariances()?,
-                m.sample(256, 2024, 4)?,
+                m.sample(256, 2024, 4, None)?,
                 mean,
                 var,
             ] {
@@ -46,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     f.write_all(&x.to_le_bytes())?;
                 }
             }
-            for x in m.score_samples(&q, 3)? {
+            for x in m.score_samples(&q, 3, None)? {
                 f.write_all(&x.to_le_bytes())?;
             }
             f.flush()?;

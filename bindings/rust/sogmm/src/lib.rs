@@ -5,7 +5,8 @@
 //! let points: Vec<f32> = vec![/* n rows of x, y, z, gray */];
 //! let opts = sogmm::Options::builder().bandwidth(0.05).seed(1).build()?;
 //! let model = sogmm::Model::fit(&points, Some(&opts))?;
-//! let samples = model.sample(1000, 42, 4)?;
+//! use sogmm::Queryable; // score, regress, sample, render: models and maps
+//! let samples = model.sample(1000, 42, 4, None)?;
 //! model.save("frame.sogmm", None)?;
 //! # Ok::<(), sogmm::Error>(())
 //! ```
@@ -29,6 +30,7 @@ pub mod metrics;
 pub mod model;
 pub mod options;
 pub mod progress;
+pub mod queryable;
 pub mod registration;
 pub mod render;
 pub mod surface;
@@ -45,6 +47,7 @@ pub use options::{
     option_info, option_keys, FusionMethod, ModeCounter, OptionInfo, OptionValues, Options, OptionsBuilder,
 };
 pub use progress::{Progress, Stage};
+pub use queryable::Queryable;
 pub use registration::{Registration, RegistrationStatus};
 pub use render::{Camera, Rendered};
 pub use sogmm_sys as sys;

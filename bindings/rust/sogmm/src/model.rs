@@ -6,11 +6,8 @@ use std::ptr::{self, NonNull};
 use sogmm_sys as sys;
 
 use crate::error::{check, Error, Result, Status};
-use crate::map::Pose;
 use crate::options::{opt_ptr, Options};
-use crate::progress::{with_progress, Progress};
-use crate::render::{render_into, Camera, Rendered};
-use std::ops::ControlFlow;
+use crate::progress::with_progress;
 
 /// A fitted 4-D GMM (x, y, z, gray) with its metadata. Arrays come out as
 /// row-major `Vec`s: weights (M), means (M x 4), covariances (M x 4 x 4).
@@ -132,27 +129,6 @@ pub(crate) fn rows(data: &[f32], cols: usize, what: &str) -> Result<usize> {
     Ok(data.len() / cols)
 }
 
-/// Checks a score request (rows of `dims` floats) and runs `call(n, out)`,
-/// the C query writing n doubles to `out`.
-pub(crate) fn score_with(points: &[f32], dims: i32, call: impl FnOnce(usize, *mut f64) -> i32) -> Result<Vec<f64>> {
-    let n = rows(points, dims_ok(dims)?, "points")?;
-    let mut out = vec![0.0f64; n];
-    check(call(n, out.as_mut_ptr()))?;
-    Ok(out)
-}
-
-/// Checks a regression request (rows of 3 floats) and runs
-/// `call(n, mean, variance)`, the C query writing n floats to each.
-pub(crate) fn regress_with(
-    xyz: &[f32],
-    call: impl FnOnce(usize, *mut f32, *mut f32) -> i32,
-) -> Result<(Vec<f32>, Vec<f32>)> {
-    let n = rows(xyz, 3, "xyz")?;
-    let (mut mean, mut var) = (vec![0.0f32; n], vec![0.0f32; n]);
-    check(call(n, mean.as_mut_ptr(), var.as_mut_ptr()))?;
-    Ok((mean, var))
-}
-
 /// `dims` as a row width, refusing anything but 3 or 4.
 pub(crate) fn dims_ok(dims: i32) -> Result<usize> {
     if dims == 3 || dims == 4 {
@@ -199,39 +175,24 @@ impl Model {
     }
 
     /// Fits a model to n points: `points` holds n rows (x, y, z, gray).
-    /// Uses the fit keys of `options` (None = defaults).
+    /// Uses the fit keys of `options` (None = defaults; `n_components` fixes
+    /// K). Their progress closure (`OptionsBuilder::on_progress`) gets the
+    /// reports; `ControlFlow::Break(())` cancels: `Err` with
+    /// `Status::Cancelled` and no model, within about 50 ms.
     pub fn fit(points: &[f32], options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        // SAFETY: `points` holds n * 4 floats; C only reads them during the call.
-        Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), opt_ptr(options)) })
+        Model::fit_points(points, None, options)
     }
 
-    /// As `fit`, reporting progress to `on_progress` (called only on this
-    /// thread, during the call; see `Progress`). Returning
-    /// `ControlFlow::Break(())` cancels: the result is `Err` with
-    /// `Status::Cancelled` and no model. A panic in the closure cancels the
-    /// fit too and then resumes on this thread once the library returned.
-    pub fn fit_with_progress(
-        points: &[f32],
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Model> {
+    /// sogmm_fit_points_f32: cold (`initial` None) or warm, with the options' progress.
+    fn fit_points(points: &[f32], initial: Option<&Model>, options: Option<&Options>) -> Result<Model> {
         let n = rows(points, 4, "points")?;
         crate::ensure_abi()?;
-        with_progress(options, on_progress, |o| {
-            // SAFETY: as fit; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, ptr::null(), o) })
+        let initial = initial.map_or(ptr::null(), Model::raw);
+        with_progress(options, |o| {
+            // SAFETY: `points` holds n * 4 floats and `initial` is a valid handle or NULL, both only read
+            // during the call.
+            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial, o) })
         })
-    }
-
-    /// As `fit_rgbd`, with progress and cancel as `fit_with_progress`.
-    pub fn fit_rgbd_with_progress(
-        frame: &Frame<'_>,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Model> {
-        crate::ensure_abi()?;
-        with_progress(options, on_progress, |o| Model::fit_rgbd_raw(frame, o))
     }
 
     /// Warm start: fits n points starting from `initial`, a model of an
@@ -240,55 +201,20 @@ impl Model {
     /// organizing: components `initial` no longer explains are dropped and
     /// new ones are added for the novel points; with SOGMM_OPT_N_COMPONENTS
     /// = K, EM runs from `initial` as given (K must be its size). Needs
-    /// n_init 1. `initial` is not changed.
+    /// n_init 1. `initial` is not changed. Progress and cancel as `fit`.
     pub fn fit_warm(points: &[f32], initial: &Model, options: Option<&Options>) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        // SAFETY: `points` holds n * 4 floats; `initial` is a valid handle, only read.
-        Model::make(|out| unsafe {
-            sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), opt_ptr(options))
-        })
+        Model::fit_points(points, Some(initial), options)
     }
 
-    /// As `fit_warm`, with progress and cancel as `fit_with_progress`.
-    pub fn fit_warm_with_progress(
-        points: &[f32],
-        initial: &Model,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Model> {
-        let n = rows(points, 4, "points")?;
-        crate::ensure_abi()?;
-        with_progress(options, on_progress, |o| {
-            // SAFETY: as fit_warm; `o` is a valid options handle for the call.
-            Model::make(|out| unsafe { sys::sogmm_fit_points_f32(out, points.as_ptr(), n, initial.raw(), o) })
-        })
-    }
-
-    /// Fits exactly `k` components (1 <= k <= n): `fit` with
-    /// SOGMM_OPT_N_COMPONENTS = k on a copy of `options`.
-    pub fn fit_fixed_k(points: &[f32], k: usize, options: Option<&Options>) -> Result<Model> {
-        if k == 0 {
-            return Err(invalid("k is 0: a fixed-K fit needs k >= 1".to_string()));
-        }
-        let k = i64::try_from(k).map_err(|_| invalid(format!("k = {k} is too large")))?;
-        let mut o = match options {
-            Some(o) => o.try_clone()?,
-            None => Options::new()?,
-        };
-        o.set_i64(sys::SOGMM_OPT_N_COMPONENTS, k)?;
-        Model::fit(points, Some(&o))
-    }
-
-    /// Fits one RGB-D frame; decimation and depth range come from `options`.
+    /// Fits one RGB-D frame; decimation and depth range come from `options`;
+    /// progress and cancel as `fit`.
     pub fn fit_rgbd(frame: &Frame<'_>, options: Option<&Options>) -> Result<Model> {
-        Model::fit_rgbd_raw(frame, opt_ptr(options))
-    }
-
-    /// fit_rgbd with a raw options pointer (NULL = defaults).
-    fn fit_rgbd_raw(frame: &Frame<'_>, options: *const sys::sogmm_options) -> Result<Model> {
         let h = frame.handle()?;
-        // SAFETY: a valid frame.
-        Model::make(|out| unsafe { sys::sogmm_fit_frame(out, h.0, options) })
+        crate::ensure_abi()?;
+        // SAFETY: a valid frame; `o` valid options or NULL.
+        with_progress(options, |o| {
+            Model::make(|out| unsafe { sys::sogmm_fit_frame(out, h.0, o) })
+        })
     }
 
     /// Builds a model from M weights, M x 4 means and M x 4 x 4 covariances
@@ -462,113 +388,10 @@ impl Model {
             .collect()
     }
 
-    /// Draws n points as n rows of `dims` floats (4: x, y, z, gray; 3: x, y,
-    /// z), grouped by component, with the default truncation. Same seed, same
-    /// samples.
-    pub fn sample(&self, n: usize, seed: u64, dims: i32) -> Result<Vec<f32>> {
-        self.sample_with(n, seed, dims, None)
-    }
-
-    /// As `sample`, with SOGMM_OPT_SAMPLE_TRUNCATION from `options`.
-    pub fn sample_with(&self, n: usize, seed: u64, dims: i32, options: Option<&Options>) -> Result<Vec<f32>> {
-        let mut out = vec![0.0f32; len_of(n, dims_ok(dims)?, "samples")?];
-        // SAFETY: `out` holds n * dims floats.
-        check(unsafe { sys::sogmm_model_sample_f32(self.raw(), n, seed, dims, opt_ptr(options), out.as_mut_ptr()) })?;
-        Ok(out)
-    }
-
-    /// Expected gray and its conditional variance at n points (`xyz`: n rows of 3).
-    pub fn regress_gray(&self, xyz: &[f32]) -> Result<(Vec<f32>, Vec<f32>)> {
-        self.regress_raw(xyz, ptr::null())
-    }
-
-    /// As `regress_gray`, with SOGMM_OPT_THREADS and
-    /// SOGMM_OPT_QUERY_TRUNCATION_NATS from `options` (`OptionsBuilder::threads`,
-    /// `query_truncation_nats`; None = exact, all cores).
-    pub fn regress_gray_with(&self, xyz: &[f32], options: Option<&Options>) -> Result<(Vec<f32>, Vec<f32>)> {
-        self.regress_raw(xyz, opt_ptr(options))
-    }
-
-    /// As `regress_gray_with` (threads and culling of `options`; None =
-    /// exact, all cores), reporting `Stage::Regression` (points done) and
-    /// cancellable as `fit_with_progress`; the same values.
-    pub fn regress_gray_with_progress(
-        &self,
-        xyz: &[f32],
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<(Vec<f32>, Vec<f32>)> {
-        with_progress(options, on_progress, |o| self.regress_raw(xyz, o))
-    }
-
-    fn regress_raw(&self, xyz: &[f32], o: *const sys::sogmm_options) -> Result<(Vec<f32>, Vec<f32>)> {
-        // SAFETY: regress_with passes n rows and n floats of room in each output; `o` valid or NULL.
-        regress_with(xyz, |n, mean, var| unsafe {
-            sys::sogmm_model_regress_gray_f32(self.raw(), xyz.as_ptr(), n, o, mean, var)
-        })
-    }
-
-    /// Log-density of rows of `dims` floats (4: joint; 3: marginal over gray).
-    pub fn score_samples(&self, points: &[f32], dims: i32) -> Result<Vec<f64>> {
-        self.score_raw(points, dims, ptr::null())
-    }
-
-    /// As `score_samples`, with the threads and culling of `options` as
-    /// `regress_gray_with`: each culled score is at most
-    /// ln(1 + M e^-nats) below the exact one.
-    pub fn score_samples_with(&self, points: &[f32], dims: i32, options: Option<&Options>) -> Result<Vec<f64>> {
-        self.score_raw(points, dims, opt_ptr(options))
-    }
-
-    /// As `score_samples_with` (threads and culling of `options`; None =
-    /// exact, all cores), reporting `Stage::Scoring` (points scored) and
-    /// cancellable as `fit_with_progress`; the same values.
-    pub fn score_samples_with_progress(
-        &self,
-        points: &[f32],
-        dims: i32,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Vec<f64>> {
-        with_progress(options, on_progress, |o| self.score_raw(points, dims, o))
-    }
-
-    fn score_raw(&self, points: &[f32], dims: i32, o: *const sys::sogmm_options) -> Result<Vec<f64>> {
-        // SAFETY: score_with passes n rows and n doubles of room; `o` valid or NULL.
-        score_with(points, dims, |n, out| unsafe {
-            sys::sogmm_model_score_samples_f32(self.raw(), points.as_ptr(), n, dims, o, out)
-        })
-    }
-
     /// A new model with the components of both, weighted by support size.
     pub fn merge(&self, other: &Model) -> Result<Model> {
         // SAFETY: both handles valid; const use only.
         Model::make(|out| unsafe { sys::sogmm_model_merge(out, self.raw(), other.raw()) })
-    }
-
-    /// What the model shows from `camera` at `pose` (camera-to-world; None =
-    /// identity, the model in the camera's frame): per pixel the first
-    /// surface along its ray, its depth, the gray regressed there and its
-    /// variance (NaN where nothing shows). `options`: SOGMM_OPT_DEPTH_MIN /
-    /// _MAX (the depths that count as surfaces) and SOGMM_OPT_THREADS (the
-    /// images are the same bits for any count).
-    pub fn render(&self, camera: &Camera, pose: Option<&Pose>, options: Option<&Options>) -> Result<Rendered> {
-        self.render_raw(camera, pose, opt_ptr(options))
-    }
-
-    /// As `render`, reporting `Stage::Rendering` (rows done) and cancellable.
-    pub fn render_with_progress(
-        &self,
-        camera: &Camera,
-        pose: Option<&Pose>,
-        options: Option<&Options>,
-        on_progress: impl FnMut(Progress) -> ControlFlow<()>,
-    ) -> Result<Rendered> {
-        with_progress(options, on_progress, |o| self.render_raw(camera, pose, o))
-    }
-
-    fn render_raw(&self, camera: &Camera, pose: Option<&Pose>, o: *const sys::sogmm_options) -> Result<Rendered> {
-        render_into(sys::sogmm_model_render_f32, self.raw(), camera, pose, o)
     }
 
     /// A new model moved by a rigid 4 x 4 row-major transform.

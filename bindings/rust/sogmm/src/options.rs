@@ -1,15 +1,19 @@
 //! `Options` (an owned sogmm_options handle) and its builder.
+use std::ops::ControlFlow;
 use std::ptr::{self, NonNull};
 
 use sogmm_sys as sys;
 
 use crate::error::{check, Result};
+use crate::progress::{Progress, ProgressHook};
 
 /// Enum-keyed parameters for fit, save, load and sample (sogmm_options).
 /// Ranges are checked by the library: the setter (or `OptionsBuilder::build`)
 /// fails with `Status::InvalidArg` and a message naming the key.
 pub struct Options {
     ptr: NonNull<sys::sogmm_options>,
+    /// Go-between for `set_progress`; installed per call (progress.rs).
+    progress: Option<ProgressHook>,
 }
 
 // SAFETY: spec/api.md 1.1: distinct handles never interfere; functions taking
@@ -46,6 +50,7 @@ impl Options {
         check(unsafe { sys::sogmm_options_create(&mut out) })?;
         Ok(Options {
             ptr: NonNull::new(out).expect("sogmm_options_create returned OK and NULL"),
+            progress: None,
         })
     }
 
@@ -78,13 +83,27 @@ impl Options {
         Ok(v)
     }
 
-    /// Deep copy (sogmm_options_clone); fails only when memory runs out.
+    /// Makes every call given these options report its progress to `f` (see
+    /// `Progress`); `ControlFlow::Break(())` cancels the call. A map keeps the
+    /// closure of the options it was created with for its inserts and
+    /// flushes. Clones share the closure.
+    pub fn set_progress(&mut self, f: impl FnMut(Progress) -> ControlFlow<()> + Send + 'static) {
+        self.progress = Some(ProgressHook::new(f));
+    }
+
+    pub(crate) fn progress(&self) -> Option<&ProgressHook> {
+        self.progress.as_ref()
+    }
+
+    /// Deep copy (sogmm_options_clone; the progress closure is shared); fails
+    /// only when memory runs out.
     pub fn try_clone(&self) -> Result<Options> {
         let mut out = ptr::null_mut();
         // SAFETY: valid handle and out-pointer.
         check(unsafe { sys::sogmm_options_clone(&mut out, self.ptr.as_ptr()) })?;
         Ok(Options {
             ptr: NonNull::new(out).expect("sogmm_options_clone returned OK and NULL"),
+            progress: self.progress.clone(),
         })
     }
 
@@ -133,6 +152,7 @@ enum Value {
 #[must_use]
 pub struct OptionsBuilder {
     values: Vec<(i32, Value)>,
+    progress: Option<ProgressHook>,
 }
 
 macro_rules! setters {
@@ -158,6 +178,12 @@ impl OptionsBuilder {
         self
     }
 
+    /// The progress closure of the options (`Options::set_progress`).
+    pub fn on_progress(mut self, f: impl FnMut(Progress) -> ControlFlow<()> + Send + 'static) -> Self {
+        self.progress = Some(ProgressHook::new(f));
+        self
+    }
+
     setters! {
         /// Mean-shift bandwidth (default 0.02).
         bandwidth(f64) => SOGMM_OPT_BANDWIDTH as f64 |v| v;
@@ -173,8 +199,7 @@ impl OptionsBuilder {
         /// k-means++ seed (default 0); the u64's bits, as the header says.
         seed(u64) => SOGMM_OPT_SEED as i64 |v: u64| v as i64;
         /// Worker threads of a fit, and of the queries given these options
-        /// (`score_samples_with`, `regress_gray_with`: the same bits for any
-        /// count); 0 = all cores (default).
+        /// (`Queryable`: the same bits for any count); 0 = all cores (default).
         threads(i64) => SOGMM_OPT_THREADS as i64 |v| v;
         /// Mode-count variant.
         mode_counter(ModeCounter) => SOGMM_OPT_MODE_COUNTER as i64 |m| match m {
@@ -188,6 +213,9 @@ impl OptionsBuilder {
         /// Forces the depth-quantisation floor on or off; the default
         /// (sogmm_sys::SOGMM_DEQUANTISE_AUTO) floors RGB-D frames and not arrays.
         dequantise_depth(bool) => SOGMM_OPT_DEQUANTISE_DEPTH as i64 i64::from;
+        /// SQUAREM-accelerated EM (true) or plain EM (false, default); see
+        /// SOGMM_OPT_EM_ACCELERATION in sogmm.h.
+        squarem(bool) => SOGMM_OPT_EM_ACCELERATION as i64 i64::from;
         /// Raw depth units per metre (default 1000).
         depth_scale(f64) => SOGMM_OPT_DEPTH_SCALE as f64 |v| v;
         /// Nearest valid depth in metres, exclusive (default 0.1).
@@ -209,7 +237,7 @@ impl OptionsBuilder {
         verify_checksums(bool) => SOGMM_OPT_VERIFY_CHECKSUMS as i64 i64::from;
         /// Sampling truncation in standard deviations (default 2.5; may be inf).
         sample_truncation(f64) => SOGMM_OPT_SAMPLE_TRUNCATION as f64 |v| v;
-        /// Culled queries (`score_samples_with`, `regress_gray_with`): 0 = exact
+        /// Culled queries (`Queryable::score_samples`, `regress_gray`): 0 = exact
         /// (default); > 0 skips a component at a point only when its term is
         /// provably more than this many nats below the point's largest, so a
         /// score is at most ln(1 + M e^-nats) below the exact one. Negative or
@@ -246,6 +274,7 @@ impl OptionsBuilder {
 
     pub fn build(&self) -> Result<Options> {
         let mut o = Options::new()?;
+        o.progress = self.progress.clone();
         for &(key, v) in &self.values {
             match v {
                 Value::F64(x) => o.set_f64(key, x)?,

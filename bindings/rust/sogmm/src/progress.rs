@@ -1,15 +1,21 @@
 //! Progress reports and cancellation of long calls (sogmm_progress_fn).
 //!
-//! The closure is called only on the thread that made the call, during the
-//! call (the C API's guarantee), so it needs neither `Send` nor `'static`.
-//! `ControlFlow::Break(())` cancels; a panic cancels too and is resumed on the
-//! caller's side once the library has returned (a panic must never unwind
-//! through C++ frames).
+//! The closure rides on the options of a call (`OptionsBuilder::on_progress`,
+//! `Options::set_progress`; a map keeps the one of the options it was created
+//! with for its inserts and flushes), as git2-rs's callbacks ride on its
+//! `FetchOptions`. It is called only on the thread that made the call, during
+//! the call (the C API's guarantee); it is `Send + 'static` because options
+//! are shared between threads (state it fills goes behind an `Arc`).
+//! `ControlFlow::Break(())` cancels: the call returns `Err` with
+//! `Status::Cancelled`. A panic cancels too and is resumed on the caller's
+//! side once the library has returned (a panic must never unwind through C++
+//! frames). Progress never changes a result.
 use std::any::Any;
 use std::ffi::c_void;
 use std::ops::ControlFlow;
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 use std::ptr;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use sogmm_sys as sys;
 
@@ -71,8 +77,28 @@ pub struct Progress {
     pub log_likelihood: f64,
 }
 
+/// The progress closure of an `Options` value, shared by its clones and by
+/// maps created with it. Calls on several threads with the same options take
+/// turns per report.
+#[derive(Clone)]
+pub(crate) struct ProgressHook(Arc<Mutex<ProgressFn>>);
+
+type ProgressFn = Box<dyn FnMut(Progress) -> ControlFlow<()> + Send>;
+
+impl ProgressHook {
+    pub(crate) fn new(f: impl FnMut(Progress) -> ControlFlow<()> + Send + 'static) -> ProgressHook {
+        ProgressHook(Arc::new(Mutex::new(Box::new(f))))
+    }
+}
+
+impl std::fmt::Debug for ProgressHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressHook(..)")
+    }
+}
+
 struct Ctx<'a> {
-    f: &'a mut dyn FnMut(Progress) -> ControlFlow<()>,
+    hook: &'a ProgressHook,
     panic: Option<Box<dyn Any + Send>>,
 }
 
@@ -89,7 +115,10 @@ unsafe extern "C" fn trampoline(stage: i32, step: u64, total: u64, log_likelihoo
         total,
         log_likelihood,
     };
-    match catch_unwind(AssertUnwindSafe(|| (cx.f)(report))) {
+    // A panic of an earlier report (resumed then) leaves the lock poisoned;
+    // the closure itself is still whole.
+    let mut f = cx.hook.0.lock().unwrap_or_else(PoisonError::into_inner);
+    match catch_unwind(AssertUnwindSafe(|| (*f)(report))) {
         Ok(ControlFlow::Continue(())) => 0,
         Ok(ControlFlow::Break(())) => 1,
         Err(payload) => {
@@ -99,24 +128,21 @@ unsafe extern "C" fn trampoline(stage: i32, step: u64, total: u64, log_likelihoo
     }
 }
 
-/// Runs `call` with a private clone of `options` (or of the defaults) that
-/// carries the trampoline for `f`; resumes a panic of `f` afterwards.
+/// Runs `call` with the C pointer of `options` or, when they carry a progress
+/// closure, of a private clone that reports to it; resumes a panic of the
+/// closure afterwards.
 pub(crate) fn with_progress<T>(
     options: Option<&Options>,
-    mut f: impl FnMut(Progress) -> ControlFlow<()>,
     call: impl FnOnce(*const sys::sogmm_options) -> Result<T>,
 ) -> Result<T> {
+    let Some((options, hook)) = options.and_then(|o| o.progress().map(|h| (o, h))) else {
+        return call(opt_ptr(options));
+    };
     let mut raw = ptr::null_mut();
-    // SAFETY: valid out-pointer; opt_ptr is a valid handle or NULL.
-    check(unsafe {
-        if options.is_some() {
-            sys::sogmm_options_clone(&mut raw, opt_ptr(options))
-        } else {
-            sys::sogmm_options_create(&mut raw)
-        }
-    })?;
+    // SAFETY: valid out-pointer and handle.
+    check(unsafe { sys::sogmm_options_clone(&mut raw, options.as_ptr()) })?;
     let private = OwnedRaw(raw);
-    let mut cx = Ctx { f: &mut f, panic: None };
+    let mut cx = Ctx { hook, panic: None };
     // SAFETY: `private` is ours; `cx` outlives the call below, the only one
     // that uses these options.
     check(unsafe {
@@ -130,16 +156,19 @@ pub(crate) fn with_progress<T>(
     result
 }
 
-/// Runs `call` with the trampoline for `f` installed on `map`
+/// Runs `call` with the trampoline for `hook` (if any) installed on `map`
 /// (sogmm_map_set_progress, for its inserts and flushes) and removed again
-/// on every path; resumes a panic of `f` afterwards. The caller holds the map
-/// exclusively (`&mut`), so no other call sees the callback.
+/// on every path; resumes a panic of the closure afterwards. The caller holds
+/// the map exclusively (`&mut`), so no other call sees the callback.
 pub(crate) fn with_map_progress<T>(
     map: *mut sys::sogmm_map,
-    mut f: impl FnMut(Progress) -> ControlFlow<()>,
+    hook: Option<&ProgressHook>,
     call: impl FnOnce() -> Result<T>,
 ) -> Result<T> {
-    let mut cx = Ctx { f: &mut f, panic: None };
+    let Some(hook) = hook else {
+        return call();
+    };
+    let mut cx = Ctx { hook, panic: None };
     // SAFETY: `map` is a valid handle used only by this thread for the call;
     // `cx` outlives it, and the callback is removed before `cx` goes away.
     check(unsafe { sys::sogmm_map_set_progress(map, Some(trampoline), &mut cx as *mut Ctx<'_> as *mut c_void) })?;

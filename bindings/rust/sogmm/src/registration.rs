@@ -7,7 +7,7 @@ use sogmm_sys as sys;
 use crate::error::{check, Result};
 use crate::map::Pose;
 use crate::model::rows;
-use crate::options::opt_ptr;
+use crate::progress::with_progress;
 use crate::{Model, Options};
 
 /// How a registration ended (`SOGMM_REGISTRATION_*`).
@@ -47,7 +47,8 @@ pub struct Registration {
 impl Model {
     /// The rigid pose that best explains `points` (rows of x, y, z, gray in
     /// their own frame) under this model, from `init` (None = identity).
-    /// Check `status`: the pose is an estimate only when `Converged`.
+    /// Check `status`: the pose is an estimate only when `Converged`. The
+    /// options' progress closure gets `Stage::Registration` reports.
     pub fn register_points(
         &self,
         points: &[f32],
@@ -56,46 +57,58 @@ impl Model {
     ) -> Result<Registration> {
         let n = rows(points, 4, "points")?;
         let mut pose: Pose = [0.0; 16];
-        let mut info = sys::sogmm_registration_info {
-            struct_size: std::mem::size_of::<sys::sogmm_registration_info>(),
-            status: 0,
-            iterations: 0,
-            log_likelihood: 0.0,
-            inlier_ratio: 0.0,
-            rmse: 0.0,
-            information: [0.0; 36],
-            unobservable: 0,
-            eigen_ratio: 0.0,
-        };
+        let mut info = empty_info();
         let init_ptr = init.map_or(std::ptr::null(), |p| p.as_ptr());
-        // SAFETY: n rows of 4 floats, init 16 doubles or NULL, room for 16 doubles and the sized struct.
-        check(unsafe {
-            sys::sogmm_register_points_f32(
-                self.raw(),
-                points.as_ptr(),
-                n,
-                init_ptr,
-                opt_ptr(options),
-                pose.as_mut_ptr(),
-                &mut info,
-            )
+        with_progress(options, |o| {
+            // SAFETY: n rows of 4 floats, init 16 doubles or NULL, room for 16 doubles and the sized struct.
+            check(unsafe {
+                sys::sogmm_register_points_f32(
+                    self.raw(),
+                    points.as_ptr(),
+                    n,
+                    init_ptr,
+                    o,
+                    pose.as_mut_ptr(),
+                    &mut info,
+                )
+            })
         })?;
-        let status = match info.status {
-            sys::SOGMM_REGISTRATION_CONVERGED => RegistrationStatus::Converged,
-            sys::SOGMM_REGISTRATION_LOW_FITNESS => RegistrationStatus::LowFitness,
-            sys::SOGMM_REGISTRATION_DEGENERATE => RegistrationStatus::Degenerate,
-            _ => RegistrationStatus::NotConverged,
-        };
-        Ok(Registration {
-            pose,
-            status,
-            iterations: info.iterations,
-            log_likelihood: info.log_likelihood,
-            inlier_ratio: info.inlier_ratio,
-            rmse: info.rmse,
-            information: info.information,
-            unobservable: info.unobservable,
-            eigen_ratio: info.eigen_ratio,
-        })
+        Ok(registration_of(pose, &info))
+    }
+}
+
+/// A `sogmm_registration_info` sized for this binding, to be filled by a call.
+pub(crate) fn empty_info() -> sys::sogmm_registration_info {
+    sys::sogmm_registration_info {
+        struct_size: std::mem::size_of::<sys::sogmm_registration_info>(),
+        status: 0,
+        iterations: 0,
+        log_likelihood: 0.0,
+        inlier_ratio: 0.0,
+        rmse: 0.0,
+        information: [0.0; 36],
+        unobservable: 0,
+        eigen_ratio: 0.0,
+    }
+}
+
+/// The figures a call wrote into `info`, with its pose.
+pub(crate) fn registration_of(pose: Pose, info: &sys::sogmm_registration_info) -> Registration {
+    let status = match info.status {
+        sys::SOGMM_REGISTRATION_CONVERGED => RegistrationStatus::Converged,
+        sys::SOGMM_REGISTRATION_LOW_FITNESS => RegistrationStatus::LowFitness,
+        sys::SOGMM_REGISTRATION_DEGENERATE => RegistrationStatus::Degenerate,
+        _ => RegistrationStatus::NotConverged,
+    };
+    Registration {
+        pose,
+        status,
+        iterations: info.iterations,
+        log_likelihood: info.log_likelihood,
+        inlier_ratio: info.inlier_ratio,
+        rmse: info.rmse,
+        information: info.information,
+        unobservable: info.unobservable,
+        eigen_ratio: info.eigen_ratio,
     }
 }

@@ -1,5 +1,5 @@
 //! Tests of the safe API against hand-computed values and invariants.
-use sogmm::{Color, Frame, Model, Options, Status};
+use sogmm::{Color, Frame, Model, Options, Queryable, Status};
 
 /// One 4-D Gaussian: mean (0, 0, 0, 0.5); covariance diag(1, 1, 1, 0.5) with
 /// cov(x, gray) = 0.2.
@@ -47,7 +47,9 @@ fn regression_matches_closed_form() {
     // Gaussian conditioning: mean = 0.5 + 0.2 * x, variance = 0.5 - 0.2^2.
     // Both points are within 2.3 sigma: far out (beyond ~6.5 sigma) the answer
     // blends towards the prior on purpose (sogmm.h, sogmm_model_regress_gray).
-    let (mean, var) = one_gaussian().regress_gray(&[1.0, 0.0, 0.0, -2.0, 0.5, 1.0]).unwrap();
+    let (mean, var) = one_gaussian()
+        .regress_gray(&[1.0, 0.0, 0.0, -2.0, 0.5, 1.0], None)
+        .unwrap();
     assert!((mean[0] - 0.7).abs() < 1e-6 && (mean[1] - 0.1).abs() < 1e-6, "{mean:?}");
     assert!(var.iter().all(|v| (v - 0.46).abs() < 1e-6), "{var:?}");
 }
@@ -55,18 +57,18 @@ fn regression_matches_closed_form() {
 #[test]
 fn score_matches_closed_form() {
     // log N(mu; mu, S) = -0.5 (4 ln 2 pi + ln det S), det S = 0.5 - 0.04.
-    let got = one_gaussian().score_samples(&[0.0, 0.0, 0.0, 0.5], 4).unwrap();
+    let got = one_gaussian().score_samples(&[0.0, 0.0, 0.0, 0.5], 4, None).unwrap();
     let want = -0.5 * (4.0 * (2.0 * std::f64::consts::PI).ln() + 0.46f64.ln());
     assert!((got[0] - want).abs() < 1e-5, "{got:?} vs {want}");
     // Marginal over gray: a 3-D standard normal at its mean.
-    let got3 = one_gaussian().score_samples(&[0.0, 0.0, 0.0], 3).unwrap();
+    let got3 = one_gaussian().score_samples(&[0.0, 0.0, 0.0], 3, None).unwrap();
     assert!((got3[0] + 1.5 * (2.0 * std::f64::consts::PI).ln()).abs() < 1e-5);
 }
 
 #[test]
 fn fixed_k_fit_finds_both_blobs() {
-    let opts = Options::builder().seed(7).threads(1).build().unwrap();
-    let m = Model::fit_fixed_k(&two_blobs(400), 2, Some(&opts)).unwrap();
+    let opts = Options::builder().seed(7).threads(1).n_components(2).build().unwrap();
+    let m = Model::fit(&two_blobs(400), Some(&opts)).unwrap();
     let mut xs: Vec<(f32, f32)> = m.means().unwrap().chunks(4).map(|r| (r[0], r[3])).collect();
     xs.sort_by(|a, b| a.0.total_cmp(&b.0));
     assert!((xs[0].0 + 1.0).abs() < 0.05 && (xs[0].1 - 0.2).abs() < 0.01, "{xs:?}");
@@ -83,9 +85,9 @@ fn self_organizing_fit_and_seeds() {
     let a = Model::fit(&two_blobs(200), Some(&opts)).unwrap();
     let b = Model::fit(&two_blobs(200), Some(&opts)).unwrap();
     assert_eq!(a.means().unwrap(), b.means().unwrap(), "same seed, same fit");
-    assert_eq!(a.sample(100, 9, 4).unwrap(), b.sample(100, 9, 4).unwrap());
-    assert_ne!(a.sample(100, 9, 4).unwrap(), a.sample(100, 10, 4).unwrap());
-    assert_eq!(a.sample(50, 1, 3).unwrap().len(), 150);
+    assert_eq!(a.sample(100, 9, 4, None).unwrap(), b.sample(100, 9, 4, None).unwrap());
+    assert_ne!(a.sample(100, 9, 4, None).unwrap(), a.sample(100, 10, 4, None).unwrap());
+    assert_eq!(a.sample(50, 1, 3, None).unwrap().len(), 150);
 }
 
 #[test]
@@ -109,9 +111,9 @@ fn errors_carry_status_and_message() {
     let e = Model::load("/nonexistent/dir/x.sogmm", None).unwrap_err();
     assert_eq!(e.status(), Status::Io);
 
-    let e = one_gaussian().sample(1, 0, 5).unwrap_err();
+    let e = one_gaussian().sample(1, 0, 5, None).unwrap_err();
     assert_eq!(e.status(), Status::InvalidArg);
-    let e = one_gaussian().sample(usize::MAX / 2, 0, 4).unwrap_err();
+    let e = one_gaussian().sample(usize::MAX / 2, 0, 4, None).unwrap_err();
     assert_eq!(e.status(), Status::Limit); // n * dims overflows: refused before allocating
 }
 
@@ -214,12 +216,12 @@ fn shared_model_across_threads_matches_serial() {
     assert_send_sync::<Model>();
     assert_send_sync::<Options>();
     let m = one_gaussian();
-    let serial: Vec<Vec<f32>> = (0..4).map(|s| m.sample(500, s, 4).unwrap()).collect();
+    let serial: Vec<Vec<f32>> = (0..4).map(|s| m.sample(500, s, 4, None).unwrap()).collect();
     let parallel: Vec<Vec<f32>> = std::thread::scope(|sc| {
         let hs: Vec<_> = (0..4)
             .map(|s| {
                 let m = &m;
-                sc.spawn(move || m.sample(500, s, 4).unwrap())
+                sc.spawn(move || m.sample(500, s, 4, None).unwrap())
             })
             .collect();
         hs.into_iter().map(|h| h.join().unwrap()).collect()
@@ -229,7 +231,7 @@ fn shared_model_across_threads_matches_serial() {
     std::thread::scope(|sc| {
         sc.spawn(|| assert!(Model::fit(&[f32::NAN; 4], None).is_err()));
     });
-    assert!(m.sample(1, 0, 4).is_ok());
+    assert!(m.sample(1, 0, 4, None).is_ok());
 }
 
 #[test]
@@ -326,4 +328,45 @@ fn option_info_reports_every_default_a_fresh_handle_holds() {
     let tol = sogmm::option_info(sogmm::sys::SOGMM_OPT_TOL).unwrap();
     assert_eq!(tol.name, "SOGMM_OPT_TOL");
     assert_eq!(sogmm::option_info(99).unwrap_err().status(), sogmm::Status::InvalidArg);
+}
+
+/// SQUAREM (`squarem(true)`, SOGMM_OPT_EM_ACCELERATION) reaches plain EM's
+/// fixed point on three overlapping clusters in fewer passes, no lower; a
+/// value outside 0..=1 is refused.
+#[test]
+fn squarem_reaches_the_fixed_point_in_fewer_passes() {
+    let mut s: u64 = 35;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 40) as f32 / (1u64 << 24) as f32) - 0.5 // [-0.5, 0.5)
+    };
+    let mut pts = Vec::new();
+    for i in 0..3000 {
+        let k = (i % 3) as f32;
+        pts.extend_from_slice(&[
+            0.8 * k + 1.5 * next(),
+            0.5 * next(),
+            1.0 + 0.3 * next(),
+            0.3 + 0.3 * next(),
+        ]);
+    }
+    let fit = |squarem: bool| {
+        let o = Options::builder()
+            .n_components(3)
+            .seed(1)
+            .threads(1)
+            .tol(1e-7)
+            .max_iter(3000)
+            .squarem(squarem);
+        let m = Model::fit(&pts, Some(&o.build().unwrap())).unwrap();
+        let it = m.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap().unwrap();
+        let ll = m.info_f64(sogmm::sys::SOGMM_INFO_FIT_LOG_LIKELIHOOD).unwrap().unwrap();
+        (it, ll)
+    };
+    let (plain, fast) = (fit(false), fit(true));
+    assert!(fast.0 < plain.0, "{fast:?} vs {plain:?}");
+    assert!(fast.1 >= plain.1 - 1e-5, "{fast:?} vs {plain:?}");
+    let mut o = Options::new().unwrap();
+    assert_eq!(o.get_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION).unwrap(), 0);
+    assert!(o.set_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION, 2).is_err());
 }

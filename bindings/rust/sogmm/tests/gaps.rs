@@ -3,7 +3,7 @@
 use std::ops::ControlFlow;
 
 use sogmm::sys;
-use sogmm::{psnr_images, Map, Model, Options, Progress, Status};
+use sogmm::{psnr_images, Map, Model, Options, Progress, Queryable, Status};
 
 // ---- psnr_images --------------------------------------------------------
 
@@ -144,11 +144,11 @@ fn culled(nats: f64, threads: i64) -> Options {
 fn culled_scores_and_regression_are_within_the_bound() {
     let m = far_cluster();
     let big_m = m.n_components() as f64;
-    let exact = m.score_samples(&QUERY, 4).unwrap();
-    let (mean, var) = m.regress_gray(&QUERY_XYZ).unwrap();
+    let exact = m.score_samples(&QUERY, 4, None).unwrap();
+    let (mean, var) = m.regress_gray(&QUERY_XYZ, None).unwrap();
     for nats in [2.0, 6.0] {
-        let c = m.score_samples_with(&QUERY, 4, Some(&culled(nats, 1))).unwrap();
-        assert_eq!(c, m.score_samples_with(&QUERY, 4, Some(&culled(nats, 2))).unwrap());
+        let c = m.score_samples(&QUERY, 4, Some(&culled(nats, 1))).unwrap();
+        assert_eq!(c, m.score_samples(&QUERY, 4, Some(&culled(nats, 2))).unwrap());
         let bound = (big_m * (-nats).exp()).ln_1p();
         for (e, c) in exact.iter().zip(&c) {
             assert!(
@@ -163,7 +163,7 @@ fn culled_scores_and_regression_are_within_the_bound() {
         // Dropped components hold a share <= (M - 1) e^-nats at a point, and
         // every conditional gray is in [0.25, 0.75]: the mean moves by at
         // most 0.5 times that share.
-        let (cm, cv) = m.regress_gray_with(&QUERY_XYZ, Some(&culled(nats, 2))).unwrap();
+        let (cm, cv) = m.regress_gray(&QUERY_XYZ, Some(&culled(nats, 2))).unwrap();
         let shift = 0.5 * (big_m - 1.0) * (-nats).exp();
         for i in 0..3 {
             assert!(((cm[i] - mean[i]) as f64).abs() <= shift, "{cm:?} vs {mean:?}");
@@ -172,10 +172,10 @@ fn culled_scores_and_regression_are_within_the_bound() {
         assert_ne!(cm, mean);
     }
     // Far above every gap: nothing is culled, the exact bits.
-    assert_eq!(m.score_samples_with(&QUERY, 4, Some(&culled(40.0, 2))).unwrap(), exact);
-    let (cm, cv) = m.regress_gray_with(&QUERY_XYZ, Some(&culled(40.0, 1))).unwrap();
+    assert_eq!(m.score_samples(&QUERY, 4, Some(&culled(40.0, 2))).unwrap(), exact);
+    let (cm, cv) = m.regress_gray(&QUERY_XYZ, Some(&culled(40.0, 1))).unwrap();
     assert_eq!((cm, cv), (mean, var));
-    assert_eq!(m.score_samples_with(&QUERY, 4, None).unwrap(), exact);
+    assert_eq!(m.score_samples(&QUERY, 4, None).unwrap(), exact);
 }
 
 #[test]
@@ -188,31 +188,25 @@ fn map_queries_take_the_same_options() {
     let map = Map::load(&path, None).unwrap();
     std::fs::remove_file(&path).unwrap();
     let o = culled(2.0, 2);
-    let c = map.score_samples_with(&QUERY, 4, Some(&o)).unwrap();
-    assert_eq!(c, m.score_samples_with(&QUERY, 4, Some(&o)).unwrap());
-    assert_ne!(c, map.score_samples(&QUERY, 4).unwrap());
-    let r = map.regress_gray_with(&QUERY_XYZ, Some(&o)).unwrap();
-    assert_eq!(r, m.regress_gray_with(&QUERY_XYZ, Some(&o)).unwrap());
-    assert_ne!(r, map.regress_gray(&QUERY_XYZ).unwrap());
-    // The progress variants take the same options, and report every point.
-    let mut last = 0;
-    let mut count = |p: Progress| {
-        last = p.step;
+    let c = map.score_samples(&QUERY, 4, Some(&o)).unwrap();
+    assert_eq!(c, m.score_samples(&QUERY, 4, Some(&o)).unwrap());
+    assert_ne!(c, map.score_samples(&QUERY, 4, None).unwrap());
+    let r = map.regress_gray(&QUERY_XYZ, Some(&o)).unwrap();
+    assert_eq!(r, m.regress_gray(&QUERY_XYZ, Some(&o)).unwrap());
+    assert_ne!(r, map.regress_gray(&QUERY_XYZ, None).unwrap());
+    // A progress closure on the same options reports every point and changes no bit.
+    let last = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let sink = std::sync::Arc::clone(&last);
+    let mut reporting = o.clone();
+    reporting.set_progress(move |p: Progress| {
+        sink.store(p.step, std::sync::atomic::Ordering::SeqCst);
         ControlFlow::Continue(())
-    };
-    assert_eq!(
-        map.score_samples_with_progress(&QUERY, 4, Some(&o), &mut count)
-            .unwrap(),
-        c
-    );
-    assert_eq!(
-        m.score_samples_with_progress(&QUERY, 4, Some(&o), &mut count).unwrap(),
-        c
-    );
-    assert_eq!(last, 3);
-    let go_on = |_| ControlFlow::Continue(());
-    assert_eq!(map.regress_gray_with_progress(&QUERY_XYZ, Some(&o), go_on).unwrap(), r);
-    assert_eq!(m.regress_gray_with_progress(&QUERY_XYZ, Some(&o), go_on).unwrap(), r);
+    });
+    assert_eq!(map.score_samples(&QUERY, 4, Some(&reporting)).unwrap(), c);
+    assert_eq!(m.score_samples(&QUERY, 4, Some(&reporting)).unwrap(), c);
+    assert_eq!(last.load(std::sync::atomic::Ordering::SeqCst), 3);
+    assert_eq!(map.regress_gray(&QUERY_XYZ, Some(&reporting)).unwrap(), r);
+    assert_eq!(m.regress_gray(&QUERY_XYZ, Some(&reporting)).unwrap(), r);
 }
 
 #[test]

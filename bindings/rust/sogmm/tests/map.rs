@@ -2,8 +2,10 @@
 //! (bitwise the exported model's), progress and cancel; the warm start.
 use std::ops::ControlFlow;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::{Arc, Mutex};
 
-use sogmm::{Color, Frame, Map, Model, Options, Pose, Stage, Status};
+use sogmm::{Color, Frame, Map, Model, Options, Pose, Queryable, Stage, Status};
 
 const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
 
@@ -24,13 +26,36 @@ fn blobs(n: usize, seed: u64) -> Vec<f32> {
     (0..n).flat_map(|i| centres[i % 3].map(|c| c + 0.05 * next())).collect()
 }
 
-fn map_options(novelty: bool) -> Options {
+fn map_builder(novelty: bool) -> sogmm::OptionsBuilder {
     Options::builder()
         .map_novelty(novelty)
         .map_batch_size(100_000)
         .threads(2)
-        .build()
-        .unwrap()
+}
+
+fn map_options(novelty: bool) -> Options {
+    map_builder(novelty).build().unwrap()
+}
+
+/// What `steered` does at each report: go on, stop, or panic.
+const GO_ON: u8 = 0;
+const STOP: u8 = 1;
+const PANIC: u8 = 2;
+
+/// A progress closure doing what `mode` says, recording the stages it sees.
+fn steered(
+    mode: &Arc<AtomicU8>,
+    stages: &Arc<Mutex<Vec<Stage>>>,
+) -> impl FnMut(sogmm::Progress) -> ControlFlow<()> + Send + 'static {
+    let (mode, stages) = (Arc::clone(mode), Arc::clone(stages));
+    move |p| {
+        stages.lock().unwrap_or_else(|e| e.into_inner()).push(p.stage);
+        match mode.load(Ordering::SeqCst) {
+            GO_ON => ControlFlow::Continue(()),
+            STOP => ControlFlow::Break(()),
+            _ => panic!("stop"),
+        }
+    }
 }
 
 /// Two posed copies of the blobs, flushed.
@@ -101,48 +126,73 @@ fn queries_equal_the_exported_model_bitwise() {
         .collect();
     let q3: Vec<f32> = q4.chunks(4).flat_map(|r| [r[0], r[1], r[2]]).collect();
     for (q, dims) in [(&q3, 3), (&q4, 4)] {
-        let want = model.score_samples(q, dims).unwrap();
-        assert_eq!(map.score_samples(q, dims).unwrap(), want);
-        let mut last = 0;
-        let got = map
-            .score_samples_with_progress(q, dims, None, |p| {
+        let want = model.score_samples(q, dims, None).unwrap();
+        assert_eq!(map.score_samples(q, dims, None).unwrap(), want);
+        let last = Arc::new(AtomicU64::new(0));
+        let sink = Arc::clone(&last);
+        let o = Options::builder()
+            .on_progress(move |p| {
                 assert_eq!(p.stage, Stage::Scoring);
-                last = p.step;
+                sink.store(p.step, Ordering::SeqCst);
                 ControlFlow::Continue(())
             })
+            .build()
             .unwrap();
+        let got = map.score_samples(q, dims, Some(&o)).unwrap();
         assert_eq!(got, want);
-        assert_eq!(last, 5000);
+        assert_eq!(last.load(Ordering::SeqCst), 5000);
     }
-    assert_eq!(map.regress_gray(&q3).unwrap(), model.regress_gray(&q3).unwrap());
     assert_eq!(
-        map.regress_gray_with_progress(&q3, None, |_| ControlFlow::Continue(()))
-            .unwrap(),
-        model.regress_gray(&q3).unwrap()
+        map.regress_gray(&q3, None).unwrap(),
+        model.regress_gray(&q3, None).unwrap()
     );
-    assert_eq!(map.sample(4000, 3, 4, None).unwrap(), model.sample(4000, 3, 4).unwrap());
+    let go_on = Options::builder()
+        .on_progress(|_| ControlFlow::Continue(()))
+        .build()
+        .unwrap();
+    assert_eq!(
+        map.regress_gray(&q3, Some(&go_on)).unwrap(),
+        model.regress_gray(&q3, None).unwrap()
+    );
+    assert_eq!(
+        map.sample(4000, 3, 4, None).unwrap(),
+        model.sample(4000, 3, 4, None).unwrap()
+    );
     let trunc = Options::builder().sample_truncation(1.0).build().unwrap();
     assert_eq!(
         map.sample(4000, 3, 3, Some(&trunc)).unwrap(),
-        model.sample_with(4000, 3, 3, Some(&trunc)).unwrap()
+        model.sample(4000, 3, 3, Some(&trunc)).unwrap()
     );
     // Cancel and bad input.
-    let e = map
-        .regress_gray_with_progress(&q3, None, |_| ControlFlow::Break(()))
-        .unwrap_err();
+    let stop = Options::builder()
+        .on_progress(|_| ControlFlow::Break(()))
+        .build()
+        .unwrap();
+    let e = map.regress_gray(&q3, Some(&stop)).unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
-    assert_eq!(map.score_samples(&q3, 5).unwrap_err().status(), Status::InvalidArg);
-    assert_eq!(map.score_samples(&q3[..4], 3).unwrap_err().status(), Status::InvalidArg);
+    assert_eq!(
+        map.score_samples(&q3, 5, None).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    assert_eq!(
+        map.score_samples(&q3[..4], 3, None).unwrap_err().status(),
+        Status::InvalidArg
+    );
     let mut nan = q3.clone();
     nan[4] = f32::NAN;
-    assert_eq!(map.score_samples(&nan, 3).unwrap_err().status(), Status::InvalidData);
+    assert_eq!(
+        map.score_samples(&nan, 3, None).unwrap_err().status(),
+        Status::InvalidData
+    );
     let empty = Map::new(None).unwrap();
     assert_eq!(empty.sample(10, 1, 4, None).unwrap_err().status(), Status::InvalidData);
     // Shared across threads: the same answers.
     std::thread::scope(|s| {
-        let handles: Vec<_> = (0..2).map(|_| s.spawn(|| map.score_samples(&q4, 4).unwrap())).collect();
+        let handles: Vec<_> = (0..2)
+            .map(|_| s.spawn(|| map.score_samples(&q4, 4, None).unwrap()))
+            .collect();
         for h in handles {
-            assert_eq!(h.join().unwrap(), model.score_samples(&q4, 4).unwrap());
+            assert_eq!(h.join().unwrap(), model.score_samples(&q4, 4, None).unwrap());
         }
     });
 }
@@ -150,36 +200,37 @@ fn queries_equal_the_exported_model_bitwise() {
 #[test]
 fn a_cancelled_insert_or_flush_leaves_the_map_as_it_was() {
     let pts = blobs(3000, 5);
-    let mut map = Map::new(Some(&map_options(false))).unwrap();
-    let mut stages = Vec::new();
-    map.insert_points_with_progress(&pts, &IDENTITY, |p| {
-        stages.push(p.stage);
-        ControlFlow::Continue(())
-    })
-    .unwrap();
-    assert_eq!(stages.last(), Some(&Stage::Em));
+    let (mode, stages) = (Arc::new(AtomicU8::new(GO_ON)), Arc::new(Mutex::new(Vec::new())));
+    let steered_options = map_builder(false).on_progress(steered(&mode, &stages)).build().unwrap();
+    let mut map = Map::new(Some(&steered_options)).unwrap();
+    map.insert_points(&pts, &IDENTITY).unwrap();
+    assert_eq!(stages.lock().unwrap().last(), Some(&Stage::Em));
     let before = (map.stats().unwrap(), map.export().unwrap().means().unwrap());
-    let e = map
-        .insert_points_with_progress(&pts, &shifted(3.0), |_| ControlFlow::Break(()))
-        .unwrap_err();
+    mode.store(STOP, Ordering::SeqCst);
+    let e = map.insert_points(&pts, &shifted(3.0)).unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
     assert_eq!((map.stats().unwrap(), map.export().unwrap().means().unwrap()), before);
     // A panic cancels too, resumes here, and leaves the map as it was.
+    mode.store(PANIC, Ordering::SeqCst);
     let r = catch_unwind(AssertUnwindSafe(|| {
-        let _ = map.insert_points_with_progress(&pts, &shifted(3.0), |_| panic!("stop"));
+        let _ = map.insert_points(&pts, &shifted(3.0));
     }));
     assert!(r.is_err());
     assert_eq!(map.stats().unwrap(), before.0);
-    // The callback is gone after the call: a plain insert works.
+    // The closure still works after a panic: the next insert goes through.
+    mode.store(GO_ON, Ordering::SeqCst);
     map.insert_points(&pts, &shifted(3.0)).unwrap();
     assert_eq!(map.stats().unwrap().n_frames, 2);
 
-    let mut pending = Map::new(Some(&map_options(true))).unwrap();
+    let steered_pending = map_builder(true).on_progress(steered(&mode, &stages)).build().unwrap();
+    let mut pending = Map::new(Some(&steered_pending)).unwrap();
     pending.insert_points(&pts, &IDENTITY).unwrap();
-    let e = pending.flush_with_progress(|_| ControlFlow::Break(())).unwrap_err();
+    mode.store(STOP, Ordering::SeqCst);
+    let e = pending.flush().unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
     assert_eq!(pending.stats().unwrap().n_pending, 3000);
-    pending.flush_with_progress(|_| ControlFlow::Continue(())).unwrap();
+    mode.store(GO_ON, Ordering::SeqCst);
+    pending.flush().unwrap();
     assert_eq!(pending.stats().unwrap().n_pending, 0);
 }
 
@@ -190,15 +241,22 @@ fn warm_start_from_a_fit_of_the_same_points() {
     let cold = Model::fit(&pts, Some(&fixed)).unwrap();
     // EM from a converged model of the same points: at least as likely (EM
     // never lowers the likelihood) and the same size.
-    let mut reports = 0;
-    let warm = Model::fit_warm_with_progress(&pts, &cold, Some(&fixed), |_| {
-        reports += 1;
-        ControlFlow::Continue(())
-    })
-    .unwrap();
-    assert!(reports > 0);
+    let reports = Arc::new(AtomicU64::new(0));
+    let sink = Arc::clone(&reports);
+    let counted = Options::builder()
+        .n_components(3)
+        .seed(2)
+        .threads(2)
+        .on_progress(move |_| {
+            sink.fetch_add(1, Ordering::SeqCst);
+            ControlFlow::Continue(())
+        })
+        .build()
+        .unwrap();
+    let warm = Model::fit_warm(&pts, &cold, Some(&counted)).unwrap();
+    assert!(reports.load(Ordering::SeqCst) > 0);
     assert_eq!(warm.n_components(), 3);
-    let ll = |m: &Model| m.score_samples(&pts, 4).unwrap().iter().sum::<f64>() / 3000.0;
+    let ll = |m: &Model| m.score_samples(&pts, 4, None).unwrap().iter().sum::<f64>() / 3000.0;
     assert!(ll(&warm) >= ll(&cold) - 1e-6, "{} < {}", ll(&warm), ll(&cold));
     assert_eq!(
         Model::fit_warm(&pts, &cold, Some(&fixed)).unwrap().means().unwrap(),
@@ -215,7 +273,11 @@ fn warm_start_from_a_fit_of_the_same_points() {
         Model::fit_warm(&pts, &cold, Some(&two_runs)).unwrap_err().status(),
         Status::InvalidArg
     );
-    let e = Model::fit_warm_with_progress(&pts, &cold, None, |_| ControlFlow::Break(())).unwrap_err();
+    let stop = Options::builder()
+        .on_progress(|_| ControlFlow::Break(()))
+        .build()
+        .unwrap();
+    let e = Model::fit_warm(&pts, &cold, Some(&stop)).unwrap_err();
     assert_eq!(e.status(), Status::Cancelled);
 }
 
@@ -306,5 +368,71 @@ fn discard_pending_unlocks_a_map_that_cannot_be_saved() {
     // The dropped points' voxels are forgotten: the same frame is new again.
     map.insert_points(&pts, &IDENTITY).unwrap();
     assert_eq!(map.frame_stats(1).unwrap().n_novel, 300);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Deltas applied in order rebuild the sender's map bit for bit; a gap is
+/// refused and leaves the receiver at its revision.
+#[test]
+fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
+    let mut sender = Map::new(Some(&map_options(false))).unwrap();
+    let mut receiver = Map::new(None).unwrap();
+    let mut deltas = Vec::new();
+    for (k, tx) in [0.0, 3.0].into_iter().enumerate() {
+        let since = sender.revision().unwrap();
+        sender.insert_points(&blobs(1500, 11 + k as u64), &shifted(tx)).unwrap();
+        deltas.push(sender.export_delta(since).unwrap());
+    }
+    assert_eq!(sender.revision().unwrap(), 2);
+    assert_eq!(
+        receiver.apply_delta(&deltas[1]).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    assert_eq!(receiver.revision().unwrap(), 0);
+    for d in &deltas {
+        receiver.apply_delta(d).unwrap();
+    }
+    let (a, b) = (sender.export().unwrap(), receiver.export().unwrap());
+    let bits = |v: Vec<f32>| v.into_iter().map(f32::to_bits).collect::<Vec<u32>>();
+    assert_eq!(bits(a.weights().unwrap()), bits(b.weights().unwrap()));
+    assert_eq!(bits(a.means().unwrap()), bits(b.means().unwrap()));
+    assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
+}
+
+// Issue 36: a map 1000 km out holds its components relative to its origin
+// (the first frame's translation rounded to 1 km), finds in a mapped frame
+// the novel points it finds at the world origin, and keeps the origin
+// through save and load; it is declared only before the first insert.
+#[test]
+fn a_far_map_keeps_its_origin() {
+    let pts = blobs(300, 3);
+    let dir = std::env::temp_dir().join(format!("sogmm_rust_origin_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("far.sogmm");
+    let mut novel = Vec::new();
+    for km in [0.0, 1000.0] {
+        let mut pose = IDENTITY;
+        pose[3] = 1000.0 * km + 3.37;
+        pose[7] = -1000.0 * km;
+        let mut map = Map::new(Some(&map_options(true))).unwrap();
+        map.insert_points(&pts, &pose).unwrap();
+        map.flush().unwrap();
+        assert_eq!(map.origin().unwrap(), [1000.0 * km, -1000.0 * km, 0.0]);
+        map.insert_points(&pts, &pose).unwrap();
+        novel.push(map.frame_stats(1).unwrap().n_novel);
+        map.discard_pending().unwrap();
+        map.save(&path, None).unwrap();
+    }
+    assert_eq!(novel[1], novel[0]);
+    let mut loaded = Map::load(&path, Some(&map_options(true))).unwrap();
+    assert_eq!(loaded.origin().unwrap(), [1.0e6, -1.0e6, 0.0]);
+    assert_eq!(loaded.set_origin([0.0; 3]).unwrap_err().status(), Status::InvalidArg);
+    let mut fresh = Map::new(Some(&map_options(true))).unwrap();
+    assert_eq!(
+        fresh.set_origin([f64::NAN, 0.0, 0.0]).unwrap_err().status(),
+        Status::InvalidArg
+    );
+    fresh.set_origin([5.0e5, 0.5, 0.0]).unwrap();
+    assert_eq!(fresh.origin().unwrap(), [5.0e5, 0.5, 0.0]);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,7 +1,7 @@
 //! `Model::register_points` (issue 32): points sampled from a corner of three
 //! planes and moved by -t register back to the translation t; a NaN initial
 //! pose is an invalid argument.
-use sogmm::{Model, Pose, RegistrationStatus, Status};
+use sogmm::{Model, Pose, Queryable, RegistrationStatus, Status};
 
 /// Flat components tiling the unit squares of the planes x = 0, y = 0, z = 0.
 fn corner() -> Model {
@@ -32,7 +32,7 @@ fn corner() -> Model {
 fn recovers_a_translation() {
     let model = corner();
     let t = [0.02f32, -0.01, 0.03];
-    let mut pts = model.sample(3000, 1, 4).unwrap();
+    let mut pts = model.sample(3000, 1, 4, None).unwrap();
     for row in pts.chunks_mut(4) {
         for k in 0..3 {
             row[k] -= t[k];

@@ -4,7 +4,7 @@
 //! bad input.
 use std::ops::ControlFlow;
 
-use sogmm::{Camera, Map, Model, Options, Pose, Stage, Status};
+use sogmm::{Camera, Map, Model, Options, Pose, Queryable, Stage, Status};
 
 const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
 const CAM: Camera = Camera {
@@ -93,25 +93,30 @@ fn map_renders_as_its_export_with_progress_and_cancel() {
     let mut map = Map::new(Some(&opts)).unwrap();
     assert_eq!(map.render(&cam, None, None).unwrap_err().status(), Status::InvalidData);
     // Points drawn from a model stand for a frame.
-    let pts = on_axis().sample(3000, 7, 4).unwrap();
+    let pts = on_axis().sample(3000, 7, 4, None).unwrap();
     map.insert_points(&pts, &IDENTITY).unwrap();
     map.flush().unwrap();
     let a = map.render(&cam, Some(&IDENTITY), Some(&opts)).unwrap();
-    let mut last = (None, 0u64);
-    let b = map
-        .export()
-        .unwrap()
-        .render_with_progress(&cam, None, None, |p| {
-            last = (Some(p.stage), p.step);
+    let last = std::sync::Arc::new(std::sync::Mutex::new(None));
+    let sink = std::sync::Arc::clone(&last);
+    let reporting = Options::builder()
+        .on_progress(move |p| {
+            *sink.lock().unwrap() = Some((p.stage, p.step));
             ControlFlow::Continue(())
         })
+        .build()
         .unwrap();
+    let b = map.export().unwrap().render(&cam, None, Some(&reporting)).unwrap();
     let bits = |v: &Vec<f32>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&a.depth), bits(&b.depth));
     assert_eq!(bits(&a.gray), bits(&b.gray));
     assert!(a.depth.iter().any(|d| !d.is_nan()));
-    assert_eq!(last, (Some(Stage::Rendering), 30));
-    let cancelled = map.render_with_progress(&cam, None, None, |_| ControlFlow::Break(()));
+    assert_eq!(*last.lock().unwrap(), Some((Stage::Rendering, 30)));
+    let stop = Options::builder()
+        .on_progress(|_| ControlFlow::Break(()))
+        .build()
+        .unwrap();
+    let cancelled = map.render(&cam, None, Some(&stop));
     assert_eq!(cancelled.unwrap_err().status(), Status::Cancelled);
 }
 

@@ -2,7 +2,9 @@
 //! 31) on a plane at z = 2 m seen from the origin: z = 1 free, z = 2
 //! occupied, z = 3 and outside the frustum unknown (0.5); the distance
 //! |z - 2| and the plane's normal; spheres on and clear of the plane; bad input.
-use sogmm::{Color, Frame, Map, Options, Pose, Status, OCCUPANCY_FREE, OCCUPANCY_OCCUPIED, OCCUPANCY_UNKNOWN};
+use sogmm::{
+    Color, Frame, Map, Options, Pose, Queryable, Status, OCCUPANCY_FREE, OCCUPANCY_OCCUPIED, OCCUPANCY_UNKNOWN,
+};
 
 const IDENTITY: Pose = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
 

@@ -7,6 +7,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use sogmm::Queryable;
+
 fn cubes() -> Vec<f32> {
     let mut points = Vec::new();
     for (c, gray) in [0.2f32, 0.8].into_iter().enumerate() {
@@ -27,7 +29,7 @@ fn run(path: PathBuf) -> Result<(), Box<dyn std::error::Error>> {
     let model = sogmm::Model::fit(&cubes(), Some(&opts))?;
     model.save(&path, None)?;
     let loaded = sogmm::Model::load(&path, None)?;
-    let (gray, _) = loaded.regress_gray(&[0.015, 0.015, 1.015, 1.015, 0.015, 1.015])?;
+    let (gray, _) = loaded.regress_gray(&[0.015, 0.015, 1.015, 1.015, 0.015, 1.015], None)?;
     let (fitted, m) = (model.n_components(), loaded.n_components());
     println!(
         "{fitted} components fitted, {m} loaded from {}, gray {:.3} and {:.3}",

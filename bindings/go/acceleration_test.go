@@ -1,0 +1,60 @@
+package sogmm
+
+import (
+	"context"
+	"errors"
+	"testing"
+)
+
+// SQUAREM (Squarem(true), OptEmAcceleration) reaches plain EM's fixed point
+// on three overlapping clusters in fewer passes, no lower; a value outside
+// 0..1 is refused.
+func TestSquaremReachesTheFixedPointInFewerPasses(t *testing.T) {
+	s := uint64(35)
+	next := func() float32 {
+		s = s*6364136223846793005 + 1442695040888963407
+		return float32(s>>40)/float32(1<<24) - 0.5 // [-0.5, 0.5)
+	}
+	pts := make([]float32, 0, 4*3000)
+	for i := 0; i < 3000; i++ {
+		k := float32(i % 3)
+		pts = append(pts, 0.8*k+1.5*next(), 0.5*next(), 1.0+0.3*next(), 0.3+0.3*next())
+	}
+	fit := func(on bool) (int64, float64) {
+		o, err := NewOptions(NComponents(3), Seed(1), Threads(1), Tol(1e-7), MaxIter(3000), Squarem(on))
+		if err != nil {
+			t.Fatal(err)
+		}
+		defer o.Close()
+		m, err := Fit(context.Background(), pts, o)
+		if err != nil {
+			t.Fatal(err)
+		}
+		defer m.Close()
+		it, err := m.InfoI64(InfoFitIterations)
+		if err != nil {
+			t.Fatal(err)
+		}
+		ll, err := m.InfoF64(InfoFitLogLik)
+		if err != nil {
+			t.Fatal(err)
+		}
+		return it, ll
+	}
+	plainIt, plainLL := fit(false)
+	fastIt, fastLL := fit(true)
+	if fastIt >= plainIt || fastLL < plainLL-1e-5 {
+		t.Fatalf("squarem %d passes, LL %v; plain %d passes, LL %v", fastIt, fastLL, plainIt, plainLL)
+	}
+	o, err := NewOptions()
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer o.Close()
+	if v, _ := o.GetI64(OptEmAcceleration); v != 0 {
+		t.Fatalf("default em_acceleration %v, want 0", v)
+	}
+	if err := o.Set(I64(OptEmAcceleration, 2)); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("em_acceleration 2: %v", err)
+	}
+}

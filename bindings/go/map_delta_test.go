@@ -1,0 +1,62 @@
+package sogmm
+
+import (
+	"context"
+	"errors"
+	"slices"
+	"testing"
+)
+
+// A receiver fed the deltas in order holds the sender's map bit for bit; a
+// gap is refused and changes nothing.
+func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
+	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
+	sender, err := NewMap(o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer sender.Close()
+	receiver, err := NewMap(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer receiver.Close()
+	var deltas [][]byte
+	for k, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)} {
+		since, _ := sender.Revision()
+		if err := sender.InsertPoints(context.Background(), twoBlobs(200+50*k), pose); err != nil {
+			t.Fatal(err)
+		}
+		d, err := sender.ExportDelta(since)
+		if err != nil {
+			t.Fatal(err)
+		}
+		deltas = append(deltas, d)
+	}
+	if err := receiver.ApplyDelta(deltas[1]); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("a gap: got %v", err)
+	}
+	if r, _ := receiver.Revision(); r != 0 {
+		t.Fatalf("revision %d after a refused delta", r)
+	}
+	for _, d := range deltas {
+		if err := receiver.ApplyDelta(d); err != nil {
+			t.Fatal(err)
+		}
+	}
+	a, err := sender.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	b, err := receiver.Export(nil)
+	if err != nil {
+		t.Fatal(err)
+	}
+	for _, get := range []func(*Model) ([]float32, error){(*Model).Weights, (*Model).Means, (*Model).Covariances} {
+		x, _ := get(a)
+		y, _ := get(b)
+		if !slices.Equal(x, y) || len(x) == 0 {
+			t.Fatalf("receiver differs from sender")
+		}
+	}
+}

@@ -1,0 +1,169 @@
+// SQUAREM-accelerated EM: the S3 step with its two safeguards (see
+// em_acceleration.hpp).
+#include "em_acceleration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+namespace sogmm::detail {
+namespace {
+
+// The step-length schedule of the reference implementation (R package
+// SQUAREM, squarem1's defaults): a is capped at step_max, which starts at 1
+// (the first cycle is plain EM, while the k-means++ start still moves a
+// lot), grows x4 each time the cap binds and shrinks /4 (not below 1) when a
+// capped step is rejected.
+constexpr double kStepMax0 = 1.0;
+constexpr double kStepFactor = 4.0;
+// A step length this close to 1 is the plain step (t2 itself).
+constexpr double kPlain = 1.01;
+// Pull-backs of an extrapolation that is not a model before taking t2.
+constexpr int kMaxPullBacks = 8;
+// Log-weights below this (a component without weight, e.g. a warm start's
+// zero weights at -1e30) make differences that mean nothing: plain step.
+constexpr double kLowestLogWeight = -700.0;
+
+using Mat4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+
+// sum_k w_k |t_k - s_k|^2 in t0's Fisher metric, for the differences
+// (d_mean, d_cov, d_logw) given per component by `diff`.
+template <typename Diff>
+double fisher_norm2(const Working& t0, const std::vector<Eigen::LLT<Eigen::Matrix4d>>& llt,
+                    const std::vector<double>& weight, Diff diff) {
+  double total = 0.0;
+  for (std::size_t k = 0; k < t0.size(); ++k) {
+    Eigen::Vector4d dm;
+    Mat4 dc;
+    double dl = 0.0;
+    diff(k, dm, dc, dl);
+    const Eigen::Matrix4d l = llt[k].matrixL();
+    const Eigen::Vector4d y = l.triangularView<Eigen::Lower>().solve(dm);
+    // L^-1 dS L^-T: its squared Frobenius norm is tr((S^-1 dS)^2).
+    const Eigen::Matrix4d half = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d(dc));
+    const Eigen::Matrix4d whitened = l.triangularView<Eigen::Lower>().solve(half.transpose());
+    total += weight[k] * (y.squaredNorm() + 0.5 * whitened.squaredNorm() + dl * dl);
+  }
+  return total;
+}
+
+}  // namespace
+
+double squarem_step_length(const Working& t0, const Working& t1, const Working& t2) {
+  const std::size_t m = t0.size();
+  double top = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!(t0.log_weight[k] > kLowestLogWeight) || !(t1.log_weight[k] > kLowestLogWeight)) return 0.0;
+    top = std::max(top, t0.log_weight[k]);
+  }
+  std::vector<double> weight(m);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < m; ++k) sum += weight[k] = std::exp(t0.log_weight[k] - top);
+  std::vector<Eigen::LLT<Eigen::Matrix4d>> llt(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    weight[k] /= sum;
+    llt[k].compute(Eigen::Map<const Mat4>(&t0.covariance[16 * k]));
+    if (llt[k].info() != Eigen::Success) return 0.0;
+  }
+  const double r2 = fisher_norm2(t0, llt, weight, [&](std::size_t k, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
+    dm = Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * k]) - Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * k]);
+    dc = Eigen::Map<const Mat4>(&t1.covariance[16 * k]) - Eigen::Map<const Mat4>(&t0.covariance[16 * k]);
+    dl = t1.log_weight[k] - t0.log_weight[k];
+  });
+  const double v2 = fisher_norm2(t0, llt, weight, [&](std::size_t k, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
+    dm = Eigen::Map<const Eigen::Vector4d>(&t2.mean[4 * k]) - 2.0 * Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * k]) +
+         Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * k]);
+    dc = Eigen::Map<const Mat4>(&t2.covariance[16 * k]) - 2.0 * Eigen::Map<const Mat4>(&t1.covariance[16 * k]) +
+         Eigen::Map<const Mat4>(&t0.covariance[16 * k]);
+    dl = t2.log_weight[k] - 2.0 * t1.log_weight[k] + t0.log_weight[k];
+  });
+  const double a = std::sqrt(r2 / v2);
+  return std::isfinite(a) ? a : 0.0;
+}
+
+Working squarem_extrapolate(const Working& t0, const Working& t1, const Working& t2, double a) {
+  // t0 + 2a (t1 - t0) + a^2 (t2 - 2 t1 + t0), coefficient by coefficient.
+  const double c0 = 1.0 - 2.0 * a + a * a, c1 = 2.0 * a - 2.0 * a * a, c2 = a * a;
+  const auto mix = [&](const std::vector<double>& x0, const std::vector<double>& x1, const std::vector<double>& x2) {
+    std::vector<double> out(x0.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = c0 * x0[i] + c1 * x1[i] + c2 * x2[i];
+    return out;
+  };
+  Working out{mix(t0.mean, t1.mean, t2.mean), mix(t0.covariance, t1.covariance, t2.covariance),
+              mix(t0.log_weight, t1.log_weight, t2.log_weight)};
+  // Weights through their logarithms (the softmax parameterisation): any
+  // extrapolated log-weights are a distribution once renormalised.
+  double top = -std::numeric_limits<double>::infinity();
+  for (double l : out.log_weight) top = std::max(top, l);
+  double sum = 0.0;
+  for (double l : out.log_weight) sum += std::exp(l - top);
+  const double log_sum = top + std::log(sum);
+  for (double& l : out.log_weight) l -= log_sum;
+  return out;
+}
+
+void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,
+                 const EmIterationCallback& on_iteration) {
+  double previous = -std::numeric_limits<double>::infinity();
+  int iter = 0;
+  // A kept pass: reported, and the convergence test against the last kept one.
+  const auto keep = [&](double ll) {
+    report.iterations = iter;
+    report.log_likelihood = ll;
+    if (on_iteration) on_iteration(iter, ll);
+    report.converged = std::fabs(ll - previous) < options.tol;
+    previous = ll;
+    return report.converged;
+  };
+  double step_max = kStepMax0;
+  Working t0, t1, t2;
+  while (iter < options.max_iter) {
+    t0 = w;
+    ++iter;
+    if (keep(pass(w)) || iter == options.max_iter) break;
+    t1 = w;
+    ++iter;
+    const double ll1 = pass(w);
+    if (keep(ll1) || iter == options.max_iter) break;
+    // w is t2 and current: a plain step needs nothing more.
+    const double length = squarem_step_length(t0, t1, w);
+    const bool capped = length >= step_max;
+    double a = std::min(length, step_max);
+    if (!(a > kPlain)) {
+      if (capped) step_max *= kStepFactor;  // the cap, not the step, made it plain
+      continue;
+    }
+    Working next = squarem_extrapolate(t0, t1, w, a);
+    bool loaded = load(next, true);
+    for (int pull = 0; !loaded && pull < kMaxPullBacks; ++pull) {
+      a = 0.5 * (a + 1.0);
+      if (!(a > kPlain)) break;
+      next = squarem_extrapolate(t0, t1, w, a);
+      loaded = load(next, true);
+    }
+    if (!loaded) continue;  // no extrapolation was a model: t2 is still current
+    t2.mean.swap(w.mean);
+    t2.covariance.swap(w.covariance);
+    t2.log_weight.swap(w.log_weight);
+    w = std::move(next);
+    ++iter;
+    const double ll = pass(w);
+    if (ll >= ll1) {
+      ++report.extrapolations_kept;
+      if (capped) step_max *= kStepFactor;
+      if (keep(ll)) break;
+    } else {
+      // Rejected: back to t2, the plain step (always a model: an M-step's).
+      ++report.extrapolations_rejected;
+      if (capped) step_max = std::max(kStepMax0, step_max / kStepFactor);
+      w = t2;
+      load(w, false);
+      report.iterations = iter;
+    }
+  }
+}
+
+}  // namespace sogmm::detail

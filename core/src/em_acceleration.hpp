@@ -1,0 +1,54 @@
+// SQUAREM-accelerated EM (EmAcceleration::Squarem; private to em.cpp).
+//
+// Varadhan & Roland (2008), "Simple and globally convergent methods for
+// accelerating the convergence of any EM algorithm", scheme S3: from a model
+// t0 and two EM steps t1 = F(t0), t2 = F(t1), with r = t1 - t0 and
+// v = t2 - 2 t1 + t0, the extrapolated model is t0 + 2 a r + a^2 v with
+// a = |r| / |v| (a = 1 gives t2 exactly), followed by one EM step from it.
+#pragma once
+
+#include <functional>
+
+#include "em_working.hpp"
+#include "sogmm/em.hpp"
+
+namespace sogmm::detail {
+
+/// One E+M pass: evaluates the model last made current (returns its mean
+/// log-likelihood per point) and writes the M-step's model into `w`, which
+/// becomes current.
+using EmPass = std::function<double(Working& w)>;
+/// Makes `w` the current model; returns false and changes nothing when `w`
+/// is not a model (a covariance not positive definite, a non-finite
+/// constant) or, with `extrapolated`, lies outside the set the M-step maps
+/// into (a covariance minus the reg_covar diagonal not positive definite):
+/// from there the next M-step, which adds the floors back, could lower the
+/// likelihood.
+using EmLoad = std::function<bool(Working& w, bool extrapolated)>;
+
+/// Runs EM from the current model `w` with SQUAREM steps until
+/// |change of the log-likelihood| < options.tol or options.max_iter passes.
+/// Safeguards: an extrapolated model that is not a model is pulled back
+/// towards t2 (a halved, down to the plain step), and one whose
+/// log-likelihood is below t1's is rejected (the run continues from t2, as
+/// plain EM would). The model returned in `w` is always an M-step's (its
+/// floors and the depth floor hold). The EM step after a kept extrapolation
+/// may lower the likelihood slightly (the M-step's reg_covar floors: see
+/// EmOptions::acceleration). `on_iteration`
+/// sees every pass but the rejected ones (its numbers then skip one);
+/// report->iterations counts every pass.
+void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,
+                 const EmIterationCallback& on_iteration);
+
+/// The extrapolated model t0 + 2 a r + a^2 v (log-weights renormalised).
+/// Exposed for its test.
+Working squarem_extrapolate(const Working& t0, const Working& t1, const Working& t2, double a);
+
+/// |r| / |v| in the Fisher metric of t0 (sum over components of
+/// w_k (dmu^T S^-1 dmu + tr((S^-1 dS)^2) / 2 + dlogw^2), w_k, S = t0's weight
+/// and covariance), so the step length does not depend on the data's units
+/// or offset; 0 when it cannot be measured (t0 not a model, a weight below
+/// e^-700, v = 0).
+double squarem_step_length(const Working& t0, const Working& t1, const Working& t2);
+
+}  // namespace sogmm::detail
