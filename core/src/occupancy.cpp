@@ -112,7 +112,9 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   // surface, or not seen: nothing) is decided once from the block's box and
   // the depth range under it; the others are asked point by point, in frame
   // order. The result is bitwise the one of asking every frame for every
-  // point: whole evidence enters the sums as a count, the rest in frame order.
+  // point with this Evidence (whole evidence enters the sums as a count, the
+  // rest in frame order; test OccupancyBlocks.BitwiseTheAnswerOfEveryFrame),
+  // and within the bound of occupancy_evidence.hpp of main's 0f45b28.
   const double band = (options.thickness + detail::kExactSigmas * options.surface_sigma) * (1.0 + 1e-9) + 1e-9;
   std::vector<std::vector<std::uint32_t>> scratch(static_cast<std::size_t>(team));
   detail::progress_begin(Stage::Scoring, n);
