@@ -103,4 +103,53 @@ Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
   return out;
 }
 
+BoxView FrameIndex::view(std::uint32_t f, const double lo[3], const double hi[3]) const {
+  const FrameView& fv = views_[f];
+  double z_lo = 0, z_hi = 0, u_lo = 0, u_hi = 0, w_lo = 0, w_hi = 0, scale = 0;
+  double corner[8][3];
+  for (int c = 0; c < 8; ++c) {
+    const double x[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
+    for (int i = 0; i < 3; ++i) {
+      corner[c][i] = fv.r[3 * i] * x[0] + fv.r[3 * i + 1] * x[1] + fv.r[3 * i + 2] * x[2] + fv.t[i];
+      scale = std::max({scale, std::abs(corner[c][i]), std::abs(x[i]), std::abs(fv.t[i])});
+    }
+    z_lo = c == 0 ? corner[c][2] : std::min(z_lo, corner[c][2]);
+    z_hi = c == 0 ? corner[c][2] : std::max(z_hi, corner[c][2]);
+  }
+  // p_z is affine in x, so the corners bound it; project() computes it with
+  // an error below 1e-15 of `scale`, far inside this margin.
+  const double margin = 1e-9 * (1.0 + scale);
+  BoxView out;
+  out.z_lo = z_lo - margin;
+  out.z_hi = z_hi + margin;
+  if (out.z_hi <= depth_min_ || out.z_lo > depth_max_) return out;
+  out.visible = true;
+  if (out.z_lo <= 0.0) return out;  // the box reaches behind the camera: no pixel bound
+  // The image of a box in front of the camera is the convex hull of its
+  // corners' images, so the corners bound every point's (u, v).
+  for (int c = 0; c < 8; ++c) {
+    const double u = camera_.fx * corner[c][0] / corner[c][2] + camera_.cx;
+    const double w = camera_.fy * corner[c][1] / corner[c][2] + camera_.cy;
+    u_lo = c == 0 ? u : std::min(u_lo, u);
+    u_hi = c == 0 ? u : std::max(u_hi, u);
+    w_lo = c == 0 ? w : std::min(w_lo, w);
+    w_hi = c == 0 ? w : std::max(w_hi, w);
+  }
+  // Nearest pixels, one more on each side for the rounding of project().
+  const auto pixel = [](double v, double limit) { return std::floor(std::clamp(v, -4.0, limit + 4.0) + 0.5); };
+  const double W = camera_.width, H = camera_.height;
+  const double a0 = pixel(u_lo, W) - 1, a1 = pixel(u_hi, W) + 1, b0 = pixel(w_lo, H) - 1, b1 = pixel(w_hi, H) + 1;
+  if (a1 < 0 || b1 < 0 || a0 >= W || b0 >= H) {
+    out.visible = false;
+    return out;
+  }
+  out.bounded = true;
+  out.seen_all = out.z_lo > depth_min_ && out.z_hi <= depth_max_ && a0 >= 0 && b0 >= 0 && a1 < W && b1 < H;
+  out.u0 = static_cast<int>(std::max(a0, 0.0));
+  out.v0 = static_cast<int>(std::max(b0, 0.0));
+  out.u1 = static_cast<int>(std::min(a1, W - 1));
+  out.v1 = static_cast<int>(std::min(b1, H - 1));
+  return out;
+}
+
 }  // namespace sogmm::detail

@@ -26,6 +26,16 @@ struct Projection {
   double depth = 0.0; ///< p_z, metres
 };
 
+/// Where a box of world points falls in a frame: bounds that hold for every
+/// point of the box (widened past rounding), not the exact set.
+struct BoxView {
+  bool visible = false;   ///< some point of the box may be seen; false: none is
+  bool bounded = false;   ///< the box is in front of the camera: the rest is set
+  bool seen_all = false;  ///< every point of the box is seen (in depth range and image)
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;  ///< pixels any seen point of the box may fall on (inclusive)
+  double z_lo = 0, z_hi = 0;              ///< the points' depths p_z lie in [z_lo, z_hi]
+};
+
 class FrameIndex {
  public:
   /// The views of `poses` through `camera` (already decimated) for depths in
@@ -37,6 +47,8 @@ class FrameIndex {
   const std::vector<std::uint32_t>* candidates(const double x[3]) const;
   /// The projection of world point `x` into frame f.
   Projection project(std::uint32_t f, const double x[3]) const;
+  /// The view of frame f of the box [lo, hi] (world).
+  BoxView view(std::uint32_t f, const double lo[3], const double hi[3]) const;
 
  private:
   std::int64_t cell(double v, int axis) const;

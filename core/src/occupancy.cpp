@@ -2,6 +2,7 @@
 #include "sogmm/occupancy.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -9,53 +10,23 @@
 #include <vector>
 
 #include "finite_rows.hpp"
+#include "depth_tiles.hpp"
 #include "frame_index.hpp"
+#include "occupancy_evidence.hpp"
 #include "parallel.hpp"
 #include "progress.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/options.hpp"
+#include "z_order.hpp"
 
 namespace sogmm {
 
 namespace {
 
-double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+using detail::Evidence;
 
-// The evidence of all frames at one point, and its probability and state.
-struct Evidence {
-  double unknown = 1.0;   // U = prod_f b_f
-  double occupied = 0.0;  // sum_f o_f
-  double free = 0.0;      // sum_f e_f
-
-  void add(double r, double surface, const OccupancyOptions& o) {
-    // Far from the surface the terms are exactly 0 or 1 in double (Phi
-    // underflows below -38.5 sigma), so they are taken without erfc: the
-    // same bits, and most query points are far in front of a surface.
-    constexpr double kExact = 40.0;
-    if ((r - surface + o.thickness) / o.surface_sigma < -kExact) {  // e = 1, b = 0, o = 0
-      unknown = 0.0;
-      free += 1.0;
-      return;
-    }
-    if ((r - surface - o.thickness) / o.surface_sigma > kExact) return;  // e = 0, b = 1, o = 0
-    const double e = 1.0 - normal_cdf((r - surface + o.thickness) / o.surface_sigma);
-    const double b = normal_cdf((r - surface - o.thickness) / o.surface_sigma);
-    unknown *= b;
-    free += e;
-    occupied += std::max(0.0, 1.0 - e - b);
-  }
-  void finish(double& probability, std::uint8_t* state) const {
-    const double seen = occupied + free;
-    const double q = seen > 0 ? occupied / seen : 0.5;
-    probability = std::min(1.0, std::max(0.0, (1.0 - unknown) * q + 0.5 * unknown));
-    if (state == nullptr) return;
-    const double occ = (1.0 - unknown) * q, fr = (1.0 - unknown) * (1.0 - q);
-    OccupancyState s = OccupancyState::Free;
-    if (unknown >= occ && unknown >= fr) s = OccupancyState::Unknown;
-    else if (occ >= fr) s = OccupancyState::Occupied;
-    *state = static_cast<std::uint8_t>(s);
-  }
-};
+// Points per block: the frames' whole evidence is decided once per block.
+constexpr std::size_t kBlock = 64;
 
 void world_point(const float* xyz, std::size_t i, double x[3]) {
   for (int k = 0; k < 3; ++k) x[k] = xyz[3 * i + k];
@@ -88,35 +59,101 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   for (const FrameStats& f : map.frames()) poses.push_back(f.pose);
   const detail::FrameIndex index(poses, camera, info.depth_min, info.depth_max);
 
-  // Which frames see at least one point: only those are rendered.
+  // Blocks of points near each other (Z-order), with their boxes and the
+  // frames whose frustum box holds one of their points (sorted).
+  const std::vector<std::size_t> order = detail::z_ordered(xyz, n, 3, team);
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::array<double, 6>> box(blocks);
+  std::vector<std::vector<std::uint32_t>> frames(blocks);
   std::vector<std::atomic<bool>> seen(poses.size());
-  detail::parallel_for(n, team, 4096, [&](std::size_t i, int) {
-    double x[3];
-    world_point(xyz, i, x);
-    const auto* frames = index.candidates(x);
-    if (frames == nullptr) return;
-    for (std::uint32_t f : *frames)
-      if (!seen[f].load(std::memory_order_relaxed) && index.project(f, x).pixel >= 0)
-        seen[f].store(true, std::memory_order_relaxed);
+  detail::parallel_for(blocks, team, 16, [&](std::size_t blk, int) {
+    const std::size_t first = blk * kBlock, last = std::min(n, first + kBlock);
+    auto& b = box[blk];
+    const std::vector<std::uint32_t>* previous = nullptr;
+    for (std::size_t j = first; j < last; ++j) {
+      double x[3];
+      world_point(xyz, order[j], x);
+      for (int k = 0; k < 3; ++k) {
+        b[k] = j == first ? x[k] : std::min(b[k], x[k]);
+        b[3 + k] = j == first ? x[k] : std::max(b[3 + k], x[k]);
+      }
+      const auto* list = index.candidates(x);
+      if (list == nullptr || list == previous) continue;
+      previous = list;
+      auto& f = frames[blk];
+      const auto mid = static_cast<std::ptrdiff_t>(f.size());
+      f.insert(f.end(), list->begin(), list->end());
+      std::inplace_merge(f.begin(), f.begin() + mid, f.end());
+      f.erase(std::unique(f.begin(), f.end()), f.end());
+    }
+    // Only frames that see a query point are rendered.
+    for (std::uint32_t f : frames[blk]) {
+      if (seen[f].load(std::memory_order_relaxed) || !index.view(f, b.data(), b.data() + 3).visible) continue;
+      for (std::size_t j = first; j < last; ++j) {
+        double x[3];
+        world_point(xyz, order[j], x);
+        if (index.project(f, x).pixel >= 0) {
+          seen[f].store(true, std::memory_order_relaxed);
+          break;
+        }
+      }
+    }
   });
   std::vector<std::shared_ptr<const std::vector<float>>> depth(poses.size());
   for (std::size_t f = 0; f < poses.size(); ++f)
     if (seen[f]) depth[f] = map.frame_depth(f, threads);
+  std::vector<detail::DepthTiles> tiles(poses.size());
+  detail::parallel_for(poses.size(), team, 1, [&](std::size_t f, int) {
+    if (depth[f]) tiles[f] = detail::DepthTiles(*depth[f], camera.width, camera.height);
+  });
 
+  // Per block, a frame that gives every point of the block whole evidence
+  // (more than h + 9 sigma in front of its surface: free; behind it, or no
+  // surface, or not seen: nothing) is decided once from the block's box and
+  // the depth range under it; the others are asked point by point, in frame
+  // order. The result is bitwise the one of asking every frame for every
+  // point with this Evidence (whole evidence enters the sums as a count, the
+  // rest in frame order; test OccupancyBlocks.BitwiseTheAnswerOfEveryFrame),
+  // and within the bound of occupancy_evidence.hpp of main's 0f45b28.
+  const double band = (options.thickness + detail::kExactSigmas * options.surface_sigma) * (1.0 + 1e-9) + 1e-9;
+  std::vector<std::vector<std::uint32_t>> scratch(static_cast<std::size_t>(team));
   detail::progress_begin(Stage::Scoring, n);
-  detail::parallel_for(n, team, 1024, [&](std::size_t i, int) {
-    double x[3];
-    world_point(xyz, i, x);
-    Evidence ev;
-    if (const auto* frames = index.candidates(x))
-      for (std::uint32_t f : *frames) {
+  detail::parallel_for(blocks, team, 4, [&](std::size_t blk, int thread) {
+    const auto& b = box[blk];
+    auto& asked = scratch[static_cast<std::size_t>(thread)];
+    asked.clear();
+    std::uint64_t whole_free = 0;
+    for (std::uint32_t f : frames[blk]) {
+      if (!depth[f]) continue;  // sees no query point
+      const detail::BoxView v = index.view(f, b.data(), b.data() + 3);
+      if (!v.visible) continue;
+      if (v.bounded) {
+        const detail::DepthTiles::Range r = tiles[f].over(v.u0, v.v0, v.u1, v.v1);
+        if (!r.any_surface) continue;
+        if (v.z_lo - static_cast<double>(r.hi) > band) continue;
+        if (v.seen_all && !r.any_empty && v.z_hi - static_cast<double>(r.lo) < -band) {
+          ++whole_free;
+          continue;
+        }
+      }
+      asked.push_back(f);
+    }
+    const std::size_t first = blk * kBlock, last = std::min(n, first + kBlock);
+    for (std::size_t j = first; j < last; ++j) {
+      const std::size_t i = order[j];
+      double x[3];
+      world_point(xyz, i, x);
+      Evidence ev;
+      ev.add_whole_free(whole_free);
+      for (std::uint32_t f : asked) {
         const detail::Projection p = index.project(f, x);
         if (p.pixel < 0) continue;
         const float d = (*depth[f])[static_cast<std::size_t>(p.pixel)];
         if (std::isnan(d)) continue;  // no surface rendered: no evidence
         ev.add(p.depth * p.ray, d * p.ray, options);
       }
-    ev.finish(probability[i], state ? state + i : nullptr);
+      ev.finish(probability[i], state ? state + i : nullptr);
+    }
   });
 }
 

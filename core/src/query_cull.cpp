@@ -9,37 +9,6 @@
 #include "z_order.hpp"
 
 namespace sogmm::detail {
-namespace {
-
-// The points' permutation along a Z-order curve over their bounding box.
-std::vector<std::size_t> z_order(const float* points, std::size_t n, int width, int team) {
-  double lo[3], hi[3];
-  for (int j = 0; j < 3; ++j) lo[j] = hi[j] = points[j];
-  for (std::size_t i = 1; i < n; ++i)
-    for (int j = 0; j < 3; ++j) {
-      lo[j] = std::min<double>(lo[j], points[width * i + j]);
-      hi[j] = std::max<double>(hi[j], points[width * i + j]);
-    }
-  double extent = 0.0;
-  for (int j = 0; j < 3; ++j) extent = std::max(extent, hi[j] - lo[j]);
-  const double scale = extent > 0 ? 65535.0 / extent : 0.0;
-  // Keys and sort in parallel: serial, they were a fifth of a culled query's
-  // work (issue 17). (key, index) pairs are all distinct, so the order is
-  // the same for any team.
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
-  parallel_for(n, team, 4096, [&](std::size_t i, int) {
-    std::uint32_t c[3];
-    for (int j = 0; j < 3; ++j)
-      c[j] = static_cast<std::uint32_t>(std::clamp((points[width * i + j] - lo[j]) * scale, 0.0, 65535.0));
-    keyed[i] = {z_order_key(c[0], c[1], c[2]), i};
-  });
-  parallel_sort(keyed, team);
-  std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
-  return order;
-}
-
-}  // namespace
 
 QueryCuller::QueryCuller(const Gmm& gmm, const std::vector<double>& params, int dims, bool background, double nats,
                          const float* points, std::size_t n, int width, int team)
@@ -62,7 +31,7 @@ QueryCuller::QueryCuller(const Gmm& gmm, const std::vector<double>& params, int 
   index_ = ComponentIndex(std::min(100.0, std::sqrt(2.0 * half_r2_)));
   half_r2_ = 0.5 * index_.sigmas() * index_.sigmas();
   index_.build(gmm);
-  order_ = z_order(points, n, width, team);
+  order_ = z_ordered(points, n, width, team);
 }
 
 void QueryCuller::choose_first(const QueryBlock& block, CullScratch& s) const {

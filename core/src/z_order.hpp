@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "parallel.hpp"
@@ -47,6 +48,35 @@ void parallel_sort(std::vector<T>& v, int team) {
       if (first + width < pieces) std::inplace_merge(at(first), at(first + width), at(first + 2 * width));
     });
   }
+}
+
+/// The permutation of n points (rows of `width` floats, x y z first) along a
+/// Z-order curve over their bounding box (2^16 cells a side). Keys and sort
+/// run on `team` threads; (key, index) pairs are all distinct, so the order
+/// is the same for any team.
+inline std::vector<std::size_t> z_ordered(const float* points, std::size_t n, int width, int team) {
+  if (n == 0) return {};
+  double lo[3], hi[3];
+  for (int j = 0; j < 3; ++j) lo[j] = hi[j] = points[j];
+  for (std::size_t i = 1; i < n; ++i)
+    for (int j = 0; j < 3; ++j) {
+      lo[j] = std::min<double>(lo[j], points[width * i + j]);
+      hi[j] = std::max<double>(hi[j], points[width * i + j]);
+    }
+  double extent = 0.0;
+  for (int j = 0; j < 3; ++j) extent = std::max(extent, hi[j] - lo[j]);
+  const double scale = extent > 0 ? 65535.0 / extent : 0.0;
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
+  parallel_for(n, team, 4096, [&](std::size_t i, int) {
+    std::uint32_t c[3];
+    for (int j = 0; j < 3; ++j)
+      c[j] = static_cast<std::uint32_t>(std::clamp((points[width * i + j] - lo[j]) * scale, 0.0, 65535.0));
+    keyed[i] = {z_order_key(c[0], c[1], c[2]), i};
+  });
+  parallel_sort(keyed, team);
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
 }
 
 }  // namespace sogmm::detail

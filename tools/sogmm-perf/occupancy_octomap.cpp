@@ -10,6 +10,9 @@
 //
 // Usage: sogmm-occupancy-octomap --sequence DIR [--map-frames 0:2] [--ray-frames 2]
 //          [--decimate 5] [--octomap-decimate 1] [--resolutions 0.02,0.05] [--threads 2] [--repeats 3]
+//          [--save-map FILE] [--map FILE] [--compare-main]
+// --map answers with a map saved by an earlier run's --save-map (no build;
+// the loop's map takes minutes); --resolutions none skips OctoMap.
 // Frame selections as `sogmm map --frames`: I, A:B or A:B:STEP. The synthetic
 // loop of the issue: `sogmm demo --write-frame DIR --loop`, then
 // --map-frames 0:300:3 --ray-frames 1:300:30.
@@ -34,7 +37,9 @@
 #include "sequence.hpp"
 #include "sogmm/format.hpp"
 #include "sogmm/map.hpp"
+#include "occupancy_main_path.hpp"
 #include "sogmm/occupancy.hpp"
+#include "sogmm/surface_distance.hpp"
 
 namespace {
 
@@ -115,8 +120,9 @@ void report(const char* name, double auc, std::size_t bytes, double build_s, std
 
 int main(int argc, char** argv) {
   CLI::App app{"Occupancy of a SOGMM map against OctoMap on the rays of a held-out frame"};
-  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05";
+  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05", save_map, load_map;
   int decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
+  bool compare_main = false;
   app.add_option("--sequence", dir, "Redwood folder: depth/, color/, intrinsics.json, trajectory.log")->required();
   app.add_option("--map-frames", map_frames, "frames the maps are built from (I, A:B or A:B:STEP)")
       ->capture_default_str();
@@ -127,6 +133,11 @@ int main(int argc, char** argv) {
   app.add_option("--resolutions", resolutions, "OctoMap resolutions (m, comma-separated)")->capture_default_str();
   app.add_option("--threads", threads, "query threads")->capture_default_str();
   app.add_option("--repeats", repeats, "timed repeats (median)")->capture_default_str();
+  app.add_option("--save-map", save_map, "write the SOGMM map built from --map-frames here");
+  app.add_option("--map", load_map, "answer with this saved map instead of building one (build time 0)");
+  app.add_flag("--compare-main", compare_main,
+               "also time main's per-point occupancy (0f45b28) and surface distance on the same points, "
+               "and report the largest difference of the answers");
   CLI11_PARSE(app, argc, argv);
   try {
     using namespace sogmm;
@@ -153,9 +164,14 @@ int main(int argc, char** argv) {
 
     auto t0 = Clock::now();
     Map map(mo);
-    for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(frame(k).view(cam), poses[k]);
-    map.flush();
-    const double map_build = seconds_since(t0);
+    if (!load_map.empty()) {
+      map = Map::from_model(format::load(load_map), mo);
+    } else {
+      for (std::size_t k = 0; k < n_map; ++k) map.insert_rgbd(frame(k).view(cam), poses[k]);
+      map.flush();
+    }
+    const double map_build = load_map.empty() ? seconds_since(t0) : 0.0;
+    if (!save_map.empty()) format::save(save_map, map.to_model());
     const std::size_t map_bytes = format::to_bytes(map.to_model()).size();
     std::vector<double> p(n);
     occupancy(map, xyz.data(), n, p.data(), nullptr, {}, threads);  // renders, kept until the map changes
@@ -163,9 +179,31 @@ int main(int argc, char** argv) {
     char name[64];
     std::snprintf(name, sizeof name, "SOGMM map (%zu comp.)", map.size());
     report(name, roc_auc(p, label), map_bytes, map_build, n, map_query);
+    if (compare_main) {
+      std::vector<double> pm(n);
+      std::vector<std::uint8_t> sm(n), s(n);
+      occupancy(map, xyz.data(), n, p.data(), s.data(), {}, threads);
+      sogmm_bench::main_occupancy(map, xyz.data(), n, pm.data(), sm.data(), threads);  // renders every frame once
+      const double main_query =
+          median_seconds(repeats, [&] { sogmm_bench::main_occupancy(map, xyz.data(), n, pm.data(), sm.data(), threads); });
+      double worst = 0.0;
+      std::size_t states = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        worst = std::max(worst, std::abs(p[i] - pm[i]));
+        states += s[i] != sm[i];
+      }
+      std::vector<double> dist(n);
+      const double distance_query =
+          median_seconds(repeats, [&] { surface_distance(map, xyz.data(), n, dist.data(), nullptr, {}, threads); });
+      std::printf("occupancy: main (0f45b28) %.3f M points/s, this build %.3f M points/s, ratio %.2f; "
+                  "largest |p - p_main| %.3g, states that differ %zu of %zu\n",
+                  n / main_query * 1e-6, n / map_query * 1e-6, main_query / map_query, worst, states, n);
+      std::printf("surface distance: %.3f M points/s (%zu components, %d threads)\n", n / distance_query * 1e-6,
+                  map.size(), threads);
+    }
 
 #ifdef SOGMM_HAVE_OCTOMAP
-    std::stringstream res_list(resolutions);
+    std::stringstream res_list(resolutions == "none" ? std::string() : resolutions);
     for (std::string item; std::getline(res_list, item, ',');) {
       const double res = std::stod(item);
       t0 = Clock::now();

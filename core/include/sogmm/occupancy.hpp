@@ -29,7 +29,10 @@
 // (Map::frame_depth keeps the renders between calls). So the first call
 // after an insert costs O(frames seen x pixels x components near a ray) for
 // the renders, and every call O(n x frames whose box holds a point) for the
-// lookups.
+// lookups at worst; per block of 64 points the frames whose surface is more
+// than h + 9 sigma from every point of the block are decided once (spec/api.md
+// 4.9 has the bound this cut puts on the answer), so a point asks only the
+// frames whose surface band may reach it.
 #pragma once
 
 #include <cstddef>
