@@ -36,6 +36,7 @@ const (
 	OptVerifyChecksums             Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
 	OptSampleTruncation            Key = C.SOGMM_OPT_SAMPLE_TRUNCATION
 	OptQueryTruncationNats         Key = C.SOGMM_OPT_QUERY_TRUNCATION_NATS
+	OptRenderSurfaceSigma          Key = C.SOGMM_OPT_RENDER_SURFACE_SIGMA
 	OptMapNovelty                  Key = C.SOGMM_OPT_MAP_NOVELTY
 	OptMapNoveltyThreshold         Key = C.SOGMM_OPT_MAP_NOVELTY_THRESHOLD
 	OptMapBatchSize                Key = C.SOGMM_OPT_MAP_BATCH_SIZE
@@ -305,3 +306,9 @@ func SampleTruncation(v float64) Option { return F64(OptSampleTruncation, v) }
 // so a score is at most ln(1 + M e^-v) below the exact one. Negative or not
 // finite: ErrInvalidArg.
 func QueryTruncationNats(v float64) Option { return F64(OptQueryTruncationNats, v) }
+
+// RenderSurfaceSigma sets the evidence a mode along a pixel's ray needs to be
+// a surface in Render: 0 = every mode (default); s > 0 = that of one
+// component at s sigma, so a ray grazing a nearer object's components shows
+// the surface behind. Negative or not finite: ErrInvalidArg.
+func RenderSurfaceSigma(v float64) Option { return F64(OptRenderSurfaceSigma, v) }

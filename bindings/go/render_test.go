@@ -85,6 +85,38 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 	}
 }
 
+// Two components (weights 0.5): A at (0.025, 0, 1), isotropic sigma 0.01,
+// gray 0.2; B a flat patch at (0, 0, 2) (sigma 0.1, 0.1, 0.01), gray 0.8.
+// The optical axis passes A at 2.5 sigma: at z = 1 the evidence
+// sum_k exp(-D_k^2 / 2) is exp(-3.125) = 0.044 (B is 100 sigma away), at
+// z = 2 it is 1. Surface sigma 0 shows A at 1 m (gray 0.2); s = 2 needs
+// exp(-2) = 0.135 there, so the ray passes on to B at 2 m (gray 0.8); s = 3
+// needs exp(-4.5) = 0.011 and shows A again.
+func TestRenderSurfaceSigmaPassesAGraze(t *testing.T) {
+	cov := []float32{1e-4, 0, 0, 0, 0, 1e-4, 0, 0, 0, 0, 1e-4, 0, 0, 0, 0, 0.01,
+		0.01, 0, 0, 0, 0, 0.01, 0, 0, 0, 0, 1e-4, 0, 0, 0, 0, 0.01}
+	m, err := FromArrays([]float32{0.5, 0.5}, []float32{0.025, 0, 1, 0.2, 0, 0, 2, 0.8}, cov, 100)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer m.Close()
+	axis := Camera{Width: 1, Height: 1, Fx: 100, Fy: 100}
+	for _, c := range []struct{ s, depth, gray float64 }{{0, 1, 0.2}, {2, 2, 0.8}, {3, 1, 0.2}} {
+		o, err := NewOptions(RenderSurfaceSigma(c.s))
+		if err != nil {
+			t.Fatal(err)
+		}
+		r, err := m.Render(context.Background(), axis, nil, o)
+		o.Close()
+		if err != nil || math.Abs(float64(r.Depth[0])-c.depth) > 1e-5 || math.Abs(float64(r.Gray[0])-c.gray) > 1e-5 {
+			t.Fatalf("surface sigma %v: %+v (err %v)", c.s, r, err)
+		}
+	}
+	if _, err := NewOptions(RenderSurfaceSigma(-1)); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("surface sigma -1: %v", err)
+	}
+}
+
 // A map renders bitwise as its export; progress reports rows; a cancel is ErrCancelled.
 func TestMapRenderEqualsTheExport(t *testing.T) {
 	m, model := twoFrameMapAndExport(t)

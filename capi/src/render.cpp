@@ -36,7 +36,7 @@ void render_into(const sogmm::Gmm& gmm, std::uint32_t width, std::uint32_t heigh
   std::array<double, 16> pose{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   if (camera_to_world != nullptr) pose = sogmm_capi::require_rigid(camera_to_world, "camera_to_world");
   const sogmm_options& o = sogmm_capi::opts_or_default(options);
-  sogmm::RenderOptions ro;
+  sogmm::RenderOptions ro = o.settings.render;
   ro.depth_min = o.settings.depth.depth_min;
   ro.depth_max = o.settings.depth.depth_max;
   ro.threads = o.settings.query.threads;

@@ -132,6 +132,11 @@ std::vector<OptionSpec> make_table() {
                     "0: exact score and regression; > 0: culled ones, which skip a component at a point only when its "
                     "term is provably more than this many nats below the point's largest (as TRUNCATION_NATS for "
                     "the E-step): a score is then at most log(1 + M exp(-nats)) below the exact one"),
+      SOGMM_F64_ROW(RENDER_SURFACE_SIGMA, render.surface_sigma, 0.0, kInf, finite, ">= 0, finite", "standard deviations",
+                    "renders: 0 shows every mode of the density along a pixel's ray; s > 0 only modes where the "
+                    "evidence sum_k exp(-D_k^2 / 2) (D_k the Mahalanobis distance to component k) reaches that of one "
+                    "component at s sigma, so a ray grazing a nearer object's components passes on to the surface behind "
+                    "(RenderOptions::surface_sigma)"),
       // ---- incremental map ----
       SOGMM_I64_ROW(MAP_NOVELTY, map.novelty, 0, 1, "0 or 1", "",
                     "1: only points the map does not explain are fitted; 0: every point is novel and each insert fits its "

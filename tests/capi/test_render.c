@@ -1,7 +1,8 @@
 /* sogmm_model_render_f32 and sogmm_map_render_f32: the closed-form depth,
  * gray and variance of one component seen along its axis; the same images
  * when model and pose move together; a map renders bitwise as its export;
- * threads change no bit; progress and cancel (outputs untouched); a status
+ * threads change no bit; SOGMM_OPT_RENDER_SURFACE_SIGMA passes a graze on to
+ * the surface behind; progress and cancel (outputs untouched); a status
  * and message for every bad input. */
 #include "test_util.h"
 
@@ -73,6 +74,36 @@ static void test_closed_form(void) {
     EXPECT_TRUE(isnan(depth[CENTRE]));
     sogmm_options_free(o);
   }
+  sogmm_model_free(m);
+}
+
+/* SOGMM_OPT_RENDER_SURFACE_SIGMA. Two components (weights 0.5): A at
+ * (0.025, 0, 1), isotropic sigma 0.01, gray 0.2; B a flat patch at (0, 0, 2)
+ * (sigma 0.1, 0.1, 0.01), gray 0.8. The optical axis passes A at 2.5 sigma:
+ * at z = 1 the evidence sum_k exp(-D_k^2 / 2) is exp(-3.125) = 0.044 (B is
+ * 100 sigma away), at z = 2 it is 1. s = 0 shows A at 1 m (gray 0.2); s = 2
+ * needs exp(-2) = 0.135 there, so the ray passes on to B at 2 m (gray 0.8);
+ * s = 3 needs exp(-4.5) = 0.011 and shows A again. */
+static void test_surface_sigma(void) {
+  const float w[2] = {0.5f, 0.5f};
+  const float mean[8] = {0.025f, 0, 1, 0.2f, 0, 0, 2, 0.8f};
+  const float cov[32] = {1e-4f, 0, 0, 0, 0, 1e-4f, 0, 0, 0, 0, 1e-4f, 0, 0, 0, 0, 0.01f,
+                         0.01f, 0, 0, 0, 0, 0.01f, 0, 0, 0, 0, 1e-4f, 0, 0, 0, 0, 0.01f};
+  const double s[3] = {0, 2, 3}, want_depth[3] = {1, 2, 1}, want_gray[3] = {0.2, 0.8, 0.2};
+  sogmm_model* m = NULL;
+  sogmm_options* o = NULL;
+  REQUIRE_OK(sogmm_model_from_arrays_f32(&m, 2, w, mean, cov, 100));
+  REQUIRE_OK(sogmm_options_create(&o));
+  for (int i = 0; i < 3; ++i) {
+    float depth = 0, gray = 0;
+    REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_RENDER_SURFACE_SIGMA, s[i]));
+    EXPECT_OK(sogmm_model_render_f32(m, 1, 1, 100, 100, 0, 0, NULL, o, &depth, &gray, NULL));
+    EXPECT_NEAR(depth, want_depth[i], 1e-5);
+    EXPECT_NEAR(gray, want_gray[i], 1e-5);
+  }
+  EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_RENDER_SURFACE_SIGMA, -1), SOGMM_E_INVALID_ARG);
+  EXPECT_TRUE(message_has("SOGMM_OPT_RENDER_SURFACE_SIGMA"));
+  sogmm_options_free(o);
   sogmm_model_free(m);
 }
 
@@ -178,6 +209,7 @@ static void test_bad_input(void) {
 
 int main(void) {
   test_closed_form();
+  test_surface_sigma();
   test_pose_invariance();
   test_map_threads_progress();
   test_bad_input();

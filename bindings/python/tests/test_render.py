@@ -95,6 +95,25 @@ def test_map_renders_as_its_export_and_reports_progress():
     m.close()
 
 
+# Two components (weights 0.5): A at (0.025, 0, 1), isotropic sigma 0.01, gray 0.2; B a flat patch at
+# (0, 0, 2) (sigma 0.1, 0.1, 0.01), gray 0.8. The optical axis passes A at 2.5 sigma: at z = 1 the
+# evidence sum_k exp(-D_k^2 / 2) is exp(-3.125) = 0.044 (B is 100 sigma away), at z = 2 it is 1 (A is
+# 100 sigma away). surface_sigma 0 shows A's mode at 1 m (gray 0.2); s = 2 needs exp(-2) = 0.135 there,
+# so the ray passes on to B at 2 m (gray 0.8); s = 3 needs exp(-4.5) = 0.011 and shows A again.
+def test_surface_sigma_passes_a_graze_on_to_the_surface_behind():
+    cov_a = np.diag([1e-4, 1e-4, 1e-4, 0.01]).astype(np.float32)
+    cov_b = np.diag([0.01, 0.01, 1e-4, 0.01]).astype(np.float32)
+    model = sogmm.GMM.from_arrays([0.5, 0.5], [[0.025, 0.0, 1.0, 0.2], [0.0, 0.0, 2.0, 0.8]], [cov_a, cov_b],
+                                  support_size=100)
+    axis = sogmm.Camera(width=1, height=1, fx=100.0, fy=100.0, cx=0.0, cy=0.0)
+    for s, want_depth, want_gray in ((0.0, 1.0, 0.2), (2.0, 2.0, 0.8), (3.0, 1.0, 0.2)):
+        depth, gray, _ = model.render(axis, surface_sigma=s)
+        assert depth[0, 0] == pytest.approx(want_depth, abs=1e-5), s
+        assert gray[0, 0] == pytest.approx(want_gray, abs=1e-5), s
+    with pytest.raises(sogmm.InvalidArgumentError, match="surface_sigma"):
+        model.render(axis, surface_sigma=-1.0)
+
+
 def test_bad_input_raises():
     m = on_axis()
     with pytest.raises(sogmm.InvalidArgumentError):

@@ -256,6 +256,12 @@ typedef int32_t sogmm_key;
  * for the E-step): a score is then at most log(1 + M exp(-nats)) below the exact one.
  * f64 (nats), >= 0, finite; default 0. */
 #define SOGMM_OPT_QUERY_TRUNCATION_NATS 501
+/* Renders: 0 shows every mode of the density along a pixel's ray; s > 0 only modes where the
+ * evidence sum_k exp(-D_k^2 / 2) (D_k the Mahalanobis distance to component k) reaches that of
+ * one component at s sigma, so a ray grazing a nearer object's components passes on to the
+ * surface behind (RenderOptions::surface_sigma).
+ * f64 (standard deviations), >= 0, finite; default 0. */
+#define SOGMM_OPT_RENDER_SURFACE_SIGMA 502
 
 /* Incremental map. Read by sogmm_map_create, sogmm_map_load; a map also reads the fit keys (each
  * batch's fit; THREADS also runs the novelty test) and the RGB-D keys (sogmm_map_insert_frame). */
@@ -792,7 +798,10 @@ SOGMM_API sogmm_status sogmm_model_transform(sogmm_model** out, const sogmm_mode
  * (no component near its ray, or no surface in the depth range) is NaN in
  * all three (0 would be a valid gray, and a depth 0 a point at the camera).
  * `options` (NULL = defaults): SOGMM_OPT_DEPTH_MIN / _MAX (default 0.1 and
- * 3 m), SOGMM_OPT_THREADS (the images are bitwise the same for any count) and
+ * 3 m), SOGMM_OPT_RENDER_SURFACE_SIGMA (default 0: every mode is a surface;
+ * s > 0: only modes with the evidence of one component at s sigma, so a ray
+ * grazing a nearer object's components shows the surface behind),
+ * SOGMM_OPT_THREADS (the images are bitwise the same for any count) and
  * the progress callback (SOGMM_STAGE_RENDERING; a cancel returns
  * SOGMM_E_CANCELLED with the outputs untouched). Moving model and pose
  * together by one rigid transform renders the same images (up to rounding).

@@ -27,6 +27,7 @@
 #include "sogmm/map.hpp"
 #include "sogmm/occupancy.hpp"
 #include "sogmm/registration.hpp"
+#include "sogmm/render.hpp"
 #include "sogmm/surface_distance.hpp"
 
 namespace sogmm {
@@ -52,6 +53,9 @@ struct Settings {
   OccupancyOptions occupancy;
   SurfaceDistanceOptions surface;
   RegistrationOptions registration;
+  /// Renders: only surface_sigma is a setting here; a render's depth range
+  /// is `depth` and its threads `query.threads` (one setting each).
+  RenderOptions render;
 };
 
 /// The MapOptions of `s`: s.map with s.fit and s.depth. Throws as
@@ -85,6 +89,7 @@ enum class OptionKey : int {
   VERIFY_CHECKSUMS = 401,
   SAMPLE_TRUNCATION = 500,
   QUERY_TRUNCATION_NATS = 501,
+  RENDER_SURFACE_SIGMA = 502,
   MAP_NOVELTY = 600,
   MAP_NOVELTY_THRESHOLD = 601,
   MAP_BATCH_SIZE = 602,

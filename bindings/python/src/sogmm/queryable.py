@@ -94,12 +94,16 @@ class Queryable:
         return out
 
     def render(self, camera: Camera, pose=None, *, depth_min: float = _D.depth_min, depth_trunc: float = _D.depth_max,
-               n_threads: int = _D.threads, progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               surface_sigma: float = _D.render_surface_sigma, n_threads: int = _D.threads,
+               progress: ProgressArg = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What the model or map shows from ``camera`` placed at ``pose`` (4 x 4
         camera-to-world rigid transform; None = identity): per pixel the first
         surface along its ray (the nearest mode of the density along the ray at
         depth in (depth_min, depth_trunc]), the gray regressed there and its
-        variance. Returns three float32 (height, width) arrays: depth (camera z,
+        variance. ``surface_sigma`` 0 counts every mode as a surface; s > 0
+        only modes with the evidence of one component at s sigma, so a ray
+        grazing a nearer object's components shows the surface behind.
+        Returns three float32 (height, width) arrays: depth (camera z,
         metres), gray, variance; NaN where nothing shows. Bitwise the same for
         any ``n_threads``; ``progress``: stage STAGE_RENDERING, rows done. Bad
         camera or pose: InvalidArgumentError."""
@@ -109,7 +113,8 @@ class Queryable:
         if camera.width * camera.height > MAX_RENDER_PIXELS:  # before allocating the images
             raise LimitError(f"render: {camera.width} x {camera.height} pixels exceed {MAX_RENDER_PIXELS}")
         depth, gray, var = (np.empty((camera.height, camera.width), dtype=np.float32) for _ in range(3))
-        options = _ffi.Options(f64={_ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc},
+        options = _ffi.Options(f64={_ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc,
+                                    _ffi.OPT_RENDER_SURFACE_SIGMA: surface_sigma},
                                i64={_ffi.OPT_THREADS: n_threads})
         self._query("render", "render_f32", options, progress,
                    lambda o: (camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy, p, o,

@@ -99,6 +99,7 @@ pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
 pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
 pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
 pub const SOGMM_OPT_QUERY_TRUNCATION_NATS: sogmm_key = 501;
+pub const SOGMM_OPT_RENDER_SURFACE_SIGMA: sogmm_key = 502;
 pub const SOGMM_OPT_MAP_NOVELTY: sogmm_key = 600;
 pub const SOGMM_OPT_MAP_NOVELTY_THRESHOLD: sogmm_key = 601;
 pub const SOGMM_OPT_MAP_BATCH_SIZE: sogmm_key = 602;

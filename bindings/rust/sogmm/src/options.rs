@@ -243,6 +243,12 @@ impl OptionsBuilder {
         /// score is at most ln(1 + M e^-nats) below the exact one. Negative or
         /// not finite: `build` fails with `Status::InvalidArg`.
         query_truncation_nats(f64) => SOGMM_OPT_QUERY_TRUNCATION_NATS as f64 |v| v;
+        /// Renders (`Queryable::render`): 0 = every mode along a ray is a
+        /// surface (default); s > 0 = only modes with the evidence of one
+        /// component at s sigma, so a ray grazing a nearer object's components
+        /// shows the surface behind. Negative or not finite: `build` fails
+        /// with `Status::InvalidArg`.
+        render_surface_sigma(f64) => SOGMM_OPT_RENDER_SURFACE_SIGMA as f64 |v| v;
         /// Map: test each point's novelty (default true; false = append everything).
         map_novelty(bool) => SOGMM_OPT_MAP_NOVELTY as i64 i64::from;
         /// Map: points with a 3-D log-likelihood below this (nats) are novel (default 3.0).

@@ -97,7 +97,8 @@ pub trait Queryable: sealed::Handle {
     /// What shows from `camera` at the camera-to-world `pose` (None =
     /// identity): per pixel the first surface along its ray, its depth, the
     /// gray regressed there and its variance. `options` gives depth_min /
-    /// depth_max (the depths that count as surfaces) and threads (the same
+    /// depth_max (the depths that count as surfaces), render_surface_sigma
+    /// (the evidence a mode needs to be a surface) and threads (the same
     /// bits for any count). Progress: `Stage::Rendering` (rows done).
     fn render(&self, camera: &Camera, pose: Option<&Pose>, options: Option<&Options>) -> Result<Rendered> {
         // The pixel limit first, so that no huge buffer is allocated for a call that must fail.

@@ -39,6 +39,41 @@ fn single_component_closed_form() {
     assert!(on_axis().render(&CAM, None, Some(&near)).unwrap().depth[CENTRE].is_nan());
 }
 
+/// Two components (weights 0.5): A at (0.025, 0, 1), isotropic sigma 0.01,
+/// gray 0.2; B a flat patch at (0, 0, 2) (sigma 0.1, 0.1, 0.01), gray 0.8.
+/// The optical axis passes A at 2.5 sigma: at z = 1 the evidence
+/// sum_k exp(-D_k^2 / 2) is exp(-3.125) = 0.044 (B is 100 sigma away), at
+/// z = 2 it is 1. Surface sigma 0 shows A at 1 m (gray 0.2); s = 2 needs
+/// exp(-2) = 0.135 there, so the ray passes on to B at 2 m (gray 0.8); s = 3
+/// needs exp(-4.5) = 0.011 and shows A again.
+#[test]
+fn render_surface_sigma_passes_a_graze_on_to_the_surface_behind() {
+    let cov = [
+        1e-4, 0., 0., 0., 0., 1e-4, 0., 0., 0., 0., 1e-4, 0., 0., 0., 0., 0.01, //
+        0.01, 0., 0., 0., 0., 0.01, 0., 0., 0., 0., 1e-4, 0., 0., 0., 0., 0.01,
+    ];
+    let m = Model::from_arrays(&[0.5, 0.5], &[0.025, 0., 1., 0.2, 0., 0., 2., 0.8], &cov, 100).unwrap();
+    let axis = Camera {
+        width: 1,
+        height: 1,
+        fx: 100.0,
+        fy: 100.0,
+        cx: 0.0,
+        cy: 0.0,
+    };
+    for (s, depth, gray) in [(0.0, 1.0, 0.2), (2.0, 2.0, 0.8), (3.0, 1.0, 0.2)] {
+        let o = Options::builder().render_surface_sigma(s).build().unwrap();
+        let r = m.render(&axis, None, Some(&o)).unwrap();
+        assert!(
+            (r.depth[0] - depth).abs() < 1e-5 && (r.gray[0] - gray).abs() < 1e-5,
+            "s {s}: {:?}",
+            r
+        );
+    }
+    let bad = Options::builder().render_surface_sigma(-1.0).build();
+    assert_eq!(bad.unwrap_err().status(), Status::InvalidArg);
+}
+
 #[test]
 fn moving_model_and_pose_together_renders_the_same() {
     // A rotation of 0.7 rad about (1, 1, 0) / sqrt 2 (Rodrigues) and a shift.
