@@ -7,6 +7,7 @@
 
 #include "sogmm/error.hpp"
 #include "sogmm/map_delta.hpp"
+#include "text_rows.hpp"
 
 namespace sogmm {
 namespace {
@@ -60,15 +61,7 @@ std::uint64_t count_of(const Model& m, const char* key) {
 
 std::vector<DeltaOp> parse_ops(const std::string& text) {
   std::vector<DeltaOp> ops;
-  std::istringstream in(text);
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    auto bad = [&](const std::string& why) {
-      return bad_key(kDeltaOpsKey, "line " + std::to_string(line_no) + ": " + why);
-    };
-    std::istringstream row(line);
+  detail::for_each_text_row(text, std::string("map delta: key ") + kDeltaOpsKey, [&](std::istream& row, auto bad) {
     std::string name, token;
     row >> name;
     std::vector<std::uint64_t> numbers;
@@ -91,7 +84,7 @@ std::vector<DeltaOp> parse_ops(const std::string& text) {
       throw bad("unknown step '" + name + "'");
     }
     ops.push_back(std::move(op));
-  }
+  });
   return ops;
 }
 

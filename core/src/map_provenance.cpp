@@ -11,6 +11,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
+#include "text_rows.hpp"
 
 namespace sogmm {
 namespace detail {
@@ -61,16 +62,7 @@ namespace detail {
 
 std::vector<FrameStats> parse_frames(const std::string& text, std::uint64_t first_index, const char* key) {
   std::vector<FrameStats> frames;
-  std::istringstream in(text);
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    auto bad = [&](const std::string& why) {
-      return Error(ErrorCode::Format, std::string("map: key ") + key + ", line " + std::to_string(line_no) +
-                                          ": " + why);
-    };
-    std::istringstream row(line);
+  detail::for_each_text_row(text, std::string("map: key ") + key, [&](std::istream& row, auto bad) {
     std::uint64_t index = 0;
     std::size_t n_points = 0, n_novel = 0;
     if (!(read_count(row, index) && read_count(row, n_points) && read_count(row, n_novel)))
@@ -97,7 +89,7 @@ std::vector<FrameStats> parse_frames(const std::string& text, std::uint64_t firs
     const std::string problem = rigid_pose_error(f.pose);
     if (!problem.empty()) throw bad("pose is not rigid: " + problem);
     frames.push_back(f);
-  }
+  });
   return frames;
 }
 

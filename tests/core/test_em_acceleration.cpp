@@ -15,6 +15,7 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"
 #include "test_util.hpp"
+#include "thread_fits.hpp"
 
 namespace {
 
@@ -130,16 +131,7 @@ TEST(EmAcceleration, BitIdenticalForOneTwoThreeThreads) {
   o.n_components = 18;
   o.seed = 4;
   o.em.acceleration = EmAcceleration::Squarem;
-  std::vector<sogmm::FitResult> r;
-  for (int threads : {1, 2, 3}) {
-    o.em.threads = threads;
-    r.push_back(sogmm::fit(view(pts), o));
-  }
-  for (int i : {1, 2}) {
-    EXPECT_TRUE(sogmm_test::bit_identical(r[0].gmm, r[i].gmm)) << "1 vs " << i + 1 << " threads";
-    EXPECT_EQ(r[0].em.log_likelihood, r[i].em.log_likelihood);
-    EXPECT_EQ(r[0].em.iterations, r[i].em.iterations);
-  }
+  sogmm_test::expect_same_fit_for_one_two_three_threads(pts, o, "SQUAREM");
 }
 
 // The scene moved by 10 m and 1 km (the same float32 cloud moved back, as in

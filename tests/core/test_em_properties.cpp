@@ -19,6 +19,7 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"
 #include "test_util.hpp"
+#include "thread_fits.hpp"
 
 namespace {
 
@@ -175,29 +176,11 @@ TEST(EmProperties, BitIdenticalForOneTwoThreeThreads) {
   sogmm::FitOptions o;
   o.n_components = 20;
   o.seed = 9;
-  std::vector<sogmm::FitResult> r;
-  for (int threads : {1, 2, 3}) {
-    o.em.threads = threads;
-    r.push_back(sogmm::fit(view(pts), o));
-  }
-  for (int i : {1, 2}) {
-    EXPECT_TRUE(sogmm_test::bit_identical(r[0].gmm, r[i].gmm)) << "1 vs " << i + 1 << " threads";
-    EXPECT_EQ(r[0].em.log_likelihood, r[i].em.log_likelihood);
-    EXPECT_EQ(r[0].em.iterations, r[i].em.iterations);
-  }
+  sogmm_test::expect_same_fit_for_one_two_three_threads(pts, o, "frame");
   // The same for components the kernels evaluate in double (a 1 km plane).
-  const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
   o.n_components = 10;
   o.em.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2, float32 kernels)
-  std::vector<sogmm::FitResult> p;
-  for (int threads : {1, 2, 3}) {
-    o.em.threads = threads;
-    p.push_back(sogmm::fit(view(plane), o));
-  }
-  for (int i : {1, 2}) {
-    EXPECT_TRUE(sogmm_test::bit_identical(p[0].gmm, p[i].gmm)) << "1 km plane: 1 vs " << i + 1 << " threads";
-    EXPECT_EQ(p[0].em.log_likelihood, p[i].em.log_likelihood);
-  }
+  sogmm_test::expect_same_fit_for_one_two_three_threads(large_geometry_points("plane_1km_1cm"), o, "1 km plane");
 }
 
 // 4-D scaling: x, y, z, gray by s, bandwidth by s, reg_covar by s^2 gives the

@@ -142,6 +142,22 @@ def test_save_load_and_box(tmp_path):
     assert not (tmp_path / "pending.sogmm").exists()
 
 
+def test_a_loaded_map_takes_the_registry_depth_defaults(tmp_path):
+    # Map.load runs the constructor's keywords: the depth settings of later
+    # RGB-D inserts are the library's (sogmm_option_get_info), or the caller's.
+    path = tmp_path / "map.sogmm"
+    with sogmm.Map(novelty=False, **FIT) as m:
+        m.insert_points(frames()[0], POSES[0])
+        m.save(path)
+    keys = (sogmm._ffi.OPT_DEPTH_SCALE, sogmm._ffi.OPT_DEPTH_MIN, sogmm._ffi.OPT_DEPTH_MAX, sogmm._ffi.OPT_DECIMATION)
+    with sogmm.Map.load(path) as back:
+        assert back._depth == tuple(sogmm._ffi.option_default(k) for k in keys)
+    with sogmm.Map.load(path, depth_scale=5000.0, decimate=4) as tum:
+        assert tum._depth[0] == 5000.0 and tum._depth[3] == 4
+    with pytest.raises(sogmm.InvalidArgumentError):
+        sogmm.Map.load(path, decimate=0)
+
+
 def test_warm_start_fits_each_frame_from_the_previous_fit():
     # Independent truth: fit frame 0 cold, frame 1 warm from frame 0's fit moved
     # into frame 1's camera (SOGMM.fit(init=)), each moved to the world, appended.

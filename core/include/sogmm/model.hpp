@@ -32,10 +32,11 @@ struct FitInfo {
 struct CameraInfo {
   bool known = false;
   Camera camera;                   ///< full-resolution intrinsics
-  std::int32_t decimation = 1;
-  double depth_scale = 1000.0;
-  double depth_min = 0.1;
-  double depth_max = 3.0;
+  // The defaults are DepthOptions' (one copy, the option registry's).
+  std::int32_t decimation = DepthOptions{}.decimate;
+  double depth_scale = DepthOptions{}.depth_scale;
+  double depth_min = DepthOptions{}.depth_min;
+  double depth_max = DepthOptions{}.depth_max;
 };
 
 /// A model plus metadata. The Gmm is what all numerical operations use.

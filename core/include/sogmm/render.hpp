@@ -20,8 +20,8 @@ namespace sogmm {
 struct RenderOptions {
   /// Only modes at depth t in (depth_min, depth_max] (metres along the
   /// camera's z axis) count as surfaces; DepthOptions' defaults.
-  double depth_min = 0.1;
-  double depth_max = 3.0;
+  double depth_min = DepthOptions{}.depth_min;
+  double depth_max = DepthOptions{}.depth_max;
   /// A pixel whose ray passes farther than this many standard deviations
   /// (Mahalanobis distance) from every component's mean shows nothing.
   double max_mahalanobis = 3.0;

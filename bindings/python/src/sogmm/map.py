@@ -166,7 +166,10 @@ class Map(Queryable):
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                            fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) as o:
             out = c_void_p()
-            check(lib.sogmm_map_create(byref(out), o.ptr))
+            if self._load_from is None:
+                check(lib.sogmm_map_create(byref(out), o.ptr))
+            else:
+                self._load(o, out)
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
@@ -447,38 +450,30 @@ class Map(Queryable):
         with _write_options(float64, compress, zstd_level) as o, self._guard.reading("save"):
             check(lib.sogmm_map_save(self._h(), os.fsencode(path), o.ptr))
 
+    # Set by load() for the constructor's run: (path, verify_checksums, max_decoded_bytes).
+    _load_from = None
+
     @classmethod
     def load(cls, path: str | os.PathLike, *, verify_checksums: bool = bool(_D.verify_checksums),
              max_decoded_bytes: int = _D.max_decoded_bytes,
              **options) -> "Map":
-        """Reads a map file (or any world-frame model). ``options`` (as the
-        constructor's) govern later inserts."""
+        """Reads a map file (or any world-frame model). ``options`` (the
+        constructor's keywords, with its defaults) govern later inserts."""
         obj = cls.__new__(cls)
-        obj._ptr = None
-        obj._finalizer = None
-        obj._guard = _UseGuard()
-        obj._depth = (options.pop("depth_scale", 1000.0), options.pop("depth_min", 0.1),
-                      options.pop("depth_trunc", 3.0), options.pop("decimate", 1))
-        d = _D
-        map_keys = dict(novelty=bool(d.map_novelty), novelty_threshold=d.map_novelty_threshold,
-                        batch_size=d.map_batch_size, fusion=None, fusion_threshold=d.map_fusion_threshold,
-                        warm_start=bool(d.map_warm_start), novelty_bandwidth_scale=d.map_novelty_bandwidth_scale,
-                        revisit_refit_ratio=d.map_revisit_refit_ratio,
-                        registration_use_gray=bool(d.registration_use_gray))
-        for k in list(map_keys):
-            if k in options:
-                map_keys[k] = options.pop(k)
-        with obj._options(fit_params=options, **map_keys) as o, _read_options(verify_checksums,
-                                                                               max_decoded_bytes) as r:
+        obj._load_from = (path, verify_checksums, max_decoded_bytes)
+        obj.__init__(**options)
+        del obj._load_from
+        return obj
+
+    def _load(self, o: _ffi.Options, out: c_void_p) -> None:
+        path, verify_checksums, max_decoded_bytes = self._load_from
+        with _read_options(verify_checksums, max_decoded_bytes) as r:
             # One options handle carries both: copy the read keys over.
             for key in (_ffi.OPT_VERIFY_CHECKSUMS, _ffi.OPT_MAX_DECODED_BYTES):
                 v = c_int64()
                 check(lib.sogmm_options_get_i64(r.ptr, key, byref(v)))
                 check(lib.sogmm_options_set_i64(o.ptr, key, v.value))
-            out = c_void_p()
             check(lib.sogmm_map_load(byref(out), os.fsencode(path), o.ptr))
-        obj._attach(out)
-        return obj
 
     def __repr__(self) -> str:
         if self._ptr is None:
