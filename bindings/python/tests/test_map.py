@@ -302,6 +302,18 @@ def test_deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused():
             receiver.apply_delta(deltas[1])  # a duplicate
 
 
+def test_a_bounded_delta_history_refuses_older_revisions():
+    with sogmm.Map(novelty=False, delta_history=1, **FIT) as m:
+        for pts, pose in zip(frames(), POSES):
+            m.insert_points(pts, pose)
+        assert m.revision == 2
+        assert len(m.export_delta(1)) > 0
+        with pytest.raises(sogmm.InvalidArgumentError, match="changes from revision 1"):
+            m.export_delta(0)
+    with pytest.raises(sogmm.InvalidArgumentError, match="delta_history"):
+        sogmm.Map(delta_history=1.5)
+
+
 def test_a_far_map_keeps_its_origin(tmp_path):
     # Issue 36: a map 1000 km out holds its components relative to its origin
     # (the first frame's translation rounded to 1 km) and finds in a mapped

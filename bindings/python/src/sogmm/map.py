@@ -133,6 +133,10 @@ class Map(Queryable):
         registration_use_gray: :meth:`track_rgbd` registers with gray too (the
             4-D density, as :func:`sogmm.register`'s ``use_gray``), which holds
             the pose where geometry alone lets a frame slide (a wall, a floor).
+        delta_history: how many of its latest revisions the map keeps the
+            changes of for :meth:`export_delta` (0, the default: all of them;
+            an older start then raises InvalidArgumentError naming the oldest
+            kept). Bounds what a long run keeps.
         **fit_params: parameters of each batch's fit, as :class:`sogmm.SOGMM`
             (bandwidth, seed, n_threads, ...).
 
@@ -158,13 +162,15 @@ class Map(Queryable):
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
                  registration_use_gray: bool = bool(_D.registration_use_gray),
+                 delta_history: int = _D.map_delta_history,
                  **fit_params):
         self._ptr = None
         self._finalizer = None
         self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) as o:
+                           fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
+                           delta_history) as o:
             out = c_void_p()
             if self._load_from is None:
                 check(lib.sogmm_map_create(byref(out), o.ptr))
@@ -173,11 +179,13 @@ class Map(Queryable):
         self._attach(out)
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
-                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray) -> _ffi.Options:
+                 fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
+                 delta_history) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
-        if isinstance(batch_size, bool) or not isinstance(batch_size, (int, np.integer)):
-            raise InvalidArgumentError(f"batch_size must be an int, got {batch_size!r}")
+        for name, v in (("batch_size", batch_size), ("delta_history", delta_history)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise InvalidArgumentError(f"{name} must be an int, got {v!r}")
         for k in fit_params:
             if k not in SOGMM._PARAMS:
                 raise InvalidArgumentError(f"unknown parameter {k!r} for Map")
@@ -191,7 +199,8 @@ class Map(Queryable):
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
                _ffi.OPT_MAP_WARM_START: int(bool(warm_start)),
-               _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(registration_use_gray))}
+               _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(registration_use_gray)),
+               _ffi.OPT_MAP_DELTA_HISTORY: int(delta_history)}
         if _FUSION[fusion] is not None:
             i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
         # The fit keys exactly as SOGMM sets them (same checks and messages).
