@@ -15,6 +15,12 @@
 // pair_fraction / EM seconds: an effective rate, since the pairs of rows that
 // the kernel skips exactly (every responsibility 0 in float) are counted too;
 // pair_fraction < 1 only for the truncated E-step.
+//
+// Quality beside the speed: the training log-likelihood, and the held-out
+// figures of `sogmm eval` (issue 29 item 1; eval_pixels.hpp): the mean
+// log-likelihood per point on the held-out grid (the d + 1 grid minus the
+// fitting grid, pixels the fit never saw) and the per-pixel PSNR of the
+// model's render there. Computed after every timed stage.
 #include <time.h>
 
 #include <chrono>
@@ -25,6 +31,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "eval_pixels.hpp"
 #include "image_io.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
@@ -176,6 +183,7 @@ int main(int argc, char** argv) {
   const PsnrResult p = psnr(r.gmm, cloud.view(), decimated(camera, opt.decimate));
   const ReconstructionResult rec = reconstruction_metrics(r.gmm, cloud.view(), 0.01, 0);
   const double s_metrics = std::chrono::duration<double>(clock::now() - t).count();
+  const tools::PixelFigures held = tools::pixel_figures(r.gmm, frame, camera, opt, 1.0, 0.0);
 
   if (!dump.empty()) {
     // Points and the k-means++ seeds of this fit, for the scikit-learn peer.
@@ -209,9 +217,10 @@ int main(int argc, char** argv) {
       "{\"n\": %zu, \"m\": %zu, \"s_mode_count\": %.6f, \"s_seeding\": %.6f, \"s_em\": %.6f, \"s_total_fit\": %.6f, "
       "\"em_iterations\": %d, \"ms_per_iteration\": %.4f, \"pair_fraction\": %.4f, \"gflops\": %.3f, \"s_regress\": %.6f, \"s_score\": %.6f, \"s_regress_culled\": %.6f, \"s_score_culled\": %.6f, \"peak_pairs_per_s\": %.6g, \"s_sample\": %.6f, "
       "\"s_metrics\": %.6f, \"peak_rss_mib\": %.1f, \"log_likelihood\": %.6f, \"psnr\": %.4f, \"mre\": %.6f, "
-      "\"fscore\": %.4f%s}\n",
+      "\"fscore\": %.4f, \"log_likelihood_heldout\": %.6f, \"pixel_psnr_heldout\": %.4f, \"heldout_decimate\": %d%s}\n",
       n, m, r.seconds_mode_count, r.seconds_seeding, r.seconds_em, r.seconds_total, r.em.iterations,
       1000.0 * r.seconds_em / r.em.iterations, r.em.pair_fraction, 80.0 * pairs / r.seconds_em * 1e-9, s_regress, s_score, s_regress_culled, s_score_culled, peak_pairs_per_s, s_sample, s_metrics,
-      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore, cpu.c_str());
+      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore, held.log_likelihood_heldout,
+      held.heldout.psnr, held.decimate + 1, cpu.c_str());
   return 0;
 }
