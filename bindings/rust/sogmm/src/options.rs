@@ -276,6 +276,11 @@ impl OptionsBuilder {
         map_fusion_threshold(f64) => SOGMM_OPT_MAP_FUSION_THRESHOLD as f64 |v| v;
         /// Map: warm-start each batch's fit from the previous one (default false; needs n_init 1).
         map_warm_start(bool) => SOGMM_OPT_MAP_WARM_START as i64 i64::from;
+        /// Map: keep the changes of only the last N revisions for
+        /// `Map::export_delta` (default 0: all of them); an export from an
+        /// older revision then fails with `Status::InvalidArg` naming the
+        /// oldest kept. Negative: `build` fails with `Status::InvalidArg`.
+        map_delta_history(i64) => SOGMM_OPT_MAP_DELTA_HISTORY as i64 |v| v;
     }
 
     pub fn build(&self) -> Result<Options> {

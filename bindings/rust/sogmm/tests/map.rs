@@ -399,6 +399,29 @@ fn deltas_in_order_rebuild_the_map_bitwise_and_a_gap_is_refused() {
     assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
 }
 
+/// A bounded journal (`map_delta_history`): with N = 1 the last revision's
+/// changes are exported and older ones are refused, naming the oldest kept.
+#[test]
+fn a_bounded_delta_history_refuses_older_revisions() {
+    let o = Options::builder()
+        .threads(1)
+        .map_novelty(false)
+        .map_delta_history(1)
+        .build()
+        .unwrap();
+    let mut sender = Map::new(Some(&o)).unwrap();
+    for (k, tx) in [0.0, 3.0].into_iter().enumerate() {
+        sender.insert_points(&blobs(400, 21 + k as u64), &shifted(tx)).unwrap();
+    }
+    assert_eq!(sender.revision().unwrap(), 2);
+    assert!(!sender.export_delta(1).unwrap().is_empty());
+    let e = sender.export_delta(0).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+    assert!(e.message().contains("changes from revision 1"), "{}", e.message());
+    let bad = Options::builder().map_delta_history(-1).build().unwrap_err();
+    assert_eq!(bad.status(), Status::InvalidArg);
+}
+
 // Issue 36: a map 1000 km out holds its components relative to its origin
 // (the first frame's translation rounded to 1 km), finds in a mapped frame
 // the novel points it finds at the world origin, and keeps the origin
