@@ -126,12 +126,19 @@ def test_rgbd_errors():
         est.fit_rgbd(depth, color.astype(np.float32), cam)  # float RGB
     with pytest.raises(sogmm.InvalidArgumentError):
         est.fit_rgbd(depth, color, "camera")
-    with pytest.raises(sogmm.InvalidArgumentError):
+    # The ranges and the rules between the values are the library's registry's
+    # (the binding checks only that decimate is an integer).
+    with pytest.raises(sogmm.InvalidArgumentError, match="DEPTH_MIN = 2 must be < SOGMM_OPT_DEPTH_MAX = 1"):
         est.fit_rgbd(depth, color, cam, depth_min=2.0, depth_trunc=1.0)
-    with pytest.raises(sogmm.InvalidArgumentError):
+    with pytest.raises(sogmm.InvalidArgumentError, match=r"decimate = 0 is invalid.*\[1, 1024\]"):
         est.fit_rgbd(depth, color, cam, decimate=0)
-    with pytest.raises(sogmm.InvalidArgumentError):
+    with pytest.raises(sogmm.InvalidArgumentError, match="leaves no pixel"):
         est.fit_rgbd(depth, color, cam, decimate=cam.height + 1)
+    for bad in (1.5, True, "2"):
+        with pytest.raises(sogmm.InvalidArgumentError, match="must be an integer"):
+            sogmm.rgbd_to_points(depth, color, cam, decimate=bad)
+    with pytest.raises(sogmm.InvalidArgumentError, match="leaves no pixel"):
+        sogmm.rgbd_to_points(depth, color, cam, decimate=cam.width + 1)
     with pytest.raises(sogmm.InvalidDataError) as e:
         est.fit_rgbd(np.zeros_like(depth), color, cam)  # no valid pixel: found by C
     assert e.value.status == -3 and "pixel" in e.value.message

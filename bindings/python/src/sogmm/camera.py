@@ -151,22 +151,19 @@ def prepare_color(color, camera: Camera) -> tuple[str, np.ndarray]:
     raise InvalidArgumentError(f"color must be (H, W) gray or (H, W, 3) RGB, got shape {c.shape}")
 
 
-def check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera: Camera) -> tuple[float, float, float, int]:
-    depth_scale, depth_min, depth_trunc = float(depth_scale), float(depth_min), float(depth_trunc)
-    if not (math.isfinite(depth_scale) and depth_scale > 0):
-        raise InvalidArgumentError(f"depth_scale = {depth_scale} must be finite and > 0")
-    if not (math.isfinite(depth_min) and depth_min >= 0):
-        raise InvalidArgumentError(f"depth_min = {depth_min} must be finite and >= 0")
-    if not (math.isfinite(depth_trunc) and depth_trunc > depth_min):
-        raise InvalidArgumentError(f"depth_trunc = {depth_trunc} must be finite and > depth_min = {depth_min}")
-    if isinstance(decimate, bool) or int(decimate) != decimate or not (1 <= int(decimate) <= 1024):
-        raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer in [1, 1024]")
-    decimate = int(decimate)
-    if decimate > camera.width or decimate > camera.height:
-        raise InvalidArgumentError(
-            f"decimate = {decimate} leaves no pixel of a {camera.width} x {camera.height} image"
-        )
-    return depth_scale, depth_min, depth_trunc, decimate
+def check_depth_options(depth_scale, depth_min, depth_trunc, decimate) -> tuple[float, float, float, int]:
+    """Only what the C call cannot see: ``decimate`` must be an integer (``int()``
+    would round 1.5 and turn True into 1 before C sees it). The ranges and the
+    rules between the values (depth_trunc > depth_min, decimate at most the
+    image's width and height) are the library's option registry's, checked when
+    the options are set and at the call (InvalidArgumentError naming the value)."""
+    try:
+        whole = not isinstance(decimate, (bool, str)) and int(decimate) == decimate
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    if not whole:
+        raise InvalidArgumentError(f"decimate = {decimate!r} must be an integer")
+    return float(depth_scale), float(depth_min), float(depth_trunc), int(decimate)
 
 
 def rgbd_to_points(
@@ -194,11 +191,12 @@ def rgbd_to_points(
     by row, identical to what ``SOGMM.fit_rgbd`` fits.
     """
     f = prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, decimate)
-    d = f.i64[_ffi.OPT_DECIMATION]
-    capacity = 4 * (f.camera.width // d) * (f.camera.height // d)  # every decimated pixel valid
-    out = np.empty(capacity, dtype=np.float32)
     n = c_size_t(0)
+    # The options handle checks the values first (the registry's ranges).
     with _ffi.Options(f64=f.f64, i64=f.i64) as o, f.handle() as frame:
+        d = f.i64[_ffi.OPT_DECIMATION]
+        capacity = 4 * (f.camera.width // d) * (f.camera.height // d)  # every decimated pixel valid
+        out = np.empty(capacity, dtype=np.float32)
         _ffi.check(_ffi.lib.sogmm_frame_to_points_f32(out, capacity, byref(n), frame, o.ptr))
     return out[: 4 * n.value].reshape(n.value, 4).copy()
 
@@ -237,7 +235,7 @@ def prepare_frame(depth, color, camera, depth_scale, depth_min, depth_trunc, dec
     camera = _as_camera(camera)
     d = prepare_depth(depth, camera)
     kind, c = prepare_color(color, camera)
-    depth_scale, depth_min, depth_trunc, dec = check_depth_options(depth_scale, depth_min, depth_trunc, decimate, camera)
+    depth_scale, depth_min, depth_trunc, dec = check_depth_options(depth_scale, depth_min, depth_trunc, decimate)
     return PreparedFrame(
         camera=camera,
         depth=d,
