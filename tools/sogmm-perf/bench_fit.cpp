@@ -24,6 +24,7 @@
 #include <time.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -61,6 +62,15 @@ struct CpuMark {
     return m;
   }
 };
+
+// A JSON number, or null where there is none: at d = 1 every pixel of the
+// d + 1 grid is on the fitting grid, so the held-out figures are NaN.
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6f", v);
+  return text;
+}
 
 // Per stage: "cpu_S", "serial_cpu_S", "loops_S", "pcpu_S", and the team
 // split of the wall time (sogmm/loop_accounting.hpp): "wall_S" and
@@ -217,10 +227,10 @@ int main(int argc, char** argv) {
       "{\"n\": %zu, \"m\": %zu, \"s_mode_count\": %.6f, \"s_seeding\": %.6f, \"s_em\": %.6f, \"s_total_fit\": %.6f, "
       "\"em_iterations\": %d, \"ms_per_iteration\": %.4f, \"pair_fraction\": %.4f, \"gflops\": %.3f, \"s_regress\": %.6f, \"s_score\": %.6f, \"s_regress_culled\": %.6f, \"s_score_culled\": %.6f, \"peak_pairs_per_s\": %.6g, \"s_sample\": %.6f, "
       "\"s_metrics\": %.6f, \"peak_rss_mib\": %.1f, \"log_likelihood\": %.6f, \"psnr\": %.4f, \"mre\": %.6f, "
-      "\"fscore\": %.4f, \"log_likelihood_heldout\": %.6f, \"pixel_psnr_heldout\": %.4f, \"heldout_decimate\": %d%s}\n",
+      "\"fscore\": %.4f, \"log_likelihood_heldout\": %s, \"pixel_psnr_heldout\": %s, \"heldout_decimate\": %d%s}\n",
       n, m, r.seconds_mode_count, r.seconds_seeding, r.seconds_em, r.seconds_total, r.em.iterations,
       1000.0 * r.seconds_em / r.em.iterations, r.em.pair_fraction, 80.0 * pairs / r.seconds_em * 1e-9, s_regress, s_score, s_regress_culled, s_score_culled, peak_pairs_per_s, s_sample, s_metrics,
-      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore, held.log_likelihood_heldout,
-      held.heldout.psnr, held.decimate + 1, cpu.c_str());
+      peak_rss_kib / 1024.0, r.em.log_likelihood, p.psnr, rec.mre, rec.fscore, json_number(held.log_likelihood_heldout).c_str(),
+      json_number(held.heldout.psnr).c_str(), held.decimate + 1, cpu.c_str());
   return 0;
 }

@@ -76,7 +76,7 @@ def run_warm(threads, repeat, max_iter=0):
 
 
 def medians(runs):
-    keys = [k for k in runs[0] if isinstance(runs[0][k], (int, float))]
+    keys = [k for k in runs[0] if isinstance(runs[0][k], (int, float)) and not isinstance(runs[0][k], bool)]
     return {k: statistics.median(r[k] for r in runs) for k in keys}
 
 
