@@ -11,16 +11,8 @@ import (
 // gap is refused and changes nothing.
 func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
 	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
-	sender, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer sender.Close()
-	receiver, err := NewMap(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer receiver.Close()
+	sender := mustMap(t, o)
+	receiver := mustMap(t, nil)
 	var deltas [][]byte
 	for k, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)} {
 		since, _ := sender.Revision()
