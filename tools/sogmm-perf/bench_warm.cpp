@@ -22,12 +22,10 @@
 #include "sogmm/loop_accounting.hpp"
 #include "sogmm/metrics.hpp"
 #include "sogmm/warm_start.hpp"
+#include "median.hpp"
 
 namespace {
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using sogmm::perf::median;
 }  // namespace
 
 int main(int argc, char** argv) {
