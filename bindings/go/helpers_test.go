@@ -54,6 +54,13 @@ func mustLoadMap(t testing.TB, path string) *Map {
 	return held(t, m, err)
 }
 
+// mustExport is m.Export(nil).
+func mustExport(t testing.TB, m *Map) *Model {
+	t.Helper()
+	model, err := m.Export(nil)
+	return held(t, model, err)
+}
+
 // savedFile is the path of m saved (default options) as name in a fresh
 // temporary folder.
 func savedFile(t testing.TB, m interface{ Save(string, *Options) error }, name string) string {

@@ -36,14 +36,7 @@ func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
 			t.Fatal(err)
 		}
 	}
-	a, err := sender.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	b, err := receiver.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
+	a, b := mustExport(t, sender), mustExport(t, receiver)
 	for _, get := range []func(*Model) ([]float32, error){(*Model).Weights, (*Model).Means, (*Model).Covariances} {
 		x, _ := get(a)
 		y, _ := get(b)

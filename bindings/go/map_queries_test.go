@@ -31,12 +31,7 @@ func twoFrameMapAndExport(t *testing.T) (*Map, *Model) {
 	t.Helper()
 	m := twoFrameMap(t)
 	t.Cleanup(func() { m.Close() })
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(func() { model.Close() })
-	return m, model
+	return m, mustExport(t, m)
 }
 
 // A map of two posed copies of twoBlobs, flushed.

@@ -44,10 +44,7 @@ func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 			t.Fatalf("frame %d stats %+v (%v)", k, fs, err)
 		}
 	}
-	got, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
+	got := mustExport(t, m)
 	gw, _ := got.Weights()
 	ww, _ := want.Weights()
 	gm, _ := got.Means()
