@@ -18,7 +18,6 @@
 // Usage: sogmm-corun [--repeat 7]; prints one JSON line.
 #include <omp.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>

@@ -26,7 +26,6 @@
 #include <CLI/CLI.hpp>
 
 #include "frame_flags.hpp"
-#include "image_io.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"

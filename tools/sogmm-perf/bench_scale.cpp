@@ -6,7 +6,6 @@
 //
 // Usage: sogmm-bench-scale --depth D --color C --intrinsics J [--decimate 5]
 //        [--bandwidth 0.02] [--repeats 7] [--threads 1]
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -16,7 +15,6 @@
 #include <CLI/CLI.hpp>
 
 #include "frame_flags.hpp"
-#include "image_io.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"

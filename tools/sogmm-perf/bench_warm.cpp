@@ -7,7 +7,6 @@
 //
 // Usage: sogmm-bench-warm --sequence DIR --trajectory LOG --from A --to B
 //        --decimate d --bandwidth S [--threads T] [--repeat R] [--seed s]
-#include <algorithm>
 #include <cstdlib>
 #include <cstdio>
 #include <string>

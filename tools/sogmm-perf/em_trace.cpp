@@ -23,7 +23,6 @@
 #include <Eigen/Eigenvalues>
 
 #include "frame_flags.hpp"
-#include "image_io.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/depth_quantisation.hpp"
 #include "sogmm/em.hpp"
