@@ -1,7 +1,6 @@
 package sogmm
 
 import (
-	"context"
 	"errors"
 	"testing"
 )
@@ -21,16 +20,8 @@ func TestSquaremReachesTheFixedPointInFewerPasses(t *testing.T) {
 		pts = append(pts, 0.8*k+1.5*next(), 0.5*next(), 1.0+0.3*next(), 0.3+0.3*next())
 	}
 	fit := func(on bool) (int64, float64) {
-		o, err := NewOptions(NComponents(3), Seed(1), Threads(1), Tol(1e-7), MaxIter(3000), Squarem(on))
-		if err != nil {
-			t.Fatal(err)
-		}
-		defer o.Close()
-		m, err := Fit(context.Background(), pts, o)
-		if err != nil {
-			t.Fatal(err)
-		}
-		defer m.Close()
+		o := mustOptions(t, NComponents(3), Seed(1), Threads(1), Tol(1e-7), MaxIter(3000), Squarem(on))
+		m := mustFit(t, pts, o)
 		it, err := m.InfoI64(InfoFitIterations)
 		if err != nil {
 			t.Fatal(err)
@@ -46,11 +37,7 @@ func TestSquaremReachesTheFixedPointInFewerPasses(t *testing.T) {
 	if fastIt >= plainIt || fastLL < plainLL-1e-5 {
 		t.Fatalf("squarem %d passes, LL %v; plain %d passes, LL %v", fastIt, fastLL, plainIt, plainLL)
 	}
-	o, err := NewOptions()
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t)
 	if v, _ := o.GetI64(OptEmAcceleration); v != 0 {
 		t.Fatalf("default em_acceleration %v, want 0", v)
 	}

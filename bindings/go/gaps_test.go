@@ -85,11 +85,7 @@ func twoComponents(t *testing.T) *Model {
 		}
 	}
 	m, err := FromArrays([]float32{0.25, 0.75}, []float32{0, 1, 2, 3, 4, 5, 6, 7}, cov, 40)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(m.Close)
-	return m
+	return held(t, m, err)
 }
 
 func TestSetInfoRoundTripsThroughAFile(t *testing.T) {
@@ -180,11 +176,7 @@ func farCluster(t *testing.T) *Model {
 		weights[k] = 0.1
 	}
 	model, err := FromArrays(weights, means, cov, 1000) // a known support: a map refuses 0 (unknown)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(model.Close)
-	return model
+	return held(t, model, err)
 }
 
 var (
@@ -195,11 +187,7 @@ var (
 func culled(t *testing.T, nats float64, threads int64) *Options {
 	t.Helper()
 	o, err := NewOptions(QueryTruncationNats(nats), Threads(threads))
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(o.Close)
-	return o
+	return held(t, o, err)
 }
 
 func TestCulledQueriesWithinTheBound(t *testing.T) {
@@ -264,15 +252,7 @@ func TestMapQueriesTakeTheSameOptions(t *testing.T) {
 	if err := m.SetValue("coordinate_frame", "world"); err != nil {
 		t.Fatal(err)
 	}
-	path := filepath.Join(t.TempDir(), "far.sogmm")
-	if err := m.Save(path, nil); err != nil {
-		t.Fatal(err)
-	}
-	mp, err := LoadMap(path, nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer mp.Close()
+	mp := mustLoadMap(t, savedFile(t, m, "far.sogmm"))
 	o := culled(t, 2, 2)
 	c, err := mp.ScoreSamples(context.Background(), cullQuery, 4, o)
 	if err != nil {
@@ -338,11 +318,7 @@ func TestSaveAboveTheDecodedSizeCapIsRefused(t *testing.T) {
 	m := twoComponents(t) // 2 x 15 float32 values: 120 decoded bytes
 	capped := func(c int64) *Options {
 		o, err := NewOptions(I64(OptMaxDecodedBytes, c))
-		if err != nil {
-			t.Fatal(err)
-		}
-		t.Cleanup(o.Close)
-		return o
+		return held(t, o, err)
 	}
 	_, err := m.Bytes(capped(119))
 	if !errors.Is(err, ErrLimit) || !strings.Contains(err.Error(), "over the cap of 119 bytes") {

@@ -12,16 +12,8 @@ import (
 // gap is refused and changes nothing.
 func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
 	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
-	sender, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer sender.Close()
-	receiver, err := NewMap(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer receiver.Close()
+	sender := mustMap(t, o)
+	receiver := mustMap(t, nil)
 	var deltas [][]byte
 	for k, pose := range [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)} {
 		since, _ := sender.Revision()
@@ -45,14 +37,7 @@ func TestMapDeltasRebuildTheMapBitwiseAndRefuseAGap(t *testing.T) {
 			t.Fatal(err)
 		}
 	}
-	a, err := sender.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	b, err := receiver.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
+	a, b := mustExport(t, sender), mustExport(t, receiver)
 	for _, get := range []func(*Model) ([]float32, error){(*Model).Weights, (*Model).Means, (*Model).Covariances} {
 		x, _ := get(a)
 		y, _ := get(b)

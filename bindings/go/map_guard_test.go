@@ -26,6 +26,17 @@ func isBusy(err error) bool {
 	return errors.Is(err, ErrBusy) && errors.As(err, &e) && strings.HasPrefix(e.Message, "map busy: ")
 }
 
+// expectAllBusy reports each of errs (what: which calls) that is not a
+// "map busy" ErrBusy.
+func expectAllBusy(t *testing.T, errs []error, what string) {
+	t.Helper()
+	for k, e := range errs {
+		if !isBusy(e) {
+			t.Errorf("%s %d: %v, want map busy", what, k, e)
+		}
+	}
+}
+
 // The map's own progress func calling into it gets ErrBusy, Close from it
 // leaves the map open, and the insert goes on (issue 36).
 func TestMapCallsFromItsProgressFuncAreBusy(t *testing.T) {
@@ -46,11 +57,7 @@ func TestMapCallsFromItsProgressFuncAreBusy(t *testing.T) {
 	if err != nil {
 		t.Fatal(err)
 	}
-	for k, e := range nested {
-		if !isBusy(e) {
-			t.Errorf("nested call %d: %v, want map busy", k, e)
-		}
-	}
+	expectAllBusy(t, nested, "nested call")
 	s, err := m.Stats() // still open
 	if err != nil || s.Frames != 1 || s.Flushes != 1 {
 		t.Fatalf("after the insert: %+v, %v", s, err)
@@ -82,11 +89,7 @@ func TestMapCallsFromAnotherGoroutineAreBusy(t *testing.T) {
 	if err != nil {
 		t.Fatal(err)
 	}
-	for k, e := range errs {
-		if !isBusy(e) {
-			t.Errorf("call %d of the other goroutine: %v, want map busy", k, e)
-		}
-	}
+	expectAllBusy(t, errs, "call of the other goroutine")
 	if s, err := m.Stats(); err != nil || s.Frames != 1 {
 		t.Fatalf("after the insert: %+v, %v", s, err)
 	}

@@ -13,11 +13,7 @@ import (
 func testOptions(t *testing.T, opts ...Option) *Options {
 	t.Helper()
 	o, err := NewOptions(append([]Option{Bandwidth(0.3), Seed(2), Threads(2)}, opts...)...)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(func() { o.Close() })
-	return o
+	return held(t, o, err)
 }
 
 // newTestMap is NewMap with testOptions(t, opts...).
@@ -35,12 +31,7 @@ func twoFrameMapAndExport(t *testing.T) (*Map, *Model) {
 	t.Helper()
 	m := twoFrameMap(t)
 	t.Cleanup(func() { m.Close() })
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(func() { model.Close() })
-	return m, model
+	return m, mustExport(t, m)
 }
 
 // A map of two posed copies of twoBlobs, flushed.
@@ -120,11 +111,7 @@ func TestMapQueriesEqualTheExportedModel(t *testing.T) {
 	if _, err := m.ScoreSamples(context.Background(), q3, 5, nil); !errors.Is(err, ErrInvalidArg) {
 		t.Fatalf("dims 5: %v", err)
 	}
-	empty, err := NewMap(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer empty.Close()
+	empty := mustMap(t, nil)
 	if _, err := empty.Sample(context.Background(), 10, 1, 4, nil); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty map: %v", err)
 	}
@@ -184,11 +171,7 @@ func TestFitWarm(t *testing.T) {
 	pts := twoBlobs(2000)
 	o, _ := NewOptions(NComponents(2), Seed(1), Threads(2))
 	defer o.Close()
-	cold, err := Fit(context.Background(), pts, o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer cold.Close()
+	cold := mustFit(t, pts, o)
 	warm, err := FitWarm(context.Background(), pts, cold, o)
 	if err != nil {
 		t.Fatal(err)

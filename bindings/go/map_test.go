@@ -18,11 +18,7 @@ func yawPose(deg float64, tx, ty, tz float64) [16]float64 {
 // merged, component for component (computed here with Fit/Transform/Merge).
 func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 	o := testOptions(t, Threads(1), I64(OptMapNovelty, 0))
-	m, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer m.Close()
+	m := mustMap(t, o)
 	poses := [][16]float64{yawPose(0, 0, 0, 0), yawPose(30, 0.5, 0, -0.2)}
 	var want *Model
 	for k, pose := range poses {
@@ -48,10 +44,7 @@ func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 			t.Fatalf("frame %d stats %+v (%v)", k, fs, err)
 		}
 	}
-	got, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
+	got := mustExport(t, m)
 	gw, _ := got.Weights()
 	ww, _ := want.Weights()
 	gm, _ := got.Means()
@@ -59,26 +52,14 @@ func TestMapAppendEverythingEqualsFitsMergedByHand(t *testing.T) {
 	if !slices.Equal(gw, ww) || !slices.Equal(gm, wm) {
 		t.Fatalf("map differs from the merged fits: %d vs %d components", len(gw), len(ww))
 	}
-	path := filepath.Join(t.TempDir(), "map.sogmm")
-	if err := m.Save(path, nil); err != nil {
-		t.Fatal(err)
-	}
-	back, err := LoadMap(path, nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer back.Close()
+	back := mustLoadMap(t, savedFile(t, m, "map.sogmm"))
 	if s, err := back.Stats(); err != nil || s.Frames != 2 || s.Components != uint64(len(gw)) {
 		t.Fatalf("loaded map stats %+v (%v)", s, err)
 	}
 }
 
 func TestMapRejectsBadPoseAndEmptyFrame(t *testing.T) {
-	m, err := NewMap(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer m.Close()
+	m := mustMap(t, nil)
 	scaled := yawPose(0, 0, 0, 0)
 	scaled[0] = 2
 	if err := m.InsertPoints(context.Background(), twoBlobs(50), scaled); !errors.Is(err, ErrInvalidArg) {
@@ -164,11 +145,7 @@ func TestMapFarFromTheOriginKeepsItsOrigin(t *testing.T) {
 	if novel[1] != novel[0] {
 		t.Fatalf("novel points of a mapped frame: %d at 1000 km, %d at 0 km", novel[1], novel[0])
 	}
-	loaded, err := LoadMap(path, nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer loaded.Close()
+	loaded := mustLoadMap(t, path)
 	if o, err := loaded.Origin(); err != nil || o != [3]float64{1e6, -1e6, 0} {
 		t.Fatalf("loaded origin %v (%v)", o, err)
 	}

@@ -54,16 +54,8 @@ func cornerFrame(pose [16]float64, onlyWall bool) Frame {
 
 func TestTrackFrameFollowsAKnownMotionAndRefusesAPlane(t *testing.T) {
 	ctx := context.Background()
-	o, err := NewOptions(Decimation(2), Bandwidth(0.05), Threads(1))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
-	m, err := NewMap(o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer m.Close()
+	o := mustOptions(t, Decimation(2), Bandwidth(0.05), Threads(1))
+	m := mustMap(t, o)
 	identity := [16]float64{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}
 	r, inserted, err := m.TrackFrame(ctx, cornerFrame(identity, false), nil)
 	if err != nil || !inserted || r.Iterations != 0 || r.Pose != identity {

@@ -8,11 +8,7 @@ import (
 
 // The registry's defaults are what a fresh Options holds, for every key.
 func TestOptionInfoReportsEveryDefaultAFreshHandleHolds(t *testing.T) {
-	o, err := NewOptions()
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t)
 	keys, err := OptionKeys()
 	if err != nil || len(keys) < 31 {
 		t.Fatalf("OptionKeys: %v (%d keys)", err, len(keys))

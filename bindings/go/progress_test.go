@@ -22,11 +22,7 @@ func cube(n int) []float32 {
 func emOptions(t *testing.T) *Options {
 	t.Helper()
 	o, err := NewOptions(NComponents(8), Tol(1e-12), MaxIter(25), Seed(5), Threads(2))
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(o.Close)
-	return o
+	return held(t, o, err)
 }
 
 func TestProgressReportsEMInOrderAndChangesNothing(t *testing.T) {
@@ -40,11 +36,7 @@ func TestProgressReportsEMInOrderAndChangesNothing(t *testing.T) {
 		t.Fatal(err)
 	}
 	defer m.Close()
-	plain, err := Fit(context.Background(), pts, emOptions(t))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer plain.Close()
+	plain := mustFit(t, pts, emOptions(t))
 	a, _ := m.Means()
 	b, _ := plain.Means()
 	if len(a) != len(b) || len(a) == 0 {

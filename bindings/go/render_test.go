@@ -74,11 +74,7 @@ func TestRenderSingleComponentClosedForm(t *testing.T) {
 	if _, err := m.Render(context.Background(), Camera{Width: 20000, Height: 20000, Fx: 1, Fy: 1}, nil, nil); !errors.Is(err, ErrLimit) {
 		t.Fatalf("2^28 pixels: %v", err)
 	}
-	o, err := NewOptions(DepthRange(0.1, 1.4))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t, DepthRange(0.1, 1.4))
 	near, err := m.Render(context.Background(), renderCam, nil, o)
 	if err != nil || !math.IsNaN(float64(near.Depth[renderCentre])) {
 		t.Fatalf("depth max 1.4: %v (err %v)", near.Depth[renderCentre], err)
@@ -154,11 +150,7 @@ func TestMapRenderEqualsTheExport(t *testing.T) {
 	if _, err := m.Render(ctx, cam, nil, nil); !errors.Is(err, ErrCancelled) {
 		t.Fatalf("cancelled render: %v", err)
 	}
-	empty, err := NewMap(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer empty.Close()
+	empty := mustMap(t, nil)
 	if _, err := empty.Render(context.Background(), cam, nil, nil); !errors.Is(err, ErrInvalidData) {
 		t.Fatalf("empty map: %v", err)
 	}

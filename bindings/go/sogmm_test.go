@@ -6,7 +6,6 @@ import (
 	"fmt"
 	"math"
 	"os"
-	"path/filepath"
 	"reflect"
 	"runtime"
 	"slices"
@@ -25,11 +24,7 @@ func oneGaussian(t *testing.T) *Model {
 	cov[0], cov[5], cov[10], cov[15] = 1, 1, 1, 0.5
 	cov[3], cov[12] = 0.2, 0.2
 	m, err := FromArrays([]float32{1}, []float32{0, 0, 0, 0.5}, cov, 10)
-	if err != nil {
-		t.Fatal(err)
-	}
-	t.Cleanup(m.Close)
-	return m
+	return held(t, m, err)
 }
 
 // twoBlobs: deterministic points around x = -1 (gray 0.2) and x = +1 (gray 0.8).
@@ -90,16 +85,8 @@ func TestRegressionAndScoreClosedForm(t *testing.T) {
 }
 
 func TestFixedKFit(t *testing.T) {
-	o, err := NewOptions(Seed(7), Threads(1), NComponents(2))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
-	m, err := Fit(context.Background(), twoBlobs(400), o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer m.Close()
+	o := mustOptions(t, Seed(7), Threads(1), NComponents(2))
+	m := mustFit(t, twoBlobs(400), o)
 	mu, _ := m.Means()
 	xs := [][2]float32{{mu[0], mu[3]}, {mu[4], mu[7]}}
 	sort.Slice(xs, func(i, j int) bool { return xs[i][0] < xs[j][0] })
@@ -113,11 +100,7 @@ func TestFixedKFit(t *testing.T) {
 }
 
 func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
-	o, err := NewOptions(Seed(1), Threads(1), NComponents(2))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t, Seed(1), Threads(1), NComponents(2))
 	if v, _ := o.GetF64(OptRegCovar); v != RegCovarAuto {
 		t.Fatalf("default reg_covar %v, want RegCovarAuto", v)
 	}
@@ -126,11 +109,7 @@ func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
 		for i := 0; i < len(pts); i += 4 {
 			pts[i], pts[i+1], pts[i+2] = scale*pts[i], scale*pts[i+1], scale*pts[i+2]
 		}
-		m, err := Fit(context.Background(), pts, o)
-		if err != nil {
-			t.Fatal(err)
-		}
-		defer m.Close()
+		m := mustFit(t, pts, o)
 		f, err := m.InfoF64(InfoFitRegCovar)
 		if err != nil {
 			t.Fatal(err)
@@ -164,11 +143,7 @@ func TestRegCovarAutoFollowsTheDataScale(t *testing.T) {
 func TestSeedsAreReproducible(t *testing.T) {
 	o, _ := NewOptions(Bandwidth(0.5), Seed(3), Threads(1))
 	defer o.Close()
-	a, err := Fit(context.Background(), twoBlobs(200), o)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer a.Close()
+	a := mustFit(t, twoBlobs(200), o)
 	b, _ := Fit(context.Background(), twoBlobs(200), o)
 	defer b.Close()
 	ma, _ := a.Means()
@@ -241,15 +216,8 @@ func TestBytesFilesMetadata(t *testing.T) {
 	if p, _ := back.Pose(); p != pose {
 		t.Fatalf("pose %v", p)
 	}
-	path := filepath.Join(t.TempDir(), "m.sogmm")
-	if err := m.Save(path, nil); err != nil {
-		t.Fatal(err)
-	}
-	loaded, err := Load(path, nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer loaded.Close()
+	path := savedFile(t, m, "m.sogmm")
+	loaded := mustLoad(t, path)
 	c1, _ := m.Covariances()
 	c2, _ := loaded.Covariances()
 	vs, _ := loaded.Values()
@@ -391,11 +359,7 @@ func TestSharedModelAcrossGoroutines(t *testing.T) {
 }
 
 func TestOptionsCloneAndGet(t *testing.T) {
-	o, err := NewOptions(Seed(math.MaxUint64), ZstdLevel(3))
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t, Seed(math.MaxUint64), ZstdLevel(3))
 	if s, _ := o.GetI64(OptSeed); s != -1 {
 		t.Fatalf("seed bits %d", s)
 	}
@@ -456,11 +420,7 @@ func staircaseFrame() Frame {
 // same points given as an array; DequantiseDepth forces either.
 func TestTheDepthFloorIsTheDefaultForFrames(t *testing.T) {
 	covariances := func(extra ...Option) []float32 {
-		o, err := NewOptions(append([]Option{Bandwidth(0.05), Seed(3), Threads(1), Decimation(2)}, extra...)...)
-		if err != nil {
-			t.Fatal(err)
-		}
-		defer o.Close()
+		o := mustOptions(t, append([]Option{Bandwidth(0.05), Seed(3), Threads(1), Decimation(2)}, extra...)...)
 		m, err := FitRGBD(context.Background(), staircaseFrame(), o)
 		if err != nil {
 			t.Fatal(err)
@@ -472,11 +432,7 @@ func TestTheDepthFloorIsTheDefaultForFrames(t *testing.T) {
 		}
 		return c
 	}
-	o, err := NewOptions()
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer o.Close()
+	o := mustOptions(t)
 	if v, _ := o.GetI64(OptDequantiseDepth); v != DequantiseAuto {
 		t.Fatalf("default dequantise_depth %v, want DequantiseAuto", v)
 	}

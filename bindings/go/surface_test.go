@@ -45,11 +45,7 @@ func TestPlaneOccupancyDistanceCollision(t *testing.T) {
 	if math.Abs(d[0]-0.3) > 0.005 || math.Abs(d[1]-0.05) > 0.005 || g[2] > -0.98 || g[5] < 0.98 {
 		t.Fatalf("distance %v gradient %v", d, g)
 	}
-	model, err := m.Export(nil)
-	if err != nil {
-		t.Fatal(err)
-	}
-	defer model.Close()
+	model := mustExport(t, m)
 	d2, _, err := model.SurfaceDistance(context.Background(), []float32{0.2, -0.1, 1.7, 0.2, -0.1, 2.05}, nil)
 	if err != nil || d2[0] != d[0] || d2[1] != d[1] {
 		t.Fatalf("model distance %v (%v), map %v", d2, err, d)

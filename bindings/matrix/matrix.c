@@ -45,6 +45,19 @@ static long read_floats(const char* path, float** out) {
   return n;
 }
 
+/* The protocol's fit options in a new *o: bandwidth 0.05, seed 16, one
+ * thread, and `decimation` when > 0. 0, or fail()'s code naming the step. */
+static int protocol_options(sogmm_options** o, int64_t decimation) {
+  sogmm_status st;
+  if ((st = sogmm_options_create(o)) != SOGMM_OK) return fail("options", st);
+  if ((st = sogmm_options_set_f64(*o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) return fail("bandwidth", st);
+  if ((st = sogmm_options_set_i64(*o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) return fail("seed", st);
+  if ((st = sogmm_options_set_i64(*o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) return fail("threads", st);
+  if (decimation > 0 && (st = sogmm_options_set_i64(*o, SOGMM_OPT_DECIMATION, decimation)) != SOGMM_OK)
+    return fail("decimation", st);
+  return 0;
+}
+
 static int write_model(const char* points_path, const char* out_path) {
   float* pts = NULL;
   sogmm_options* o = NULL;
@@ -56,13 +69,10 @@ static int write_model(const char* points_path, const char* out_path) {
     fprintf(stderr, "matrix.c: cannot read %s\n", points_path);
     return 1;
   }
-  if ((st = sogmm_options_create(&o)) != SOGMM_OK) rc = fail("options", st);
-  else if ((st = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) rc = fail("bandwidth", st);
-  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) rc = fail("seed", st);
-  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) rc = fail("threads", st);
-  else if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, NULL, o)) != SOGMM_OK) rc = fail("fit", st);
-  else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
-  else rc = 0;
+  if ((rc = protocol_options(&o, 0)) == 0) {
+    if ((st = sogmm_fit_points_f32(&m, pts, (size_t)n / 4, NULL, o)) != SOGMM_OK) rc = fail("fit", st);
+    else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
+  }
   sogmm_model_free(m);
   sogmm_options_free(o);
   free(pts);
@@ -77,14 +87,10 @@ static int fit_frame(const char* depth_path, const char* color_path, const char*
   int rc = 1;
   if ((st = sogmm_frame_read(&frame, depth_path, color_path)) != SOGMM_OK) rc = fail("frame_read", st);
   else if ((st = sogmm_frame_set_intrinsics(frame, 525.0, 525.0, 319.5, 239.5)) != SOGMM_OK) rc = fail("intrinsics", st);
-  else if ((st = sogmm_options_create(&o)) != SOGMM_OK) rc = fail("options", st);
-  else if ((st = sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05)) != SOGMM_OK) rc = fail("bandwidth", st);
-  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_SEED, 16)) != SOGMM_OK) rc = fail("seed", st);
-  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1)) != SOGMM_OK) rc = fail("threads", st);
-  else if ((st = sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2)) != SOGMM_OK) rc = fail("decimation", st);
-  else if ((st = sogmm_fit_frame(&m, frame, o)) != SOGMM_OK) rc = fail("fit_frame", st);
-  else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
-  else rc = 0;
+  else if ((rc = protocol_options(&o, 2)) == 0) {
+    if ((st = sogmm_fit_frame(&m, frame, o)) != SOGMM_OK) rc = fail("fit_frame", st);
+    else if ((st = sogmm_model_save(m, out_path, NULL)) != SOGMM_OK) rc = fail("save", st);
+  }
   sogmm_model_free(m);
   sogmm_options_free(o);
   sogmm_frame_free(frame);

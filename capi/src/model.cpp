@@ -23,11 +23,21 @@ std::int64_t now_unix_ms() {
   return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
 }
 
-void copy_out(const std::vector<float>& src, float* out, std::size_t capacity, const char* what) {
-  if (capacity < src.size())
-    fail(SOGMM_E_BUFFER_TOO_SMALL, std::string(what) + ": capacity " + std::to_string(capacity) +
-                                       " < " + std::to_string(src.size()) + " floats needed");
-  if (!src.empty()) std::memcpy(out, src.data(), src.size() * sizeof(float));
+/// sogmm_model_get_weights_f32, _means_f32 and _covariances_f32: the
+/// mixture's array `array` (named `what`) copied to `out`, which holds
+/// `capacity` floats.
+sogmm_status get_array(const sogmm_model* model, std::vector<float> sogmm::Gmm::*array, float* out,
+                       std::size_t capacity, const char* what) {
+  SOGMM_TRY {
+    require_nonnull(model, "model");
+    require_nonnull(out, "out");
+    const std::vector<float>& src = model->model.gmm.*array;
+    if (capacity < src.size())
+      fail(SOGMM_E_BUFFER_TOO_SMALL, std::string(what) + ": capacity " + std::to_string(capacity) + " < " +
+                                         std::to_string(src.size()) + " floats needed");
+    if (!src.empty()) std::memcpy(out, src.data(), src.size() * sizeof(float));
+  }
+  SOGMM_CATCH
 }
 
 [[noreturn]] void absent(sogmm_key key, const char* what) {
@@ -86,6 +96,20 @@ std::int64_t info_i64(const sogmm_model& m, sogmm_key key) {
     case SOGMM_INFO_CAMERA_DECIMATION: return camera_info(m, key).decimation;
     default: fail(SOGMM_E_INTERNAL, "info key table out of sync");
   }
+}
+
+/// sogmm_model_get_info_f64 and _i64: the checks every info read makes
+/// (handle, out, a known info key of `type`), then `read` of the key.
+template <typename T>
+sogmm_status get_info(const sogmm_model* model, sogmm_key key, T* out, sogmm_capi::KeyType type,
+                      T (*read)(const sogmm_model&, sogmm_key)) {
+  SOGMM_TRY {
+    require_nonnull(model, "model");
+    require_nonnull(out, "out");
+    sogmm_capi::require_key(key, sogmm_capi::KeyKind::Info, type, "get");
+    *out = read(*model, key);
+  }
+  SOGMM_CATCH
 }
 
 /// The structural checks of sogmm::validate that the C API reports as
@@ -172,51 +196,24 @@ SOGMM_API sogmm_status sogmm_model_n_components(const sogmm_model* model, size_t
 }
 
 SOGMM_API sogmm_status sogmm_model_get_weights_f32(const sogmm_model* model, float* out, size_t capacity) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_nonnull(out, "out");
-    copy_out(model->model.gmm.weights, out, capacity, "weights");
-  }
-  SOGMM_CATCH
+  return get_array(model, &sogmm::Gmm::weights, out, capacity, "weights");
 }
 
 SOGMM_API sogmm_status sogmm_model_get_means_f32(const sogmm_model* model, float* out, size_t capacity) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_nonnull(out, "out");
-    copy_out(model->model.gmm.means, out, capacity, "means");
-  }
-  SOGMM_CATCH
+  return get_array(model, &sogmm::Gmm::means, out, capacity, "means");
 }
 
 SOGMM_API sogmm_status sogmm_model_get_covariances_f32(const sogmm_model* model, float* out,
                                                        size_t capacity) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_nonnull(out, "out");
-    copy_out(model->model.gmm.covariances, out, capacity, "covariances");
-  }
-  SOGMM_CATCH
+  return get_array(model, &sogmm::Gmm::covariances, out, capacity, "covariances");
 }
 
 SOGMM_API sogmm_status sogmm_model_get_info_f64(const sogmm_model* model, sogmm_key key, double* out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_nonnull(out, "out");
-    sogmm_capi::require_key(key, sogmm_capi::KeyKind::Info, sogmm_capi::KeyType::F64, "get");
-    *out = info_f64(*model, key);
-  }
-  SOGMM_CATCH
+  return get_info(model, key, out, sogmm_capi::KeyType::F64, info_f64);
 }
 
 SOGMM_API sogmm_status sogmm_model_get_info_i64(const sogmm_model* model, sogmm_key key, int64_t* out) {
-  SOGMM_TRY {
-    require_nonnull(model, "model");
-    require_nonnull(out, "out");
-    sogmm_capi::require_key(key, sogmm_capi::KeyKind::Info, sogmm_capi::KeyType::I64, "get");
-    *out = info_i64(*model, key);
-  }
-  SOGMM_CATCH
+  return get_info(model, key, out, sogmm_capi::KeyType::I64, info_i64);
 }
 
 SOGMM_API sogmm_status sogmm_model_get_pose(const sogmm_model* model, double* pose_out) {

@@ -60,22 +60,45 @@ static float* query_points(const float* pts, size_t n, int dims) {
   return q;
 }
 
+/* The outputs of n query rows asked twice (w: without, g: with a callback
+ * or from the other handle): scores and regressed means and variances. */
+typedef struct {
+  double *want, *got;
+  float *mean_w, *var_w, *mean_g, *var_g;
+} QueryBuffers;
+
+static QueryBuffers query_buffers(size_t n) {
+  QueryBuffers b;
+  b.want = (double*)malloc(n * sizeof(double));
+  b.got = (double*)malloc(n * sizeof(double));
+  b.mean_w = (float*)malloc(n * sizeof(float));
+  b.var_w = (float*)malloc(n * sizeof(float));
+  b.mean_g = (float*)malloc(n * sizeof(float));
+  b.var_g = (float*)malloc(n * sizeof(float));
+  if (!b.want || !b.got || !b.mean_w || !b.var_w || !b.mean_g || !b.var_g) exit(2);
+  return b;
+}
+
+static void free_query_buffers(QueryBuffers* b) {
+  free(b->want);
+  free(b->got);
+  free(b->mean_w);
+  free(b->var_w);
+  free(b->mean_g);
+  free(b->var_g);
+}
+
 static void equals_exported_model(const sogmm_map* map, const float* pts, size_t n) {
   sogmm_model* model = NULL;
   sogmm_options* po = NULL;
   Recorder rec;
   float* q3 = query_points(pts, n, 3);
   float* q4 = query_points(pts, n, 4);
-  double* want = (double*)malloc(n * sizeof(double));
-  double* got = (double*)malloc(n * sizeof(double));
-  float* mean_w = (float*)malloc(n * sizeof(float));
-  float* var_w = (float*)malloc(n * sizeof(float));
-  float* mean_g = (float*)malloc(n * sizeof(float));
-  float* var_g = (float*)malloc(n * sizeof(float));
+  QueryBuffers b = query_buffers(n);
   float* s_w = (float*)malloc(n * 4 * sizeof(float));
   float* s_g = (float*)malloc(n * 4 * sizeof(float));
   int dims;
-  if (!want || !got || !mean_w || !var_w || !mean_g || !var_g || !s_w || !s_g) exit(2);
+  if (!s_w || !s_g) exit(2);
 
   REQUIRE_OK(sogmm_map_export(&model, map, NULL));
   REQUIRE_OK(sogmm_options_create(&po));
@@ -83,27 +106,27 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
 
   for (dims = 3; dims <= 4; ++dims) {
     const float* q = dims == 3 ? q3 : q4;
-    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, NULL, want));
-    REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, NULL, got));
-    EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
+    REQUIRE_OK(sogmm_model_score_samples_f32(model, q, n, dims, NULL, b.want));
+    REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, NULL, b.got));
+    EXPECT_TRUE(memcmp(b.want, b.got, n * sizeof(double)) == 0);
     /* With a callback: in chunks, the same bits; reports of SCORING up to n. */
     memset(&rec, 0, sizeof rec);
-    memset(got, 0, n * sizeof(double));
-    REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, po, got));
-    EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
+    memset(b.got, 0, n * sizeof(double));
+    REQUIRE_OK(sogmm_map_score_samples_f32(map, q, n, dims, po, b.got));
+    EXPECT_TRUE(memcmp(b.want, b.got, n * sizeof(double)) == 0);
     EXPECT_TRUE(rec.n >= 2 && rec.first_stage == SOGMM_STAGE_SCORING && rec.last_stage == SOGMM_STAGE_SCORING);
     EXPECT_TRUE(rec.last_step == n && rec.last_total == n && !rec.decreasing);
   }
   /* A far point really is far: the test covers both regimes. */
-  EXPECT_TRUE(want[0] < want[1] - 50.0);
+  EXPECT_TRUE(b.want[0] < b.want[1] - 50.0);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
-  REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, NULL, mean_g, var_g));
-  EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, b.mean_w, b.var_w));
+  REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, NULL, b.mean_g, b.var_g));
+  EXPECT_TRUE(memcmp(b.mean_w, b.mean_g, n * sizeof(float)) == 0 && memcmp(b.var_w, b.var_g, n * sizeof(float)) == 0);
   memset(&rec, 0, sizeof rec);
-  memset(mean_g, 0, n * sizeof(float));
-  REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, po, mean_g, NULL)); /* variance optional */
-  EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0);
+  memset(b.mean_g, 0, n * sizeof(float));
+  REQUIRE_OK(sogmm_map_regress_gray_f32(map, q3, n, po, b.mean_g, NULL)); /* variance optional */
+  EXPECT_TRUE(memcmp(b.mean_w, b.mean_g, n * sizeof(float)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_REGRESSION && rec.last_step == n && !rec.decreasing);
 
   for (dims = 3; dims <= 4; ++dims) {
@@ -122,15 +145,15 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
   /* Cancel: SOGMM_E_CANCELLED, the message names the stage, outputs untouched. */
   memset(&rec, 0, sizeof rec);
   rec.cancel = 1;
-  memset(got, 0x7f, n * sizeof(double));
-  EXPECT_STATUS(sogmm_map_score_samples_f32(map, q4, n, 4, po, got), SOGMM_E_CANCELLED);
+  memset(b.got, 0x7f, n * sizeof(double));
+  EXPECT_STATUS(sogmm_map_score_samples_f32(map, q4, n, 4, po, b.got), SOGMM_E_CANCELLED);
   EXPECT_TRUE(message_has("scoring") && rec.n == 1);
-  EXPECT_TRUE(got[0] == got[n - 1] && ((const unsigned char*)got)[0] == 0x7f);
-  memset(mean_g, 0x7f, n * sizeof(float));
-  memset(var_g, 0x7f, n * sizeof(float));
-  EXPECT_STATUS(sogmm_map_regress_gray_f32(map, q3, n, po, mean_g, var_g), SOGMM_E_CANCELLED);
+  EXPECT_TRUE(b.got[0] == b.got[n - 1] && ((const unsigned char*)b.got)[0] == 0x7f);
+  memset(b.mean_g, 0x7f, n * sizeof(float));
+  memset(b.var_g, 0x7f, n * sizeof(float));
+  EXPECT_STATUS(sogmm_map_regress_gray_f32(map, q3, n, po, b.mean_g, b.var_g), SOGMM_E_CANCELLED);
   EXPECT_TRUE(message_has("regression"));
-  EXPECT_TRUE(((const unsigned char*)mean_g)[0] == 0x7f && ((const unsigned char*)var_g)[4 * n - 1] == 0x7f);
+  EXPECT_TRUE(((const unsigned char*)b.mean_g)[0] == 0x7f && ((const unsigned char*)b.var_g)[4 * n - 1] == 0x7f);
   memset(s_g, 0x7f, n * 4 * sizeof(float));
   EXPECT_STATUS(sogmm_map_sample_f32(map, n, 7, 4, po, s_g), SOGMM_E_CANCELLED);
   EXPECT_TRUE(message_has("sampling") && ((const unsigned char*)s_g)[0] == 0x7f);
@@ -139,12 +162,7 @@ static void equals_exported_model(const sogmm_map* map, const float* pts, size_t
   sogmm_model_free(model);
   free(q3);
   free(q4);
-  free(want);
-  free(got);
-  free(mean_w);
-  free(var_w);
-  free(mean_g);
-  free(var_g);
+  free_query_buffers(&b);
   free(s_w);
   free(s_g);
 }
@@ -317,53 +335,42 @@ static void model_with_progress(const sogmm_map* map, const float* pts, size_t n
   sogmm_options* po = NULL;
   Recorder rec;
   float* q3 = query_points(pts, n, 3);
-  double* want = (double*)malloc(n * sizeof(double));
-  double* got = (double*)malloc(n * sizeof(double));
-  float* mean_w = (float*)malloc(n * sizeof(float));
-  float* var_w = (float*)malloc(n * sizeof(float));
-  float* mean_g = (float*)malloc(n * sizeof(float));
-  float* var_g = (float*)malloc(n * sizeof(float));
-  if (!want || !got || !mean_w || !var_w || !mean_g || !var_g) exit(2);
+  QueryBuffers b = query_buffers(n);
   REQUIRE_OK(sogmm_map_export(&model, map, NULL));
   REQUIRE_OK(sogmm_options_create(&po));
   REQUIRE_OK(sogmm_options_set_progress(po, record, &rec));
 
-  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, NULL, want));
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, NULL, b.want));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, po, got));
-  EXPECT_TRUE(memcmp(want, got, n * sizeof(double)) == 0);
+  REQUIRE_OK(sogmm_model_score_samples_f32(model, q3, n, 3, po, b.got));
+  EXPECT_TRUE(memcmp(b.want, b.got, n * sizeof(double)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_SCORING && rec.last_step == n && rec.last_total == n);
 
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, mean_w, var_w));
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, NULL, b.mean_w, b.var_w));
   memset(&rec, 0, sizeof rec);
-  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, var_g));
-  EXPECT_TRUE(memcmp(mean_w, mean_g, n * sizeof(float)) == 0 && memcmp(var_w, var_g, n * sizeof(float)) == 0);
+  REQUIRE_OK(sogmm_model_regress_gray_f32(model, q3, n, po, b.mean_g, b.var_g));
+  EXPECT_TRUE(memcmp(b.mean_w, b.mean_g, n * sizeof(float)) == 0 && memcmp(b.var_w, b.var_g, n * sizeof(float)) == 0);
   EXPECT_TRUE(rec.first_stage == SOGMM_STAGE_REGRESSION && rec.last_step == n && !rec.decreasing);
 
   rec.cancel = 1;
-  memset(got, 0x7f, n * sizeof(double));
-  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 3, po, got), SOGMM_E_CANCELLED);
-  EXPECT_TRUE(((const unsigned char*)got)[8 * n - 1] == 0x7f);
-  memset(mean_g, 0x7f, n * sizeof(float));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_CANCELLED);
-  EXPECT_TRUE(((const unsigned char*)mean_g)[0] == 0x7f);
+  memset(b.got, 0x7f, n * sizeof(double));
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 3, po, b.got), SOGMM_E_CANCELLED);
+  EXPECT_TRUE(((const unsigned char*)b.got)[8 * n - 1] == 0x7f);
+  memset(b.mean_g, 0x7f, n * sizeof(float));
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, b.mean_g, NULL), SOGMM_E_CANCELLED);
+  EXPECT_TRUE(((const unsigned char*)b.mean_g)[0] == 0x7f);
   /* Bad input, with and without options. */
-  EXPECT_STATUS(sogmm_model_score_samples_f32(NULL, q3, n, 3, NULL, got), SOGMM_E_NULL_ARG);
-  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 5, NULL, got), SOGMM_E_INVALID_ARG);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(NULL, q3, n, 3, NULL, b.got), SOGMM_E_NULL_ARG);
+  EXPECT_STATUS(sogmm_model_score_samples_f32(model, q3, n, 5, NULL, b.got), SOGMM_E_INVALID_ARG);
   EXPECT_OK(sogmm_model_regress_gray_f32(model, NULL, 0, po, NULL, NULL));
-  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, (size_t)-1 / 2, NULL, mean_g, NULL), SOGMM_E_LIMIT);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, (size_t)-1 / 2, NULL, b.mean_g, NULL), SOGMM_E_LIMIT);
   q3[4] = NAN;
-  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, mean_g, NULL), SOGMM_E_INVALID_DATA);
+  EXPECT_STATUS(sogmm_model_regress_gray_f32(model, q3, n, po, b.mean_g, NULL), SOGMM_E_INVALID_DATA);
 
   sogmm_options_free(po);
   sogmm_model_free(model);
   free(q3);
-  free(want);
-  free(got);
-  free(mean_w);
-  free(var_w);
-  free(mean_g);
-  free(var_g);
+  free_query_buffers(&b);
 }
 
 int main(void) {

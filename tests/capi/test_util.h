@@ -190,37 +190,37 @@ static inline sogmm_frame* test_frame(const uint16_t* depth, const void* color, 
   return f;
 }
 
+/* The body of the three wrappers below: `call` (a status expression on the
+ * frame f) run on test_frame(...) of the wrapper's own arguments; the frame
+ * is freed and the first status that is not SOGMM_OK returned. */
+#define ON_TEST_FRAME(call)                                                            \
+  do {                                                                                 \
+    sogmm_status s_;                                                                   \
+    sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s_); \
+    if (s_ == SOGMM_OK) s_ = (call);                                                   \
+    sogmm_frame_free(f);                                                               \
+    return s_;                                                                         \
+  } while (0)
+
 /* sogmm_fit_frame, sogmm_map_insert_frame and sogmm_frame_to_points_f32 on
  * test_frame(...): the first status that is not SOGMM_OK. */
 static inline sogmm_status test_fit_rgbd(sogmm_model** out, const uint16_t* depth, const void* color,
                                          int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
                                          double cx, double cy, const sogmm_options* options) {
-  sogmm_status s;
-  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
-  if (s == SOGMM_OK) s = sogmm_fit_frame(out, f, options);
-  sogmm_frame_free(f);
-  return s;
+  ON_TEST_FRAME(sogmm_fit_frame(out, f, options));
 }
 
 static inline sogmm_status test_map_insert_rgbd(sogmm_map* map, const uint16_t* depth, const void* color,
                                                 int32_t color_format, uint32_t w, uint32_t h, double fx, double fy,
                                                 double cx, double cy, const double* pose) {
-  sogmm_status s;
-  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
-  if (s == SOGMM_OK) s = sogmm_map_insert_frame(map, f, pose);
-  sogmm_frame_free(f);
-  return s;
+  ON_TEST_FRAME(sogmm_map_insert_frame(map, f, pose));
 }
 
 static inline sogmm_status test_rgbd_to_points(float* out, size_t capacity, size_t* n_points, const uint16_t* depth,
                                                const void* color, int32_t color_format, uint32_t w, uint32_t h,
                                                double fx, double fy, double cx, double cy,
                                                const sogmm_options* options) {
-  sogmm_status s;
-  sogmm_frame* f = test_frame(depth, color, color_format, w, h, fx, fy, cx, cy, &s);
-  if (s == SOGMM_OK) s = sogmm_frame_to_points_f32(out, capacity, n_points, f, options);
-  sogmm_frame_free(f);
-  return s;
+  ON_TEST_FRAME(sogmm_frame_to_points_f32(out, capacity, n_points, f, options));
 }
 
 /* A fixed-K fit: sogmm_fit_points_f32 with SOGMM_OPT_N_COMPONENTS = k on a

@@ -1,5 +1,5 @@
-// Row-major 4 x 4 poses as Eigen matrices, and the error of an estimate
-// against the truth (the registration tests).
+// Row-major 4 x 4 poses as Eigen matrices, built from a rotation and a
+// translation, and the error of an estimate against the truth.
 #pragma once
 
 #include <Eigen/Dense>
@@ -14,6 +14,17 @@ inline Eigen::Matrix4d pose_matrix(const std::array<double, 16>& p) {
   Eigen::Matrix4d m;
   for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = p[i];
   return m;
+}
+
+/// The pose [r t; 0 1].
+inline std::array<double, 16> pose_of(const Eigen::Matrix3d& r, const Eigen::Vector3d& t) {
+  std::array<double, 16> p{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) p[4 * i + j] = r(i, j);
+    p[4 * i + 3] = t(i);
+  }
+  p[15] = 1.0;
+  return p;
 }
 
 inline std::array<double, 16> pose_array(const Eigen::Matrix4d& m) {

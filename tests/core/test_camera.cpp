@@ -12,15 +12,24 @@
 #include "sogmm/camera.hpp"
 #include "test_util.hpp"
 
+namespace {
+
+// Every field of `c` against `want` (size exactly, intrinsics within 4 ULP).
+void expect_camera(const sogmm::Camera& c, const sogmm::Camera& want) {
+  EXPECT_EQ(c.width, want.width);
+  EXPECT_EQ(c.height, want.height);
+  EXPECT_DOUBLE_EQ(c.fx, want.fx);
+  EXPECT_DOUBLE_EQ(c.fy, want.fy);
+  EXPECT_DOUBLE_EQ(c.cx, want.cx);
+  EXPECT_DOUBLE_EQ(c.cy, want.cy);
+}
+
+}  // namespace
+
 TEST(Camera, DecimatedIntrinsics) {
   const sogmm::Camera c{640, 480, 525.0, 520.0, 319.5, 239.5};
   const sogmm::Camera d = sogmm::decimated(c, 5);
-  EXPECT_EQ(d.width, 128);
-  EXPECT_EQ(d.height, 96);
-  EXPECT_DOUBLE_EQ(d.fx, 105.0);
-  EXPECT_DOUBLE_EQ(d.fy, 104.0);
-  EXPECT_DOUBLE_EQ(d.cx, 63.9);
-  EXPECT_DOUBLE_EQ(d.cy, 47.9);
+  expect_camera(d, {128, 96, 105.0, 104.0, 63.9, 47.9});
   const sogmm::Camera odd = sogmm::decimated(sogmm::Camera{643, 481, 500, 500, 321, 240}, 5);
   EXPECT_EQ(odd.width, 128);
   EXPECT_EQ(odd.height, 96);
@@ -163,12 +172,7 @@ TEST(Camera, ParseOpen3dIntrinsicsColumnMajor) {
   const std::string text =
       R"({"width": 640, "height": 480, "intrinsic_matrix": [500.0, 0, 0, 0, 510.0, 0, 320.5, 240.25, 1]})";
   const sogmm::Camera c = sogmm::parse_intrinsics_json(text);
-  EXPECT_EQ(c.width, 640);
-  EXPECT_EQ(c.height, 480);
-  EXPECT_DOUBLE_EQ(c.fx, 500.0);
-  EXPECT_DOUBLE_EQ(c.fy, 510.0);
-  EXPECT_DOUBLE_EQ(c.cx, 320.5);
-  EXPECT_DOUBLE_EQ(c.cy, 240.25);
+  expect_camera(c, {640, 480, 500.0, 510.0, 320.5, 240.25});
 }
 
 TEST(Camera, ReadIntrinsicsFile) {
@@ -180,10 +184,5 @@ TEST(Camera, ReadIntrinsicsFile) {
   }
   const sogmm::Camera c = sogmm::read_intrinsics_json(path);
   std::remove(path.c_str());
-  EXPECT_EQ(c.width, 320);
-  EXPECT_EQ(c.height, 240);
-  EXPECT_DOUBLE_EQ(c.fx, 262.5);
-  EXPECT_DOUBLE_EQ(c.fy, 263.0);
-  EXPECT_DOUBLE_EQ(c.cx, 159.5);
-  EXPECT_DOUBLE_EQ(c.cy, 119.5);
+  expect_camera(c, {320, 240, 262.5, 263.0, 159.5, 119.5});
 }

@@ -144,10 +144,7 @@ struct WarmSequence {
 };
 
 TEST(MapTest, WarmStartFitsEachFrameFromThePreviousOne) {
-  const WarmSequence w;
-  const auto& frames = w.frames;
-  const auto& poses = w.poses;
-  const MapOptions& o = w.o;
+  const auto& [frames, poses, o] = WarmSequence();
   Map map(o);
   sogmm::Gmm previous;
   std::vector<float> expected_means;
@@ -175,10 +172,7 @@ TEST(MapTest, WarmStartFitsEachFrameFromThePreviousOne) {
 // warm-starts from the last saved fit (recovered from the per-frame
 // component counts): nearly the fit the unsaved map makes, not a cold one.
 TEST(MapTest, WarmStartSurvivesSaveAndLoad) {
-  const WarmSequence w;
-  const auto& frames = w.frames;
-  const auto& poses = w.poses;
-  const MapOptions& o = w.o;
+  const auto& [frames, poses, o] = WarmSequence();
   Map map(o);
   map.insert_points(view(frames[0]), poses[0]);
   map.insert_points(view(frames[1]), poses[1]);

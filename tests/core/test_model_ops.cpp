@@ -5,10 +5,12 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <vector>
 
 #include "sogmm/inference.hpp"
 #include "sogmm/model.hpp"
+#include "pose_util.hpp"
 #include "test_util.hpp"
 
 using sogmm_test::cov_of;
@@ -43,15 +45,25 @@ sogmm::Gmm model_b() {
 
 }  // namespace
 
+namespace {
+// The weights of m, each within 1e-7 of `want` (exact ratios stored as float).
+void expect_weights(const sogmm::Gmm& m, std::initializer_list<double> want) {
+  ASSERT_EQ(m.weights.size(), want.size());
+  std::size_t k = 0;
+  for (double w : want) {
+    EXPECT_NEAR(m.weights[k], w, 1e-7) << "weight " << k;
+    ++k;
+  }
+}
+}  // namespace
+
 TEST(Merge, ReweightsBySupportSize) {
   const sogmm::Gmm a = model_a(), b = model_b();
   const sogmm::Gmm m = sogmm::merge(a, b);
   ASSERT_EQ(m.size(), 3u);
   EXPECT_EQ(m.support_size, 400u);
   // 0.25 * 100/400, 0.75 * 100/400, 1 * 300/400
-  EXPECT_NEAR(m.weights[0], 0.0625, 1e-7);
-  EXPECT_NEAR(m.weights[1], 0.1875, 1e-7);
-  EXPECT_NEAR(m.weights[2], 0.75, 1e-7);
+  expect_weights(m, {0.0625, 0.1875, 0.75});
   for (int i = 0; i < 8; ++i) EXPECT_EQ(m.means[i], a.means[i]);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(m.means[8 + i], b.means[i]);
   for (int i = 0; i < 32; ++i) EXPECT_EQ(m.covariances[i], a.covariances[i]);
@@ -66,9 +78,7 @@ TEST(Merge, ZeroSupportCountsEqually) {
   const sogmm::Gmm m = sogmm::merge(a, b);
   ASSERT_EQ(m.size(), 3u);
   EXPECT_EQ(m.support_size, 0u);
-  EXPECT_NEAR(m.weights[0], 0.125, 1e-7);
-  EXPECT_NEAR(m.weights[1], 0.375, 1e-7);
-  EXPECT_NEAR(m.weights[2], 0.5, 1e-7);
+  expect_weights(m, {0.125, 0.375, 0.5});
 }
 
 TEST(Merge, DensityIsSupportWeightedAverage) {
@@ -85,17 +95,7 @@ TEST(Merge, DensityIsSupportWeightedAverage) {
   }
 }
 
-namespace {
-std::array<double, 16> pose_of(const Eigen::Matrix3d& r, const Eigen::Vector3d& t) {
-  std::array<double, 16> p{};
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) p[4 * i + j] = r(i, j);
-    p[4 * i + 3] = t(i);
-  }
-  p[15] = 1.0;
-  return p;
-}
-}  // namespace
+using sogmm_test::pose_of;
 
 TEST(Transform, ClosedForm) {
   const sogmm::Gmm a = model_a();

@@ -13,6 +13,7 @@
 #include "sogmm/inference.hpp"
 #include "sogmm/model.hpp"
 #include "sogmm/render.hpp"
+#include "pose_util.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -233,15 +234,7 @@ TEST(Render, MovingModelAndPoseTogetherRendersTheSameImages) {
   // and the pose: the camera sees the same scene.
   const Eigen::Matrix3d Rc = Eigen::AngleAxisd(0.2, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::Matrix3d Rt = Eigen::AngleAxisd(-1.1, Eigen::Vector3d(-2, 1, 0.5).normalized()).toRotationMatrix();
-  auto pose_of = [](const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
-    std::array<double, 16> p{};
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) p[4 * i + j] = R(i, j);
-      p[4 * i + 3] = t(i);
-    }
-    p[15] = 1;
-    return p;
-  };
+  using sogmm_test::pose_of;
   const std::array<double, 16> camera = pose_of(Rc, Eigen::Vector3d(0.05, -0.02, -0.1));
   const std::array<double, 16> motion = pose_of(Rt, Eigen::Vector3d(1.5, -0.7, 0.3));
   const sogmm::Gmm world = sogmm::transform(g, camera);  // the scene in world coordinates

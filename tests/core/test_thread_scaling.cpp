@@ -39,6 +39,16 @@ std::vector<float> drawn_points(const sogmm::Gmm& g, std::size_t n, std::uint64_
   return pts;
 }
 
+// The loop accounting after an exact score of the rows of pts (x, y, z, gray)
+// under g on `threads` threads: two loops, the model's packing and the points.
+sogmm::LoopAccounting accounting_after_score(const sogmm::Gmm& g, const std::vector<float>& pts, int threads) {
+  std::vector<double> s(pts.size() / 4);
+  sogmm::QueryOptions o;
+  o.threads = threads;
+  sogmm::score_samples(g, pts.data(), s.size(), 4, s.data(), o);
+  return sogmm::loop_accounting();
+}
+
 TEST(ThreadScaling, CulledQueriesBitwiseIdenticalForAnyTeamOnLargeInputs) {
   const sogmm::Gmm g = scattered_model(17);
   const std::size_t n = 20000;
@@ -78,8 +88,7 @@ TEST(ThreadScaling, LoopAccountingCountsOnlyWhenOn) {
   // Off: nothing is counted.
   sogmm::set_loop_accounting(false);
   const sogmm::LoopAccounting a0 = sogmm::loop_accounting();
-  sogmm::score_samples(g, pts.data(), n, 4, s.data(), o);
-  const sogmm::LoopAccounting a1 = sogmm::loop_accounting();
+  const sogmm::LoopAccounting a1 = accounting_after_score(g, pts, 1);
   EXPECT_EQ(a1.loops, a0.loops);
   EXPECT_EQ(a1.cpu_seconds_in_loops, a0.cpu_seconds_in_loops);
   // On: an exact score is two loops (the model's packing and the points),
@@ -125,20 +134,14 @@ TEST(ThreadScaling, TeamSplitAddsUpToTheWallTime) {
   const sogmm::Gmm g = scattered_model(23);
   const std::size_t n = 20000;
   const std::vector<float> pts = drawn_points(g, n, 24);
-  std::vector<double> s(n);
-  sogmm::QueryOptions o;
   sogmm::set_loop_accounting(true);
   // One thread: no team loop.
-  o.threads = 1;
   const sogmm::LoopAccounting a0 = sogmm::loop_accounting();
-  sogmm::score_samples(g, pts.data(), n, 4, s.data(), o);
-  const sogmm::LoopAccounting a1 = sogmm::loop_accounting();
+  const sogmm::LoopAccounting a1 = accounting_after_score(g, pts, 1);
   EXPECT_EQ(a1.team_loops, a0.team_loops);
   EXPECT_EQ(a1.team_wall_seconds, a0.team_wall_seconds);
   // Two threads: each of the score's two loops is a team loop.
-  o.threads = 2;
-  sogmm::score_samples(g, pts.data(), n, 4, s.data(), o);
-  const sogmm::LoopAccounting a2 = sogmm::loop_accounting();
+  const sogmm::LoopAccounting a2 = accounting_after_score(g, pts, 2);
   EXPECT_EQ(a2.team_loops - a1.team_loops, 2u);
   expect_split_adds_up(a1, a2);
   // A fit on two threads: its k-means++ steps run as stages of one region.

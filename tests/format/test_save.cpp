@@ -11,6 +11,7 @@
 
 #include "internal.hpp"
 #include "sogmm/format.hpp"
+#include "scratch_dir_test.hpp"
 #include "test_support.hpp"
 
 namespace sogmm {
@@ -18,16 +19,13 @@ namespace {
 
 using format::detail::SaveStage;
 
-class Save : public ::testing::Test {
+class Save : public test::ScratchDirTest {
  protected:
-  void SetUp() override { dir_ = test::make_scratch_dir("sogmm-format-test"); }
+  Save() : ScratchDirTest("sogmm-format-test") {}
   void TearDown() override {
     format::detail::set_save_fault_hook(nullptr);
-    test::remove_scratch_dir(dir_);
+    ScratchDirTest::TearDown();
   }
-  std::vector<std::string> files() const { return test::list_dir(dir_); }
-  static std::vector<std::uint8_t> slurp(const std::string& path) { return test::read_file_bytes(path); }
-  std::string dir_;
 };
 
 TEST_F(Save, SaveLoadRoundTrip) {

@@ -21,18 +21,16 @@
 #include "internal.hpp"
 #include "sogmm/format.hpp"
 #include "sogmm/sogmm.h"
+#include "scratch_dir_test.hpp"
 #include "test_support.hpp"
 
 namespace {
 
 namespace fmt = sogmm::format;
 
-class Faults : public ::testing::Test {
+class Faults : public sogmm::test::ScratchDirTest {
  protected:
-  void SetUp() override { dir_ = sogmm::test::make_scratch_dir("sogmm-hardening"); }
-  void TearDown() override { sogmm::test::remove_scratch_dir(dir_); }
-  std::vector<std::string> files() const { return sogmm::test::list_dir(dir_); }
-  static std::vector<std::uint8_t> slurp(const std::string& path) { return sogmm::test::read_file_bytes(path); }
+  Faults() : ScratchDirTest("sogmm-hardening") {}
   static sogmm_model* capi_model(std::size_t m, std::uint32_t seed) {
     const sogmm::Model src = sogmm::test::synthetic_model(m, seed, false);
     sogmm_model* h = nullptr;
@@ -42,7 +40,6 @@ class Faults : public ::testing::Test {
         << sogmm_last_error();
     return h;
   }
-  std::string dir_;
 };
 
 TEST_F(Faults, SaveIntoAReadOnlyFileSystemFailsCleanly) {

@@ -22,18 +22,16 @@
 #include "memory_probe.hpp"
 #include "sogmm/format.hpp"
 #include "sogmm/sogmm.h"
+#include "scratch_dir_test.hpp"
 #include "test_support.hpp"
 
 namespace {
 
 namespace fmt = sogmm::format;
 
-class SavePaths : public ::testing::Test {
+class SavePaths : public sogmm::test::ScratchDirTest {
  protected:
-  void SetUp() override { dir_ = sogmm::test::make_scratch_dir("sogmm-save-paths"); }
-  void TearDown() override { sogmm::test::remove_scratch_dir(dir_); }
-  std::vector<std::string> files() const { return sogmm::test::list_dir(dir_); }
-  static std::vector<std::uint8_t> slurp(const std::string& path) { return sogmm::test::read_file_bytes(path); }
+  SavePaths() : ScratchDirTest("sogmm-save-paths") {}
   static bool is_link(const std::string& path) {
     struct stat st;
     return ::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode);
@@ -43,7 +41,6 @@ class SavePaths : public ::testing::Test {
     const ssize_t n = ::readlink(path.c_str(), buf, sizeof buf);
     return n < 0 ? std::string() : std::string(buf, static_cast<std::size_t>(n));
   }
-  std::string dir_;
 };
 
 using sogmm::test::peak_bytes;

@@ -754,22 +754,15 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sogmm", required=True)
     ap.add_argument("--data", required=True)
-    ap.add_argument("--mode", required=True, choices=["help", "errors", "synthetic", "sequence", "map", "deltas", "shared"])
+    # Every mode but "shared" (which needs the data folder) takes only the scratch folder.
+    modes = {"help": mode_help, "errors": mode_errors, "synthetic": mode_synthetic, "sequence": mode_sequence,
+             "map": mode_map, "deltas": mode_deltas}
+    ap.add_argument("--mode", required=True, choices=list(modes) + ["shared"])
     a = ap.parse_args()
     SOGMM = a.sogmm
     with tempfile.TemporaryDirectory(prefix="sogmm_cli_test_") as tmp:
-        if a.mode == "help":
-            mode_help(tmp)
-        elif a.mode == "errors":
-            mode_errors(tmp)
-        elif a.mode == "synthetic":
-            mode_synthetic(tmp)
-        elif a.mode == "sequence":
-            mode_sequence(tmp)
-        elif a.mode == "map":
-            mode_map(tmp)
-        elif a.mode == "deltas":
-            mode_deltas(tmp)
+        if a.mode in modes:
+            modes[a.mode](tmp)
         elif mode_shared(tmp, a.data) == "skip":
             return 0
     if FAILURES:

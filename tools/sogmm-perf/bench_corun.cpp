@@ -18,12 +18,12 @@
 // Usage: sogmm-corun [--repeat 7]; prints one JSON line.
 #include <omp.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
+#include "median.hpp"
 
 namespace {
 
@@ -31,10 +31,7 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using sogmm::perf::median;
 
 // Eight independent chains, so the FP units, not latency, bound it.
 double alu_work() {

@@ -25,7 +25,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "image_io.hpp"
+#include "frame_flags.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/em.hpp"
 #include "sogmm/fit.hpp"
@@ -47,15 +47,11 @@ double cpu_seconds() {
 int main(int argc, char** argv) {
   using namespace sogmm;
   CLI::App app{"sogmm-bench-estep: truncated vs dense E-step pair rate"};
-  std::string depth, color, intrinsics;
-  DepthOptions opt;
+  perf::FrameFlags in;
   FitOptions fit_options;
   double nats = 20.0;
   int iterations = 20, repeats = 5;
-  app.add_option("--depth", depth)->required();
-  app.add_option("--color", color)->required();
-  app.add_option("--intrinsics", intrinsics)->required();
-  app.add_option("--decimate", opt.decimate);
+  in.add_to(app);
   app.add_option("--bandwidth", fit_options.bandwidth);
   app.add_option("--threads", fit_options.em.threads);
   app.add_option("--seed", fit_options.seed);
@@ -66,8 +62,7 @@ int main(int argc, char** argv) {
   app.add_flag("--truncated-only", truncated_only, "run only the truncated E-step (for profiling)");
   CLI11_PARSE(app, argc, argv);
 
-  const tools::LoadedFrame frame = tools::load_frame(depth, color);
-  const PointCloud cloud = backproject(frame.view(read_intrinsics_json(intrinsics)), opt);
+  const PointCloud cloud = in.cloud();
   FitOptions count_only = fit_options;  // only M is wanted: one EM iteration
   count_only.em.max_iter = 1;
   const FitResult fitted = fit(cloud.view(), count_only);

@@ -33,7 +33,7 @@
 #include <CLI/CLI.hpp>
 
 #include "eval_pixels.hpp"
-#include "image_io.hpp"
+#include "frame_flags.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
@@ -97,14 +97,11 @@ std::string cpu_json(const std::string& stage, const CpuMark& a, const CpuMark& 
 int main(int argc, char** argv) {
   using namespace sogmm;
   CLI::App app{"sogmm-perf: time one fit and its inference stages"};
-  std::string depth, color, intrinsics, dump;
-  DepthOptions opt;
+  perf::FrameFlags in;
+  std::string dump;
   FitOptions fit_options;
-  app.add_option("--depth", depth)->required();
-  app.add_option("--color", color)->required();
-  app.add_option("--intrinsics", intrinsics)->required();
-  app.add_option("--decimate", opt.decimate);
-  app.add_option("--depth-scale", opt.depth_scale);
+  in.add_to(app);
+  app.add_option("--depth-scale", in.depth_options.depth_scale);
   app.add_option("--bandwidth", fit_options.bandwidth);
   app.add_option("--threads", fit_options.em.threads);
   app.add_option("--seed", fit_options.seed);
@@ -114,9 +111,8 @@ int main(int argc, char** argv) {
   app.add_option("--dump-points", dump, "write N x 4 float32 points, then the seed indices (uint64) to FILE");
   CLI11_PARSE(app, argc, argv);
 
-  const tools::LoadedFrame frame = tools::load_frame(depth, color);
-  const Camera camera = read_intrinsics_json(intrinsics);
-  const PointCloud cloud = backproject(frame.view(camera), opt);
+  const Camera camera = in.camera();
+  const PointCloud cloud = in.cloud();
   // The CPU clocks at the start of each stage (the progress reports come on
   // this thread), then at the end of the fit.
   set_loop_accounting(true);
@@ -190,10 +186,10 @@ int main(int argc, char** argv) {
   sample(r.gmm, n, 1, 4, samples.data());
   const double s_sample = std::chrono::duration<double>(clock::now() - t).count();
   t = clock::now();
-  const PsnrResult p = psnr(r.gmm, cloud.view(), decimated(camera, opt.decimate));
+  const PsnrResult p = psnr(r.gmm, cloud.view(), decimated(camera, in.depth_options.decimate));
   const ReconstructionResult rec = reconstruction_metrics(r.gmm, cloud.view(), 0.01, 0);
   const double s_metrics = std::chrono::duration<double>(clock::now() - t).count();
-  const tools::PixelFigures held = tools::pixel_figures(r.gmm, frame, camera, opt, 1.0, 0.0);
+  const tools::PixelFigures held = tools::pixel_figures(r.gmm, in.frame(), camera, in.depth_options, 1.0, 0.0);
 
   if (!dump.empty()) {
     // Points and the k-means++ seeds of this fit, for the scikit-learn peer.

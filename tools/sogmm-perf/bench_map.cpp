@@ -28,25 +28,22 @@
 #include "image_io.hpp"
 #include "sequence.hpp"
 #include "sogmm/map.hpp"
+#include "median.hpp"
 
 namespace {
 
 using sogmm::Pose;
+
+using sogmm::perf::median;
 
 template <typename F>
 double median_ms(std::vector<double>& ms, F&& f) {
   const auto t = std::chrono::steady_clock::now();
   f();
   ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
-  std::vector<double> s = ms;
-  std::sort(s.begin(), s.end());
-  return s[s.size() / 2];
+  return median(ms);
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 // A point on the room's surface: face f (0..5), coordinates (a, b) in [0, 1).
 void surface_point(int face, double a, double b, double p[3], int* normal_axis) {

@@ -28,13 +28,11 @@
 
 #include "sogmm/format.hpp"
 #include "sogmm/inference.hpp"
+#include "median.hpp"
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using sogmm::perf::median;
 
 double ms(const std::function<void()>& f) {
   const auto t = std::chrono::steady_clock::now();

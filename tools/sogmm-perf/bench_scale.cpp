@@ -6,19 +6,20 @@
 //
 // Usage: sogmm-bench-scale --depth D --color C --intrinsics J [--decimate 5]
 //        [--bandwidth 0.02] [--repeats 7] [--threads 1]
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "image_io.hpp"
+#include "frame_flags.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
 #include "sogmm/kmeanspp.hpp"
 #include "sogmm/mean_shift.hpp"
+#include "median.hpp"
 
 namespace {
 
@@ -30,8 +31,7 @@ double median_ms(int repeats, F&& f) {
     f();
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
   }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  return sogmm::perf::median(std::move(ms));
 }
 
 }  // namespace
@@ -39,23 +39,18 @@ double median_ms(int repeats, F&& f) {
 int main(int argc, char** argv) {
   using namespace sogmm;
   CLI::App app{"sogmm-bench-scale: mode count with a far outlier, k-means++ share of the fit"};
-  std::string depth, color, intrinsics;
-  DepthOptions opt;
-  opt.decimate = 5;
+  perf::FrameFlags in;
+  in.depth_options.decimate = 5;
   FitOptions fit_options;
   fit_options.em.threads = 1;
   int repeats = 7;
-  app.add_option("--depth", depth)->required();
-  app.add_option("--color", color)->required();
-  app.add_option("--intrinsics", intrinsics)->required();
-  app.add_option("--decimate", opt.decimate);
+  in.add_to(app);
   app.add_option("--bandwidth", fit_options.bandwidth);
   app.add_option("--repeats", repeats)->check(CLI::Range(1, 1000));
   app.add_option("--threads", fit_options.em.threads);
   CLI11_PARSE(app, argc, argv);
 
-  const tools::LoadedFrame frame = tools::load_frame(depth, color);
-  const PointCloud cloud = backproject(frame.view(read_intrinsics_json(intrinsics)), opt);
+  const PointCloud cloud = in.cloud();
   std::vector<float> with_outlier = cloud.xyzg;
   with_outlier.insert(with_outlier.end(), {0.0f, 0.0f, 1000.0f, 0.5f});  // 1 km down the optical axis
   const std::vector<double> f0 = range_gray_features(cloud.view());

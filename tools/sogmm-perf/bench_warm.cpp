@@ -7,7 +7,6 @@
 //
 // Usage: sogmm-bench-warm --sequence DIR --trajectory LOG --from A --to B
 //        --decimate d --bandwidth S [--threads T] [--repeat R] [--seed s]
-#include <algorithm>
 #include <cstdlib>
 #include <cstdio>
 #include <string>
@@ -22,12 +21,10 @@
 #include "sogmm/loop_accounting.hpp"
 #include "sogmm/metrics.hpp"
 #include "sogmm/warm_start.hpp"
+#include "median.hpp"
 
 namespace {
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using sogmm::perf::median;
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -22,7 +22,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Eigenvalues>
 
-#include "image_io.hpp"
+#include "frame_flags.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/depth_quantisation.hpp"
 #include "sogmm/em.hpp"
@@ -58,17 +58,14 @@ PointCloud dithered(const PointCloud& cloud, std::uint64_t seed) {
 
 int main(int argc, char** argv) {
   CLI::App app{"sogmm-em-trace: EM on quantised depth"};
-  std::string depth, color, intrinsics, dump, at = "50,100,130";
-  DepthOptions opt;
+  sogmm::perf::FrameFlags in;
+  std::string dump, at = "50,100,130";
   double bandwidth = 0.02;
   std::uint64_t seed = 0;
   EmOptions em;
   int trace_iter = 150;
   bool dither = false, dequantise = false;
-  app.add_option("--depth", depth)->required();
-  app.add_option("--color", color)->required();
-  app.add_option("--intrinsics", intrinsics)->required();
-  app.add_option("--decimate", opt.decimate);
+  in.add_to(app);
   app.add_option("--bandwidth", bandwidth);
   app.add_option("--seed", seed);
   app.add_option("--trace-iter", trace_iter, "iterations of the traced EM (0: no trace)");
@@ -81,9 +78,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   em.reg_covar = reg_covar;
 
-  const tools::LoadedFrame frame = tools::load_frame(depth, color);
-  const Camera camera = read_intrinsics_json(intrinsics);
-  const PointCloud quantised = backproject(frame.view(camera), opt);
+  const PointCloud quantised = in.cloud();
   const PointCloud held_out = dithered(quantised, seed + 1000);
   const PointCloud cloud = dither ? dithered(quantised, seed + 2000) : quantised;
   const MeanShiftResult modes = mean_shift_flat(range_gray_features(cloud.view()), bandwidth, MeanShiftOptions{});

@@ -104,13 +104,15 @@ cv::Mat color_bar(int height, double vmax) {
   return out;
 }
 
-cv::Mat titled(const cv::Mat& panel, const std::string& title) {
-  const int title_h = 22;
-  cv::Mat out(panel.rows + title_h, panel.cols, CV_8UC3, cv::Scalar(255, 255, 255));
-  panel.copyTo(out(cv::Rect(0, title_h, panel.cols, panel.rows)));
-  cv::putText(out, title, {4, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+// `body` below a white band `band_h` pixels high holding `text` at `at` (baseline) in a font of `scale`.
+cv::Mat with_text_band(const cv::Mat& body, const std::string& text, int band_h, cv::Point at, double scale) {
+  cv::Mat out(body.rows + band_h, body.cols, CV_8UC3, cv::Scalar(255, 255, 255));
+  body.copyTo(out(cv::Rect(0, band_h, body.cols, body.rows)));
+  cv::putText(out, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   return out;
 }
+
+cv::Mat titled(const cv::Mat& panel, const std::string& title) { return with_text_band(panel, title, 22, {4, 16}, 0.5); }
 
 cv::Mat hstack(const std::vector<cv::Mat>& parts, int gap) {
   int w = 0, h = 0;
@@ -136,11 +138,7 @@ std::vector<std::uint8_t> to_bytes(const cv::Mat& img, int* w, int* h) {
 }
 
 cv::Mat with_headline(const cv::Mat& body, const std::string& headline) {
-  const int head_h = 30;
-  cv::Mat out(body.rows + head_h, body.cols, CV_8UC3, cv::Scalar(255, 255, 255));
-  body.copyTo(out(cv::Rect(0, head_h, body.cols, body.rows)));
-  cv::putText(out, headline, {6, 21}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  return out;
+  return with_text_band(body, headline, 30, {6, 21}, 0.6);
 }
 
 }  // namespace

@@ -34,12 +34,20 @@ func write(pointsPath, outPath string) error {
 	if err != nil {
 		return err
 	}
-	o, err := sogmm.NewOptions(sogmm.Bandwidth(0.05), sogmm.Seed(16), sogmm.Threads(1))
+	return fitAndSave(outPath, func(o *sogmm.Options) (*sogmm.Model, error) {
+		return sogmm.Fit(context.Background(), pts, o)
+	})
+}
+
+// fitAndSave fits with the protocol's options (bandwidth 0.05, seed 16, one
+// thread, then extra) and saves the model to outPath.
+func fitAndSave(outPath string, fit func(o *sogmm.Options) (*sogmm.Model, error), extra ...sogmm.Option) error {
+	o, err := sogmm.NewOptions(append([]sogmm.Option{sogmm.Bandwidth(0.05), sogmm.Seed(16), sogmm.Threads(1)}, extra...)...)
 	if err != nil {
 		return err
 	}
 	defer o.Close()
-	m, err := sogmm.Fit(context.Background(), pts, o)
+	m, err := fit(o)
 	if err != nil {
 		return err
 	}
@@ -55,17 +63,9 @@ func frame(depthPath, colorPath, outPath string) error {
 		return err
 	}
 	f.Fx, f.Fy, f.Cx, f.Cy = 525, 525, 319.5, 239.5
-	o, err := sogmm.NewOptions(sogmm.Bandwidth(0.05), sogmm.Seed(16), sogmm.Threads(1), sogmm.Decimation(2))
-	if err != nil {
-		return err
-	}
-	defer o.Close()
-	m, err := sogmm.FitRGBD(context.Background(), f, o)
-	if err != nil {
-		return err
-	}
-	defer m.Close()
-	return m.Save(outPath, nil)
+	return fitAndSave(outPath, func(o *sogmm.Options) (*sogmm.Model, error) {
+		return sogmm.FitRGBD(context.Background(), f, o)
+	}, sogmm.Decimation(2))
 }
 
 func read(modelPath, queryPath, outPath string) error {

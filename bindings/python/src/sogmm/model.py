@@ -152,21 +152,20 @@ class GMM(Queryable):
     def covariances_(self) -> np.ndarray:
         return self._array("covariances", lib.sogmm_model_get_covariances_f32, (4, 4))
 
-    def _info_i64(self, key: int) -> int | None:
-        v = c_int64()
+    def _info(self, key: int, get, ctype):
+        """The value of info key ``key`` read by ``get`` into a ``ctype``; None when the model has none."""
+        v = ctype()
         try:
-            check(lib.sogmm_model_get_info_i64(self._h(), key, byref(v)))
+            check(get(self._h(), key, byref(v)))
         except NotFoundError:
             return None
-        return int(v.value)
+        return v.value
+
+    def _info_i64(self, key: int) -> int | None:
+        return self._info(key, lib.sogmm_model_get_info_i64, c_int64)
 
     def _info_f64(self, key: int) -> float | None:
-        v = c_double()
-        try:
-            check(lib.sogmm_model_get_info_f64(self._h(), key, byref(v)))
-        except NotFoundError:
-            return None
-        return float(v.value)
+        return self._info(key, lib.sogmm_model_get_info_f64, c_double)
 
     @property
     def support_size_(self) -> int:

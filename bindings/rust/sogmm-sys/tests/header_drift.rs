@@ -240,47 +240,52 @@ fn rust_callbacks(lib: &str) -> Protos {
     out
 }
 
+/// The differences of one kind of item between the header (`h`, whose items
+/// it calls `h_kind`) and the crate (`r`, `r_kind`): an item missing on one
+/// side, or the message `differ` gives for an item on both.
+fn compare<V>(
+    problems: &mut Vec<String>,
+    (h, h_kind): (&BTreeMap<String, V>, &str),
+    (r, r_kind): (&BTreeMap<String, V>, &str),
+    differ: impl Fn(&str, &V, &V) -> Option<String>,
+) {
+    for (name, c) in h {
+        match r.get(name) {
+            None => problems.push(format!("{name}: {h_kind}in sogmm.h, missing in sogmm-sys")),
+            Some(rs) => problems.extend(differ(name, c, rs)),
+        }
+    }
+    for name in r.keys().filter(|n| !h.contains_key(*n)) {
+        problems.push(format!("{name}: {r_kind}in sogmm-sys, not in sogmm.h"));
+    }
+}
+
+/// "sogmm.h says ..., sogmm-sys says ..." when the two differ.
+fn says<V: PartialEq + std::fmt::Debug>(name: &str, c: &V, rs: &V) -> Option<String> {
+    (rs != c).then(|| format!("{name}: sogmm.h says {c:?}, sogmm-sys says {rs:?}"))
+}
+
 /// Every difference between the header and the crate, one line each.
 fn drift(header: &str, lib: &str) -> Vec<String> {
     let mut problems = Vec::new();
     let (hcb, rcb) = (header_callbacks(header), rust_callbacks(lib));
-    for (name, c) in &hcb {
-        match rcb.get(name) {
-            None => problems.push(format!("{name}: callback type in sogmm.h, missing in sogmm-sys")),
-            Some(rs) if rs != c => problems.push(format!("{name}: sogmm.h says {c:?}, sogmm-sys says {rs:?}")),
-            Some(_) => {}
-        }
-    }
-    for name in rcb.keys().filter(|n| !hcb.contains_key(*n)) {
-        problems.push(format!("{name}: callback type in sogmm-sys, not in sogmm.h"));
-    }
+    compare(&mut problems, (&hcb, "callback type "), (&rcb, "callback type "), says);
     let (h, r) = (header_protos(header), rust_protos(lib));
-    for (name, c) in &h {
-        match r.get(name) {
-            None => problems.push(format!("{name}: in sogmm.h, missing in sogmm-sys")),
-            Some(rs) if rs.0.len() != c.0.len() => problems.push(format!(
+    compare(&mut problems, (&h, ""), (&r, ""), |name, c, rs| {
+        if rs.0.len() != c.0.len() {
+            Some(format!(
                 "{name}: {} arguments in sogmm.h, {} in sogmm-sys",
                 c.0.len(),
                 rs.0.len()
-            )),
-            Some(rs) if rs != c => problems.push(format!("{name}: sogmm.h says {c:?}, sogmm-sys says {rs:?}")),
-            Some(_) => {}
+            ))
+        } else {
+            says(name, c, rs)
         }
-    }
-    for name in r.keys().filter(|n| !h.contains_key(*n)) {
-        problems.push(format!("{name}: in sogmm-sys, not in sogmm.h"));
-    }
+    });
     let (hc, rc) = (header_consts(header), rust_consts(lib));
-    for (name, v) in &hc {
-        match rc.get(name) {
-            None => problems.push(format!("{name}: #define in sogmm.h, missing in sogmm-sys")),
-            Some(rv) if rv != v => problems.push(format!("{name}: {v} in sogmm.h, {rv} in sogmm-sys")),
-            Some(_) => {}
-        }
-    }
-    for name in rc.keys().filter(|n| !hc.contains_key(*n)) {
-        problems.push(format!("{name}: const in sogmm-sys, not in sogmm.h"));
-    }
+    compare(&mut problems, (&hc, "#define "), (&rc, "const "), |name, v, rv| {
+        (rv != v).then(|| format!("{name}: {v} in sogmm.h, {rv} in sogmm-sys"))
+    });
     problems
 }
 

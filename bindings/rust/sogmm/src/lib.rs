@@ -23,6 +23,9 @@
 //! take `&mut self`, so the borrow checker gives them the exclusive use the C
 //! API requires. The thread-local error message is read on the calling
 //! thread right after each call.
+#[macro_use]
+mod handle;
+
 pub mod error;
 pub mod frames;
 pub mod map;

@@ -323,12 +323,7 @@ impl Map {
     }
 }
 
-impl Drop for Map {
-    fn drop(&mut self) {
-        // SAFETY: we own the handle; nothing else uses it once dropped.
-        unsafe { sys::sogmm_map_free(self.ptr.as_ptr()) }
-    }
-}
+owned_handle!(Map, sys::sogmm_map_free);
 
 impl std::fmt::Debug for Map {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

@@ -432,21 +432,7 @@ fn not_found_is_none<T>(r: Result<()>, value: T) -> Result<Option<T>> {
     }
 }
 
-impl Clone for Model {
-    /// Panics only when memory runs out, as `Vec::clone` would; use
-    /// `try_clone` to handle that.
-    fn clone(&self) -> Model {
-        self.try_clone()
-            .unwrap_or_else(|e| panic!("cloning a sogmm model failed: {e}"))
-    }
-}
-
-impl Drop for Model {
-    fn drop(&mut self) {
-        // SAFETY: we own the handle; nothing else uses it once dropped.
-        unsafe { sys::sogmm_model_free(self.ptr.as_ptr()) }
-    }
-}
+owned_handle!(Model, sys::sogmm_model_free, clone: "a sogmm model");
 
 impl std::fmt::Debug for Model {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

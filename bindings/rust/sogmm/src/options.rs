@@ -117,21 +117,7 @@ pub(crate) fn opt_ptr(o: Option<&Options>) -> *const sys::sogmm_options {
     o.map_or(ptr::null(), Options::as_ptr)
 }
 
-impl Clone for Options {
-    /// Panics only when memory runs out, as `Vec::clone` would; use
-    /// `try_clone` to handle that.
-    fn clone(&self) -> Options {
-        self.try_clone()
-            .unwrap_or_else(|e| panic!("cloning sogmm options failed: {e}"))
-    }
-}
-
-impl Drop for Options {
-    fn drop(&mut self) {
-        // SAFETY: we own the handle; nothing else uses it once dropped.
-        unsafe { sys::sogmm_options_free(self.ptr.as_ptr()) }
-    }
-}
+owned_handle!(Options, sys::sogmm_options_free, clone: "sogmm options");
 
 impl std::fmt::Debug for Options {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

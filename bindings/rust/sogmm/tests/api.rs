@@ -173,21 +173,33 @@ fn clone_is_deep_and_merge_transform_work() {
     assert_eq!(moved.means().unwrap(), vec![1.0, 0.0, 0.0, 0.5]);
 }
 
+/// A frame of 8-bit gray, `width` x `height`, focal length `f` on both axes
+/// and principal point (cx, cy).
+fn gray_frame<'a>(
+    depth: &'a [u16],
+    gray: &'a [u8],
+    (width, height): (u32, u32),
+    f: f64,
+    (cx, cy): (f64, f64),
+) -> Frame<'a> {
+    Frame {
+        depth,
+        color: Color::Gray8(gray),
+        width,
+        height,
+        fx: f,
+        fy: f,
+        cx,
+        cy,
+    }
+}
+
 #[test]
 fn rgbd_fit_checks_slice_lengths() {
     let (w, h) = (32u32, 24u32);
     let depth: Vec<u16> = (0..w * h).map(|i| 1000 + (i % w) as u16 * 10).collect();
     let gray: Vec<u8> = (0..w * h).map(|i| if i % w < w / 2 { 40 } else { 200 }).collect();
-    let frame = Frame {
-        depth: &depth,
-        color: Color::Gray8(&gray),
-        width: w,
-        height: h,
-        fx: 30.0,
-        fy: 30.0,
-        cx: 15.5,
-        cy: 11.5,
-    };
+    let frame = gray_frame(&depth, &gray, (w, h), 30.0, (15.5, 11.5));
     let opts = Options::builder().bandwidth(0.1).threads(1).build().unwrap();
     let m = Model::fit_rgbd(&frame, Some(&opts)).unwrap();
     assert_eq!(m.info_i64(sogmm::sys::SOGMM_INFO_CAMERA_WIDTH).unwrap(), Some(32));
@@ -244,16 +256,7 @@ fn frame_to_points_by_hand() {
     // 2 x 2 frame, fx = fy = 2, cx = cy = 0.5: x = (u - 0.5) z / 2, y = (v - 0.5) z / 2.
     let depth = [1000u16, 2000, 0, 1000]; // 1 m, 2 m, no reading, 1 m
     let gray = [0u8, 255, 7, 51];
-    let frame = Frame {
-        depth: &depth,
-        color: Color::Gray8(&gray),
-        width: 2,
-        height: 2,
-        fx: 2.0,
-        fy: 2.0,
-        cx: 0.5,
-        cy: 0.5,
-    };
+    let frame = gray_frame(&depth, &gray, (2, 2), 2.0, (0.5, 0.5));
     let pts = frame.to_points(None).unwrap();
     let want = [-0.25, -0.25, 1.0, 0.0, 0.5, -0.5, 2.0, 1.0, 0.25, 0.25, 1.0, 0.2];
     assert_eq!(pts.len(), want.len(), "{pts:?}");
@@ -275,16 +278,13 @@ fn the_depth_floor_is_the_default_for_frames() {
     let (w, h) = (96u32, 72u32);
     let depth: Vec<u16> = (0..w * h).map(|i| 1000 + 100 * ((i % w) / 12) as u16).collect();
     let gray: Vec<u8> = (0..w * h).map(|i| (60 + 2 * (i % w) + i / w) as u8).collect();
-    let frame = Frame {
-        depth: &depth,
-        color: Color::Gray8(&gray),
-        width: w,
-        height: h,
-        fx: 77.0,
-        fy: 77.0,
-        cx: (w as f64 - 1.0) / 2.0,
-        cy: (h as f64 - 1.0) / 2.0,
-    };
+    let frame = gray_frame(
+        &depth,
+        &gray,
+        (w, h),
+        77.0,
+        ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0),
+    );
     let covariances = |floor: Option<bool>| {
         let mut b = Options::builder().bandwidth(0.05).seed(3).threads(1).decimation(2);
         if let Some(on) = floor {
