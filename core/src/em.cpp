@@ -314,6 +314,11 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   // Per chunk of a wave: its partial sums, reduced in chunk order afterwards
   // (so the result does not depend on which thread ran which chunk).
   std::vector<double> slot_stats(kWave * m * kStatStride);
+  // Per chunk of a wave: the components its blocks evaluated (each once), so
+  // that only their statistics are zeroed and reduced; every other slot entry
+  // would add an exact +0 (a truncated chunk touches a few of the M).
+  std::vector<std::vector<std::uint32_t>> slot_touched(kWave);
+  std::vector<char> slot_marked(kWave * m, 0);
   std::vector<double> slot_ll(kWave);
   std::vector<double> slot_pairs(kWave);
   // Per thread: one block's log-density rows and row maxima, (kBlock + 1) x M
@@ -348,7 +353,9 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
         detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
           double* st = &slot_stats[s * m * kStatStride];
-          std::fill(st, st + m * kStatStride, 0.0);
+          std::vector<std::uint32_t>& touched = slot_touched[s];
+          char* marked = &slot_marked[s * m];
+          touched.clear();
           float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
           float* row_max = scratch + m * kBlock;
           detail::TruncatedScan scan(bounds, options.truncation_nats, n_blocks);
@@ -370,6 +377,12 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
               kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
             }
             const std::size_t ne = evaluated->size();
+            for (std::uint32_t k : *evaluated)
+              if (!marked[k]) {
+                marked[k] = 1;
+                touched.push_back(k);
+                std::fill(st + std::size_t{k} * kStatStride, st + (std::size_t{k} + 1) * kStatStride, 0.0);
+              }
             ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
             pairs += static_cast<double>(block.count) * ne;
             // Next iteration starts from the components some point of this
@@ -382,7 +395,10 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
         for (std::size_t s = 0; s < wave_chunks; ++s) {
           const double* st = &slot_stats[s * m * kStatStride];
-          for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
+          for (std::uint32_t k : slot_touched[s]) {
+            for (std::size_t i = std::size_t{k} * kStatStride; i < (std::size_t{k} + 1) * kStatStride; ++i) stats[i] += st[i];
+            slot_marked[s * m + k] = 0;
+          }
           total_ll += slot_ll[s];
           iteration_pairs += slot_pairs[s];
         }
