@@ -36,6 +36,11 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 // count), so the order in which partial sums are added never changes.
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
+// The chunks' partial statistics a parallel region may hold at once: as many
+// waves as fit run in one region (the reduction order, chunk by chunk, is the
+// same), so that a sparse (truncated) pass, whose waves are short, does not pay
+// a region's start, tail imbalance and serial reduction per wave.
+constexpr std::size_t kSlotBytes = std::size_t{16} << 20;
 
 // The regulariser per diagonal (x, y, z, gray).
 using RegDiagonal = std::array<double, 4>;
@@ -303,6 +308,8 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   const std::size_t n_waves = (n_blocks + kWave * kMaxBlocksPerChunk - 1) / (kWave * kMaxBlocksPerChunk);
   const std::size_t blocks_per_chunk = std::max<std::size_t>(1, (n_blocks + kWave * n_waves - 1) / (kWave * n_waves));
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
+  const std::size_t region_chunks =
+      std::min(n_chunks, std::max(kWave, kWave * (kSlotBytes / (kWave * m * kStatStride * sizeof(double)))));
   const int threads = detail::team_size(options.threads);
   const detail::EmKernels& kernels = detail::em_kernels();
 
@@ -311,11 +318,16 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   detail::BoundParams bounds;
   std::vector<std::uint32_t> all(m);
   for (std::size_t k = 0; k < m; ++k) all[k] = static_cast<std::uint32_t>(k);
-  // Per chunk of a wave: its partial sums, reduced in chunk order afterwards
+  // Per chunk of a region: its partial sums, reduced in chunk order afterwards
   // (so the result does not depend on which thread ran which chunk).
-  std::vector<double> slot_stats(kWave * m * kStatStride);
-  std::vector<double> slot_ll(kWave);
-  std::vector<double> slot_pairs(kWave);
+  std::vector<double> slot_stats(region_chunks * m * kStatStride);
+  // Per chunk of a region: the components its blocks evaluated (each once), so
+  // that only their statistics are zeroed and reduced; every other slot entry
+  // would add an exact +0 (a truncated chunk touches a few of the M).
+  std::vector<std::vector<std::uint32_t>> slot_touched(region_chunks);
+  std::vector<char> slot_marked(region_chunks * m, 0);
+  std::vector<double> slot_ll(region_chunks);
+  std::vector<double> slot_pairs(region_chunks);
   // Per thread: one block's log-density rows and row maxima, (kBlock + 1) x M
   // floats, so the scratch is threads x block, not waves x block.
   const std::size_t scratch_floats = checked::mul<std::size_t>(kBlock + 1, m, "EM scratch");
@@ -344,11 +356,13 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       std::fill(stats.begin(), stats.end(), 0.0);
       double total_ll = 0.0;
       iteration_pairs = 0.0;
-      for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += kWave) {
-        const std::size_t wave_chunks = std::min(kWave, n_chunks - wave_start);
+      for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += region_chunks) {
+        const std::size_t wave_chunks = std::min(region_chunks, n_chunks - wave_start);
         detail::parallel_for(wave_chunks, threads, 1, [&](std::size_t s, int thread) {
           double* st = &slot_stats[s * m * kStatStride];
-          std::fill(st, st + m * kStatStride, 0.0);
+          std::vector<std::uint32_t>& touched = slot_touched[s];
+          char* marked = &slot_marked[s * m];
+          touched.clear();
           float* scratch = &thread_scratch[static_cast<std::size_t>(thread) * scratch_floats];  // m rows, then m maxima
           float* row_max = scratch + m * kBlock;
           detail::TruncatedScan scan(bounds, options.truncation_nats, n_blocks);
@@ -370,6 +384,12 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
               kernels.log_density(block, params.data(), exact.data(), all.data(), m, scratch, row_max, max_lp);
             }
             const std::size_t ne = evaluated->size();
+            for (std::uint32_t k : *evaluated)
+              if (!marked[k]) {
+                marked[k] = 1;
+                touched.push_back(k);
+                std::fill(st + std::size_t{k} * kStatStride, st + (std::size_t{k} + 1) * kStatStride, 0.0);
+              }
             ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
             pairs += static_cast<double>(block.count) * ne;
             // Next iteration starts from the components some point of this
@@ -382,7 +402,10 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
         for (std::size_t s = 0; s < wave_chunks; ++s) {
           const double* st = &slot_stats[s * m * kStatStride];
-          for (std::size_t i = 0; i < m * kStatStride; ++i) stats[i] += st[i];
+          for (std::uint32_t k : slot_touched[s]) {
+            for (std::size_t i = std::size_t{k} * kStatStride; i < (std::size_t{k} + 1) * kStatStride; ++i) stats[i] += st[i];
+            slot_marked[s * m + k] = 0;
+          }
           total_ll += slot_ll[s];
           iteration_pairs += slot_pairs[s];
         }

@@ -12,6 +12,7 @@ namespace sogmm::detail {
                       float*, float*);                                                                         \
   double em_finish(const Block&, const float*, const double*, const std::uint32_t*, std::size_t, float*,       \
                    const float*, float*, double*);                                                             \
+  void em_upper_bounds(const double*, std::size_t, const float*, double*);                                     \
   }
 SOGMM_DECLARE_KERNELS(sse2)
 SOGMM_DECLARE_KERNELS(avx2)
@@ -27,10 +28,10 @@ EmKernels choose() {
   const std::string limit = cap ? cap : "";
   if (limit != "sse2" && limit != "avx2" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
       __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw"))
-    return {&avx512::em_log_density, &avx512::em_finish, "avx512"};
+    return {&avx512::em_log_density, &avx512::em_finish, &avx512::em_upper_bounds, "avx512"};
   if (limit != "sse2" && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    return {&avx2::em_log_density, &avx2::em_finish, "avx2"};
-  return {&sse2::em_log_density, &sse2::em_finish, "sse2"};
+    return {&avx2::em_log_density, &avx2::em_finish, &avx2::em_upper_bounds, "avx2"};
+  return {&sse2::em_log_density, &sse2::em_finish, &sse2::em_upper_bounds, "sse2"};
 }
 }  // namespace
 

@@ -58,10 +58,17 @@ using EmFinishFn = double (*)(const Block& block, const float* params, const dou
                               const std::uint32_t* components, std::size_t n, float* rows, const float* max_lp,
                               float* row_lp_max, double* stats);
 
+/// The truncated E-step's upper bounds (em_truncation.cpp) of the `m`
+/// components in `col` (BoundParams' 15 columns of m doubles) over the box
+/// `box` (min[4], max[4]) into `upper` (m doubles); the same doubles on
+/// every instruction set.
+using EmUpperBoundsFn = void (*)(const double* col, std::size_t m, const float* box, double* upper);
+
 /// The kernels for this CPU (resolved once).
 struct EmKernels {
   EmLogDensityFn log_density;
   EmFinishFn finish;
+  EmUpperBoundsFn upper_bounds;
   const char* isa;  ///< "avx512", "avx2" or "sse2"
 };
 const EmKernels& em_kernels();
