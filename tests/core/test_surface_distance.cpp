@@ -2,13 +2,17 @@
 // independent truth: the closed form above and beside one flat component's
 // disc, a rotated disc against a dense sampling of its rim, the exact search
 // of many components against a brute-force minimum over each alone, a fitted
-// plane against |z - 2|, threads, and bad input.
+// plane against |z - 2|, threads, and bad input; the tree search bit for
+// bit against the brute-force answer (the nearest of each component alone,
+// the lowest id among equal distances) on random discs and a room of tiles.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "sogmm/map.hpp"
@@ -57,6 +61,70 @@ double sampled_distance(const Eigen::Vector3d& x, const Eigen::Vector3d& mu, con
   return best;
 }
 
+// The brute-force answer: each component alone gives its distance and
+// gradient; the nearest wins, the lowest id among equal distances.
+Result alone(const sogmm::Gmm& g, std::size_t k, const std::vector<float>& xyz) {
+  sogmm::Gmm one;
+  one.resize(1);
+  one.weights[0] = 1.0f;
+  std::copy(g.mean(k), g.mean(k) + 4, one.means.begin());
+  std::copy(g.covariance(k), g.covariance(k) + 16, one.covariances.begin());
+  return distance(one, xyz, 1);
+}
+
+Result brute_force(const sogmm::Gmm& g, const std::vector<float>& xyz) {
+  const std::size_t n = xyz.size() / 3;
+  Result best;
+  best.d.assign(n, std::numeric_limits<double>::infinity());
+  best.g.assign(3 * n, 0.0);
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const Result r = alone(g, k, xyz);
+    for (std::size_t i = 0; i < n; ++i)
+      if (r.d[i] < best.d[i]) {  // strict: an equal distance keeps the lower id
+        best.d[i] = r.d[i];
+        std::copy(r.g.begin() + 3 * i, r.g.begin() + 3 * i + 3, best.g.begin() + 3 * i);
+      }
+  }
+  return best;
+}
+
+void expect_bitwise(const Result& got, const Result& want, const char* what) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < want.d.size(); ++i) {
+    const bool same = got.d[i] == want.d[i] && got.g[3 * i] == want.g[3 * i] && got.g[3 * i + 1] == want.g[3 * i + 1] &&
+                      got.g[3 * i + 2] == want.g[3 * i + 2];
+    if (!same && ++differ <= 5)
+      ADD_FAILURE() << what << ": point " << i << " distance " << got.d[i] << " against " << want.d[i];
+  }
+  EXPECT_EQ(differ, 0u) << what;
+}
+
+// Flat tiles (axis-aligned squares of side 2 * tile, as a fitted wall's
+// components are) covering the floor, the ceiling and four walls of a
+// w x w x h room.
+sogmm::Gmm tiled_room(double w, double h, double tile) {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> patches;  // centre, sd per axis
+  const double thin = 0.002, sd = tile / 2;                           // 2 sigma = the half side
+  for (double u = tile; u < w; u += 2 * tile)
+    for (double v = tile; v < w; v += 2 * tile) {
+      patches.push_back({{u, v, 0.0}, {sd, sd, thin}});
+      patches.push_back({{u, v, h}, {sd, sd, thin}});
+    }
+  for (double u = tile; u < w; u += 2 * tile)
+    for (double v = tile; v < h; v += 2 * tile) {
+      patches.push_back({{u, 0.0, v}, {sd, thin, sd}});
+      patches.push_back({{u, w, v}, {sd, thin, sd}});
+      patches.push_back({{0.0, u, v}, {thin, sd, sd}});
+      patches.push_back({{w, u, v}, {thin, sd, sd}});
+    }
+  sogmm::Gmm g;
+  g.resize(patches.size());
+  for (std::size_t k = 0; k < patches.size(); ++k)
+    set_component(g, k, 1.0 / patches.size(), patches[k].first,
+                  patches[k].second.cwiseProduct(patches[k].second).asDiagonal());
+  return g;
+}
+
 TEST(SurfaceDistance, OneFlatComponentClosedForm) {
   sogmm::Gmm g;
   g.resize(1);
@@ -103,37 +171,86 @@ TEST(SurfaceDistance, RotatedDiscAgainstASampledRim) {
 }
 
 TEST(SurfaceDistance, ExactSearchEqualsTheMinimumOverEachComponentAlone) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> pos(-1.0, 1.0), ang(-M_PI, M_PI), sc(0.01, 0.1);
-  const std::size_t m = 150;
+  // Random discs of every size and direction; points on them, millimetres
+  // off them and metres away: distances and gradients bit for bit those of
+  // the brute force, on one thread and on two.
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> pos(-2.0, 2.0), ang(-M_PI, M_PI), sc(0.005, 0.2), unit(0.0, 1.0);
+  const std::size_t m = 300;
   sogmm::Gmm g;
   g.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
     const Eigen::Matrix3d R = (Eigen::AngleAxisd(ang(rng), Eigen::Vector3d::UnitX()) *
                                Eigen::AngleAxisd(ang(rng), Eigen::Vector3d::UnitY()))
                                   .toRotationMatrix();
-    const Eigen::Vector3d sd(sc(rng), sc(rng), 0.002);
-    set_component(g, k, 1.0 / m, Eigen::Vector3d(pos(rng), pos(rng), pos(rng)),
+    const Eigen::Vector3d sd(sc(rng), sc(rng), 0.001 + 0.004 * unit(rng));
+    set_component(g, k, 1.0 / m, Eigen::Vector3d(pos(rng), pos(rng), 0.3 * pos(rng)),
                   R * sd.cwiseProduct(sd).asDiagonal() * R.transpose());
   }
   std::vector<float> xyz;
-  for (int i = 0; i < 1000; ++i)
-    for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(1.5 * pos(rng)));
-  const Result all = distance(g, xyz);
-  std::vector<double> brute(1000, std::numeric_limits<double>::infinity());
-  for (std::size_t k = 0; k < m; ++k) {
-    sogmm::Gmm one;
-    one.resize(1);
-    one.weights[0] = 1.0f;
-    std::copy(g.mean(k), g.mean(k) + 4, one.means.begin());
-    std::copy(g.covariance(k), g.covariance(k) + 16, one.covariances.begin());
-    const Result r = distance(one, xyz);
-    for (int i = 0; i < 1000; ++i) brute[i] = std::min(brute[i], r.d[i]);
+  for (int i = 0; i < 900; ++i) {
+    const double spread = i % 3 == 0 ? 4.0 : 1.0;  // a third far outside the discs' slab
+    for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(spread * pos(rng)));
   }
-  for (int i = 0; i < 1000; ++i) EXPECT_EQ(all.d[i], brute[i]) << "point " << i;
-  const Result one_thread = distance(g, xyz, 1);
-  EXPECT_EQ(one_thread.d, all.d);
-  EXPECT_EQ(one_thread.g, all.g);
+  for (std::size_t k = 0; k < m; k += 2)  // near the centres: on or just off the surface
+    for (int i = 0; i < 3; ++i) xyz.push_back(static_cast<float>(g.mean(k)[i] + 0.003 * (unit(rng) - 0.5)));
+  const Result want = brute_force(g, xyz);
+  expect_bitwise(distance(g, xyz), want, "two threads");
+  expect_bitwise(distance(g, xyz, 1), want, "one thread");
+}
+
+TEST(SurfaceDistance, RoomOfTilesIsTheBruteForceAnswerBitwise) {
+  // A loop-like scene: a 4 x 4 x 2.5 m room of flat tiles that meet edge to
+  // edge, asked on the rays of cameras inside it at 20, 50, 80% and 100% of
+  // the depth and 5 cm before it, as the occupancy benchmark asks. Points
+  // above a seam are equally far from two tiles: the lower id's gradient.
+  const double w = 4.0, h = 2.5;
+  const sogmm::Gmm g = tiled_room(w, h, 0.25);
+  ASSERT_GT(g.size(), 200u);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<float> xyz;
+  for (int ray = 0; ray < 200; ++ray) {
+    const Eigen::Vector3d eye(1.0 + 2.0 * unit(rng), 1.0 + 2.0 * unit(rng), 0.8 + 0.9 * unit(rng));
+    Eigen::Vector3d dir(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5);
+    dir.normalize();
+    double depth = std::numeric_limits<double>::infinity();  // to the room's box
+    for (int k = 0; k < 3; ++k) {
+      const double top = k == 2 ? h : w;
+      if (dir(k) > 0) depth = std::min(depth, (top - eye(k)) / dir(k));
+      if (dir(k) < 0) depth = std::min(depth, -eye(k) / dir(k));
+    }
+    for (double along : {0.2 * depth, 0.5 * depth, 0.8 * depth, depth, depth - 0.05}) {
+      const Eigen::Vector3d x = eye + along * dir;
+      for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(x(k)));
+    }
+  }
+  for (double u : {0.4, 1.2, 2.0}) xyz.insert(xyz.end(), {static_cast<float>(u), 1.0f, 1.0f});  // above seams
+  const Result want = brute_force(g, xyz);
+  expect_bitwise(distance(g, xyz), want, "two threads");
+  expect_bitwise(distance(g, xyz, 1), want, "one thread");
+}
+
+TEST(SurfaceDistance, EqualDistancesGoToTheLowestId) {
+  // Two equal discs at z = +1 and z = -1 among others: a point at the
+  // origin is 1 from both, and its gradient is the one of the lower id
+  // (pointing away from that disc), whichever the tree visits first.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> pos(3.0, 6.0);
+  const std::size_t m = 200;
+  for (const auto& [upper, lower] : {std::pair<std::size_t, std::size_t>{7, 150}, {150, 7}}) {
+    sogmm::Gmm g;
+    g.resize(m);
+    const Eigen::Matrix3d flat = Eigen::Vector3d(0.01, 0.01, 1e-6).asDiagonal();
+    for (std::size_t k = 0; k < m; ++k) set_component(g, k, 1.0 / m, Eigen::Vector3d(pos(rng), pos(rng), pos(rng)), flat);
+    set_component(g, upper, 1.0 / m, Eigen::Vector3d(0, 0, 1), flat);
+    set_component(g, lower, 1.0 / m, Eigen::Vector3d(0, 0, -1), flat);
+    const std::vector<float> origin = {0.0f, 0.0f, 0.0f};
+    ASSERT_EQ(alone(g, upper, origin).d[0], alone(g, lower, origin).d[0]) << "the two discs tie";
+    const Result r = distance(g, origin);
+    EXPECT_DOUBLE_EQ(r.d[0], 1.0);
+    EXPECT_EQ(r.g[2], upper < lower ? -1.0 : 1.0) << "disc " << std::min(upper, lower) << " is the answer";
+  }
 }
 
 TEST(SurfaceDistance, FittedPlaneMatchesTheClosedForm) {

@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -38,6 +39,7 @@
 #include "sogmm/format.hpp"
 #include "sogmm/map.hpp"
 #include "occupancy_main_path.hpp"
+#include "surface_distance_main_path.hpp"
 #include "sogmm/occupancy.hpp"
 #include "sogmm/surface_distance.hpp"
 
@@ -48,15 +50,28 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The median wall time of `repeats` calls; `cpu` (if given) receives the
+// median CPU time of all threads per call, which other sessions' load on a
+// shared machine inflates far less than the wall time.
 template <typename F>
-double median_seconds(int repeats, F&& f) {
-  std::vector<double> s;
+double median_seconds(int repeats, F&& f, double* cpu = nullptr) {
+  std::vector<double> s, c;
   for (int r = 0; r < repeats; ++r) {
     const auto t = Clock::now();
+    const double c0 = process_cpu_seconds();
     f();
+    c.push_back(process_cpu_seconds() - c0);
     s.push_back(seconds_since(t));
   }
   std::sort(s.begin(), s.end());
+  std::sort(c.begin(), c.end());
+  if (cpu != nullptr) *cpu = c[c.size() / 2];
   return s[s.size() / 2];
 }
 
@@ -116,13 +131,44 @@ void report(const char* name, double auc, std::size_t bytes, double build_s, std
               auc, bytes, build_s, static_cast<double>(n) / query_s);
 }
 
+// Surface distance on the same points: this build, and with `compare_main`
+// main's block scan (d33d204) timed in the same run and compared bitwise
+// (distances and gradients; timed without gradients).
+void distance_rows(const sogmm::Map& map, const std::vector<float>& xyz, int threads, int repeats, bool compare_main) {
+  const std::size_t n = xyz.size() / 3;
+  std::vector<double> dist(n), dist_main(n), grad(3 * n), grad_main(3 * n);
+  double cpu = 0.0, main_cpu = 0.0;
+  const double query = median_seconds(
+      repeats, [&] { sogmm::surface_distance(map, xyz.data(), n, dist.data(), nullptr, {}, threads); }, &cpu);
+  if (!compare_main) {
+    std::printf("surface distance: %.3f M points/s (%.3f M points per CPU second; %zu components, %d threads)\n",
+                n / query * 1e-6, n / cpu * 1e-6, map.size(), threads);
+    return;
+  }
+  const sogmm::Gmm& gmm = map.model().gmm;
+  const double main_query = median_seconds(
+      repeats, [&] { sogmm_bench::main_surface_distance(gmm, xyz.data(), n, dist_main.data(), nullptr, threads); },
+      &main_cpu);
+  sogmm::surface_distance(map, xyz.data(), n, dist.data(), grad.data(), {}, threads);
+  sogmm_bench::main_surface_distance(gmm, xyz.data(), n, dist_main.data(), grad_main.data(), threads);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    differ += dist[i] != dist_main[i] || grad[3 * i] != grad_main[3 * i] || grad[3 * i + 1] != grad_main[3 * i + 1] ||
+              grad[3 * i + 2] != grad_main[3 * i + 2];
+  std::printf("surface distance: main (d33d204) %.3f M points/s, this build %.3f M points/s, ratio %.2f; "
+              "per CPU second %.3f and %.3f M points, ratio %.2f; "
+              "points whose distance or gradient differs bitwise %zu of %zu (%zu components, %d threads)\n",
+              n / main_query * 1e-6, n / query * 1e-6, main_query / query, n / main_cpu * 1e-6, n / cpu * 1e-6,
+              main_cpu / cpu, differ, n, map.size(), threads);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Occupancy of a SOGMM map against OctoMap on the rays of a held-out frame"};
   std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05", save_map, load_map;
   int decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
-  bool compare_main = false;
+  bool compare_main = false, distance_only = false;
   app.add_option("--sequence", dir, "Redwood folder: depth/, color/, intrinsics.json, trajectory.log")->required();
   app.add_option("--map-frames", map_frames, "frames the maps are built from (I, A:B or A:B:STEP)")
       ->capture_default_str();
@@ -136,8 +182,10 @@ int main(int argc, char** argv) {
   app.add_option("--save-map", save_map, "write the SOGMM map built from --map-frames here");
   app.add_option("--map", load_map, "answer with this saved map instead of building one (build time 0)");
   app.add_flag("--compare-main", compare_main,
-               "also time main's per-point occupancy (0f45b28) and surface distance on the same points, "
-               "and report the largest difference of the answers");
+               "also time main's per-point occupancy (0f45b28) and block-scan surface distance (d33d204) on the "
+               "same points, and report how far the answers are from them");
+  app.add_flag("--distance-only", distance_only,
+               "time surface distance alone (with --compare-main: against main's); no occupancy, no OctoMap");
   CLI11_PARSE(app, argc, argv);
   try {
     using namespace sogmm;
@@ -172,6 +220,10 @@ int main(int argc, char** argv) {
     }
     const double map_build = load_map.empty() ? seconds_since(t0) : 0.0;
     if (!save_map.empty()) format::save(save_map, map.to_model());
+    if (distance_only) {
+      distance_rows(map, xyz, threads, repeats, compare_main);
+      return 0;
+    }
     const std::size_t map_bytes = format::to_bytes(map.to_model()).size();
     std::vector<double> p(n);
     occupancy(map, xyz.data(), n, p.data(), nullptr, {}, threads);  // renders, kept until the map changes
@@ -192,15 +244,11 @@ int main(int argc, char** argv) {
         worst = std::max(worst, std::abs(p[i] - pm[i]));
         states += s[i] != sm[i];
       }
-      std::vector<double> dist(n);
-      const double distance_query =
-          median_seconds(repeats, [&] { surface_distance(map, xyz.data(), n, dist.data(), nullptr, {}, threads); });
       std::printf("occupancy: main (0f45b28) %.3f M points/s, this build %.3f M points/s, ratio %.2f; "
                   "largest |p - p_main| %.3g, states that differ %zu of %zu\n",
                   n / main_query * 1e-6, n / map_query * 1e-6, main_query / map_query, worst, states, n);
-      std::printf("surface distance: %.3f M points/s (%zu components, %d threads)\n", n / distance_query * 1e-6,
-                  map.size(), threads);
     }
+    distance_rows(map, xyz, threads, repeats, compare_main);
 
 #ifdef SOGMM_HAVE_OCTOMAP
     std::stringstream res_list(resolutions == "none" ? std::string() : resolutions);

@@ -20,12 +20,19 @@
 // against a 1 cm error budget; the disc keeps the mid-surface and has no
 // such bias, and its distance is exact for the union of discs.
 //
-// The search is exact: points go in Z-order blocks of 64; a block keeps the
-// components whose disc may be nearer than the best upper bound any
-// component gives for the whole block (the distance to the mean bounds the
-// distance to the disc from above; the mean's distance to the block's box
-// minus the disc's radius bounds it from below), and each point skips a
-// candidate whose lower bound |x - mu| - radius exceeds its best so far.
+// The search is exact, bit for bit the brute-force answer (the nearest disc,
+// the lowest component id among equal distances, its distance and gradient
+// as computed for that disc alone): the discs sit in a tree of bounding
+// boxes (median splits, 4 discs a leaf). Points go in Z-order blocks of 64;
+// the first point of a block searches the tree depth first, nearer box
+// first; its nearest disc is at most `bound` from every point of the block
+// (a rim point of that disc gives the bound without a solve), so every
+// block point's nearest disc lies in a leaf within `bound` of the block's
+// box, and the other points search only those leaves. A leaf or a disc is
+// skipped only when a lower bound of its distance (the box; then the
+// circle of the disc's largest radius in its plane) exceeds the best
+// distance found by more than 1e-9 of the scene's coordinates, far above
+// the rounding of either, so no disc that could win or tie is skipped.
 #pragma once
 
 #include <cstddef>
