@@ -49,6 +49,13 @@ namespace {
 
 constexpr int kTestPoints = 7;
 constexpr int kMajority = 4;
+// Scores this close (relative) are one sharpness, so that a tie stays a tie:
+// a map's marginals keep log(weight x support) from when each component was
+// added (merge() rescales the weight in float32, so the product drifts by
+// ~1e-7 relative), while a copy's are computed from the rescaled weights;
+// and two indexes may sum a neighbourhood in different orders. Real
+// differences of sharpness are tenths of a nat and more.
+constexpr double kTie = 1e-6;
 
 // The 7 test points (x, y, z) of every component of `gmm`, in order.
 std::vector<double> test_points(const Gmm& gmm) {
@@ -103,7 +110,9 @@ std::vector<std::size_t> outmatched(const std::vector<double>& own, const std::v
     int wins = 0;
     for (int i = 0; i < kTestPoints; ++i) {
       const double o = own[kTestPoints * k + i], r = rival[kTestPoints * k + i];
-      if (r > o || (ties_to_rival && r == o && r > -std::numeric_limits<double>::infinity())) ++wins;
+      if (!(r > -std::numeric_limits<double>::infinity())) continue;
+      const double tie = kTie * std::max(1.0, std::fabs(o));
+      if (ties_to_rival ? r >= o - tie : r > o + tie) ++wins;
     }
     if (wins >= kMajority) out.push_back(k);
   }

@@ -71,30 +71,34 @@ void expect_same_gmm(const Gmm& a, const Gmm& b) {
   EXPECT_EQ(a.support_size, b.support_size);
 }
 
-// A fitted map: two frames of a textured wall and floor, each a flush.
-Map fitted_map(double shift) {
-  MapOptions o;
-  o.batch_size = 1;
-  Map m(o);
-  TestRng rng(7);
-  for (int f = 0; f < 2; ++f) {
-    std::vector<float> p;
-    for (int i = 0; i < 3000; ++i) {
-      const double x = shift + 0.1 * f + 0.8 * rng.uniform() - 0.4;
-      const bool floor = i % 3 == 2;
-      const double y = floor ? 0.4 + 0.002 * rng.normal() : 0.6 * rng.uniform() - 0.2;
-      const double z = floor ? 1.0 + 0.5 * rng.uniform() : 1.5 + 0.002 * rng.normal();
-      const double gray = 0.5 + 0.3 * std::sin(9.0 * x) + 0.02 * rng.normal();
-      p.insert(p.end(), {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z), static_cast<float>(gray)});
+// A fitted map: two frames of a textured wall and floor, each a flush;
+// fitted once, each test takes a copy (its saved form, as a robot's).
+Map fitted_map() {
+  static const Model saved = [] {
+    MapOptions o;
+    o.batch_size = 1;
+    Map m(o);
+    TestRng rng(7);
+    for (int f = 0; f < 2; ++f) {
+      std::vector<float> p;
+      for (int i = 0; i < 1500; ++i) {
+        const double x = 0.1 * f + 0.8 * rng.uniform() - 0.4;
+        const bool floor = i % 3 == 2;
+        const double y = floor ? 0.4 + 0.002 * rng.normal() : 0.6 * rng.uniform() - 0.2;
+        const double z = floor ? 1.0 + 0.5 * rng.uniform() : 1.5 + 0.002 * rng.normal();
+        const double gray = 0.5 + 0.3 * std::sin(9.0 * x) + 0.02 * rng.normal();
+        p.insert(p.end(),
+                 {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z), static_cast<float>(gray)});
+      }
+      m.insert_points({p.data(), p.size() / 4}, kIdentity);
     }
-    m.insert_points({p.data(), p.size() / 4}, kIdentity);
-  }
-  m.flush();
-  return m;
+    return m.to_model();
+  }();
+  return Map::from_model(saved);
 }
 
 TEST(MapMerge, IntoAnEmptyMapGivesTheOtherMap) {
-  const Map other = fitted_map(0.0);
+  const Map other = fitted_map();
   ASSERT_GT(other.size(), 0u);
   Map empty;
   const sogmm::MapMergeStats st = empty.merge_map(other, kIdentity);
@@ -110,7 +114,7 @@ TEST(MapMerge, IntoAnEmptyMapGivesTheOtherMap) {
 }
 
 TEST(MapMerge, WithACopyOfItselfAddsNoComponent) {
-  Map map = fitted_map(0.0);
+  Map map = fitted_map();
   const Map copy = Map::from_model(map.to_model());
   const Gmm before = map.model().gmm;
   const sogmm::MapMergeStats st = map.merge_map(copy, kIdentity);
@@ -181,8 +185,8 @@ TEST(MapMerge, OtherFrameAndPoseCancel) {
 // Disjoint maps (the other 10 m away): nothing is outmatched, every
 // component stays with its mass in points: weights w S / (S_a + S_b).
 TEST(MapMerge, DisjointMapsKeepEveryComponentWithItsMass) {
-  Map a = fitted_map(0.0);
-  const Map b = fitted_map(0.0);
+  Map a = fitted_map();
+  const Map b = fitted_map();
   const Gmm ga = a.model().gmm, gb = b.model().gmm;
   const sogmm::MapMergeStats st = a.merge_map(b, translated(10.0));
   EXPECT_EQ(st.n_removed + st.n_skipped, 0u);
@@ -204,8 +208,8 @@ TEST(MapMerge, DeltasFollowTheMerge) {
   coarse_side[0].w = 0.75f;
   coarse_side[1].w = 0.25f;
   Map a = hand_map(coarse_side, 400);
-  Map receiver;
-  receiver.apply_delta(a.delta_since(0));
+  // A receiver holding a's base map (a loaded map's file, with its identity).
+  Map receiver = Map::from_model(a.to_model());
   const std::uint64_t before = a.revision();
   a.merge_map(hand_map(fine_patch(), 800), kIdentity);
   EXPECT_EQ(a.revision(), before + 1);
@@ -221,8 +225,8 @@ TEST(MapMerge, DeltasFollowTheMerge) {
 // Bad input: a clear error, and the map as before (components, frames,
 // revision).
 TEST(MapMerge, BadInputChangesNothing) {
-  Map map = fitted_map(0.0);
-  const Map other = fitted_map(0.3);
+  Map map = fitted_map();
+  const Map other = fitted_map();
   const Gmm before = map.model().gmm;
   const std::uint64_t revision = map.revision();
   const std::size_t frames = map.frames().size();
