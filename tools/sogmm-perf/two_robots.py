@@ -25,7 +25,7 @@ single-robot map, with at most 1.2x its components.
 
 Usage (from the repository root, after building):
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
-      python3 tools/sogmm-perf/two_robots.py [--frames 300] [--eval-step 10] [--map-merge] [--work /tmp/two_robots]
+      python3 tools/sogmm-perf/two_robots.py [--frames 300] [--eval-step 10] [--map-merge] [--robot-alone] [--work /tmp/two_robots]
 Prints a table and one JSON line.
 """
 import argparse
@@ -66,6 +66,8 @@ def main():
     ap.add_argument("--decimate", type=int, default=5)
     ap.add_argument("--eval-step", type=int, default=10)
     ap.add_argument("--work", default="/tmp/two_robots")
+    ap.add_argument("--robot-alone", action="store_true",
+                    help="also evaluate each robot's map alone (B moved to the world) on the frames of its half")
     ap.add_argument("--map-merge", action="store_true",
                     help="also merge with Map.merge_map and evaluate it beside the plain merge")
     a = ap.parse_args()
@@ -124,6 +126,21 @@ def main():
                                                                   res["components_ratio"]))
     print("held-out pixel PSNR, frames %s: single %.2f dB, merged %.2f dB; worst frame merged - single %.2f dB" %
           (frames, res["single_pixel_psnr_heldout"], res["merged_pixel_psnr_heldout"], worst))
+    if a.robot_alone:
+        # Whether a gap is the merge's or a robot's own: each robot's map on
+        # its own half's frames, beside the single-robot map there.
+        sogmm.GMM.load(os.path.join(a.work, "b.sogmm")).transform(relative).save(os.path.join(a.work, "b_world.sogmm"))
+        alone = {}
+        for name, path, first, end in (("a", "a.sogmm", 0, half), ("b", "b_world.sogmm", half, a.frames)):
+            r = run_json([a.sogmm, "eval", os.path.join(a.work, path), "--sequence", loop, "--trajectory", traj,
+                          "--frames", "%d:%d:%d" % (first, end, a.eval_step), "--decimate", str(d),
+                          "--intrinsics", os.path.join(loop, "intrinsics.json")])
+            alone[name] = {f["frame"]: f["pixel_psnr_heldout"] for f in r["frames"]}
+        res["robot_alone_pixel_psnr_heldout"] = alone
+        for name in ("a", "b"):
+            print("robot %s alone on its half: " % name.upper() +
+                  ", ".join("%d: %.2f (single %.2f)" % (f, v, next(s for g, s, _ in per_frame if g == f))
+                            for f, v in sorted(alone[name].items()) if any(g == f for g, _, _ in per_frame)))
     if a.map_merge:
         mm = [f["pixel_psnr_heldout"] for f in ev["map_merged"]["frames"]]
         mm_worst = min(x - s for (_, s, _), x in zip(per_frame, mm))
