@@ -349,20 +349,18 @@ FrameStats Map::insert_points(const PointsView& points, const Pose& camera_to_wo
   return insert_frame(*s_, *this, points, camera_to_world, false, progress);
 }
 
-namespace {
-void require_map_camera(const Map::State& s, const Camera& camera) {
+void detail::require_map_camera(const Map::State& s, const Camera& camera, const char* what) {
   if (s.camera)
     require(same_camera(*s.camera, camera), ErrorCode::InvalidArgument,
-            "map: frame camera (" + camera_text(camera) + ") differs from the map's first frame (" +
+            std::string("map: ") + what + " (" + camera_text(camera) + ") differs from the map's first frame (" +
                 camera_text(*s.camera) + ")");
 }
-}  // namespace
 
 FrameStats Map::insert_rgbd(const RgbdView& frame, const Pose& camera_to_world, const ProgressSink& progress) {
   require_rigid(camera_to_world);
   require(frame.depth != nullptr && frame.gray != nullptr, ErrorCode::InvalidArgument,
           "map: the RGB-D frame has no depth or gray image");
-  require_map_camera(*s_, frame.camera);  // before the work of back-projecting
+  detail::require_map_camera(*s_, frame.camera);  // before the work of back-projecting
   const PointCloud cloud = backproject(frame, s_->options.depth);
   return insert_backprojected(cloud.view(), frame.camera, camera_to_world, progress);
 }
@@ -370,7 +368,7 @@ FrameStats Map::insert_rgbd(const RgbdView& frame, const Pose& camera_to_world, 
 FrameStats Map::insert_backprojected(const PointsView& points, const Camera& camera, const Pose& camera_to_world,
                                      const ProgressSink& progress) {
   require_rigid(camera_to_world);
-  require_map_camera(*s_, camera);
+  detail::require_map_camera(*s_, camera);
   require(points.size > 0, ErrorCode::InvalidData,
           "map: the RGB-D frame has no valid depth pixel (depth range " + checked::exact(s_->options.depth.depth_min) +
               " to " + checked::exact(s_->options.depth.depth_max) + " m)");

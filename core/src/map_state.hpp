@@ -205,6 +205,11 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
                                                const std::vector<std::int64_t>& dominant, std::uint64_t frame_index,
                                                const ProgressSink& progress);
 
+/// Error(InvalidArgument) naming both cameras when the map has a camera
+/// (fixed by its first RGB-D frame) and `camera` differs from it; `what`
+/// names the newcomer ("frame camera").
+void require_map_camera(const Map::State& s, const Camera& camera, const char* what = "frame camera");
+
 /// `gmm` without the components `removed`; the others keep their mass in
 /// points (weights renormalised, support size scaled). Empty when all go.
 Gmm without_components(const Gmm& gmm, const std::vector<std::size_t>& removed);

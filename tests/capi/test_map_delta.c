@@ -1,6 +1,9 @@
 /* sogmm_map_export_delta / sogmm_map_apply_delta and SOGMM_MAP_REVISION: a
  * receiver fed the deltas in order holds the sender's map bit for bit; a gap,
- * a duplicate and a damaged delta are refused and change nothing. */
+ * a duplicate and a damaged delta are refused and change nothing.
+ * sogmm_map_merge_map: into an empty map it gives the other map, with a copy
+ * of itself it adds nothing, its revision travels as a delta, bad input
+ * changes nothing. */
 #include "test_util.h"
 
 static const double k_identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -130,6 +133,56 @@ int main(void) {
     EXPECT_STATUS(sogmm_map_export_delta(bounded, 0, NULL, NULL, 0, &n), SOGMM_E_INVALID_ARG);
     EXPECT_TRUE(strstr(sogmm_last_error(), "changes from revision 1") != NULL);
     sogmm_map_free(bounded);
+  }
+
+  /* sogmm_map_merge_map. sender and receiver hold the same map here. */
+  {
+    sogmm_map *empty = NULL, *none = NULL, *follower = NULL;
+    uint64_t st[5] = {9, 9, 9, 9, 9};
+    int64_t n = 0, frames = 0;
+    double bad[16];
+    uint8_t* m = NULL;
+    size_t msize = 0;
+    REQUIRE_OK(sogmm_map_create(&empty, NULL));
+    REQUIRE_OK(sogmm_map_create(&none, NULL));
+    REQUIRE_OK(sogmm_map_create(&follower, NULL));
+    REQUIRE_OK(sogmm_map_get_i64(sender, SOGMM_MAP_N_COMPONENTS, &n));
+    /* Into an empty map: the other map, bitwise. */
+    REQUIRE_OK(sogmm_map_merge_map(empty, sender, k_identity, st));
+    EXPECT_TRUE(st[0] == 0 && st[1] == 0 && st[2] == (uint64_t)n && st[3] == 0 && st[4] == 2);
+    EXPECT_TRUE(same_maps(empty, sender));
+    EXPECT_TRUE(revision_of(empty) == 1);
+    /* A follower of the receiver, then the receiver merged with a copy of
+     * itself: every component ties with its twin, none is added. */
+    m = export_delta(receiver, 0, &msize);
+    REQUIRE_OK(sogmm_map_apply_delta(follower, m, msize, NULL));
+    free(m);
+    REQUIRE_OK(sogmm_map_merge_map(receiver, empty, k_identity, st));
+    EXPECT_TRUE(st[0] == (uint64_t)n && st[1] == 0 && st[2] == 0 && st[3] == (uint64_t)n);
+    EXPECT_TRUE(same_maps(sender, receiver));
+    EXPECT_OK(sogmm_map_get_i64(receiver, SOGMM_MAP_N_FRAMES, &frames));
+    EXPECT_TRUE(frames == 4); /* both provenances */
+    /* The merge is one revision; the follower takes it as a delta. */
+    EXPECT_TRUE(revision_of(receiver) == 5);
+    m = export_delta(receiver, 4, &msize);
+    REQUIRE_OK(sogmm_map_apply_delta(follower, m, msize, NULL));
+    free(m);
+    EXPECT_TRUE(revision_of(follower) == 5 && same_maps(follower, receiver));
+    /* Bad input: a clear error, the map unchanged. */
+    EXPECT_STATUS(sogmm_map_merge_map(receiver, receiver, k_identity, NULL), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(strstr(sogmm_last_error(), "itself") != NULL);
+    EXPECT_STATUS(sogmm_map_merge_map(receiver, NULL, k_identity, NULL), SOGMM_E_NULL_ARG);
+    EXPECT_STATUS(sogmm_map_merge_map(receiver, empty, NULL, NULL), SOGMM_E_NULL_ARG);
+    memcpy(bad, k_identity, sizeof bad);
+    bad[7] = NAN;
+    EXPECT_STATUS(sogmm_map_merge_map(receiver, empty, bad, NULL), SOGMM_E_INVALID_ARG);
+    EXPECT_TRUE(strstr(sogmm_last_error(), "not finite") != NULL);
+    EXPECT_STATUS(sogmm_map_merge_map(receiver, none, k_identity, NULL), SOGMM_E_INVALID_DATA);
+    EXPECT_TRUE(strstr(sogmm_last_error(), "no component") != NULL);
+    EXPECT_TRUE(revision_of(receiver) == 5 && same_maps(sender, receiver));
+    sogmm_map_free(empty);
+    sogmm_map_free(none);
+    sogmm_map_free(follower);
   }
 
   for (i = 0; i < 3; ++i) free(d[i]);

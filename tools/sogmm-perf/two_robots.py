@@ -13,7 +13,10 @@ into one world map, taking robot B's frame from the known relative pose.
    weights by support size). (Re-observing each receiver's map from its
    frames' poses into one novelty map was tried first: on a 60-frame loop it
    kept 3x the single map's components, since the renders differ from the
-   maps' own frames everywhere.);
+   maps' own frames everywhere.) With --map-merge, the same run also merges
+   the two receivers with the core's map-to-map merge (Map.merge_map,
+   core/src/map_merge.cpp: where both maps hold a surface the sharper view
+   wins instead of both being stacked) and evaluates it beside the plain one;
 4. the single-robot map of the whole loop (`sogmm map` over all frames) and
    the merged map are evaluated per pixel on the same frames (`sogmm eval`,
    held-out pixel PSNR), and their components are counted.
@@ -22,7 +25,7 @@ single-robot map, with at most 1.2x its components.
 
 Usage (from the repository root, after building):
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
-      python3 tools/sogmm-perf/two_robots.py [--frames 300] [--step 3] [--eval-step 10] [--work /tmp/two_robots]
+      python3 tools/sogmm-perf/two_robots.py [--frames 300] [--eval-step 10] [--map-merge] [--robot-alone] [--work /tmp/two_robots]
 Prints a table and one JSON line.
 """
 import argparse
@@ -63,6 +66,10 @@ def main():
     ap.add_argument("--decimate", type=int, default=5)
     ap.add_argument("--eval-step", type=int, default=10)
     ap.add_argument("--work", default="/tmp/two_robots")
+    ap.add_argument("--robot-alone", action="store_true",
+                    help="also evaluate each robot's map alone (B moved to the world) on the frames of its half")
+    ap.add_argument("--map-merge", action="store_true",
+                    help="also merge with Map.merge_map and evaluate it beside the plain merge")
     a = ap.parse_args()
     shutil.rmtree(a.work, ignore_errors=True)
     os.makedirs(a.work)
@@ -90,13 +97,18 @@ def main():
     with follow(os.path.join(a.work, "deltas_a")) as ra, follow(os.path.join(a.work, "deltas_b")) as rb:
         assert ra.n_components_ == robots["a"]["n_components"] and rb.n_components_ == robots["b"]["n_components"]
         world = ra.export().merge(rb.export().transform(relative))
-    world.save(merged)
-    merged_components = world.n_components_
+        world.save(merged)
+        merged_components = world.n_components_
+        if a.map_merge:
+            map_merged = os.path.join(a.work, "map_merged.sogmm")
+            merge_stats = ra.merge_map(rb, relative)
+            ra.save(map_merged)
+            map_merged_components = ra.n_components_
 
     frames = "0:%d:%d" % (a.frames, a.eval_step)
     ev = {m: run_json([a.sogmm, "eval", path, "--sequence", loop, "--trajectory", traj, "--frames", frames,
                        "--decimate", str(d), "--intrinsics", os.path.join(loop, "intrinsics.json")])
-          for m, path in (("single", single), ("merged", merged))}
+          for m, path in (("single", single), ("merged", merged)) + ((("map_merged", map_merged),) if a.map_merge else ())}
     per_frame = [(s["frame"], s["pixel_psnr_heldout"], m["pixel_psnr_heldout"])
                  for s, m in zip(ev["single"]["frames"], ev["merged"]["frames"])]
     worst = min(m - s for _, s, m in per_frame)
@@ -114,8 +126,36 @@ def main():
                                                                   res["components_ratio"]))
     print("held-out pixel PSNR, frames %s: single %.2f dB, merged %.2f dB; worst frame merged - single %.2f dB" %
           (frames, res["single_pixel_psnr_heldout"], res["merged_pixel_psnr_heldout"], worst))
-    for f, s, m in per_frame:
-        print("  frame %3d: single %.2f, merged %.2f" % (f, s, m))
+    if a.robot_alone:
+        # Whether a gap is the merge's or a robot's own: each robot's map on
+        # its own half's frames, beside the single-robot map there.
+        sogmm.GMM.load(os.path.join(a.work, "b.sogmm")).transform(relative).save(os.path.join(a.work, "b_world.sogmm"))
+        alone = {}
+        for name, path, first, end in (("a", "a.sogmm", 0, half), ("b", "b_world.sogmm", half, a.frames)):
+            r = run_json([a.sogmm, "eval", os.path.join(a.work, path), "--sequence", loop, "--trajectory", traj,
+                          "--frames", "%d:%d:%d" % (first, end, a.eval_step), "--decimate", str(d),
+                          "--intrinsics", os.path.join(loop, "intrinsics.json")])
+            alone[name] = {f["frame"]: f["pixel_psnr_heldout"] for f in r["frames"]}
+        res["robot_alone_pixel_psnr_heldout"] = alone
+        for name in ("a", "b"):
+            print("robot %s alone on its half: " % name.upper() +
+                  ", ".join("%d: %.2f (single %.2f)" % (f, v, next(s for g, s, _ in per_frame if g == f))
+                            for f, v in sorted(alone[name].items()) if any(g == f for g, _, _ in per_frame)))
+    if a.map_merge:
+        mm = [f["pixel_psnr_heldout"] for f in ev["map_merged"]["frames"]]
+        mm_worst = min(x - s for (_, s, _), x in zip(per_frame, mm))
+        res.update({"map_merged_components": map_merged_components,
+                    "map_merged_components_ratio": map_merged_components / one["n_components"],
+                    "map_merged_pixel_psnr_heldout": ev["map_merged"]["mean"]["pixel_psnr_heldout"],
+                    "map_merged_worst_frame_psnr_difference": mm_worst, "map_merge": merge_stats})
+        print("map merge (Map.merge_map): %d components (%.2fx; A kept %d, removed %d; B added %d, left out %d); "
+              "held-out pixel PSNR %.2f dB; worst frame map-merged - single %.2f dB" %
+              (map_merged_components, res["map_merged_components_ratio"], merge_stats["n_kept"],
+               merge_stats["n_removed"], merge_stats["n_added"], merge_stats["n_skipped"],
+               res["map_merged_pixel_psnr_heldout"], mm_worst))
+    for i, (f, s, m) in enumerate(per_frame):
+        print("  frame %3d: single %.2f, merged %.2f" % (f, s, m) +
+              (", map-merged %.2f" % mm[i] if a.map_merge else ""))
     print(json.dumps(res))
 
 

@@ -1072,6 +1072,32 @@ SOGMM_API sogmm_status sogmm_map_export_delta(const sogmm_map* map, uint64_t sin
 SOGMM_API sogmm_status sogmm_map_apply_delta(sogmm_map* map, const void* data, size_t size,
                                              const sogmm_options* options);
 
+/* Merges the map `other` into `map` (two robots, one map):
+ * `other_to_map` (16 doubles, row-major) is the rigid transform of the other
+ * map's world frame into this map's. Where both maps hold the same surface
+ * the sharper view wins instead of both being stacked: each of the other
+ * map's components that `map` already explains at least as sharply (the
+ * novelty test's local 3-D log-density at 4 of its 7 test points: its mean
+ * and +-1 sigma along its spatial axes; ties to `map`) is left out, then
+ * each of `map`'s components that the other's kept components explain more
+ * sharply is removed; kept components keep their mass in points. The other
+ * map's frame provenance is appended (poses moved into this world). A map
+ * with no origin yet takes the other's, moved. One revision
+ * (SOGMM_MAP_REVISION + 1): its delta (sogmm_map_export_delta) carries it.
+ * Into an empty map it gives the other map's components (bitwise for the
+ * identity); with a copy of itself it adds none. `stats_out` (NULL or 5
+ * uint64): this map's components kept, removed; the other's added, left
+ * out; frame lines added. Errors (the map unchanged): map, other or
+ * other_to_map NULL -> SOGMM_E_NULL_ARG; other == map ->
+ * SOGMM_E_INVALID_ARG; points pending in either map (flush first) or a pose
+ * not finite or not rigid -> SOGMM_E_INVALID_ARG; the other map without
+ * components -> SOGMM_E_INVALID_DATA; both maps with a camera and different
+ * ones, or a component moved beyond float32 -> SOGMM_E_INVALID_ARG. Needs
+ * exclusive use of `map` (like an insert) and shared use of `other` (like an
+ * export): either in use by another call -> SOGMM_E_BUSY. */
+SOGMM_API sogmm_status sogmm_map_merge_map(sogmm_map* map, const sogmm_map* other, const double* other_to_map,
+                                           uint64_t* stats_out);
+
 /* ---- trajectories (Redwood .log) -------------------------------------- */
 /* A .log file holds, per frame, a header line "i j n" and four lines of a
  * row-major 4 x 4 camera-to-world matrix. Blank lines are skipped. */

@@ -189,6 +189,15 @@ struct MapStats {
   std::uint64_t n_refits = 0;       ///< revisit refits run (also counted in n_flushes: fits run)
 };
 
+/// What Map::merge_map did (counts of components and frame lines).
+struct MapMergeStats {
+  std::size_t n_kept = 0;     ///< this map's components kept
+  std::size_t n_removed = 0;  ///< this map's components the other map holds more sharply (removed)
+  std::size_t n_added = 0;    ///< the other map's components added
+  std::size_t n_skipped = 0;  ///< the other map's components this map already holds as sharply (left out)
+  std::size_t n_frames = 0;   ///< frame provenance lines added (the other map's frames)
+};
+
 /// Metadata keys of a saved map (Map::to_model / Map::from_model; listed in
 /// spec/format.md section 2.3). Values are ASCII text.
 inline constexpr const char* kMapFramesKey = "map_frames";    ///< per-frame provenance, one line per frame
@@ -356,6 +365,29 @@ class Map {
   /// the map at its last revision. This map's options are kept (they govern
   /// later inserts).
   void apply_delta(const MapDelta& delta);
+
+  /// Merges another map into this one (issue 33: two robots, one map),
+  /// `other_to_this` the rigid transform of the other map's world frame into
+  /// this map's (core/src/map_merge.cpp says why and how). Where both maps
+  /// hold the same surface, the sharper view wins instead of both being
+  /// stacked: first each of the other map's components whose test points
+  /// (its mean and +-1 sigma along its three spatial axes) this map explains
+  /// at least as sharply at most of them (the novelty test's local 3-D
+  /// log-density, ties to this map) is left out; then each of this map's
+  /// components that the other map's kept components explain more sharply
+  /// at most of its test points is removed. Kept components keep their mass
+  /// in points (weight x support size); the other map's frame provenance is
+  /// appended (poses moved to this world, component counts 0). A map
+  /// without an origin takes the other's, moved. One revision: a delta
+  /// carries it as a Remove and a Merge step. Merging into an empty map
+  /// gives the other map's components (bitwise for the identity); a map
+  /// merged with a copy of itself keeps its own components only. Errors,
+  /// nothing changed: `other` is this map, points pending in either map,
+  /// or `other_to_this` not a finite rigid transform -> Error(InvalidArgument);
+  /// the other map without components -> Error(InvalidData); both maps with
+  /// cameras that differ -> Error(InvalidArgument) naming both; a component
+  /// moved beyond float32 -> Error(InvalidArgument).
+  MapMergeStats merge_map(const Map& other, const Pose& other_to_this);
 
   struct State;  ///< the implementation (core/src/map_state.hpp)
 

@@ -251,6 +251,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_map_load": (STATUS, [HANDLE_OUT, c_char_p, HANDLE]),
     "sogmm_map_export_delta": (STATUS, [HANDLE, c_uint64, HANDLE, c_void_p, c_size_t, POINTER(c_size_t)]),
     "sogmm_map_apply_delta": (STATUS, [HANDLE, c_void_p, c_size_t, HANDLE]),
+    "sogmm_map_merge_map": (STATUS, [HANDLE, HANDLE, F64_IN, POINTER(c_uint64)]),
     "sogmm_trajectory_read": (STATUS, [HANDLE_OUT, c_char_p]),
     "sogmm_trajectory_free": (None, [HANDLE]),
     "sogmm_trajectory_size": (c_size_t, [HANDLE]),

@@ -451,6 +451,28 @@ class Map(Queryable):
         with self._guard.changing("apply_delta"):
             check(lib.sogmm_map_apply_delta(self._h(), data, len(data), None))
 
+    def merge_map(self, other: "Map", pose=None) -> dict:
+        """Merges the map ``other`` into this one (two robots, one map), the
+        4 x 4 rigid ``pose`` (None = identity) moving the other map's world
+        frame into this map's. Where both hold a surface the sharper view
+        wins instead of both being stacked; the other's frame provenance is
+        appended; one revision, carried by deltas (sogmm_map_merge_map).
+        Returns the counts n_kept, n_removed (this map's components),
+        n_added, n_skipped (the other's) and n_frames (frame lines added).
+        Errors (this map unchanged): ``other`` not a Map or this map, points
+        pending in either, a pose not finite or not rigid ->
+        InvalidArgumentError; ``other`` without components ->
+        InvalidDataError; either map in use -> MapBusyError."""
+        if not isinstance(other, Map):
+            raise InvalidArgumentError(f"merge_map needs a Map, got {type(other).__name__}")
+        if other is self:
+            raise InvalidArgumentError("a map cannot be merged into itself (merge a copy)")
+        p = _pose(np.eye(4) if pose is None else pose)
+        out = (c_uint64 * 5)()
+        with self._guard.changing("merge_map"), other._guard.reading("merge_map"):
+            check(lib.sogmm_map_merge_map(self._h(), other._h(), p, out))
+        return dict(zip(("n_kept", "n_removed", "n_added", "n_skipped", "n_frames"), (int(v) for v in out)))
+
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
              zstd_level: int = _D.zstd_level) -> None:

@@ -504,6 +504,12 @@ extern "C" {
         size: usize,
         options: *const sogmm_options,
     ) -> sogmm_status;
+    pub fn sogmm_map_merge_map(
+        map: *mut sogmm_map,
+        other: *const sogmm_map,
+        other_to_map: *const f64,
+        stats_out: *mut u64,
+    ) -> sogmm_status;
     pub fn sogmm_fit_points_f32(
         out: *mut *mut sogmm_model,
         points: *const f32,

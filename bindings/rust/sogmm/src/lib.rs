@@ -43,7 +43,7 @@ use std::sync::OnceLock;
 
 pub use error::{Error, Result, Status};
 pub use frames::{ColorPixels, ImageFrame, Trajectory};
-pub use map::{Map, MapFrameStats, MapStats, Pose};
+pub use map::{Map, MapFrameStats, MapMergeStats, MapStats, Pose};
 pub use metrics::{psnr_images, Psnr};
 pub use model::{Color, Frame, Model};
 pub use options::{

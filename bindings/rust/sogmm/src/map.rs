@@ -15,6 +15,21 @@ use crate::registration::{self, Registration};
 /// A row-major 4 x 4 rigid camera-to-world transform [R t; 0 0 0 1].
 pub type Pose = [f64; 16];
 
+/// What `Map::merge_map` did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapMergeStats {
+    /// This map's components kept.
+    pub n_kept: u64,
+    /// This map's components the other map holds more sharply (removed).
+    pub n_removed: u64,
+    /// The other map's components added.
+    pub n_added: u64,
+    /// The other map's components this map already holds as sharply (left out).
+    pub n_skipped: u64,
+    /// Frame provenance lines added (the other map's frames).
+    pub n_frames: u64,
+}
+
 /// Totals of a map.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MapStats {
@@ -311,6 +326,29 @@ impl Map {
         // SAFETY: exclusive use of the map; `delta` is read during the call.
         check(unsafe {
             sys::sogmm_map_apply_delta(self.ptr.as_ptr(), delta.as_ptr().cast(), delta.len(), std::ptr::null())
+        })
+    }
+
+    /// Merges the map `other` into this one (two robots, one map),
+    /// `other_to_this` moving the other map's world frame into this map's:
+    /// where both hold a surface the sharper view wins instead of both being
+    /// stacked; the other's frame provenance is appended; one revision,
+    /// carried by deltas (sogmm_map_merge_map). Errors (this map unchanged):
+    /// points pending in either map or a pose not finite or not rigid ->
+    /// InvalidArg; `other` without components -> InvalidData.
+    pub fn merge_map(&mut self, other: &Map, other_to_this: &Pose) -> Result<MapMergeStats> {
+        let mut out = [0u64; 5];
+        // SAFETY: exclusive use of this map, shared use of `other` (the
+        // borrows rule out the same map); 16 pose doubles and 5 outputs.
+        check(unsafe {
+            sys::sogmm_map_merge_map(self.ptr.as_ptr(), other.raw(), other_to_this.as_ptr(), out.as_mut_ptr())
+        })?;
+        Ok(MapMergeStats {
+            n_kept: out[0],
+            n_removed: out[1],
+            n_added: out[2],
+            n_skipped: out[3],
+            n_frames: out[4],
         })
     }
 

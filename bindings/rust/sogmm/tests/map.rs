@@ -459,3 +459,37 @@ fn a_far_map_keeps_its_origin() {
     assert_eq!(fresh.origin().unwrap(), [5.0e5, 0.5, 0.0]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+// sogmm_map_merge_map: into an empty map it gives the other map bitwise, a
+// receiver follows it as one delta, bad input changes nothing.
+#[test]
+fn merge_map_into_an_empty_map_gives_the_other_map() {
+    let mut other = Map::new(Some(&map_options(false))).unwrap();
+    other.insert_points(&blobs(1500, 11), &IDENTITY).unwrap();
+    let n = other.stats().unwrap().n_components;
+    let mut map = Map::new(None).unwrap();
+    let mut receiver = Map::new(None).unwrap();
+    let st = map.merge_map(&other, &IDENTITY).unwrap();
+    assert_eq!(
+        (st.n_kept, st.n_removed, st.n_added, st.n_skipped, st.n_frames),
+        (0, 0, n, 0, 1)
+    );
+    assert_eq!(map.revision().unwrap(), 1);
+    receiver.apply_delta(&map.export_delta(0).unwrap()).unwrap();
+    let bits = |v: Vec<f32>| v.into_iter().map(f32::to_bits).collect::<Vec<u32>>();
+    for m in [&map, &receiver] {
+        let (a, b) = (other.export().unwrap(), m.export().unwrap());
+        assert_eq!(bits(a.weights().unwrap()), bits(b.weights().unwrap()));
+        assert_eq!(bits(a.means().unwrap()), bits(b.means().unwrap()));
+        assert_eq!(bits(a.covariances().unwrap()), bits(b.covariances().unwrap()));
+    }
+    let mut nan = IDENTITY;
+    nan[3] = f64::NAN;
+    assert_eq!(map.merge_map(&other, &nan).unwrap_err().status(), Status::InvalidArg);
+    let empty = Map::new(None).unwrap();
+    assert_eq!(
+        map.merge_map(&empty, &IDENTITY).unwrap_err().status(),
+        Status::InvalidData
+    );
+    assert_eq!(map.revision().unwrap(), 1);
+}
