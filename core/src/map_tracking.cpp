@@ -3,6 +3,7 @@
 
 #include "sogmm/error.hpp"
 #include "sogmm/model.hpp"
+#include "tracking_target.hpp"
 
 namespace sogmm {
 
@@ -37,7 +38,8 @@ TrackedFrame track_backprojected(Map& map, const PointsView& points, const Camer
     return t;
   }
   auto register_to_map = [&] {
-    t.registration = register_points(map.model().gmm, points.data, points.size, guess, options, threads, progress);
+    t.registration =
+        register_points(detail::tracking_target(map), points.data, points.size, guess, options, threads, progress);
     t.registered = true;
   };
   if (map.size() == 0) {

@@ -264,6 +264,10 @@ class Map {
   std::size_t size() const;
   /// Novel points waiting for a flush.
   std::size_t pending() const;
+  /// Those points (x, y, z, gray) in the world frame, oldest frame first:
+  /// the newest surfaces, which tracking registers to with the components
+  /// (sogmm/map_tracking.hpp). Empty when nothing is pending.
+  PointCloud pending_points() const;
   MapStats stats() const;
   /// One entry per inserted frame, in order.
   const std::vector<FrameStats>& frames() const;

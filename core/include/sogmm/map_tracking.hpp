@@ -6,12 +6,15 @@
 // the same rules: which target the frame is registered to, when pending
 // points are flushed to serve as target, what is inserted and what is not.
 //
-// The target is the map's components. Pending points (novel surfaces not
-// yet fitted) are flushed only when the map has no component yet, or when a
-// registration against the components alone does not converge: a flush per
-// frame would fit each frame's few novel points alone (thousands of small
-// batches, a poorer map and 10x the fit time), while the views that need the
-// newest surfaces are the ones that leave the mapped space.
+// The target is the map's components joined by its pending points (novel
+// surfaces not yet fitted), summarised as 6 cm cells of their mean and
+// covariance (core/src/tracking_target.hpp): the views that leave the mapped
+// space are the ones that need the newest surfaces, and without them the
+// synthetic loop's errors came in steps (frames 0-99 with gray: 1.94 cm ATE
+// against 0.46 cm with the cells). Pending points are flushed only when the
+// map has no component yet, or when a registration against that target does
+// not converge: a flush per frame would fit each frame's few novel points
+// alone (thousands of small batches, a poorer map and 10x the fit time).
 #pragma once
 
 #include "sogmm/camera.hpp"
@@ -40,7 +43,7 @@ struct TrackedFrame {
 Pose predict_constant_velocity(const Map& map);
 
 /// Registers the frame's points (backproject() with map.options().depth) to
-/// the map from `guess` (camera-to-world) and inserts the frame at the
+/// the map (its components and pending points) from `guess` (camera-to-world) and inserts the frame at the
 /// registered pose when the registration's status is Converged. A frame
 /// whose registration ends otherwise (not converged, low fitness,
 /// degenerate) is not inserted: the caller reads why in the result, and the
