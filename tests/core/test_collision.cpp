@@ -54,7 +54,9 @@ TEST(Collision, SphereAndEllipsoidAboveADiscClosedForm) {
     for (std::size_t i = 0; i < heights.size(); ++i) {
       // Above the disc's interior the clearance is h - 0.1 (the z semi-axis).
       EXPECT_NEAR(p[i], phi(-(heights[i] - 0.1) / sigma), 1e-6) << "h = " << heights[i];
-      if (i > 0) EXPECT_LE(p[i], p[i - 1]);
+      if (i > 0) {
+        EXPECT_LE(p[i], p[i - 1]);
+      }
     }
     EXPECT_GE(p[0], 0.99);   // the robot's centre on the surface
     EXPECT_NEAR(p[3], 0.5, 1e-6);  // touching
