@@ -213,17 +213,24 @@ def update_readme(report, baseline_root, runs):
     if README_BEGIN not in text or README_END not in text:
         sys.exit(f"run_perf: {path} has no run_perf markers")
     cpu = "unknown CPU"
+    flags = set()
     if os.path.exists("/proc/cpuinfo"):
         for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
+            if line.startswith("model name") and cpu == "unknown CPU":
                 cpu = line.split(":", 1)[1].strip()
-                break
+            elif line.startswith("flags") and not flags:
+                flags = set(line.split(":", 1)[1].split())
+    # The EM/query kernel the runtime dispatch picks (core/src/em_dispatch.cpp):
+    # the widest the CPU has, unless SOGMM_ISA caps it.
+    avx512 = {"avx512f", "avx512vl", "avx512dq", "avx512bw"} <= flags
+    best = "AVX-512" if avx512 else ("AVX2" if {"avx2", "fma"} <= flags else "SSE2")
+    kernel = os.environ.get("SOGMM_ISA", "").upper().replace("AVX512", "AVX-512") or best
     dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
                            capture_output=True, text=True).stdout.strip()
     head = git_head(ROOT) + (" with uncommitted changes" if dirty else "")
     base = f'"today" is {git_head(baseline_root)}' if baseline_root else "no baseline build"
-    header = (f"Measured {datetime.date.today().isoformat()} on {os.cpu_count()} cores of {cpu}, medians of {runs} "
-              f"runs: {base}, \"new\" is {head}.\n\n")
+    header = (f"Measured {datetime.date.today().isoformat()} on {os.cpu_count()} cores of {cpu} ({kernel} kernel), "
+              f"medians of {runs} runs: {base}, \"new\" is {head}.\n\n")
     before, rest = text.split(README_BEGIN, 1)
     after = rest.split(README_END, 1)[1]
     with open(path + ".tmp", "w") as f:
