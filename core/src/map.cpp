@@ -95,11 +95,9 @@ Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, co
   Model kept = s.model;
   kept.gmm = detail::without_components(s.model.gmm, plan.replaced);
   Gmm batch_gmm = batch.gmm;
-  Searchable out{kept.gmm.size() == 0 ? std::move(batch) : merge(kept, batch), ComponentIndex(s.options.index_sigmas),
-                 {}, std::move(batch_gmm), {}};
-  out.marginals.reserve(out.model.gmm.size());
-  for (std::size_t k = 0; k < out.model.gmm.size(); ++k) out.marginals.push_back(detail::marginal3(out.model.gmm, k));
-  out.index.build(out.model.gmm);
+  Model model = kept.gmm.size() == 0 ? std::move(batch) : merge(kept, batch);
+  detail::Searches searches = detail::searches_of(model.gmm, s.options.index_sigmas);
+  Searchable out{std::move(model), std::move(searches.index), std::move(searches.marginals), std::move(batch_gmm), {}};
   out.world = world_of(s, out.model);
   return out;
 }

@@ -220,11 +220,7 @@ void Map::apply_delta(const MapDelta& d) {
   if (map_digest(model.gmm, detail::frames_text(frames)) != d.digest)
     throw bad_delta("the map after it differs from the sender's (digest mismatch): damaged, or a receiver whose "
                     "arithmetic differs");
-  std::vector<detail::Marginal3> marginals;
-  marginals.reserve(model.gmm.size());
-  for (std::size_t k = 0; k < model.gmm.size(); ++k) marginals.push_back(detail::marginal3(model.gmm, k));
-  ComponentIndex index(s.options.index_sigmas);
-  index.build(model.gmm);
+  detail::Searches searches = detail::searches_of(model.gmm, s.options.index_sigmas);
   detail::JournalEntry entry;
   entry.revision_before = d.base_revision;
   entry.revision_after = d.revision;
@@ -242,8 +238,8 @@ void Map::apply_delta(const MapDelta& d) {
   s.model = std::move(model);
   s.world = std::move(world);
   s.frames = std::move(frames);
-  s.marginals = std::move(marginals);
-  s.index = std::move(index);
+  s.marginals = std::move(searches.marginals);
+  s.index = std::move(searches.index);
   ++s.revision;
   if (d.revision > d.base_revision) j.append(std::move(entry));
   j.map_id = d.map_id;

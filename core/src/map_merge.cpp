@@ -81,17 +81,6 @@ std::vector<double> test_points(const Gmm& gmm) {
   return out;
 }
 
-// What a map's novelty test needs to score points: its index and marginals.
-struct Scorer {
-  ComponentIndex index;
-  std::vector<detail::Marginal3> marginals;
-  Scorer(const Gmm& gmm, double sigmas) : index(sigmas) {
-    marginals.reserve(gmm.size());
-    for (std::size_t k = 0; k < gmm.size(); ++k) marginals.push_back(detail::marginal3(gmm, k));
-    index.build(gmm);
-  }
-};
-
 std::vector<double> scores(const ComponentIndex& index, const std::vector<detail::Marginal3>& marginals, int threads,
                            const std::vector<double>& points) {
   std::vector<double> out(points.size() / 3);
@@ -163,14 +152,14 @@ MapMergeStats Map::merge_map(const Map& other_map, const Pose& other_to_this) {
   std::vector<std::size_t> skipped, removed;
   if (s.model.gmm.size() > 0) {
     const std::vector<double> points = test_points(theirs);
-    const Scorer own(theirs, sigmas);
+    const detail::Searches own = detail::searches_of(theirs, sigmas);
     skipped = outmatched(scores(own.index, own.marginals, threads, points),
                          scores(s.index, s.marginals, threads, points), true);
   }
   const Gmm kept = skipped.empty() ? theirs : detail::without_components(theirs, skipped);
   if (kept.size() > 0 && s.model.gmm.size() > 0) {
     const std::vector<double> points = test_points(s.model.gmm);
-    const Scorer rival(kept, sigmas);
+    const detail::Searches rival = detail::searches_of(kept, sigmas);
     removed = outmatched(scores(s.index, s.marginals, threads, points),
                          scores(rival.index, rival.marginals, threads, points), false);
   }
@@ -190,7 +179,7 @@ MapMergeStats Map::merge_map(const Map& other_map, const Pose& other_to_this) {
   }
   s.journal.remove(removed);
   if (kept.size() > 0) s.journal.merge(kept);
-  Scorer searches(merged.gmm, sigmas);
+  detail::Searches searches = detail::searches_of(merged.gmm, sigmas);
   Model world = detail::is_zero(origin) ? Model{} : detail::world_frame(merged, origin);
   std::vector<FrameStats> frames = s.frames;
   frames.reserve(s.frames.size() + o.frames.size());

@@ -54,6 +54,14 @@ Marginal3 marginal3(const Gmm& gmm, std::size_t m) {
   return r;
 }
 
+Searches searches_of(const Gmm& gmm, double index_sigmas) {
+  Searches s{ComponentIndex(index_sigmas), {}};
+  s.marginals.reserve(gmm.size());
+  for (std::size_t k = 0; k < gmm.size(); ++k) s.marginals.push_back(marginal3(gmm, k));
+  s.index.build(gmm);
+  return s;
+}
+
 namespace {
 // -0.0 and 0.0 are one voxel: == says so, and the hash reads bits.
 double canonical(double v) { return v == 0.0 ? 0.0 : v; }

@@ -175,9 +175,9 @@ Map Map::from_model(const Model& model, const MapOptions& options) {
   detail::read_identity(s.model, s.journal);
   if (model.camera.known) s.camera = model.camera.camera;
   restore_warm_start(s);
-  s.marginals.reserve(s.model.gmm.size());
-  for (std::size_t k = 0; k < s.model.gmm.size(); ++k) s.marginals.push_back(detail::marginal3(s.model.gmm, k));
-  s.index.build(s.model.gmm);
+  detail::Searches searches = detail::searches_of(s.model.gmm, s.options.index_sigmas);
+  s.index = std::move(searches.index);
+  s.marginals = std::move(searches.marginals);
   return map;
 }
 

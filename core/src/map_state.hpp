@@ -32,6 +32,16 @@ struct Marginal3 {
 /// positive definite in double, which validate(Gmm) rules out).
 Marginal3 marginal3(const Gmm& gmm, std::size_t m);
 
+/// What the novelty test searches in a model: its component index and each
+/// component's Marginal3 (one per component, in order).
+struct Searches {
+  ComponentIndex index;
+  std::vector<Marginal3> marginals;
+};
+
+/// The Searches of `gmm`, its index built with `index_sigmas`.
+Searches searches_of(const Gmm& gmm, double index_sigmas);
+
 /// log N(x | component) of a world point.
 inline double log_density(const Marginal3& c, const double x[3]) {
   const double d0 = x[0] - c.mu[0], d1 = x[1] - c.mu[1], d2 = x[2] - c.mu[2];
