@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -13,6 +14,7 @@
 #include "covariance_storage.hpp"
 #include "em_acceleration.hpp"
 #include "em_kernel.hpp"
+#include "em_regions.hpp"
 #include "em_truncation.hpp"
 #include "em_working.hpp"
 #include "sogmm/options.hpp"
@@ -36,11 +38,12 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 // count), so the order in which partial sums are added never changes.
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
-// The chunks' partial statistics a parallel region may hold at once: as many
-// waves as fit run in one region (the reduction order, chunk by chunk, is the
-// same), so that a sparse (truncated) pass, whose waves are short, does not pay
-// a region's start, tail imbalance and serial reduction per wave.
-constexpr std::size_t kSlotBytes = std::size_t{16} << 20;
+// The chunks' partial statistics a parallel region may hold at once
+// (em_regions.hpp): as many waves as fit run in one region (the reduction
+// order, chunk by chunk, is the same), so that a sparse (truncated) pass, whose
+// waves are short, does not pay a region's start, tail imbalance and serial
+// reduction per wave.
+std::atomic<std::size_t> g_region_bytes{detail::kDefaultEmRegionBytes};
 
 // The regulariser per diagonal (x, y, z, gray).
 using RegDiagonal = std::array<double, 4>;
@@ -309,7 +312,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   const std::size_t blocks_per_chunk = std::max<std::size_t>(1, (n_blocks + kWave * n_waves - 1) / (kWave * n_waves));
   const std::size_t n_chunks = (n_blocks + blocks_per_chunk - 1) / blocks_per_chunk;
   const std::size_t region_chunks =
-      std::min(n_chunks, std::max(kWave, kWave * (kSlotBytes / (kWave * m * kStatStride * sizeof(double)))));
+      std::min(n_chunks, std::max(kWave, kWave * (detail::em_region_bytes() / (kWave * m * kStatStride * sizeof(double)))));
   const int threads = detail::team_size(options.threads);
   const detail::EmKernels& kernels = detail::em_kernels();
 
@@ -538,6 +541,12 @@ Gmm fit_em_from(const PointsView& points, const Gmm& initial, const EmOptions& o
     w.log_weight[k] = initial.weights[k] > 0 ? std::log(static_cast<double>(initial.weights[k])) : -1e30;
   }
   return run_em(points, std::move(w), frame, floors, options, report, on_iteration);
+}
+
+std::size_t detail::em_region_bytes() { return g_region_bytes.load(std::memory_order_relaxed); }
+
+std::size_t detail::set_em_region_bytes(std::size_t bytes) {
+  return g_region_bytes.exchange(bytes, std::memory_order_relaxed);
 }
 
 }  // namespace sogmm

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "em_regions.hpp"
 #include "sogmm/em.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/fit.hpp"
@@ -324,6 +325,42 @@ TEST(EmProperties, MultiWavePathMatchesTheSingleCopy) {
     EXPECT_LT((sogmm_test::mean_of(forty, k) - sogmm_test::mean_of(one, k)).cwiseAbs().maxCoeff(), 1e-6);
     const Eigen::Matrix4d c = sogmm_test::cov_of(one, k);
     EXPECT_LT((sogmm_test::cov_of(forty, k) - c).cwiseAbs().maxCoeff(), 1e-5 * c.cwiseAbs().maxCoeff());
+  }
+}
+
+// The E-step's chunks run in parallel regions of as many chunks as 16 MiB of
+// their statistics allow (em_regions.hpp); real fits start a second region
+// only at M of a few thousand beyond 131k points. With the budget at one byte
+// every region holds one wave of 16 chunks, so the 40-copy cloud (more than
+// 16 x 32 blocks, hence more than 16 chunks) takes several regions per pass:
+// exact and truncated, 1 and 2 threads, the bits are those of one region.
+TEST(EmProperties, RegionsPerPassDoNotChangeABit) {
+  const std::vector<float> pts = frame_points();
+  std::vector<float> many;
+  for (int c = 0; c < 40; ++c) many.insert(many.end(), pts.begin(), pts.end());
+  ASSERT_GT(many.size() / 4, 16u * 32u * 256u) << "one region would hold every chunk: the test would be vacuous";
+  const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(pts), 24, 3);
+  for (double nats : {0.0, 8.0}) {
+    sogmm::EmOptions o;
+    o.max_iter = 4;
+    o.tol = 0.0;
+    o.truncation_nats = nats;
+    sogmm::EmReport one_region;
+    const sogmm::Gmm reference = sogmm::fit_em(view(many), seeds, o, &one_region);
+    const std::size_t previous = sogmm::detail::set_em_region_bytes(1);
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE("truncation " + std::to_string(nats) + ", threads " + std::to_string(threads));
+      o.threads = threads;
+      sogmm::EmReport regions;
+      const sogmm::Gmm g = sogmm::fit_em(view(many), seeds, o, &regions);
+      EXPECT_TRUE(sogmm_test::bit_identical(reference, g));
+      EXPECT_EQ(one_region.log_likelihood, regions.log_likelihood);
+      EXPECT_EQ(one_region.pair_fraction, regions.pair_fraction);
+    }
+    sogmm::detail::set_em_region_bytes(previous);
+    if (nats > 0) {
+      EXPECT_LT(one_region.pair_fraction, 0.9) << "nothing was skipped: the truncated case would be vacuous";
+    }
   }
 }
 
