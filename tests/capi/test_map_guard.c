@@ -2,7 +2,8 @@
  * sogmm.h "Use guard" and sogmm_progress_fn):
  * - a call on a map from the progress callback of a call on that map returns
  *   SOGMM_E_BUSY ("map busy: ...") and changes nothing: a nested flush no
- *   longer merges the batch twice, a nested free frees nothing;
+ *   longer merges the batch twice, a nested free frees nothing, a map-to-map
+ *   merge that would write or read the busy map is refused;
  * - a call from another thread while one runs gets the same error (the two
  *   threads meet at a handshake inside the first call's callback, so the
  *   overlap is certain, not a matter of timing);
@@ -46,10 +47,11 @@ static sogmm_map* small_batch_map(void) {
 
 typedef struct {
   sogmm_map* map;
+  sogmm_map* idle;       /* another map, not in use (NULL: no merge is tried) */
   const float* points;
   int calls;             /* callback invocations */
   int nested_done;       /* the nested calls ran (on the first invocation) */
-  sogmm_status insert, flush, set_progress, stats, score;
+  sogmm_status insert, flush, set_progress, stats, score, merge_into, merge_from;
   int busy_messages;     /* nested failures whose message starts "map busy: " */
   int free_refused;      /* sogmm_map_free left the map and said "map busy" */
 } Reentry;
@@ -73,6 +75,12 @@ static int32_t reenter(int32_t stage, uint64_t step, uint64_t total, double ll, 
   r->busy_messages += message_starts("map busy: sogmm_map_get_i64");
   r->score = sogmm_map_score_samples_f32(r->map, xyz, 1, 4, NULL, &score);
   r->busy_messages += message_starts("map busy: sogmm_map_score_samples_f32");
+  if (r->idle != NULL) { /* merging into the busy map writes it; merging it into another reads it */
+    r->merge_into = sogmm_map_merge_map(r->map, r->idle, k_identity, NULL);
+    r->busy_messages += message_starts("map busy: sogmm_map_merge_map");
+    r->merge_from = sogmm_map_merge_map(r->idle, r->map, k_identity, NULL);
+    r->busy_messages += message_starts("map busy: sogmm_map_merge_map");
+  }
   sogmm_map_free(r->map); /* refused: the map is in use; the outer call goes on with it */
   r->free_refused = message_starts("map busy: sogmm_map_free");
   return 0;
@@ -86,6 +94,7 @@ static void test_reentry_from_callback(void) {
   Reentry r;
   memset(&r, 0, sizeof r);
   r.map = map;
+  r.idle = ref;
   r.points = pts;
 
   /* Reference: the same insert without a callback. */
@@ -99,12 +108,16 @@ static void test_reentry_from_callback(void) {
   EXPECT_TRUE(r.calls > 0 && r.nested_done);
   EXPECT_TRUE(r.insert == SOGMM_E_BUSY && r.flush == SOGMM_E_BUSY && r.set_progress == SOGMM_E_BUSY);
   EXPECT_TRUE(r.stats == SOGMM_E_BUSY && r.score == SOGMM_E_BUSY);
-  EXPECT_TRUE(r.busy_messages == 5);
+  EXPECT_TRUE(r.merge_into == SOGMM_E_BUSY && r.merge_from == SOGMM_E_BUSY);
+  EXPECT_TRUE(r.busy_messages == 7);
   EXPECT_TRUE(r.free_refused);
   /* Nothing nested took effect: the map is the reference, frame for frame. */
   REQUIRE_OK(test_map_get_stats(map, &got));
   EXPECT_TRUE(got.n_components == want.n_components && got.n_frames == 1 && got.n_pending == want.n_pending);
   EXPECT_TRUE(got.n_flushes == 1);
+  /* Nor did the refused merge change the idle map. */
+  REQUIRE_OK(test_map_get_stats(ref, &got));
+  EXPECT_TRUE(got.n_components == want.n_components && got.n_frames == want.n_frames && got.n_flushes == 1);
 
   /* A nested flush (the C finding: it merged one batch twice). The frame
    * goes in pending (large batch), the outer flush runs the callback. */
