@@ -96,6 +96,11 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
   validate(gmm);
   const std::string pose_problem = rigid_pose_error(pose);
   require(pose_problem.empty(), ErrorCode::InvalidArgument, "pose: " + pose_problem);
+  // The identity keeps every bit: the arithmetic below would turn a -0
+  // coordinate into +0, and a map that merges or loads at the identity must
+  // hold exactly the components it was given.
+  static constexpr std::array<double, 16> kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (pose == kIdentity) return gmm;
   const Eigen::Matrix4d t = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(pose.data());
   const Mat3 r = t.topLeftCorner<3, 3>();
   // Acting on (x, y, z, g) with the block-diagonal [R 0; 0 1].

@@ -58,8 +58,7 @@ Origin split_origin(Model& model) {
   }
   // A map file's pose is a translation; another world model's pose may also
   // rotate (spec/format.md 2.1), which is applied to its components.
-  const Pose identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  if (rotation != identity) model.gmm = transform(model.gmm, rotation);
+  model.gmm = transform(model.gmm, rotation);
   return o;
 }
 

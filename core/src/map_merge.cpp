@@ -108,11 +108,6 @@ std::vector<std::size_t> outmatched(const std::vector<double>& own, const std::v
   return out;
 }
 
-bool is_identity(const Pose& p) {
-  const Pose identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  return p == identity;
-}
-
 }  // namespace
 
 MapMergeStats Map::merge_map(const Map& other_map, const Pose& other_to_this) {
@@ -143,7 +138,7 @@ MapMergeStats Map::merge_map(const Map& other_map, const Pose& other_to_this) {
   }
   Pose relative = other_to_this;
   for (int i = 0; i < 3; ++i) relative[4 * i + 3] = moved[i] - origin[i];
-  const Gmm theirs = is_identity(relative) ? o.model.gmm : transform(o.model.gmm, relative);
+  const Gmm theirs = transform(o.model.gmm, relative);
 
   // The other map's components that this map does not already hold as
   // sharply, then this map's that those hold more sharply.

@@ -121,6 +121,19 @@ TEST(Transform, ClosedForm) {
   EXPECT_TRUE(sogmm_test::model_is_valid(b));
 }
 
+// The identity is no move at all: every bit stays, a -0 coordinate too (the
+// arithmetic would give +0). A map merge or load at the identity relies on it.
+TEST(Transform, IdentityKeepsEveryBit) {
+  sogmm::Gmm a = model_a();
+  a.means[0] = -0.0f;
+  const sogmm::Gmm b = sogmm::transform(a, pose_of(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()));
+  EXPECT_TRUE(sogmm_test::bit_identical(a, b));
+  EXPECT_TRUE(std::signbit(b.means[0]));
+  // Not the identity by 1e-300 in translation: arithmetic, so -0 + 1e-300 rounds away from -0.
+  const sogmm::Gmm c = sogmm::transform(a, pose_of(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1e-300, 0, 0)));
+  EXPECT_FALSE(std::signbit(c.means[0]));
+}
+
 // A moved covariance is stored exactly symmetric (bitwise), as every model
 // the library makes: an asymmetric one in memory is not what the file keeps
 // (the writer stores the symmetric part), so a map built with it would change
