@@ -2,7 +2,7 @@
 // (no SOGMM library): the reading procedure of section 9, step by step, with
 // the category and reason of the first check that fails.
 //
-//   read(bytes, {maxDecodedBytes, verifyChecksums, metadataOnly}) -> model
+//   await ready(); read(bytes, {maxDecodedBytes, verifyChecksums, metadataOnly}) -> model
 //
 // model: the canonical dump's metadata (section 10; u64/i64 fields as BigInt)
 // plus typed arrays `weights` (M), `means` (M x 4) and `covariances` (M x 16,
@@ -18,6 +18,8 @@ import { checkValues } from './values.js';
 
 export { SogmmError } from './errors.js';
 export { crc32c } from './crc32c.js';
+// read() decodes zstd arrays with WebAssembly: `await ready()` once before.
+export { zstdReady as ready } from './zstd.js';
 
 const MAGIC = [0x89, 0x53, 0x4f, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
 const END = [0x53, 0x47, 0x4d, 0x4d]; // "SGMM"
