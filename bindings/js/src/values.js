@@ -69,24 +69,41 @@ function fullComponent(stored, k, cov, a) {
   cov.set(a, o);
 }
 
+// Each hot loop is a function of its own: the page runs each once, cold, and
+// V8 optimises a running loop on its own (on-stack replacement), so code
+// after a loop that has not run yet would send it back to the interpreter.
+
+// 19a: x - x is 0 for a finite x and NaN for NaN or infinity.
+function allFinite(arr) {
+  for (let i = 0; i < arr.length; i++) if (arr[i] - arr[i] !== 0) return false;
+  return true;
+}
+
+// 19b: the sum of the weights, each checked >= 0 on the way.
+function weightSum(weights, M) {
+  let sum = 0;
+  for (let i = 0; i < M; i++) {
+    if (weights[i] < 0) numeric('bad_weights', `weight ${i} is negative`);
+    sum += weights[i];
+  }
+  return sum;
+}
+
+function packedCovariances(stored, M, cov) {
+  for (let k = 0; k < M; k++) packedComponent(stored, k, cov);
+}
+
 /**
  * Checks weights, means and stored covariances (19a-d) and returns the
  * covariances as M full symmetric row-major 4x4 matrices (Float32Array).
  */
 export function checkValues(weights, means, stored, M, packed) {
-  for (const arr of [weights, means, stored]) {
-    // x - x is 0 for a finite x and NaN for NaN or infinity.
-    for (let i = 0; i < arr.length; i++) if (arr[i] - arr[i] !== 0) numeric('non_finite', 'NaN or infinity in the arrays');
-  }
-  let sum = 0;
-  for (let i = 0; i < M; i++) {
-    if (weights[i] < 0) numeric('bad_weights', `weight ${i} is negative`);
-  }
-  for (let i = 0; i < M; i++) sum += weights[i];
+  if (!allFinite(weights) || !allFinite(means) || !allFinite(stored)) numeric('non_finite', 'NaN or infinity in the arrays');
+  const sum = weightSum(weights, M);
   if (!(Math.abs(sum - 1) <= 1e-4)) numeric('bad_weights', `weights sum to ${sum}`);
   const cov = new Float32Array(16 * M);
   if (packed) {
-    for (let k = 0; k < M; k++) packedComponent(stored, k, cov);
+    packedCovariances(stored, M, cov);
   } else {
     const a = new Float64Array(16);
     for (let k = 0; k < M; k++) fullComponent(stored, k, cov, a);

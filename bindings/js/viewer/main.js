@@ -116,6 +116,13 @@ function weightColour(t, out) { // t in [0, 1]: dark blue -> teal -> yellow
 }
 
 function colourComponents(mesh, model, by) { // current.drawing set
+  if (by !== 'weight') {
+    current.drawing.colour(mesh, (k, c) => {
+      const g = Math.min(Math.max(model.means[4 * k + 3], 0), 1);
+      c.setRGB(g, g, g, THREE.SRGBColorSpace);
+    });
+    return;
+  }
   const M = Number(model.n_components);
   let lo = Infinity;
   let hi = -Infinity;
@@ -124,12 +131,7 @@ function colourComponents(mesh, model, by) { // current.drawing set
     lo = Math.min(lo, w);
     hi = Math.max(hi, w);
   }
-  current.drawing.colour(mesh, by === 'weight'
-    ? (k, c) => weightColour(hi > lo ? (Math.log(Math.max(model.weights[k], 1e-12)) - lo) / (hi - lo) : 1, c)
-    : (k, c) => {
-      const g = Math.min(Math.max(model.means[4 * k + 3], 0), 1);
-      c.setRGB(g, g, g, THREE.SRGBColorSpace);
-    });
+  current.drawing.colour(mesh, (k, c) => weightColour(hi > lo ? (Math.log(Math.max(model.weights[k], 1e-12)) - lo) / (hi - lo) : 1, c));
 }
 
 // --- samples ---------------------------------------------------------------
