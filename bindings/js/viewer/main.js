@@ -44,8 +44,10 @@ const SPRITES = {
 // memory; this one answers at once with the reason `limit`.
 const MAX_DECODED_BYTES = 2 ** 27;
 const $ = (id) => document.getElementById(id);
-// The zstd decoder (WebAssembly) compiles in the background from here on.
+// The zstd decoder (WebAssembly) compiles in the background from here on;
+// should that fail, loading a file shows why.
 const decoderReady = ready();
+decoderReady.catch(() => {});
 const state = { status: 'loading', reason: null, drawn: 0, frame: null, frames: 0, timings: {} };
 window.sogmmViewer = state;
 
