@@ -54,7 +54,7 @@ for tool in cargo go; do
     echo "setup: $tool not found: the ctest $tool-based binding tests will be skipped" >&2
 done
 
-# The pinned npm packages of bindings/js (package-lock.json): fzstd, three,
+# The pinned npm packages of bindings/js (package-lock.json): zstddec, three,
 # esbuild, playwright-core. Nothing downloads a browser: the test uses
 # Debian's /usr/bin/chromium.
 (cd bindings/js && npm ci --no-audit --no-fund --loglevel=error)

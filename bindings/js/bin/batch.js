@@ -5,13 +5,14 @@
 //   "accept <canonical JSON dump, compact>" | "reject <category> <reason>" | "error <message>"
 // Usage: node bin/batch.js LIST   (LIST: one path per line)
 import fs from 'node:fs';
-import { read, SogmmError } from '../src/reader.js';
+import { read, ready, SogmmError } from '../src/reader.js';
 import { dumpJson } from '../src/dump.js';
 
 if (process.argv.length !== 3) {
   process.stderr.write('usage: batch.js LIST\n');
   process.exit(2);
 }
+await ready();
 const lines = [];
 for (const file of fs.readFileSync(process.argv[2], 'utf8').split('\n').filter(Boolean)) {
   try {

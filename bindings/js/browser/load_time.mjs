@@ -34,4 +34,7 @@ for (const [j, page] of pages.entries()) {
   const median = (k) => rows[j].map((r) => r[k]).sort((a, b) => a - b)[Math.floor(rows[j].length / 2)];
   console.log(`${page}: median of ${rows[j].length}: parse ${median('parseMs').toFixed(0)} ms, first frame ${median('firstFrameMs').toFixed(0)} ms, ` +
     `parse + first frame ${median('totalMs').toFixed(0)} ms, navigation to ready ${median('navigationToReadyMs')} ms (${rows[j][0].n} components)`);
+  // Each of the page's timings (the parts need not add up to the medians above).
+  const parts = Object.keys(rows[j][0]).filter((k) => k.endsWith('Ms') && typeof rows[j][0][k] === 'number');
+  console.log(`  medians: ${parts.map((k) => `${k.slice(0, -2)} ${median(k).toFixed(0)}`).join(', ')}`);
 }

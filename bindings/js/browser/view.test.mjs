@@ -15,9 +15,10 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { chromium } from 'playwright-core';
-import { read, getValue } from '../src/reader.js';
+import { read, ready, getValue } from '../src/reader.js';
 import { canvasStats } from './page_stats.js';
 
+await ready();
 const CLI = process.env.SOGMM_CLI;
 const CHROMIUM = process.env.SOGMM_CHROMIUM || '/usr/bin/chromium';
 const RGBD = process.env.SOGMM_RGBD || '/work/shared/data/rgbd/livingroom';

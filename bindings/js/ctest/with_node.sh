@@ -8,7 +8,7 @@ node="$1"; dir="$2"; shift 2
 if ! command -v "$node" >/dev/null 2>&1; then
   echo "SKIP: node not found (install nodejs >= 20, then npm ci in bindings/js)"; exit 77
 fi
-if [ ! -f "$dir/node_modules/fzstd/package.json" ]; then
+if [ ! -f "$dir/node_modules/zstddec/package.json" ]; then
   echo "SKIP: $dir/node_modules missing: run npm ci in $dir (tools/setup.sh does)"; exit 77
 fi
 if [ -n "${SOGMM_CHROMIUM:-}" ] && [ ! -x "$SOGMM_CHROMIUM" ]; then

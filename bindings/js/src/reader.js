@@ -2,7 +2,7 @@
 // (no SOGMM library): the reading procedure of section 9, step by step, with
 // the category and reason of the first check that fails.
 //
-//   read(bytes, {maxDecodedBytes, verifyChecksums, metadataOnly}) -> model
+//   await ready(); read(bytes, {maxDecodedBytes, verifyChecksums, metadataOnly}) -> model
 //
 // model: the canonical dump's metadata (section 10; u64/i64 fields as BigInt)
 // plus typed arrays `weights` (M), `means` (M x 4) and `covariances` (M x 16,
@@ -18,6 +18,8 @@ import { checkValues } from './values.js';
 
 export { SogmmError } from './errors.js';
 export { crc32c } from './crc32c.js';
+// read() decodes zstd arrays with WebAssembly: `await ready()` once before.
+export { zstdReady as ready } from './zstd.js';
 
 const MAGIC = [0x89, 0x53, 0x4f, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
 const END = [0x53, 0x47, 0x4d, 0x4d]; // "SGMM"
@@ -209,6 +211,18 @@ function decodeArray(data, r, rows, cols, name, verifyChecksums) {
   return out;
 }
 
+// Stored elements e = first .. first + count - 1 of a byte_stream_split
+// float32 array of n elements (byte k of e at k n + e) as words at
+// d, d + step, ... A function of its own with one loop, so that V8's
+// on-stack replacement optimises it once, cold, for every column.
+function unsplitWords(bytes, n, words, first, count, d, step) {
+  const n2 = 2 * n;
+  const n3 = 3 * n;
+  for (let e = first, end = first + count; e < end; e++, d += step) {
+    words[d] = bytes[e] | (bytes[n + e] << 8) | (bytes[n2 + e] << 16) | (bytes[n3 + e] << 24);
+  }
+}
+
 // The canonical (component-major, unsplit) bytes of an array stored with
 // byte_stream_split and/or column_major: byte k of stored element e is at
 // k * n + e when split, else at e * width + k; element e is (m, c) at
@@ -220,14 +234,8 @@ function canonicalBytes(bytes, rows, cols, width, split, columnMajor) {
   const out = new Uint8Array(n * width);
   if (split && width === 4 && LITTLE_ENDIAN) { // float32 (the usual case): a word at a time
     const words = new Uint32Array(out.buffer);
-    const n2 = 2 * n;
-    const n3 = 3 * n;
-    for (let c = 0, e = 0; c < (columnMajor ? cols : 1); c++) {
-      const step = columnMajor ? cols : 1; // canonical index of element e: m cols + c
-      for (let d = c, end = e + (columnMajor ? rows : n); e < end; e++, d += step) {
-        words[d] = bytes[e] | (bytes[n + e] << 8) | (bytes[n2 + e] << 16) | (bytes[n3 + e] << 24);
-      }
-    }
+    if (!columnMajor) unsplitWords(bytes, n, words, 0, n, 0, 1);
+    for (let c = 0; columnMajor && c < cols; c++) unsplitWords(bytes, n, words, c * rows, rows, c, cols);
     return out;
   }
   const byteStride = split ? n : 1;

@@ -6,12 +6,13 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { read, crc32c, SogmmError } from '../src/reader.js';
+import { read, ready, crc32c, SogmmError } from '../src/reader.js';
 import { dumpJson } from '../src/dump.js';
 import { parseExact, sameJson } from '../test_support/json_exact.js';
 
 const HERE = path.dirname(fileURLToPath(import.meta.url));
 const DIR = process.env.SOGMM_CONFORMANCE_DIR || path.resolve(HERE, '../../../spec/conformance');
+await ready();
 const manifest = JSON.parse(fs.readFileSync(path.join(DIR, 'manifest.json'), 'utf8'));
 
 test('the manifest covers the reasons of section 9', () => {

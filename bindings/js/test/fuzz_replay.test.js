@@ -8,8 +8,9 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { read, SogmmError } from '../src/reader.js';
+import { read, ready, SogmmError } from '../src/reader.js';
 
+await ready();
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../..');
 const FORMAT_TARGETS = ['load_memory', 'load_file', 'verify'];
 

@@ -19,7 +19,15 @@ const result = await build({
   write: false,
   logLevel: 'warning',
 });
-const js = result.outputFiles[0].text;
+// Packages whose notices esbuild does not keep (no @license comment): their
+// LICENSE files, which the page redistributes in binary form (zstddec embeds
+// libzstd compiled to WebAssembly, BSD-3-Clause).
+const notices = ['zstddec'].map((name) => {
+  const text = fs.readFileSync(path.join(here, '../node_modules', name, 'LICENSE'), 'utf8');
+  if (text.includes('*/')) throw new Error(`${name}'s LICENSE would close its comment`);
+  return `\n/*! ${name}: ${text}*/\n`;
+});
+const js = result.outputFiles[0].text + notices.join('');
 if (/<\/script/i.test(js) || js.includes('@@SOGMM_')) throw new Error('bundle contains a </script or a page marker');
 const template = fs.readFileSync(path.join(here, 'page.html'), 'utf8');
 const page = template.replace('@@SOGMM_VIEWER_JS@@', () => js);
