@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "container.hpp"
+#include "packed_key_values.hpp"
 #include "source.hpp"
 #include "sogmm/format.hpp"
 
@@ -34,11 +35,25 @@ struct Tweaks {
   std::optional<std::vector<double>> raw_pose;         ///< pose vector written as is (any length)
   bool unknown_optional_fields = false;  ///< appends fields with ids unknown to format 1.0
   bool share_strings = false;  ///< key/value strings stored once and shared (FlatBuffers CreateSharedString)
+  /// Key/values packed in the body (spec/format.md 2.5.1; the caller sets
+  /// features bit 1): the metadata keeps only the entry that locates them.
+  bool pack_key_values = false;
 };
 
-/// The version and feature bit of a map delta (spec/format.md section 2.5):
-/// written as format 1.1 with features_required bit 0, checked as a delta.
+/// The version and feature bits of a map delta (spec/format.md sections 2.5
+/// and 2.5.1): written as format 1.2 with features_required bit 0 and its
+/// key/values packed (bit 1), checked as a delta.
 inline Tweaks map_delta_tweaks() {
+  Tweaks t;
+  t.minor = 2;
+  t.features_required = kFeatureMapDelta | kFeaturePackedKeyValues;
+  t.pack_key_values = true;
+  return t;
+}
+
+/// A map delta as format 1.1 wrote it (key/values in the metadata), for the
+/// tests that old deltas still read.
+inline Tweaks map_delta_tweaks_1_1() {
   Tweaks t;
   t.minor = 1;
   t.features_required = kFeatureMapDelta;

@@ -11,6 +11,7 @@
 #include "container.hpp"
 #include "crc32c.hpp"
 #include "decode.hpp"
+#include "packed_key_values.hpp"
 #include "schema.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/format.hpp"
@@ -21,6 +22,9 @@ namespace detail {
 namespace {
 
 constexpr bool kBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+// The features_required bits a map delta's reader knows (spec/format.md
+// sections 2.5 and 2.5.1); a model reader knows neither.
+constexpr std::uint64_t kDeltaFeatures = kKnownFeatures | kFeatureMapDelta | kFeaturePackedKeyValues;
 const char* const kNames[3] = {"weights", "means", "covariances"};
 
 // Steps 1-16: the header and the trailer first, then the metadata block, read
@@ -97,7 +101,7 @@ void expand_upper_in_place(float* cov, std::uint64_t m) {
 // components are checked as a delta's and returned as stored (a symmetric
 // part would change the bits the receiver must reproduce).
 Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, bool delta) {
-  ParsedMetadata meta = read_metadata(src, options, delta ? kKnownFeatures | kFeatureMapDelta : kKnownFeatures);
+  ParsedMetadata meta = read_metadata(src, options, delta ? kDeltaFeatures : kKnownFeatures);
   if (delta && (meta.info.features_required & kFeatureMapDelta) == 0)
     fail(ErrorCode::Format, "not_a_delta", "the file is a model, not a map delta (feature bit 0 is not set)");
   const std::uint64_t m = meta.info.n_components;  // its arrays fit the cap (step 15)
@@ -111,6 +115,18 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, 
   if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
   check_values(g, delta);  // 19
   if (!meta.packed && !delta) symmetrize(g);
+  if (meta.info.features_required & kFeaturePackedKeyValues) {  // 20 (a delta reader only knows the bit)
+    Header h;
+    h.file_length = meta.info.file_length;
+    h.metadata_length = static_cast<std::uint32_t>(meta.info.metadata_length);
+    std::uint64_t ranges[3][2], decoded = 0;
+    for (int i = 0; i < 3; ++i) {
+      ranges[i][0] = meta.arrays[i].offset;
+      ranges[i][1] = meta.arrays[i].stored_length;
+      decoded += meta.arrays[i].decoded_length;  // at most the cap (step 15)
+    }
+    unpack_key_values(src, h, ranges, decoded, options, model);
+  }
   if (info != nullptr) {
     *info = std::move(meta.info);
     info->metadata = Model{};
@@ -135,7 +151,7 @@ Model from_bytes(const void* data, std::size_t size, const ReadOptions& options)
 
 FileInfo read_info(const void* data, std::size_t size, const ReadOptions& options) {
   const detail::MemorySource src(detail::bytes_of(data, size, "read_info"), size);
-  return detail::read_metadata(src, options, detail::kKnownFeatures | detail::kFeatureMapDelta).info;
+  return detail::read_metadata(src, options, detail::kDeltaFeatures).info;
 }
 
 Model load(const std::string& path, const ReadOptions& options) { return load(path, options, nullptr); }
@@ -147,7 +163,7 @@ Model load(const std::string& path, const ReadOptions& options, FileInfo* info) 
 
 FileInfo read_info_file(const std::string& path, const ReadOptions& options) {
   const detail::FileSource src(path);
-  return detail::read_metadata(src, options, detail::kKnownFeatures | detail::kFeatureMapDelta).info;
+  return detail::read_metadata(src, options, detail::kDeltaFeatures).info;
 }
 
 }  // namespace sogmm::format

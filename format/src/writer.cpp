@@ -15,6 +15,7 @@
 #include "container.hpp"
 #include "crc32c.hpp"
 #include "internal.hpp"
+#include "packed_key_values.hpp"
 #include "schema.hpp"
 #include "strings.hpp"
 #include "sogmm/checked.hpp"
@@ -205,7 +206,15 @@ class EncodedFile {
     if (t.means_offset) records[kMeans].offset = *t.means_offset;
 
     const std::size_t hint = static_cast<std::size_t>(std::min<std::uint64_t>(bounds.upper, kMetadataLengthLimit));
-    metadata_ = build_metadata(model, records, n_declared, packed, t, hint);
+    if (t.pack_key_values) {
+      // The entries go to the body; the metadata keeps the one that finds them.
+      packed_kv_ = pack_key_values(model.key_values, options);
+      Model stripped = model;
+      stripped.key_values = {packed_kv_.entry};
+      metadata_ = build_metadata(stripped, records, n_declared, packed, t, hint);
+    } else {
+      metadata_ = build_metadata(model, records, n_declared, packed, t, hint);
+    }
     if (t.validate && metadata_.size() >= kMetadataLengthLimit) {
       fail(ErrorCode::Limit, "limit",
            "the metadata block would have " + std::to_string(metadata_.size()) +
@@ -219,6 +228,7 @@ class EncodedFile {
       end += arrays_[i].stored.size();
       if (i < 2) end = pad8(end);
     }
+    end += packed_kv_.stored.size();  // last in the body, unaligned (section 2.5.1)
     const bool patch[3] = {true, !t.means_offset, true};
     set_array_offsets(metadata_.data(), offsets, patch);
 
@@ -245,6 +255,7 @@ class EncodedFile {
       sink(arrays_[i].stored.data(), arrays_[i].stored.size());
       at += arrays_[i].stored.size();
     }
+    sink(packed_kv_.stored.data(), packed_kv_.stored.size());
     sink(kEndMagic.data(), kEndMagic.size());
   }
 
@@ -263,6 +274,7 @@ class EncodedFile {
   Header header_;
   flatbuffers::DetachedBuffer metadata_;
   EncodedArray arrays_[3];
+  PackedKeyValues packed_kv_;  // empty unless Tweaks::pack_key_values
 };
 
 }  // namespace

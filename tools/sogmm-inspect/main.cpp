@@ -240,15 +240,16 @@ int main(int argc, char** argv) {
       std::printf("checksums           metadata verified; arrays not read\n");
       return 0;
     }
-    // A map delta (spec/format.md 2.5: bit 0 and its keys) is verified by
-    // the delta rules and shown as the model form it is stored in (delta
-    // keys included). Bit 0 without the keys is no delta: read as a model,
+    // A map delta (spec/format.md 2.5: bit 0 and its keys, or bit 0 and bit 1,
+    // its keys packed, 2.5.1) is verified by the delta rules and shown as
+    // the model form it is stored in (delta keys included, unpacked). Bit 0 without the keys is no delta: read as a model,
     // it is refused as such (unsupported_feature). The probe's metadata is
     // freed before the full read (section 8's memory bound).
     bool delta = false;
     {
       const fmt::FileInfo probe = fmt::read_info_file(path);
-      delta = (probe.features_required & 1u) != 0 && sogmm::find_value(probe.metadata, sogmm::kDeltaOpsKey) != nullptr;
+      delta = (probe.features_required & 1u) != 0 &&
+              ((probe.features_required & 2u) != 0 || sogmm::find_value(probe.metadata, sogmm::kDeltaOpsKey) != nullptr);
     }
     fmt::FileInfo info;
     sogmm::Model model;

@@ -17,11 +17,17 @@
    with its F-score at 1 cm against the cloud it came from, beside the map's F-score at 1 cm (`sogmm eval`, mass-weighted)
    on the same frames. "Equal F-score" compares the deltas with the coarsest
    Draco step whose F-score is still at least the map's.
+6. with --compare-sogmm PATH (another build, e.g. of an older commit): the
+   same map with that binary in the same run, its deltas' bytes beside
+   these (the format 1.1 deltas of a67de64 against the packed 1.2 ones).
+Each delta's bytes are split into its header and metadata block (32 +
+pad8(metadata length)) and its body (arrays, packed key/values, end marker).
 MCAP is not measured here.
 
 Usage (from the repository root):
     python3 tools/sogmm-perf/map_deltas.py [--sogmm build/tools/sogmm/sogmm] [--frames 100]
-        [--decimate 5] [--bandwidth 0.02] [--work /tmp/sogmm_deltas] [--draco-step K] [-- MAP FLAGS...]
+        [--decimate 5] [--bandwidth 0.02] [--work /tmp/sogmm_deltas] [--draco-step K]
+        [--compare-sogmm OTHER/sogmm] [-- MAP FLAGS...]
 Prints a table and one JSON line.
 """
 import argparse
@@ -78,6 +84,28 @@ def draco_clouds(loop, frames, decimate, step):
     return out, used
 
 
+def delta_sizes(sogmm, loop, decimate, bandwidth, out, deltas, map_flags):
+    """Maps the loop with `sogmm --deltas`; the map summary and, per delta
+    file in order, (bytes, header + metadata bytes)."""
+    s = run_json([sogmm, "map", loop, "--trajectory", os.path.join(loop, "trajectory.log"), "--decimate",
+                  str(decimate), "--bandwidth", str(bandwidth), "-o", out, "--deltas", deltas, "-q"] + map_flags)
+    sizes = []
+    for n in sorted(os.listdir(deltas)):
+        with open(os.path.join(deltas, n), "rb") as f:
+            head = f.read(32)
+        meta = int.from_bytes(head[24:28], "little")
+        sizes.append((os.path.getsize(os.path.join(deltas, n)), 32 + (meta + 7) // 8 * 8))
+    return s, sizes
+
+
+def summary(sizes, n_frames):
+    total = sum(b for b, _ in sizes)
+    meta = sum(m for _, m in sizes)
+    return {"deltas": len(sizes), "delta_bytes_total": total, "delta_bytes_mean": total / len(sizes),
+            "delta_bytes_max": max(b for b, _ in sizes), "delta_bytes_per_frame": total / n_frames,
+            "metadata_bytes_mean": meta / len(sizes), "body_bytes_mean": (total - meta) / len(sizes)}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sogmm", default="build/tools/sogmm/sogmm")
@@ -86,6 +114,7 @@ def main():
     ap.add_argument("--bandwidth", type=float, default=0.02)
     ap.add_argument("--work", default="/tmp/sogmm_deltas")
     ap.add_argument("--draco-step", type=int, default=0, help="compare with Draco on every K-th frame (0: off)")
+    ap.add_argument("--compare-sogmm", help="also map with this binary and report its deltas beside these")
     ap.add_argument("map_flags", nargs="*")
     a = ap.parse_args()
     loop, deltas = os.path.join(a.work, "loop"), os.path.join(a.work, "deltas")
@@ -94,9 +123,8 @@ def main():
     subprocess.run([a.sogmm, "demo", "--write-frame", loop, "--loop", "--frames", str(a.frames)], check=True,
                    stdout=subprocess.DEVNULL)
     out = os.path.join(a.work, "loop.sogmm")
-    s = run_json([a.sogmm, "map", loop, "--trajectory", os.path.join(loop, "trajectory.log"), "--decimate",
-                  str(a.decimate), "--bandwidth", str(a.bandwidth), "-o", out, "--deltas", deltas, "-q"] + a.map_flags)
-    sizes = [os.path.getsize(os.path.join(deltas, n)) for n in sorted(os.listdir(deltas))]
+    s, split = delta_sizes(a.sogmm, loop, a.decimate, a.bandwidth, out, deltas, a.map_flags)
+    sizes = [b for b, _ in split]
     with open(os.path.join(a.work, "loop.csv")) as f:
         rows = list(csv.DictReader(f))
     flushed_components = [int(r["components"]) for r in rows if r["flushed"] == "1"]
@@ -113,10 +141,24 @@ def main():
         "whole_map_every_delta_bytes": round(whole), "whole_over_deltas": whole / total,
         "map_file_bytes": s["file_bytes"], "rebuilt_components": r["n_components"],
     }
+    res.update({k: v for k, v in summary(split, s["n_frames"]).items() if k.startswith(("metadata", "body"))})
     print("frames %d, points %d, map %d components (%d bytes)" % (res["frames"], res["points"], res["components"],
                                                                   res["map_file_bytes"]))
     print("deltas: %d, total %d bytes, mean %.0f, max %d, per frame %.0f" %
           (len(sizes), total, res["delta_bytes_mean"], res["delta_bytes_max"], res["delta_bytes_per_frame"]))
+    print("  per delta: header and metadata %.0f bytes, body (arrays, packed key/values) %.0f" %
+          (res["metadata_bytes_mean"], res["body_bytes_mean"]))
+    if a.compare_sogmm:
+        cs, csplit = delta_sizes(a.compare_sogmm, loop, a.decimate, a.bandwidth, os.path.join(a.work, "compare.sogmm"),
+                                 os.path.join(a.work, "deltas-compare"), a.map_flags)
+        c = summary(csplit, cs["n_frames"])
+        c["components"] = cs["n_components"]
+        res["compare"] = c
+        print("compare (%s): %d deltas, total %d bytes, mean %.0f, max %d, per frame %.0f; header and metadata %.0f, "
+              "body %.0f per delta; %d components" % (a.compare_sogmm, c["deltas"], c["delta_bytes_total"],
+                                                     c["delta_bytes_mean"], c["delta_bytes_max"],
+                                                     c["delta_bytes_per_frame"], c["metadata_bytes_mean"],
+                                                     c["body_bytes_mean"], c["components"]))
     print("raw decimated clouds: %d bytes (%.1fx the deltas)" % (raw, res["raw_over_deltas"]))
     print("whole map at every delta (estimate): %d bytes (%.1fx the deltas)" % (whole, res["whole_over_deltas"]))
     if a.draco_step > 0:

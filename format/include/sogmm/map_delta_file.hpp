@@ -1,7 +1,9 @@
 // Map deltas in the .sogmm container (spec/format.md section 2.5): a delta
-// is a model container of format 1.1 whose features_required has bit 0
-// (map_delta) set, so that a model reader refuses it (unsupported_feature)
-// and only a delta reader takes it. Errors as sogmm/format.hpp, plus the
+// is a model container whose features_required has bit 0 (map_delta) set, so
+// that a model reader refuses it (unsupported_feature) and only a delta
+// reader takes it. Written as format 1.2, its key/values packed and
+// compressed in the body (bit 1, section 2.5.1); deltas of format 1.1 (key/
+// values in the metadata) still read. Errors as sogmm/format.hpp, plus the
 // delta keys' (Error(Format), sogmm::delta_from_model).
 #pragma once
 
@@ -14,6 +16,10 @@
 #include "sogmm/map_delta.hpp"
 
 namespace sogmm::format {
+
+/// The metadata key of a delta of format 1.2 that locates its key/values,
+/// packed in the body (spec/format.md section 2.5.1, features_required bit 1).
+inline constexpr const char* kPackedKeyValuesKey = "packed_key_values";
 
 /// The bytes of a delta file. Refuses (throws, nothing written) what a delta
 /// reader would reject.

@@ -14,6 +14,15 @@ place (the metadata CRC-32C fixed, so only section 2.5's rules refuse them),
 and a model file. The library (Map.apply_delta) and the independent receiver
 (tests/conformance/python_reader/delta_receiver.py) must agree on every case.
 
+Since format 1.2 the library writes deltas with their key/values packed in
+the body (spec/format.md 2.5.1), so this script writes the chains as
+`points_packed_N` / `rgbd_packed_N` and, from them, the refused packed cases
+(a file a delta reader rejects, each with its step-20 reason, or a digest
+changed inside the packed bytes). The format 1.1 files (`points_N`,
+`rgbd_N` and their refused cases) were written by this script at a67de64
+and stay frozen; OUT gets only the new files and `manifest_additions.json`
+(the cases to append to deltas/manifest.json).
+
 Usage (from the repository root, after building):
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so \\
       PYTHONPATH=bindings/python/src:bindings/python/tests:tests/conformance/python_reader \\
@@ -27,6 +36,7 @@ import subprocess
 import tempfile
 
 import numpy as np
+import zstandard
 
 import sogmm
 import sogmm_reader
@@ -46,6 +56,40 @@ def patched(data: bytes, old: bytes, new: bytes) -> bytes:
     out = bytearray(data)
     out[32:32 + meta_len] = meta
     struct.pack_into("<I", out, META_CRC_OFFSET, sogmm_reader.crc32c(meta))
+    return bytes(out)
+
+
+def packed_entry(data: bytes) -> str:
+    """The metadata entry that locates the packed key/values (read without step 20)."""
+    md = sogmm_reader.read(data, delta=True, metadata_only=True)
+    return dict((k, v) for k, v in md["key_values"])[sogmm_reader.PACKED_KEY]
+
+
+def with_entry(data: bytes, codec=None, stored=None, decoded=None, crc=None) -> bytes:
+    """`data` with fields of its packed_key_values entry replaced in place
+    (each new number as long as the old one)."""
+    old = packed_entry(data)
+    fields = [int(t) for t in old.split(" ")]
+    for i, v in enumerate((codec, stored, decoded, crc)):
+        if v is not None:
+            fields[i] = v
+    new = " ".join(str(v) for v in fields)
+    return patched(data, old.encode(), new.encode())
+
+
+def repacked(data: bytes, edit) -> bytes:
+    """`data` with its packed bytes decoded, passed through `edit`, and stored
+    again (zstd, content size declared, no checksum), the entry, file length
+    and CRC-32Cs updated; the new stored length must have as many digits."""
+    codec, stored, decoded, crc = (int(t) for t in packed_entry(data).split(" "))
+    assert codec == 1
+    end = len(data) - 4
+    raw = zstandard.ZstdDecompressor().decompress(data[end - stored:end])
+    new = edit(raw)
+    z = zstandard.ZstdCompressor(level=19, write_checksum=False, write_content_size=True).compress(new)
+    out = bytearray(with_entry(data, stored=len(z), decoded=len(new), crc=sogmm_reader.crc32c(new)))
+    out[end - stored:end] = z
+    struct.pack_into("<Q", out, 16, len(out))  # file_length
     return bytes(out)
 
 
@@ -86,21 +130,49 @@ def main():
                      [lambda m, i=i, k=k: m.insert_rgbd(*frames[i], cam, poses[k]) for i, k in enumerate((0, 3))])
 
     files = {}
-    for name, deltas in (("points", points), ("rgbd", rgbd)):
+    for name, deltas in (("points_packed", points), ("rgbd_packed", rgbd)):
         for i, d in enumerate(deltas):
+            assert sogmm_reader.read(d, delta=True)["file"]["format_version"] == "1.2"
             files[f"{name}_{i + 1}.sogmm"] = d
-    digest = key_value(points[1], "delta_digest")
+    p2 = points[1]
+    codec, stored, decoded, crc = (int(t) for t in packed_entry(p2).split(" "))
+    digest = key_value(p2, "delta_digest")
     flipped = digest[:-1] + ("0" if digest[-1] != "0" else "1")
-    files["points_2_wrong_digest.sogmm"] = patched(points[1], digest.encode(), flipped.encode())
-    ops = key_value(points[1], "delta_ops")
-    assert "drop 4 5 6 7\n" in ops, ops
-    files["points_2_position_beyond.sogmm"] = patched(points[1], b"drop 4 5 6 7\n", b"drop 4 5 6 9\n")
+    # Each: (file, data, reason of a delta reader or None when only a receiver refuses it, why).
+    refused = [
+        ("points_packed_2_wrong_digest.sogmm",
+         repacked(p2, lambda raw: raw.replace(digest.encode(), flipped.encode())), None,
+         "delta_digest changed by one hex digit inside the packed key/values"),
+        ("points_packed_2_packed_crc.sogmm", with_entry(p2, crc=crc ^ 1), "checksum_mismatch",
+         "the packed key/values' CRC-32C changed in their entry"),
+        ("points_packed_2_packed_codec.sogmm", with_entry(p2, codec=2), "bad_metadata",
+         "packed key/values with codec 2 (unknown)"),
+        ("points_packed_2_packed_overlap.sogmm", with_entry(p2, stored=stored + 1), "bad_layout",
+         "packed key/values one byte longer: they overlap the covariances"),
+        ("points_packed_2_packed_length.sogmm", with_entry(p2, decoded=decoded + 1), "decompression_failed",
+         "packed key/values declare one decoded byte more than their zstd frame holds"),
+        ("points_packed_2_packed_entry_missing.sogmm",
+         patched(p2, sogmm_reader.PACKED_KEY.encode(), b"packed_key_valueZ"), "bad_metadata",
+         "feature bit 1 set but no packed_key_values entry"),
+        ("points_packed_2_packed_odd.sogmm", repacked(p2, lambda raw: raw[:-1]), "bad_metadata",
+         "packed key/values whose last value has no NUL"),
+        ("points_packed_2_packed_utf8.sogmm", repacked(p2, lambda raw: raw.replace(b"delta_ops", b"delta_op\xff")),
+         "bad_metadata", "a packed key that is not UTF-8"),
+    ]
+    for name, data, reason, _ in refused:
+        try:
+            sogmm_reader.read(data, delta=True)
+            got = None
+        except sogmm_reader.SogmmError as e:
+            got = e.reason
+        assert got == reason, (name, got, reason)
+        files[name] = data
     for name, data in files.items():
         with open(os.path.join(a.out, name), "wb") as f:
             f.write(data)
 
     cases = []
-    for name, deltas in (("points", points), ("rgbd", rgbd)):
+    for name, deltas in (("points_packed", points), ("rgbd_packed", rgbd)):
         with sogmm.Map() as receiver:
             for i, d in enumerate(deltas):
                 receiver.apply_delta(d)
@@ -109,19 +181,14 @@ def main():
                               "revision": receiver.revision, "n_components": receiver.n_components_,
                               "digest": key_value(d, "delta_digest"),
                               "steps": sorted({line.split(" ")[0] for line in key_value(d, "delta_ops").splitlines()})})
-    refused = [
-        ("gap", ["points_1.sogmm"], "points_3.sogmm", "starts at revision 2, the receiver is at 1"),
-        ("duplicate", ["points_1.sogmm", "points_2.sogmm"], "points_2.sogmm", "starts at revision 1, already applied"),
-        ("another_map", ["points_1.sogmm"], "rgbd_2.sogmm", "another map's delta at the right revision"),
-        ("wrong_digest", ["points_1.sogmm"], "points_2_wrong_digest.sogmm", "delta_digest changed by one hex digit"),
-        ("position_beyond", ["points_1.sogmm"], "points_2_position_beyond.sogmm",
-         "drop names position 9 of a map of 8"),
-        ("model_file", [], "../valid/one_component.sogmm", "a model, not a delta: not_a_delta"),
-    ]
-    for name, before, delta, why in refused:
-        cases.append({"name": name, "expect": "refused", "apply": before, "then": delta, "description": why})
-    with open(os.path.join(a.out, "manifest.json"), "w") as f:
-        json.dump({"format": "sogmm map delta vectors 1", "cases": cases}, f, indent=1)
+    for name, data, reason, why in refused:
+        case = {"name": name[:-len(".sogmm")], "expect": "refused", "apply": ["points_packed_1.sogmm"],
+                "then": name, "description": why}
+        if reason is not None:
+            case["reason"] = reason
+        cases.append(case)
+    with open(os.path.join(a.out, "manifest_additions.json"), "w") as f:
+        json.dump(cases, f, indent=1)
         f.write("\n")
     print("wrote %d files and %d cases to %s" % (len(files), len(cases), a.out))
 

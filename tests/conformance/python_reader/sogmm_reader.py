@@ -22,6 +22,8 @@ HEADER_SIZE = 32
 TRAILER_SIZE = 4
 KNOWN_FEATURES = 0
 MAP_DELTA_FEATURE = 1  # features_required bit 0: a map delta (section 2.5), known to a delta reader only
+PACKED_KEY_VALUES_FEATURE = 2  # bit 1: key/values packed in the body (section 2.5.1), known to a delta reader only
+PACKED_KEY = "packed_key_values"
 DEFAULT_MAX_DECODED_BYTES = 1 << 30
 MAX_DEPTH = 64
 MAX_TABLES = 100000
@@ -524,7 +526,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
     # 10
-    known = KNOWN_FEATURES | (MAP_DELTA_FEATURE if delta else 0)
+    known = KNOWN_FEATURES | (MAP_DELTA_FEATURE | PACKED_KEY_VALUES_FEATURE if delta else 0)
     if md["features_required"] & ~known:
         _format("unsupported_feature", hex(md["features_required"]))
     if delta and not md["features_required"] & MAP_DELTA_FEATURE:
@@ -652,4 +654,53 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     out["weights"] = weights
     out["means"] = [means[4 * k:4 * k + 4] for k in range(m)]
     out["covariances"] = mats
+    if md["features_required"] & PACKED_KEY_VALUES_FEATURE:
+        total = sum(rec["decoded_length"] for rec in md["arrays"])
+        out["key_values"] = _unpack_key_values(data, file_length, body_start, md["arrays"], total,
+                                               max_decoded_bytes, verify_checksums, out["key_values"])
     return out
+
+
+def _unpack_key_values(data, file_length, body_start, arrays, arrays_decoded, cap, verify_checksums, key_values):
+    """Step 20 (section 2.5.1): the key/values packed at the end of the body,
+    located by the first entry `packed_key_values`, which they replace."""
+    # 20a
+    at = next((i for i, (k, _) in enumerate(key_values) if k == PACKED_KEY), None)
+    if at is None:
+        _format("bad_metadata", "bit 1 set, no packed_key_values entry")
+    tokens = key_values[at][1].split(" ")
+    if len(tokens) != 4 or not all(t and len(t) <= 19 and t.isascii() and t.isdigit() for t in tokens):
+        _format("bad_metadata", "packed_key_values is not four decimal counts")
+    codec, stored, decoded, crc = (int(t) for t in tokens)
+    if codec > 1 or crc >= 1 << 32 or decoded < 2:
+        _format("bad_metadata", "packed_key_values: codec, crc32c or decoded length out of range")
+    # 20b
+    if arrays_decoded + decoded > cap:
+        _fail("limit", "limit", "arrays and packed key/values over the cap")
+    # 20c
+    end = file_length - TRAILER_SIZE
+    if stored > end - body_start:
+        _format("bad_layout", "packed key/values outside the body")
+    begin = end - stored
+    if codec == 0 and stored != decoded:
+        _format("bad_layout", "raw packed key/values length")
+    for rec in arrays:
+        if stored and rec["stored_length"] and begin < rec["offset"] + rec["stored_length"] and rec["offset"] < end:
+            _format("bad_layout", "packed key/values overlap an array")
+    # 20d-e
+    raw = data[begin:end]
+    if codec == 1:
+        _zstd_structure(raw)
+        raw = _zstd_frames(raw, decoded)
+    if verify_checksums and crc32c(raw) != crc:
+        _format("checksum_mismatch", "packed key/values CRC-32C")
+    # 20f
+    if raw[-1:] != b"\0" or raw.count(0) % 2:
+        _format("bad_metadata", "packed key/values are not key NUL value NUL ...")
+    strings = raw[:-1].split(b"\0")
+    try:
+        text = [b.decode("utf-8") for b in strings]
+    except UnicodeDecodeError:
+        _format("bad_metadata", "packed key/values: not UTF-8")
+    rest = key_values[:at] + key_values[at + 1:]
+    return rest + [[text[i], text[i + 1]] for i in range(0, len(text), 2)]

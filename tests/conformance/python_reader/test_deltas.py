@@ -22,6 +22,10 @@ def test_the_vectors_use_every_step_and_every_refusal():
     assert steps == {"merge", "remove", "set", "drop"}
     assert {c["name"] for c in CASES if c["expect"] == "refused"} >= {
         "gap", "duplicate", "another_map", "wrong_digest", "position_beyond", "model_file"}
+    # Format 1.2 (section 2.5.1): chains of packed deltas, and a refusal of each step-20 reason.
+    assert {c["reason"] for c in CASES if "reason" in c} == {
+        "checksum_mismatch", "bad_metadata", "bad_layout", "decompression_failed"}
+    assert any(c["name"].startswith("rgbd_packed") for c in CASES if c["expect"] == "applied")
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c["name"] for c in CASES])
@@ -37,6 +41,10 @@ def test_case(case):
     with pytest.raises(delta_receiver.Refused):
         r.apply((DIR / case["then"]).read_bytes())
     assert r.__dict__ == before
+    if "reason" in case:  # a file a delta reader rejects, for this reason
+        with pytest.raises(sogmm_reader.SogmmError) as err:
+            sogmm_reader.read((DIR / case["then"]).read_bytes(), delta=True)
+        assert err.value.reason == case["reason"]
 
 
 def test_a_model_reader_rejects_a_delta():
@@ -47,3 +55,7 @@ def test_a_model_reader_rejects_a_delta():
     with pytest.raises(sogmm_reader.SogmmError) as err:
         sogmm_reader.read((DIR / "../valid/one_component.sogmm").read_bytes(), delta=True)
     assert err.value.reason == "not_a_delta"
+    # Nor does a model reader know bit 1 (packed key/values, section 2.5.1).
+    with pytest.raises(sogmm_reader.SogmmError) as err:
+        sogmm_reader.read((DIR / "points_packed_1.sogmm").read_bytes())
+    assert err.value.reason == "unsupported_feature"
