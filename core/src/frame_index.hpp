@@ -47,6 +47,11 @@ class FrameIndex {
   const std::vector<std::uint32_t>* candidates(const double x[3]) const;
   /// The projection of world point `x` into frame f.
   Projection project(std::uint32_t f, const double x[3]) const;
+  /// project() of `count` world points (coordinate arrays x, y, z) into frame
+  /// f, bitwise the same numbers, as arrays: pixel (-1: not seen), depth, ray.
+  /// One frame's view stays in registers across the points.
+  void project(std::uint32_t f, const double* x, const double* y, const double* z, std::size_t count, int* pixel,
+               double* depth, double* ray) const;
   /// The view of frame f of the box [lo, hi] (world).
   BoxView view(std::uint32_t f, const double lo[3], const double hi[3]) const;
 
