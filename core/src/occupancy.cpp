@@ -31,7 +31,7 @@ constexpr std::size_t kBlock = 64;
 // One thread's block: its points as coordinate arrays, their projections
 // into one frame, their evidence, and the frames its points ask.
 struct Scratch {
-  double x[kBlock], y[kBlock], z[kBlock], depth[kBlock], ray[kBlock];
+  double x[kBlock], y[kBlock], z[kBlock], depth[kBlock], norm2[kBlock];
   int pixel[kBlock];
   Evidence ev[kBlock];
   std::vector<std::uint32_t> asked;
@@ -165,13 +165,23 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       w.ev[j].add_whole_free(whole_free);
     }
     for (std::uint32_t f : asked) {
-      index.project(f, w.x, w.y, w.z, count, w.pixel, w.depth, w.ray);
+      index.project(f, w.x, w.y, w.z, count, w.pixel, w.depth, w.norm2);
       const float* image = depth[f]->data();
       for (std::size_t j = 0; j < count; ++j) {
         if (w.pixel[j] < 0) continue;
         const float d = image[w.pixel[j]];
         if (std::isnan(d)) continue;  // no surface rendered: no evidence
-        w.ev[j].add(w.depth[j] * w.ray[j], d * w.ray[j], options);
+        // Most points are more than the band from the surface in depth, and
+        // so along the ray (ray >= 1): add() would cut them (the band's
+        // margin is far above the rounding), so no root and no Phi.
+        const double gap = w.depth[j] - static_cast<double>(d);
+        if (gap < -band) {
+          w.ev[j].add_whole_free(1);
+          continue;
+        }
+        if (gap > band) continue;
+        const double ray = detail::FrameIndex::ray_of(w.norm2[j], w.depth[j]);
+        w.ev[j].add(w.depth[j] * ray, d * ray, options);
       }
     }
     for (std::size_t j = 0; j < count; ++j) {
