@@ -124,11 +124,11 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   // Per block, a frame that gives every point of the block whole evidence
   // (more than h + 9 sigma in front of its surface: free; behind it, or no
   // surface, or not seen: nothing) is decided once from the block's box and
-  // the depth range under it; the others are asked point by point, in frame
+  // the depth range under it; the others are asked for each point, in frame
   // order. The result is bitwise the one of asking every frame for every
   // point with this Evidence (whole evidence enters the sums as a count, the
   // rest in frame order; test OccupancyBlocks.BitwiseTheAnswerOfEveryFrame),
-  // and within the bound of occupancy_evidence.hpp of main's 0f45b28.
+  // and within the bound of occupancy_evidence.hpp of the model's formula.
   const double band = (options.thickness + detail::kExactSigmas * options.surface_sigma) * (1.0 + 1e-9) + 1e-9;
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
   detail::progress_begin(Stage::Scoring, n);
