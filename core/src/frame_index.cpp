@@ -88,19 +88,44 @@ const std::vector<std::uint32_t>* FrameIndex::candidates(const double x[3]) cons
   return large_.empty() ? nullptr : &large_;
 }
 
-Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
-  const FrameView& v = views_[f];
+namespace {
+
+// One point's projection up to |p|^2 (both project() overloads, so their
+// numbers agree bitwise); ray is not set.
+inline Projection project_point(const FrameView& v, const Camera& camera, double depth_min, double depth_max,
+                                double x0, double x1, double x2, double& norm2) {
   double p[3];
-  for (int i = 0; i < 3; ++i) p[i] = v.r[3 * i] * x[0] + v.r[3 * i + 1] * x[1] + v.r[3 * i + 2] * x[2] + v.t[i];
+  for (int i = 0; i < 3; ++i) p[i] = v.r[3 * i] * x0 + v.r[3 * i + 1] * x1 + v.r[3 * i + 2] * x2 + v.t[i];
   Projection out;
-  if (!(p[2] > depth_min_ && p[2] <= depth_max_)) return out;
-  const double u = std::floor(camera_.fx * p[0] / p[2] + camera_.cx + 0.5);
-  const double w = std::floor(camera_.fy * p[1] / p[2] + camera_.cy + 0.5);
-  if (u < 0 || w < 0 || u >= camera_.width || w >= camera_.height) return out;
-  out.pixel = static_cast<int>(w) * camera_.width + static_cast<int>(u);
+  if (!(p[2] > depth_min && p[2] <= depth_max)) return out;
+  const double u = std::floor(camera.fx * p[0] / p[2] + camera.cx + 0.5);
+  const double w = std::floor(camera.fy * p[1] / p[2] + camera.cy + 0.5);
+  if (u < 0 || w < 0 || u >= camera.width || w >= camera.height) return out;
+  out.pixel = static_cast<int>(w) * camera.width + static_cast<int>(u);
   out.depth = p[2];
-  out.ray = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / p[2];
+  norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
   return out;
+}
+
+}  // namespace
+
+Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
+  double norm2 = 0.0;
+  Projection out = project_point(views_[f], camera_, depth_min_, depth_max_, x[0], x[1], x[2], norm2);
+  if (out.pixel >= 0) out.ray = ray_of(norm2, out.depth);
+  return out;
+}
+
+void FrameIndex::project(std::uint32_t f, const double* x, const double* y, const double* z, std::size_t count,
+                         int* pixel, double* depth, double* norm2) const {
+  const FrameView v = views_[f];
+  const Camera camera = camera_;
+  for (std::size_t j = 0; j < count; ++j) {
+    norm2[j] = 0.0;
+    const Projection p = project_point(v, camera, depth_min_, depth_max_, x[j], y[j], z[j], norm2[j]);
+    pixel[j] = p.pixel;
+    depth[j] = p.depth;
+  }
 }
 
 BoxView FrameIndex::view(std::uint32_t f, const double lo[3], const double hi[3]) const {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -47,6 +48,15 @@ class FrameIndex {
   const std::vector<std::uint32_t>* candidates(const double x[3]) const;
   /// The projection of world point `x` into frame f.
   Projection project(std::uint32_t f, const double x[3]) const;
+  /// project() of `count` world points (coordinate arrays x, y, z) into frame
+  /// f, as arrays: pixel (-1: not seen), depth and |p|^2, from which
+  /// ray_of(norm2, depth) is bitwise project()'s ray (a caller that needs no
+  /// ray for most points skips its root and division). One frame's view stays
+  /// in registers across the points.
+  void project(std::uint32_t f, const double* x, const double* y, const double* z, std::size_t count, int* pixel,
+               double* depth, double* norm2) const;
+  /// The ray factor |p| / p_z of a point with |p|^2 = norm2 and p_z = depth.
+  static double ray_of(double norm2, double depth) { return std::sqrt(norm2) / depth; }
   /// The view of frame f of the box [lo, hi] (world).
   BoxView view(std::uint32_t f, const double lo[3], const double hi[3]) const;
 

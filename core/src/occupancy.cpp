@@ -28,6 +28,15 @@ using detail::Evidence;
 // Points per block: the frames' whole evidence is decided once per block.
 constexpr std::size_t kBlock = 64;
 
+// One thread's block: its points as coordinate arrays, their projections
+// into one frame, their evidence, and the frames its points ask.
+struct Scratch {
+  double x[kBlock], y[kBlock], z[kBlock], depth[kBlock], norm2[kBlock];
+  int pixel[kBlock];
+  Evidence ev[kBlock];
+  std::vector<std::uint32_t> asked;
+};
+
 void world_point(const float* xyz, std::size_t i, double x[3]) {
   for (int k = 0; k < 3; ++k) x[k] = xyz[3 * i + k];
 }
@@ -99,9 +108,14 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       }
     }
   });
-  std::vector<std::shared_ptr<const std::vector<float>>> depth(poses.size());
+  // One frame per thread: a render of the small decimated image splits
+  // poorly over threads (its parallel loop waited a third of the time), and
+  // the image does not depend on the thread count.
+  std::vector<std::size_t> wanted;
   for (std::size_t f = 0; f < poses.size(); ++f)
-    if (seen[f]) depth[f] = map.frame_depth(f, threads);
+    if (seen[f]) wanted.push_back(f);
+  std::vector<std::shared_ptr<const std::vector<float>>> depth(poses.size());
+  detail::parallel_for(wanted.size(), team, 1, [&](std::size_t k, int) { depth[wanted[k]] = map.frame_depth(wanted[k], 1); });
   std::vector<detail::DepthTiles> tiles(poses.size());
   detail::parallel_for(poses.size(), team, 1, [&](std::size_t f, int) {
     if (depth[f]) tiles[f] = detail::DepthTiles(*depth[f], camera.width, camera.height);
@@ -110,17 +124,17 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   // Per block, a frame that gives every point of the block whole evidence
   // (more than h + 9 sigma in front of its surface: free; behind it, or no
   // surface, or not seen: nothing) is decided once from the block's box and
-  // the depth range under it; the others are asked point by point, in frame
+  // the depth range under it; the others are asked for each point, in frame
   // order. The result is bitwise the one of asking every frame for every
   // point with this Evidence (whole evidence enters the sums as a count, the
   // rest in frame order; test OccupancyBlocks.BitwiseTheAnswerOfEveryFrame),
-  // and within the bound of occupancy_evidence.hpp of main's 0f45b28.
+  // and within the bound of occupancy_evidence.hpp of the model's formula.
   const double band = (options.thickness + detail::kExactSigmas * options.surface_sigma) * (1.0 + 1e-9) + 1e-9;
-  std::vector<std::vector<std::uint32_t>> scratch(static_cast<std::size_t>(team));
+  std::vector<Scratch> scratch(static_cast<std::size_t>(team));
   detail::progress_begin(Stage::Scoring, n);
   detail::parallel_for(blocks, team, 4, [&](std::size_t blk, int thread) {
     const auto& b = box[blk];
-    auto& asked = scratch[static_cast<std::size_t>(thread)];
+    auto& asked = scratch[static_cast<std::size_t>(thread)].asked;
     asked.clear();
     std::uint64_t whole_free = 0;
     for (std::uint32_t f : frames[blk]) {
@@ -138,21 +152,41 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       }
       asked.push_back(f);
     }
-    const std::size_t first = blk * kBlock, last = std::min(n, first + kBlock);
-    for (std::size_t j = first; j < last; ++j) {
-      const std::size_t i = order[j];
-      double x[3];
-      world_point(xyz, i, x);
-      Evidence ev;
-      ev.add_whole_free(whole_free);
-      for (std::uint32_t f : asked) {
-        const detail::Projection p = index.project(f, x);
-        if (p.pixel < 0) continue;
-        const float d = (*depth[f])[static_cast<std::size_t>(p.pixel)];
+    // Frame by frame over the block's points (the per-point sums still run
+    // in frame order, so the bits are those of asking point by point).
+    const std::size_t first = blk * kBlock, count = std::min(n, first + kBlock) - first;
+    Scratch& w = scratch[static_cast<std::size_t>(thread)];
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::size_t i = order[first + j];
+      w.x[j] = xyz[3 * i];
+      w.y[j] = xyz[3 * i + 1];
+      w.z[j] = xyz[3 * i + 2];
+      w.ev[j] = Evidence{};
+      w.ev[j].add_whole_free(whole_free);
+    }
+    for (std::uint32_t f : asked) {
+      index.project(f, w.x, w.y, w.z, count, w.pixel, w.depth, w.norm2);
+      const float* image = depth[f]->data();
+      for (std::size_t j = 0; j < count; ++j) {
+        if (w.pixel[j] < 0) continue;
+        const float d = image[w.pixel[j]];
         if (std::isnan(d)) continue;  // no surface rendered: no evidence
-        ev.add(p.depth * p.ray, d * p.ray, options);
+        // Most points are more than the band from the surface in depth, and
+        // so along the ray (ray >= 1): add() would cut them (the band's
+        // margin is far above the rounding), so no root and no Phi.
+        const double gap = w.depth[j] - static_cast<double>(d);
+        if (gap < -band) {
+          w.ev[j].add_whole_free(1);
+          continue;
+        }
+        if (gap > band) continue;
+        const double ray = detail::FrameIndex::ray_of(w.norm2[j], w.depth[j]);
+        w.ev[j].add(w.depth[j] * ray, d * ray, options);
       }
-      ev.finish(probability[i], state ? state + i : nullptr);
+    }
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::size_t i = order[first + j];
+      w.ev[j].finish(probability[i], state ? state + i : nullptr);
     }
   });
 }

@@ -7,23 +7,26 @@
 #include <cmath>
 #include <cstdint>
 
+#include "occupancy_phi.hpp"
 #include "sogmm/occupancy.hpp"
 
 namespace sogmm::detail {
 
 /// Phi is taken as exactly 0 below -kExactSigmas and 1 above it. Above
 /// +9 sigma 0.5 erfc already rounds to 1 in double; below -9 sigma the true
-/// value is under 1.2e-19, so dropping it moves b_f and o_f by less than
-/// 1.2e-19 each (e_f = 1 - Phi rounds to the same double). The cut makes a
-/// frame whose surface is more than h + 9 sigma from a point give whole
-/// evidence (free, or none), which a test over a box of points decides once
-/// for all of them (occupancy.cpp). Against 0f45b28 (cut at 40 sigma, whole
-/// evidence summed in frame order) an answer therefore differs only by those
-/// sub-1.2e-19 terms and the rounding of the sums' order: with F frames
-/// seeing a point, |dp| <= F (2.4e-19 + 2^-52) where seen >= 1 (a cut term
-/// always comes with e_f ~ 1). Measured on the synthetic loop map (2763
-/// components, 300 frames, 614,400 points): largest |dp| 1.1e-16, no state
-/// differs (sogmm-occupancy-octomap --compare-main).
+/// value is under 1.2e-19. The cut makes a frame whose surface is more than
+/// h + 9 sigma from a point give whole evidence (free, or none), which a test
+/// over a box of points decides once for all of them (occupancy.cpp).
+/// Between the cuts Phi is the table of occupancy_phi.hpp, within
+/// kPhiTableError = 1e-10 of 0.5 erfc(-x / sqrt 2). So every e_f, b_f is
+/// within eps = 1e-10 of the model's (spec/api.md 4.9) and o_f within 2 eps,
+/// and with F frames seeing a point: |U - U'| <= F eps (a product of factors
+/// in [0, 1]); (1 - U) <= S = sum_f (o_f + e_f) (as 1 - prod b_f <= sum (1 - b_f)),
+/// so where S >= 6 F eps the pooled share moves (1 - U) q by at most 10 F eps,
+/// and where S < 6 F eps both (1 - U) q are below 15 F eps: |dP| <= 16 F eps
+/// (plus the sums' rounding, F 2^-52). Measured on the synthetic loop map
+/// (2763 components, 300 frames, 614,400 points) against a67de64 (std::erfc):
+/// see README section 7 (sogmm-occupancy-octomap --compare-main).
 inline constexpr double kExactSigmas = 9.0;
 
 struct Evidence {
@@ -36,7 +39,7 @@ struct Evidence {
   static double phi(double x) {
     if (x < -kExactSigmas) return 0.0;
     if (x > kExactSigmas) return 1.0;
-    return 0.5 * std::erfc(-x / std::sqrt(2.0));
+    return phi_table()(x);
   }
 
   /// `count` frames that see the point more than h + 9 sigma in front of their surface.

@@ -104,6 +104,24 @@ TEST(OccupancyBlocks, BitwiseTheAnswerOfEveryFrame) {
   }
 }
 
+// Phi of the evidence (occupancy_phi.hpp's table between the 9-sigma cuts)
+// against 0.5 erfc(-x / sqrt 2) on a grid finer than the table's nodes
+// (1/64) by a factor 2^11 and offset from them, past the cuts on both sides.
+TEST(OccupancyPhi, WithinItsStatedBoundOfErfc) {
+  double worst = 0.0, at = 0.0;
+  for (long k = -1572864; k <= 1572864; ++k) {  // x in [-12, 12] by 2^-17, plus a third of a step
+    const double x = (static_cast<double>(k) + 1.0 / 3.0) / 131072.0;
+    const double err = std::abs(sogmm::detail::Evidence::phi(x) - 0.5 * std::erfc(-x / std::sqrt(2.0)));
+    if (err > worst) worst = err, at = x;
+  }
+  EXPECT_LE(worst, sogmm::detail::kPhiTableError) << "at x = " << at;
+  // The cuts and the ends of the table.
+  for (double x : {-9.0, 9.0, -8.999999, 8.999999, -9.000001, 9.000001, 0.0})
+    EXPECT_LE(std::abs(sogmm::detail::Evidence::phi(x) - 0.5 * std::erfc(-x / std::sqrt(2.0))),
+              sogmm::detail::kPhiTableError)
+        << x;
+}
+
 TEST(OccupancyBlocks, BehindEverySurfaceAndOutsideEveryViewIsUnknown) {
   const sogmm::Map& map = many_frame_map();
   // Far behind every plane (the nearest frame's is at z = 2 - 0.07 * 13 plus its
