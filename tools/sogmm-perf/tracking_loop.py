@@ -67,8 +67,9 @@ def main():
     result = {"frames": a.frames, "flags": a.map_flags, "inserted": len(errors),
               "skipped": summary["n_skipped"], "ate_rmse_cm": round(float(np.sqrt((e ** 2).mean())) * 100, 3),
               "max_cm": round(errors[worst] * 100, 3), "worst_frame": worst, "first_frame_over_1cm": first_off,
-              "components": summary["n_components"], "flushes": summary["n_flushes"], "seconds": round(seconds, 1)}
-    print(f"{a.frames} {' '.join(a.map_flags)}: {result['inserted']} inserted, {result['skipped']} skipped; "
+              "odometry": summary.get("n_odometry", 0), "components": summary["n_components"],
+              "flushes": summary["n_flushes"], "seconds": round(seconds, 1)}
+    print(f"{a.frames} {' '.join(a.map_flags)}: {result['inserted']} inserted, {result['skipped']} skipped, {result['odometry']} by odometry; "
           f"ATE RMSE {result['ate_rmse_cm']} cm (max {result['max_cm']} cm at frame {worst}; first over 1 cm: "
           f"{first_off}); {result['components']} components, {result['flushes']} fits, {seconds:.0f} s")
     print(json.dumps(result))
