@@ -2,8 +2,8 @@
 // rule that decides a frame's pose (hand-made registration results), the
 // RMS displacement between two poses (closed forms), and frames of an
 // analytic room corner (floor y = 0.6, back wall z = 2.2, side wall
-// x = -0.9, uniform gray, ray-cast per pixel of a 240 x 180 camera: points
-// about 1 cm apart, so that 4 cm odometry cells hold 10 or more) tracked
+// x = -0.9, uniform gray, ray-cast per pixel of a 200 x 150 camera: points
+// about 1.3 cm apart at 2 m, so that 4 cm odometry cells hold enough) tracked
 // against maps that hold only part of what the last frame saw.
 #include <gtest/gtest.h>
 
@@ -72,7 +72,7 @@ TEST(MapTracking, RmsDisplacementHasItsClosedForms) {
 }
 
 enum Surfaces { kFloor = 1, kBack = 2, kSide = 4, kAll = 7 };
-const sogmm::Camera kCamera{240, 180, 180, 180, 119.5, 89.5};
+const sogmm::Camera kCamera{200, 150, 150, 150, 99.5, 74.5};
 
 // The corner's points (camera frame; uniform gray, so that only geometry
 // fixes a pose and a lone wall slides) seen from camera-to-world `pose`,
