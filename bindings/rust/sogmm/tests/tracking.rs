@@ -95,13 +95,21 @@ fn tracks_a_known_motion_and_refuses_a_plane() {
 #[test]
 fn tracking_options_reach_the_map() {
     let mut bad = Options::builder().build().unwrap();
-    let e = bad.set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.0).unwrap_err();
+    let e = bad
+        .set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.0)
+        .unwrap_err();
     assert_eq!(e.status(), Status::InvalidArg);
     for odometry in [0i64, 1] {
-        let mut o = Options::builder().decimation(2).bandwidth(0.05).threads(1).build().unwrap();
+        let mut o = Options::builder()
+            .decimation(2)
+            .bandwidth(0.05)
+            .threads(1)
+            .build()
+            .unwrap();
         o.set_i64(sogmm::sys::SOGMM_OPT_REGISTRATION_USE_GRAY, 1).unwrap();
         o.set_i64(sogmm::sys::SOGMM_OPT_TRACKING_ODOMETRY, odometry).unwrap();
-        o.set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.01).unwrap();
+        o.set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.01)
+            .unwrap();
         let mut map = Map::new(Some(&o)).unwrap();
         let (d0, g0) = corner(&IDENTITY, false);
         map.track_frame(&frame(&d0, &g0), None).unwrap();
@@ -109,7 +117,12 @@ fn tracking_options_reach_the_map() {
         let (r, inserted) = map.track_frame(&frame(&d1, &g1), None).unwrap();
         assert!(inserted, "odometry {odometry}: {:?}", r.status);
         for (a, b) in r.pose.iter().zip(truth().iter()) {
-            assert!((a - b).abs() < 1e-3, "odometry {odometry}: {:?} vs {:?}", r.pose, truth());
+            assert!(
+                (a - b).abs() < 1e-3,
+                "odometry {odometry}: {:?} vs {:?}",
+                r.pose,
+                truth()
+            );
         }
     }
 }
