@@ -93,8 +93,9 @@ TrackedFrame track_backprojected(Map& map, TrackingState& state, const PointsVie
   };
   // Odometry runs once, when the map first does not accept the frame (the
   // last frame does not change with a flush), and only with gray: on the
-  // loop's wall views geometry-only odometry converged 2.3 cm off, and with
-  // it frames 0-99 without gray went in at 29 cm ATE (94 inserted).
+  // loop's wall views geometry-only odometry converged 2.3 cm off with a
+  // non-degenerate status, which the disagreement bound cannot tell from a
+  // good pose.
   auto decide = [&] {
     if (t.registration.status != RegistrationStatus::Converged && tracking.odometry && options.use_gray &&
         !t.odometry_ran && holds_last_frame(state, map)) {
