@@ -12,10 +12,12 @@ import (
 // registration to the map finds (issue 32; sogmm_map_track_frame): from guess,
 // or (nil) the constant-velocity prediction from the map's last two frames;
 // the map's first frame goes in at the guess (nil: identity). Registration
-// options are the map's creation options (OptRegistration*). The frame is
-// inserted only when the registration's Status is RegistrationConverged;
-// inserted says whether it was, and the Registration's Pose is the pose used
-// (or the last iterate). The first frame reports RegistrationConverged with 0
+// options are the map's creation options (OptRegistration*, OptTracking*). The
+// frame is inserted when the registration's Status is RegistrationConverged or,
+// with OptRegistrationUseGray and OptTrackingOdometry, when its registration to
+// the last tracked frame vouches for it (sogmm.h states the rule); inserted says
+// whether it was, the Registration's Pose is the pose used (or the map
+// registration's last iterate) and its figures are the map registration's. The first frame reports RegistrationConverged with 0
 // iterations. ctx and progress as InsertPoints.
 func (m *Map) TrackFrame(ctx context.Context, f Frame, guess *[16]float64) (r *Registration, inserted bool, err error) {
 	h, err := f.handle()

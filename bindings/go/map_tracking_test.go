@@ -86,3 +86,32 @@ func TestTrackFrameFollowsAKnownMotionAndRefusesAPlane(t *testing.T) {
 		t.Fatalf("frames after the refusals: %v %+v", err, st)
 	}
 }
+
+// TRACKING_ODOMETRY / TRACKING_MAX_DISAGREEMENT (keys 810, 811) reach the map
+// through the registry: a bad bound is refused; with gray, odometry off or on,
+// the second corner frame (the map accepts it) goes in at its closed-form pose.
+func TestTrackFrameTrackingOptions(t *testing.T) {
+	if _, err := NewOptions(F64(OptTrackingMaxDisagreement, 0)); err == nil {
+		t.Fatal("a zero disagreement bound was accepted")
+	}
+	ctx := context.Background()
+	identity := [16]float64{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}
+	truth := trackTruth()
+	for _, odometry := range []int64{0, 1} {
+		o := mustOptions(t, Decimation(2), Bandwidth(0.05), Threads(1), I64(OptRegistrationUseGray, 1),
+			I64(OptTrackingOdometry, odometry), F64(OptTrackingMaxDisagreement, 0.01))
+		m := mustMap(t, o)
+		if _, _, err := m.TrackFrame(ctx, cornerFrame(identity, false), nil); err != nil {
+			t.Fatal(err)
+		}
+		r, inserted, err := m.TrackFrame(ctx, cornerFrame(truth, false), nil)
+		if err != nil || !inserted {
+			t.Fatalf("odometry %d: %v %v %+v", odometry, err, inserted, r)
+		}
+		for k := range truth {
+			if math.Abs(r.Pose[k]-truth[k]) > 1e-3 {
+				t.Fatalf("odometry %d: pose %v, truth %v", odometry, r.Pose, truth)
+			}
+		}
+	}
+}

@@ -59,6 +59,8 @@ const (
 	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
 	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
 	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
+	OptTrackingOdometry            Key = C.SOGMM_OPT_TRACKING_ODOMETRY
+	OptTrackingMaxDisagreement     Key = C.SOGMM_OPT_TRACKING_MAX_DISAGREEMENT
 )
 
 // END GENERATED option keys

@@ -8,10 +8,13 @@
 
 #include "internal.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/map_tracking.hpp"
 
 struct sogmm_map {
   sogmm::Map map;
   sogmm_options options;  ///< the creation options: RGB-D keys and progress callback of later inserts
+  /// sogmm_map_track_frame's last inserted frame (its odometry target).
+  sogmm::TrackingState tracking;
   /// Calls using the map: n > 0 const calls, or -1 for the one non-const
   /// call (or sogmm_map_free). A call that cannot take it returns
   /// SOGMM_E_BUSY instead of racing (sogmm.h, "map busy"). Mutable: the

@@ -19,10 +19,10 @@ SOGMM_API sogmm_status sogmm_map_track_frame(sogmm_map* map, const sogmm_frame* 
     const sogmm_capi::RgbdPoints r = sogmm_capi::backproject_frame(frame, map->options);
     const sogmm::Settings& s = map->options.settings;
     const sogmm::TrackedFrame t =
-        sogmm::track_backprojected(map->map, r.cloud.view(), r.camera, start, s.registration, s.query.threads,
-                                   sogmm_capi::progress_sink(map->options));
+        sogmm::track_backprojected(map->map, map->tracking, r.cloud.view(), r.camera, start, s.registration,
+                                   s.tracking, s.query.threads, sogmm_capi::progress_sink(map->options));
     if (pose_out != nullptr)
-      for (int i = 0; i < 16; ++i) pose_out[i] = t.registration.pose[i];
+      for (int i = 0; i < 16; ++i) pose_out[i] = t.pose[i];
     if (inserted_out != nullptr) *inserted_out = t.inserted ? 1 : 0;
     if (info_out != nullptr) sogmm_capi::write_registration_info(t.registration, info_out);
   }

@@ -204,6 +204,14 @@ std::vector<OptionSpec> make_table() {
                     "unobservable"),
       SOGMM_I64_ROW(REGISTRATION_MIN_POINTS, registration.min_points, 6, kI64Max, ">= 6", "points",
                     "registration: fewer finite source points are SOGMM_E_INVALID_DATA"),
+      SOGMM_I64_ROW(TRACKING_ODOMETRY, tracking.odometry, 0, 1, "0 or 1", "",
+                    "tracking: 1 registers a frame the map does not accept to the last inserted frame too and inserts "
+                    "it when the two agree or the map has too few inliers to judge; 0 inserts only frames the map "
+                    "accepts"),
+      SOGMM_F64_ROW(TRACKING_MAX_DISAGREEMENT, tracking.max_disagreement, 0.0, kInf,
+                    [](double v) { return v > 0 && std::isfinite(v); }, "> 0, finite", "m",
+                    "tracking: largest RMS distance between a frame's points at the map's and at the odometry's pose "
+                    "for the two to agree"),
   };
   return t;
 }

@@ -6,7 +6,9 @@ trajectory.log.
 
 ATE: the RMSE of the camera positions after aligning the estimate's first
 frame with the truth's (x_truth_k ~ T_truth_0 T_est_0^-1 x_est_k; no
-best-fit alignment, so drift is not hidden). Also prints the skipped frames,
+best-fit alignment, so drift is not hidden), each estimate paired with its
+frame number (from the map's CSV, so that skipped frames and slices such as
+--frames 78:96 pair right). Also prints the skipped frames,
 the worst frame, the first frame off by more than 1 cm and the wall time.
 
 Usage (from the repository root; the synthetic loop is written if missing):
@@ -60,15 +62,20 @@ def main():
     if run.returncode != 0:
         sys.exit("sogmm map failed: " + run.stderr.strip().splitlines()[-1])
     summary = json.loads(run.stdout)
-    errors = ate(read_log(out + ".log"), read_log(os.path.join(a.loop_dir, "trajectory.log")))
+    # --trajectory-out numbers the inserted frames 0, 1, ...; the CSV's rows
+    # (inserted frames only, in order) hold their frame numbers.
+    rows = [line.split(",")[0] for line in open(out + ".csv").read().splitlines()[1:] if line]
+    estimate = {int(rows[k]): pose for k, pose in read_log(out + ".log").items()}
+    errors = ate(estimate, read_log(os.path.join(a.loop_dir, "trajectory.log")))
     e = np.array(list(errors.values()))
     worst = max(errors, key=errors.get)
     first_off = next((k for k, v in errors.items() if v > 0.01), None)
     result = {"frames": a.frames, "flags": a.map_flags, "inserted": len(errors),
               "skipped": summary["n_skipped"], "ate_rmse_cm": round(float(np.sqrt((e ** 2).mean())) * 100, 3),
               "max_cm": round(errors[worst] * 100, 3), "worst_frame": worst, "first_frame_over_1cm": first_off,
-              "components": summary["n_components"], "flushes": summary["n_flushes"], "seconds": round(seconds, 1)}
-    print(f"{a.frames} {' '.join(a.map_flags)}: {result['inserted']} inserted, {result['skipped']} skipped; "
+              "odometry": summary.get("n_odometry", 0), "components": summary["n_components"],
+              "flushes": summary["n_flushes"], "seconds": round(seconds, 1)}
+    print(f"{a.frames} {' '.join(a.map_flags)}: {result['inserted']} inserted, {result['skipped']} skipped, {result['odometry']} by odometry; "
           f"ATE RMSE {result['ate_rmse_cm']} cm (max {result['max_cm']} cm at frame {worst}; first over 1 cm: "
           f"{first_off}); {result['components']} components, {result['flushes']} fits, {seconds:.0f} s")
     print(json.dumps(result))

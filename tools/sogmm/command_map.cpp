@@ -27,6 +27,8 @@ struct MapState {
   CameraFlags camera;
   MapOptions options;
   RegistrationOptions registration;  // tracking, without --trajectory
+  TrackingOptions tracking;
+  bool no_odometry = false;
   std::string fusion = "off";
   bool no_novelty = false, refine_poses = false;
   bool json = false, progress = false, quiet = false;
@@ -43,8 +45,10 @@ struct Row {
   double ms_novelty, ms_fit, ms_merge;
   std::size_t replaced;  // components a revisit refit replaced
   // How the pose came: "given" (--trajectory), "first" (the map's first
-  // frame, at the identity) or "registered" (tracking), with the
-  // registration's fitness (empty when not registered).
+  // frame, at the identity), "registered" (tracking: the map registration)
+  // or "odometry" (tracking: the registration to the last frame, which the
+  // map registration did not contradict), with the map registration's
+  // fitness (empty when not registered).
   const char* pose_source;
   double inlier_ratio, registration_ll;
 };
@@ -59,7 +63,7 @@ std::string csv_text(const std::vector<Row>& rows) {
                   r.components, r.pending, r.flushed ? 1 : 0, r.ms_novelty, r.ms_fit, r.ms_merge, r.replaced,
                   r.pose_source);
     out += buf;
-    if (std::string(r.pose_source) == "registered") {
+    if (std::string(r.pose_source) == "registered" || std::string(r.pose_source) == "odometry") {
       std::snprintf(buf, sizeof buf, "%.4f,%.4f", r.inlier_ratio, r.registration_ll);
       out += buf;
     } else {
@@ -97,6 +101,8 @@ int run_map(MapState& s) {
   if (!s.trajectory_out.empty()) outputs.push_back({"--trajectory-out", s.trajectory_out});
   check_outputs(sequence_inputs(s.src, s.camera), outputs);
   s.options.novelty = !s.no_novelty;
+  s.tracking.odometry = !s.no_odometry;
+  validate(s.tracking);
   s.options.fusion = s.fusion != "off";
   s.options.fusion_method = s.fusion == "kl" ? FusionMethod::KL : FusionMethod::Hellinger;
   Map map(s.options);  // checks the options before any file is read
@@ -109,7 +115,7 @@ int run_map(MapState& s) {
   std::size_t points = 0, novel = 0;
   double ms_novelty = 0, ms_fit = 0, ms_merge = 0;
   std::vector<Pose> poses_used;
-  std::size_t skipped = 0;
+  std::size_t skipped = 0, by_odometry = 0;
   DeltaWriter deltas(s.deltas);
   run_map_over_sequence(
       map, in, progress,
@@ -119,13 +125,14 @@ int run_map(MapState& s) {
       return;
     }
     poses_used.push_back(f.pose);
+    if (f.source == PoseSource::Odometry) ++by_odometry;
     const FrameStats& st = f.stats;
     if (st.flushed) deltas.write(map);
     const std::size_t pending = map.pending();
     const bool given = !in.poses.empty() && !in.refine_poses;
     rows.push_back({f.file.index, st.n_points, st.n_novel, st.n_components, pending, st.flushed, st.ms_novelty,
                     st.ms_fit, st.ms_merge, st.n_replaced,
-                    given ? "given" : (f.registered ? "registered" : "first"), f.registration.inlier_ratio,
+                    given ? "given" : source_name(f.source), f.registration.inlier_ratio,
                     f.registration.log_likelihood});
     points += st.n_points;
     novel += st.n_novel;
@@ -140,7 +147,7 @@ int run_map(MapState& s) {
                   st.ms_merge);
     progress.status(buf);
       },
-      s.registration);
+      s.registration, s.tracking);
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t added = map.flush(progress.fit_callback("final flush"));
   const double ms_flush = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -162,6 +169,7 @@ int run_map(MapState& s) {
     j["plot"] = plot;
     j["n_frames"] = rows.size();
     j["n_skipped"] = skipped;
+    j["n_odometry"] = by_odometry;
     j["n_points"] = points;
     j["n_novel"] = novel;
     j["n_components"] = model.gmm.size();
@@ -233,6 +241,14 @@ Command add_map_command(CLI::App& root) {
   app->add_flag("--registration-gray", s->registration.use_gray,
                 "without --trajectory or with --refine-poses: register with gray too (the 4-D density; SOGMM_OPT_REGISTRATION_USE_GRAY),\n"
                 "which holds the pose where the geometry alone lets a frame slide (a wall, a floor)");
+  app->add_flag("--no-odometry", s->no_odometry,
+                "tracking: insert only frames whose map registration converged (SOGMM_OPT_TRACKING_ODOMETRY 0); by\n"
+                "default a frame the map does not accept is registered to the last inserted frame too and inserted\n"
+                "when the two poses agree or the map has too few inliers to judge");
+  app->add_option("--odometry-max-disagreement", s->tracking.max_disagreement,
+                  "tracking: largest RMS distance (m) between a frame's points at the map's and the odometry's pose\n"
+                  "for the two to agree (SOGMM_OPT_TRACKING_MAX_DISAGREEMENT)")
+      ->capture_default_str();
   app->add_option("--frames", s->src.frames, "I, A:B (B excluded) or A:B:STEP; default all");
   add_pair_by_order_flag(*app, s->src.pair_by_order);
   add_camera_flags(*app, s->camera, s->options.depth);

@@ -76,8 +76,9 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
 
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter& progress,
                              const std::function<void(const MapRunFrame&)>& after,
-                             const RegistrationOptions& registration) {
+                             const RegistrationOptions& registration, const TrackingOptions& tracking) {
   Camera camera;
+  TrackingState tracking_state;
   for (std::size_t k = 0; k < in.selected.size(); ++k) {
     MapRunFrame r;
     r.file = in.frames[in.selected[k]];
@@ -97,14 +98,22 @@ Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter&
         r.stats = map.insert_backprojected(points.view(), camera, r.pose, recording(progress.fit_callback(r.label), r.fit));
       } else {  // the core's tracking: registered to the map from the given pose or a constant-velocity guess
         const Pose guess = in.poses.empty() ? predict_constant_velocity(map) : in.poses[k];
-        const TrackedFrame t = track_backprojected(map, points.view(), camera, guess,
-                                                   registration, 0, recording(progress.fit_callback(r.label), r.fit));
+        const TrackedFrame t =
+            track_backprojected(map, tracking_state, points.view(), camera, guess, registration, tracking, 0,
+                                recording(progress.fit_callback(r.label), r.fit));
         r.registration = t.registration;
         r.registered = t.registered;
+        r.source = t.source;
         r.skipped = !t.inserted;
-        r.pose = t.registration.pose;
+        r.pose = t.pose;
         r.stats = t.stats;
-        if (r.skipped)
+        if (r.skipped && t.odometry_ran)
+          std::fprintf(stderr,
+                       "warning: %s not inserted: its registration to the map ended %s (inliers %.2f), to the last "
+                       "frame %s, %.1f cm apart\n",
+                       r.file.depth.c_str(), status_name(r.registration.status), r.registration.inlier_ratio,
+                       status_name(t.odometry.status), 100.0 * t.disagreement);
+        else if (r.skipped)
           std::fprintf(stderr, "warning: %s not inserted: its registration to the map ended %s (inliers %.2f)\n",
                        r.file.depth.c_str(), status_name(r.registration.status), r.registration.inlier_ratio);
       }

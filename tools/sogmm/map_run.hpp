@@ -12,6 +12,7 @@
 #include "file_util.hpp"
 #include "sequence.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/map_tracking.hpp"
 #include "sogmm/registration.hpp"
 
 namespace sogmm::tools {
@@ -33,6 +34,7 @@ struct MapRunFrame {
   Pose pose{};               ///< the camera-to-world pose used (given or estimated)
   bool registered = false;   ///< the pose was estimated (no trajectory)
   bool skipped = false;      ///< the registration failed: the frame was not inserted
+  PoseSource source = PoseSource::None;  ///< when registered: where the inserted pose came from
   RegistrationResult registration;  ///< when registered or skipped
 };
 
@@ -66,14 +68,14 @@ std::vector<NamedFile> sequence_inputs(const FrameSource& src, const CameraFlags
 /// Without poses each frame's pose is estimated by the core's tracking
 /// (track_backprojected of sogmm/map_tracking.hpp, with `registration`): the
 /// first is the identity, the others are registered to the map from a
-/// constant-velocity prediction (with in.refine_poses: from its given pose);
-/// a frame whose registration does not converge is skipped with a warning
-/// on stderr.
+/// constant-velocity prediction (with in.refine_poses: from its given pose),
+/// with the odometry fallback of `tracking`; a frame the tracking does not
+/// insert is skipped with a warning on stderr.
 /// `progress` shows each fit's stages; `after` is called after each insert.
 /// Returns the camera of the frames.
 Camera run_map_over_sequence(Map& map, const SequenceInput& in, ProgressPrinter& progress,
                              const std::function<void(const MapRunFrame&)>& after,
-                             const RegistrationOptions& registration = {});
+                             const RegistrationOptions& registration = {}, const TrackingOptions& tracking = {});
 
 /// Comma-separated frame indices of the selection ("0,1,2").
 std::string frame_list(const SequenceInput& in);

@@ -69,3 +69,17 @@ def test_bad_input_raises_and_changes_nothing():
     with pytest.raises(sogmm.InvalidDataError, match="min_points"):
         m.track_rgbd(depth, np.zeros((H, W), np.uint8), CAMERA)
     assert len(m) == 1
+
+
+def test_tracking_options_reach_the_map():
+    """TRACKING_ODOMETRY / TRACKING_MAX_DISAGREEMENT (keys 810, 811) go through the
+    registry: a bad bound is refused naming it; with gray and odometry off or on,
+    a frame the map registration accepts is inserted at its closed-form pose."""
+    with pytest.raises(sogmm.InvalidArgumentError, match="TRACKING_MAX_DISAGREEMENT"):
+        sogmm.Map(tracking_max_disagreement=0.0)
+    for odometry in (False, True):
+        m = sogmm.Map(decimate=2, bandwidth=0.05, n_threads=1, registration_use_gray=True,
+                      tracking_odometry=odometry, tracking_max_disagreement=0.01)
+        m.track_rgbd(*corner(np.eye(4)), CAMERA)
+        pose, info = m.track_rgbd(*corner(truth()), CAMERA)
+        assert info["inserted"] and np.abs(pose - truth()).max() < 1e-3

@@ -352,6 +352,15 @@ typedef int32_t sogmm_key;
 /* Registration: fewer finite source points are SOGMM_E_INVALID_DATA.
  * i64 (points), >= 6; default 100. */
 #define SOGMM_OPT_REGISTRATION_MIN_POINTS 808
+/* Tracking: 1 registers a frame the map does not accept to the last inserted frame too and
+ * inserts it when the two agree or the map has too few inliers to judge; 0 inserts only frames
+ * the map accepts.
+ * i64, 0 or 1; default 1. */
+#define SOGMM_OPT_TRACKING_ODOMETRY 810
+/* Tracking: largest RMS distance between a frame's points at the map's and at the odometry's
+ * pose for the two to agree.
+ * f64 (m), > 0, finite; default 0.02. */
+#define SOGMM_OPT_TRACKING_MAX_DISAGREEMENT 811
 /* END GENERATED option keys */
 
 /* Named values of option keys. */
@@ -1251,16 +1260,24 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
  * prediction from the map's last two frames (frames assumed evenly spaced:
  * a caller that skips frames passes its own guess). The map's first frame
  * (no component, nothing pending) is inserted at the guess (NULL: the
- * identity) without registration. The target is the map's components;
- * pending points are flushed first when the map has none, or when the
- * registration to the components alone does not converge (then it runs
- * again). The frame is inserted only when the registration's status is
- * SOGMM_REGISTRATION_CONVERGED: otherwise the call still returns SOGMM_OK,
- * *inserted_out is 0, info_out says why, and the map keeps only the flush
- * it may have run. Outputs (each may be NULL): pose_out (16 doubles) the
- * pose used or the registration's last iterate, inserted_out 1/0,
- * info_out the registration's figures (struct_size set by the caller; for
- * the first frame status CONVERGED and iterations 0). Errors: NULL map or
+ * identity) without registration. The target is the map's components and
+ * its pending points; pending points are flushed first when the map has no
+ * component, or when the frame would not be inserted (then it registers
+ * again). The frame is inserted when the registration's status is
+ * SOGMM_REGISTRATION_CONVERGED, or, with SOGMM_OPT_REGISTRATION_USE_GRAY and
+ * SOGMM_OPT_TRACKING_ODOMETRY (default 1), when its registration to the
+ * last frame this call inserted into the map (odometry) converged and
+ * either agrees with the map's pose (SOGMM_OPT_TRACKING_MAX_DISAGREEMENT:
+ * then at the map's pose when its status is DEGENERATE, else at the
+ * odometry's) or the map has fewer inliers than
+ * SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO (at the odometry's); rule and
+ * why: core/include/sogmm/map_tracking.hpp. Otherwise the call still
+ * returns SOGMM_OK, *inserted_out is 0, info_out says why, and the map
+ * keeps only the flush it may have run. Outputs (each may be NULL):
+ * pose_out (16 doubles) the pose used or the map registration's last
+ * iterate, inserted_out 1/0, info_out the map registration's figures
+ * (struct_size set by the caller; for the first frame status CONVERGED
+ * and iterations 0). Errors: NULL map or
  * frame -> SOGMM_E_NULL_ARG; a non-rigid guess, info_out->struct_size too
  * small -> SOGMM_E_INVALID_ARG; fewer than REGISTRATION_MIN_POINTS valid
  * pixels -> SOGMM_E_INVALID_DATA; a busy map -> SOGMM_E_BUSY; otherwise as

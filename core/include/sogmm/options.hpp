@@ -25,6 +25,7 @@
 #include "sogmm/fit.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/map_tracking.hpp"
 #include "sogmm/occupancy.hpp"
 #include "sogmm/registration.hpp"
 #include "sogmm/render.hpp"
@@ -53,6 +54,7 @@ struct Settings {
   OccupancyOptions occupancy;
   SurfaceDistanceOptions surface;
   RegistrationOptions registration;
+  TrackingOptions tracking;
   /// Renders: only surface_sigma is a setting here; a render's depth range
   /// is `depth` and its threads `query.threads` (one setting each).
   RenderOptions render;
@@ -64,7 +66,7 @@ MapOptions map_options(const Settings& s);
 
 /// The key of each setting: the numbers and (after SOGMM_OPT_) the names of
 /// sogmm.h's SOGMM_OPT_* (stable; grouped by hundreds: fit, RGB-D, write,
-/// read, sample and query, map, occupancy and distance, registration).
+/// read, sample and query, map, occupancy and distance, registration and tracking).
 enum class OptionKey : int {
   BANDWIDTH = 100,
   N_COMPONENTS = 101,
@@ -112,6 +114,8 @@ enum class OptionKey : int {
   REGISTRATION_MIN_INLIER_RATIO = 806,
   REGISTRATION_DEGENERACY_RATIO = 807,
   REGISTRATION_MIN_POINTS = 808,
+  TRACKING_ODOMETRY = 810,
+  TRACKING_MAX_DISAGREEMENT = 811,
 };
 
 /// The value type of a setting (sogmm.h: SOGMM_TYPE_F64 = 0, SOGMM_TYPE_I64 = 1).

@@ -133,6 +133,12 @@ class Map(Queryable):
         registration_use_gray: :meth:`track_rgbd` registers with gray too (the
             4-D density, as :func:`sogmm.register`'s ``use_gray``), which holds
             the pose where geometry alone lets a frame slide (a wall, a floor).
+        tracking_odometry: with ``registration_use_gray``, a frame the map
+            does not accept is registered to the last frame :meth:`track_rgbd`
+            inserted too, and inserted when the two poses agree (within
+            ``tracking_max_disagreement`` metres, RMS over the frame's points)
+            or the map has too few inliers to judge (rule and why:
+            core/include/sogmm/map_tracking.hpp).
         delta_history: how many of its latest revisions the map keeps the
             changes of for :meth:`export_delta` (0, the default: all of them;
             an older start then raises InvalidArgumentError naming the oldest
@@ -162,6 +168,8 @@ class Map(Queryable):
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
                  registration_use_gray: bool = bool(_D.registration_use_gray),
+                 tracking_odometry: bool = bool(_D.tracking_odometry),
+                 tracking_max_disagreement: float = _D.tracking_max_disagreement,
                  delta_history: int = _D.map_delta_history,
                  **fit_params):
         self._ptr = None
@@ -170,7 +178,7 @@ class Map(Queryable):
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                            fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
-                           delta_history) as o:
+                           tracking_odometry, tracking_max_disagreement, delta_history) as o:
             out = c_void_p()
             if self._load_from is None:
                 check(lib.sogmm_map_create(byref(out), o.ptr))
@@ -180,7 +188,7 @@ class Map(Queryable):
 
     def _options(self, novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                  fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
-                 delta_history) -> _ffi.Options:
+                 tracking_odometry, tracking_max_disagreement, delta_history) -> _ffi.Options:
         if fusion not in _FUSION:
             raise InvalidArgumentError(f"fusion must be None, 'off', 'hellinger' or 'kl', got {fusion!r}")
         for name, v in (("batch_size", batch_size), ("delta_history", delta_history)):
@@ -195,11 +203,13 @@ class Map(Queryable):
         f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
                _ffi.OPT_MAP_NOVELTY_BANDWIDTH_SCALE: novelty_bandwidth_scale,
                _ffi.OPT_MAP_REVISIT_REFIT_RATIO: revisit_refit_ratio,
+               _ffi.OPT_TRACKING_MAX_DISAGREEMENT: tracking_max_disagreement,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
                _ffi.OPT_MAP_FUSION: int(_FUSION[fusion] is not None), _ffi.OPT_DECIMATION: int(decimate),
                _ffi.OPT_MAP_WARM_START: int(bool(warm_start)),
                _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(registration_use_gray)),
+               _ffi.OPT_TRACKING_ODOMETRY: int(bool(tracking_odometry)),
                _ffi.OPT_MAP_DELTA_HISTORY: int(delta_history)}
         if _FUSION[fusion] is not None:
             i64[_ffi.OPT_MAP_FUSION_METHOD] = _FUSION[fusion]
@@ -271,7 +281,10 @@ class Map(Queryable):
         to the map finds (``sogmm_map_track_frame``): from ``guess`` (4 x 4),
         or with None the constant-velocity prediction from the map's last two
         frames. The map's first frame is inserted at the guess (None: the
-        identity). The frame is inserted only when the registration converged.
+        identity). The frame is inserted only when the registration converged
+        or, with ``registration_use_gray`` and ``tracking_odometry``, when its
+        registration to the last tracked frame vouches for it (see the
+        constructor); ``info`` is the map registration's either way.
 
         Returns ``(pose, info)``: the pose used (or the registration's last
         iterate when not inserted) and :func:`sogmm.register`'s figures plus

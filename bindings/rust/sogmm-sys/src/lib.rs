@@ -122,6 +122,8 @@ pub const SOGMM_OPT_REGISTRATION_COARSE_SIGMA: sogmm_key = 805;
 pub const SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO: sogmm_key = 806;
 pub const SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO: sogmm_key = 807;
 pub const SOGMM_OPT_REGISTRATION_MIN_POINTS: sogmm_key = 808;
+pub const SOGMM_OPT_TRACKING_ODOMETRY: sogmm_key = 810;
+pub const SOGMM_OPT_TRACKING_MAX_DISAGREEMENT: sogmm_key = 811;
 // END GENERATED option keys
 // ---- named values of option keys -------------------------------------------
 /// f64 value of SOGMM_OPT_REG_COVAR (its default): floors from the data's scales (see sogmm.h).

@@ -164,10 +164,12 @@ impl Map {
     /// or (None) the constant-velocity prediction from the map's last two
     /// frames; the map's first frame goes in at the guess (None: identity).
     /// Registration options are the map's creation options
-    /// (`SOGMM_OPT_REGISTRATION_*`). Returns the registration (its pose is the
-    /// one used, or the last iterate) and whether the frame was inserted: only
-    /// when the status is `Converged`. The first frame reports `Converged`
-    /// with 0 iterations.
+    /// (`SOGMM_OPT_REGISTRATION_*`, `SOGMM_OPT_TRACKING_*`). Returns the map
+    /// registration (its pose is the one used, or its last iterate) and
+    /// whether the frame was inserted: when the status is `Converged` or, with
+    /// gray and `SOGMM_OPT_TRACKING_ODOMETRY`, when the registration to the
+    /// last tracked frame vouches for it (sogmm.h states the rule). The first
+    /// frame reports `Converged` with 0 iterations.
     pub fn track_frame(&mut self, frame: &Frame<'_>, guess: Option<&Pose>) -> Result<(Registration, bool)> {
         let h = frame.handle()?;
         let map = self.ptr.as_ptr();

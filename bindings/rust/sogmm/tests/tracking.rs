@@ -88,3 +88,41 @@ fn tracks_a_known_motion_and_refuses_a_plane() {
     assert_eq!(e.status(), Status::InvalidArg);
     assert_eq!(map.stats().unwrap().n_frames, 2);
 }
+
+/// TRACKING_ODOMETRY / TRACKING_MAX_DISAGREEMENT (keys 810, 811) reach the map
+/// through the registry: a bad bound is refused; with gray, odometry off or on,
+/// the second corner frame (the map accepts it) goes in at its closed-form pose.
+#[test]
+fn tracking_options_reach_the_map() {
+    let mut bad = Options::builder().build().unwrap();
+    let e = bad
+        .set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.0)
+        .unwrap_err();
+    assert_eq!(e.status(), Status::InvalidArg);
+    for odometry in [0i64, 1] {
+        let mut o = Options::builder()
+            .decimation(2)
+            .bandwidth(0.05)
+            .threads(1)
+            .build()
+            .unwrap();
+        o.set_i64(sogmm::sys::SOGMM_OPT_REGISTRATION_USE_GRAY, 1).unwrap();
+        o.set_i64(sogmm::sys::SOGMM_OPT_TRACKING_ODOMETRY, odometry).unwrap();
+        o.set_f64(sogmm::sys::SOGMM_OPT_TRACKING_MAX_DISAGREEMENT, 0.01)
+            .unwrap();
+        let mut map = Map::new(Some(&o)).unwrap();
+        let (d0, g0) = corner(&IDENTITY, false);
+        map.track_frame(&frame(&d0, &g0), None).unwrap();
+        let (d1, g1) = corner(&truth(), false);
+        let (r, inserted) = map.track_frame(&frame(&d1, &g1), None).unwrap();
+        assert!(inserted, "odometry {odometry}: {:?}", r.status);
+        for (a, b) in r.pose.iter().zip(truth().iter()) {
+            assert!(
+                (a - b).abs() < 1e-3,
+                "odometry {odometry}: {:?} vs {:?}",
+                r.pose,
+                truth()
+            );
+        }
+    }
+}
