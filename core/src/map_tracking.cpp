@@ -71,13 +71,18 @@ TrackedFrame track_backprojected(Map& map, TrackingState& state, const PointsVie
   t.registration.pose = guess;
   t.registration.status = RegistrationStatus::Converged;
   t.pose = guess;
+  // Odometry runs only with gray: on the loop's wall views geometry-only
+  // odometry converged 2.3 cm off with a non-degenerate status, which the
+  // disagreement bound cannot tell from a good pose.
+  const bool odometry = tracking.odometry && options.use_gray;
   auto insert_at = [&](const Pose& pose, PoseSource source) {
     t.stats = map.insert_backprojected(points, camera, pose, progress);
     t.inserted = true;
     t.source = source;
     t.pose = pose;
-    // The odometry's next target; a frame whose cells are empty leaves none.
-    state.cells = detail::odometry_target(points);
+    // The odometry's next target (none when odometry cannot run, or when the
+    // frame's cells are empty).
+    state.cells = odometry ? detail::odometry_target(points) : Gmm{};
     state.pose = pose;
     state.n_frames = map.frames().size();
     return t;
@@ -89,22 +94,19 @@ TrackedFrame track_backprojected(Map& map, TrackingState& state, const PointsVie
         register_points(detail::tracking_target(map), points.data, points.size, guess, options, threads, progress);
     t.registered = true;
     t.pose = t.registration.pose;
-    if (t.odometry_ran) t.disagreement = detail::rms_displacement(points, t.registration.pose, t.odometry.pose);
   };
   // Odometry runs once, when the map first does not accept the frame (the
-  // last frame does not change with a flush), and only with gray: on the
-  // loop's wall views geometry-only odometry converged 2.3 cm off with a
-  // non-degenerate status, which the disagreement bound cannot tell from a
-  // good pose.
+  // last frame does not change with a flush); its disagreement is with the
+  // newest map registration.
   auto decide = [&] {
-    if (t.registration.status != RegistrationStatus::Converged && tracking.odometry && options.use_gray &&
-        !t.odometry_ran && holds_last_frame(state, map)) {
+    if (t.registration.status != RegistrationStatus::Converged && odometry && !t.odometry_ran &&
+        holds_last_frame(state, map)) {
       const Pose start = compose_poses(inverse_rigid(state.pose), guess);  // in the last frame's camera frame
       t.odometry = register_points(state.cells, points.data, points.size, start, options, threads, progress);
       t.odometry.pose = compose_poses(state.pose, t.odometry.pose);
       t.odometry_ran = true;
-      t.disagreement = detail::rms_displacement(points, t.registration.pose, t.odometry.pose);
     }
+    if (t.odometry_ran) t.disagreement = detail::rms_displacement(points, t.registration.pose, t.odometry.pose);
     return decide_pose(t.registration, t.odometry_ran ? &t.odometry : nullptr, t.disagreement, options, tracking);
   };
   if (map.size() == 0) {
