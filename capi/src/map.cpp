@@ -34,7 +34,7 @@ SOGMM_API sogmm_status sogmm_map_create(sogmm_map** out, const sogmm_options* op
   SOGMM_TRY {
     sogmm_capi::require_out(out);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = new sogmm_map{sogmm::Map(map_options(o)), o};
+    *out = new sogmm_map{sogmm::Map(map_options(o)), o, {}};
   }
   SOGMM_CATCH
 }
@@ -249,7 +249,7 @@ SOGMM_API sogmm_status sogmm_map_load(sogmm_map** out, const char* path, const s
     if (status != SOGMM_OK) return status;
     const std::unique_ptr<sogmm_model> owned(loaded);
     const sogmm_options& o = sogmm_capi::opts_or_default(options);
-    *out = new sogmm_map{sogmm::Map::from_model(owned->model, map_options(o)), o};
+    *out = new sogmm_map{sogmm::Map::from_model(owned->model, map_options(o)), o, {}};
   }
   SOGMM_CATCH
 }

@@ -99,7 +99,9 @@ TEST(CovarianceStorage, NearSingularComponentsArePositiveDefiniteAtBoundedCost) 
     EXPECT_TRUE(std::isfinite(r.reported)) << c.name;
     // The report is the divergence of what was stored (to the 1e-4 that
     // double keeps of it at a condition number of 1e12).
-    if (c.check_report) EXPECT_NEAR(r.reported, kl(c.s, r.c), 1e-4 * std::max(1.0, r.reported)) << c.name;
+    if (c.check_report) {
+      EXPECT_NEAR(r.reported, kl(c.s, r.c), 1e-4 * std::max(1.0, r.reported)) << c.name;
+    }
   }
 }
 
