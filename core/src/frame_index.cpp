@@ -8,22 +8,41 @@ namespace sogmm::detail {
 
 namespace {
 
+// Cells are a quarter of the depth range on a side, and a frame is listed
+// only in the cells its widened frustum meets (may_see()), not in every cell
+// of its box: about a third of them, so a block lists fewer frames.
+constexpr double kCellsPerDepthRange = 4.0;
 // A frame whose box spans more cells than this is tested for every point
 // (kept in one list), so the grid stays linear in the number of frames.
-constexpr std::int64_t kMaxCellsPerFrame = 64;
+constexpr std::int64_t kMaxCellsPerFrame = 1024;
 // Cell coordinates are packed in 21 bits each.
 constexpr std::int64_t kCellBias = std::int64_t{1} << 20;
 
 }  // namespace
 
 FrameIndex::FrameIndex(const std::vector<Pose>& poses, const Camera& camera, double depth_min, double depth_max)
-    : camera_(camera), depth_min_(depth_min), depth_max_(depth_max), cell_(depth_max) {
+    : camera_(camera), depth_min_(depth_min), depth_max_(depth_max), cell_(depth_max / kCellsPerDepthRange) {
   std::vector<std::array<double, 6>> boxes;
   for (const Pose& p : poses) {
     FrameView v{};
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) v.r[3 * i + j] = p[4 * j + i];
     for (int i = 0; i < 3; ++i) v.t[i] = -(v.r[3 * i] * p[3] + v.r[3 * i + 1] * p[7] + v.r[3 * i + 2] * p[11]);
+    // In camera coordinates: u >= -1.5, u <= W + 0.5 (u = fx p_x / p_z + cx,
+    // times p_z > 0), the same for v, and depth_min - 1 <= p_z <= depth_max + 1
+    // (project() sees pixels with u in [-0.5, W - 0.5)); then in world ones.
+    const double W = camera.width, H = camera.height;
+    const double camera_planes[6][4] = {{camera.fx, 0, camera.cx + 1.5, 0},
+                                        {-camera.fx, 0, W + 0.5 - camera.cx, 0},
+                                        {0, camera.fy, camera.cy + 1.5, 0},
+                                        {0, -camera.fy, H + 0.5 - camera.cy, 0},
+                                        {0, 0, 1, 1.0 - depth_min},
+                                        {0, 0, -1, depth_max + 1.0}};
+    for (int k = 0; k < 6; ++k) {
+      const double* q = camera_planes[k];
+      for (int j = 0; j < 3; ++j) v.planes[k][j] = q[0] * v.r[j] + q[1] * v.r[3 + j] + q[2] * v.r[6 + j];
+      v.planes[k][3] = q[0] * v.t[0] + q[1] * v.t[1] + q[2] * v.t[2] + q[3];
+    }
     views_.push_back(v);
     // The frustum's box: the camera centre and the image corners at depth_max.
     std::array<double, 6> b{p[3], p[7], p[11], p[3], p[7], p[11]};
@@ -58,7 +77,8 @@ FrameIndex::FrameIndex(const std::vector<Pose>& poses, const Camera& camera, dou
     }
     for (std::int64_t i = lo[0]; i <= hi[0]; ++i)
       for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-        for (std::int64_t k = lo[2]; k <= hi[2]; ++k) cells_[key(i, j, k)].push_back(f);
+        for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+          if (cell_meets(f, i, j, k)) cells_[key(i, j, k)].push_back(f);
   }
   // Every cell also lists the large frames, so a point reads one list.
   if (!large_.empty())
@@ -66,6 +86,18 @@ FrameIndex::FrameIndex(const std::vector<Pose>& poses, const Camera& camera, dou
       list.insert(list.end(), large_.begin(), large_.end());
       std::sort(list.begin(), list.end());
     }
+}
+
+bool FrameIndex::cell_meets(std::uint32_t f, std::int64_t i, std::int64_t j, std::int64_t k) const {
+  // The cell's box, widened by a millionth of a cell: a point on a cell's
+  // border may be rounded into its neighbour by cell().
+  const std::int64_t c[3] = {i, j, k};
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = origin_[a] + (static_cast<double>(c[a]) - 1e-6) * cell_;
+    hi[a] = origin_[a] + (static_cast<double>(c[a]) + 1.0 + 1e-6) * cell_;
+  }
+  return may_see(f, lo, hi);
 }
 
 std::int64_t FrameIndex::cell(double v, int axis) const {
@@ -88,44 +120,39 @@ const std::vector<std::uint32_t>* FrameIndex::candidates(const double x[3]) cons
   return large_.empty() ? nullptr : &large_;
 }
 
-namespace {
-
-// One point's projection up to |p|^2 (both project() overloads, so their
-// numbers agree bitwise); ray is not set.
-inline Projection project_point(const FrameView& v, const Camera& camera, double depth_min, double depth_max,
-                                double x0, double x1, double x2, double& norm2) {
-  double p[3];
-  for (int i = 0; i < 3; ++i) p[i] = v.r[3 * i] * x0 + v.r[3 * i + 1] * x1 + v.r[3 * i + 2] * x2 + v.t[i];
-  Projection out;
-  if (!(p[2] > depth_min && p[2] <= depth_max)) return out;
-  const double u = std::floor(camera.fx * p[0] / p[2] + camera.cx + 0.5);
-  const double w = std::floor(camera.fy * p[1] / p[2] + camera.cy + 0.5);
-  if (u < 0 || w < 0 || u >= camera.width || w >= camera.height) return out;
-  out.pixel = static_cast<int>(w) * camera.width + static_cast<int>(u);
-  out.depth = p[2];
-  norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-  return out;
-}
-
-}  // namespace
-
+// occupancy_kernel.cpp repeats this arithmetic (same operations, same order).
 Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
-  double norm2 = 0.0;
-  Projection out = project_point(views_[f], camera_, depth_min_, depth_max_, x[0], x[1], x[2], norm2);
-  if (out.pixel >= 0) out.ray = ray_of(norm2, out.depth);
+  const FrameView& v = views_[f];
+  double p[3];
+  for (int i = 0; i < 3; ++i) p[i] = v.r[3 * i] * x[0] + v.r[3 * i + 1] * x[1] + v.r[3 * i + 2] * x[2] + v.t[i];
+  Projection out;
+  if (!(p[2] > depth_min_ && p[2] <= depth_max_)) return out;
+  const double u = std::floor(camera_.fx * p[0] / p[2] + camera_.cx + 0.5);
+  const double w = std::floor(camera_.fy * p[1] / p[2] + camera_.cy + 0.5);
+  if (u < 0 || w < 0 || u >= camera_.width || w >= camera_.height) return out;
+  out.pixel = static_cast<int>(w) * camera_.width + static_cast<int>(u);
+  out.depth = p[2];
+  out.ray = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / p[2];
   return out;
 }
 
-void FrameIndex::project(std::uint32_t f, const double* x, const double* y, const double* z, std::size_t count,
-                         int* pixel, double* depth, double* norm2) const {
-  const FrameView v = views_[f];
-  const Camera camera = camera_;
-  for (std::size_t j = 0; j < count; ++j) {
-    norm2[j] = 0.0;
-    const Projection p = project_point(v, camera, depth_min_, depth_max_, x[j], y[j], z[j], norm2[j]);
-    pixel[j] = p.pixel;
-    depth[j] = p.depth;
+bool FrameIndex::may_see(std::uint32_t f, const double lo[3], const double hi[3]) const {
+  double c[3], h[3];
+  for (int i = 0; i < 3; ++i) {
+    c[i] = 0.5 * (lo[i] + hi[i]);
+    h[i] = 0.5 * (hi[i] - lo[i]);
   }
+  // The planes are widened by a pixel (p_z / f metres across the ray) or a
+  // metre in depth, and a box is cleared only when it is more than a
+  // relative 1e-9 outside (rounding here and in project() is near 1e-15 of
+  // the same terms), so no frame that sees a point of the box is cleared.
+  for (const auto& n : views_[f].planes) {
+    const double centre = n[0] * c[0] + n[1] * c[1] + n[2] * c[2] + n[3];
+    const double reach = std::abs(n[0]) * h[0] + std::abs(n[1]) * h[1] + std::abs(n[2]) * h[2];
+    const double scale = std::abs(n[0] * c[0]) + std::abs(n[1] * c[1]) + std::abs(n[2] * c[2]) + std::abs(n[3]) + reach;
+    if (centre + reach < -1e-9 * scale) return false;
+  }
+  return true;
 }
 
 BoxView FrameIndex::view(std::uint32_t f, const double lo[3], const double hi[3]) const {

@@ -1,6 +1,7 @@
 // Which of a map's frames may see a point (private; occupancy.cpp): the
-// frames' view frusta, and a uniform grid over their world boxes so that a
-// point tests only the frames whose box holds it, not every frame.
+// frames' view frusta, and a uniform grid whose cells list the frames whose
+// (widened) frustum meets them, so that a point tests only those frames, not
+// every frame.
 #pragma once
 
 #include <array>
@@ -18,6 +19,10 @@ namespace sogmm::detail {
 struct FrameView {
   std::array<double, 9> r;  ///< R^T of the pose, row-major
   std::array<double, 3> t;  ///< -R^T t
+  /// The frustum, widened by one pixel and past the depth range, as world
+  /// half-spaces n . x + c >= 0 (n = [0..2], c = [3]): every point the
+  /// frame sees is inside all six (may_see()).
+  std::array<std::array<double, 4>, 6> planes;
 };
 
 /// Where a world point falls in a frame's image.
@@ -44,24 +49,29 @@ class FrameIndex {
   FrameIndex(const std::vector<Pose>& poses, const Camera& camera, double depth_min, double depth_max);
 
   std::size_t size() const { return views_.size(); }
-  /// The frames whose frustum box holds `x` (a superset of those that see it).
+  /// The frames whose widened frustum meets the grid cell of `x` (a superset
+  /// of those that see it), in increasing order.
   const std::vector<std::uint32_t>* candidates(const double x[3]) const;
   /// The projection of world point `x` into frame f.
   Projection project(std::uint32_t f, const double x[3]) const;
-  /// project() of `count` world points (coordinate arrays x, y, z) into frame
-  /// f, as arrays: pixel (-1: not seen), depth and |p|^2, from which
-  /// ray_of(norm2, depth) is bitwise project()'s ray (a caller that needs no
-  /// ray for most points skips its root and division). One frame's view stays
-  /// in registers across the points.
-  void project(std::uint32_t f, const double* x, const double* y, const double* z, std::size_t count, int* pixel,
-               double* depth, double* norm2) const;
-  /// The ray factor |p| / p_z of a point with |p|^2 = norm2 and p_z = depth.
-  static double ray_of(double norm2, double depth) { return std::sqrt(norm2) / depth; }
+  /// Frame f's world-to-camera transform, the camera and the depth range
+  /// (for occupancy_kernel.hpp, which repeats project()'s arithmetic).
+  const FrameView& frame(std::uint32_t f) const { return views_[f]; }
+  const Camera& camera() const { return camera_; }
+  double depth_min() const { return depth_min_; }
+  double depth_max() const { return depth_max_; }
+  /// False when no point of the box [lo, hi] (world) can be seen by frame f:
+  /// the box lies wholly outside one of the frame's widened frustum planes.
+  /// A few products per plane, no division: it clears most listed frames
+  /// before view(), which is several times dearer.
+  bool may_see(std::uint32_t f, const double lo[3], const double hi[3]) const;
   /// The view of frame f of the box [lo, hi] (world).
   BoxView view(std::uint32_t f, const double lo[3], const double hi[3]) const;
 
  private:
   std::int64_t cell(double v, int axis) const;
+  /// Frame f may see a point of cell (i, j, k).
+  bool cell_meets(std::uint32_t f, std::int64_t i, std::int64_t j, std::int64_t k) const;
   static std::uint64_t key(std::int64_t i, std::int64_t j, std::int64_t k);
 
   Camera camera_;

@@ -13,6 +13,8 @@
 #include "depth_tiles.hpp"
 #include "frame_index.hpp"
 #include "occupancy_evidence.hpp"
+#include "occupancy_kernel.hpp"
+#include "occupancy_phi.hpp"
 #include "parallel.hpp"
 #include "progress.hpp"
 #include "sogmm/error.hpp"
@@ -26,14 +28,12 @@ namespace {
 using detail::Evidence;
 
 // Points per block: the frames' whole evidence is decided once per block.
-constexpr std::size_t kBlock = 64;
+constexpr std::size_t kBlock = detail::kOccupancyBlock;
 
-// One thread's block: its points as coordinate arrays, their projections
-// into one frame, their evidence, and the frames its points ask.
+// One thread's block: its points and their evidence as arrays, and the
+// frames its points ask.
 struct Scratch {
-  double x[kBlock], y[kBlock], z[kBlock], depth[kBlock], norm2[kBlock];
-  int pixel[kBlock];
-  Evidence ev[kBlock];
+  detail::OccupancyLanes lanes;
   std::vector<std::uint32_t> asked;
 };
 
@@ -69,7 +69,7 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   const detail::FrameIndex index(poses, camera, info.depth_min, info.depth_max);
 
   // Blocks of points near each other (Z-order), with their boxes and the
-  // frames whose frustum box holds one of their points (sorted).
+  // frames listed in the grid cells of their points (sorted).
   const std::vector<std::size_t> order = detail::z_ordered(xyz, n, 3, team);
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::array<double, 6>> box(blocks);
@@ -97,7 +97,9 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
     }
     // Only frames that see a query point are rendered.
     for (std::uint32_t f : frames[blk]) {
-      if (seen[f].load(std::memory_order_relaxed) || !index.view(f, b.data(), b.data() + 3).visible) continue;
+      if (seen[f].load(std::memory_order_relaxed) || !index.may_see(f, b.data(), b.data() + 3) ||
+          !index.view(f, b.data(), b.data() + 3).visible)
+        continue;
       for (std::size_t j = first; j < last; ++j) {
         double x[3];
         world_point(xyz, order[j], x);
@@ -131,14 +133,20 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   // and within the bound of occupancy_evidence.hpp of the model's formula.
   const double band = (options.thickness + detail::kExactSigmas * options.surface_sigma) * (1.0 + 1e-9) + 1e-9;
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
+  const detail::OccupancyFrameFn kernel = detail::occupancy_frame_kernel();
+  const Camera& cam = index.camera();
+  const detail::OccupancyFrame each{nullptr, nullptr, cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height,
+                                    index.depth_min(), index.depth_max(), nullptr, band, options.thickness,
+                                    options.surface_sigma, detail::phi_table().coefficients()};
   detail::progress_begin(Stage::Scoring, n);
   detail::parallel_for(blocks, team, 4, [&](std::size_t blk, int thread) {
     const auto& b = box[blk];
     auto& asked = scratch[static_cast<std::size_t>(thread)].asked;
+    detail::OccupancyFrame frame = each;
     asked.clear();
     std::uint64_t whole_free = 0;
     for (std::uint32_t f : frames[blk]) {
-      if (!depth[f]) continue;  // sees no query point
+      if (!depth[f] || !index.may_see(f, b.data(), b.data() + 3)) continue;  // sees no query point
       const detail::BoxView v = index.view(f, b.data(), b.data() + 3);
       if (!v.visible) continue;
       if (v.bounded) {
@@ -152,41 +160,37 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
       }
       asked.push_back(f);
     }
-    // Frame by frame over the block's points (the per-point sums still run
-    // in frame order, so the bits are those of asking point by point).
+    // Frame by frame over the block's points, at the vector width
+    // (occupancy_kernel.hpp: the per-point sums still run in frame order,
+    // with the scalar Evidence's arithmetic, so the bits are those of asking
+    // point by point).
     const std::size_t first = blk * kBlock, count = std::min(n, first + kBlock) - first;
-    Scratch& w = scratch[static_cast<std::size_t>(thread)];
+    detail::OccupancyLanes& w = scratch[static_cast<std::size_t>(thread)].lanes;
+    const double whole = static_cast<double>(whole_free);
     for (std::size_t j = 0; j < count; ++j) {
       const std::size_t i = order[first + j];
       w.x[j] = xyz[3 * i];
       w.y[j] = xyz[3 * i + 1];
       w.z[j] = xyz[3 * i + 2];
-      w.ev[j] = Evidence{};
-      w.ev[j].add_whole_free(whole_free);
+      w.unknown[j] = whole_free > 0 ? 0.0 : 1.0;
+      w.occupied[j] = 0.0;
+      w.free[j] = 0.0;
+      w.whole_free[j] = whole;
     }
     for (std::uint32_t f : asked) {
-      index.project(f, w.x, w.y, w.z, count, w.pixel, w.depth, w.norm2);
-      const float* image = depth[f]->data();
-      for (std::size_t j = 0; j < count; ++j) {
-        if (w.pixel[j] < 0) continue;
-        const float d = image[w.pixel[j]];
-        if (std::isnan(d)) continue;  // no surface rendered: no evidence
-        // Most points are more than the band from the surface in depth, and
-        // so along the ray (ray >= 1): add() would cut them (the band's
-        // margin is far above the rounding), so no root and no Phi.
-        const double gap = w.depth[j] - static_cast<double>(d);
-        if (gap < -band) {
-          w.ev[j].add_whole_free(1);
-          continue;
-        }
-        if (gap > band) continue;
-        const double ray = detail::FrameIndex::ray_of(w.norm2[j], w.depth[j]);
-        w.ev[j].add(w.depth[j] * ray, d * ray, options);
-      }
+      const detail::FrameView& view = index.frame(f);
+      frame.r = view.r.data();
+      frame.t = view.t.data();
+      frame.depth = depth[f]->data();
+      kernel(frame, w, static_cast<int>(count));
     }
     for (std::size_t j = 0; j < count; ++j) {
-      const std::size_t i = order[first + j];
-      w.ev[j].finish(probability[i], state ? state + i : nullptr);
+      detail::Evidence ev;
+      ev.unknown = w.unknown[j];
+      ev.occupied = w.occupied[j];
+      ev.free = w.free[j];
+      ev.whole_free = static_cast<std::uint64_t>(w.whole_free[j]);
+      ev.finish(probability[order[first + j]], state ? state + order[first + j] : nullptr);
     }
   });
 }

@@ -14,7 +14,6 @@
 // |phi_table(x) - erfc(-x / sqrt 2) / 2| <= kPhiTableError for every x in [-9, 9].
 #pragma once
 
-#include <array>
 #include <vector>
 
 namespace sogmm::detail {
@@ -30,17 +29,22 @@ class PhiTable {
 
   PhiTable();
   /// Phi(x) for x in [kLo, kHi] (the caller cuts outside).
-  double operator()(double x) const {
+  double operator()(double x) const { return at(coefficients_.data(), x); }
+  /// The four coefficients of each interval, in order (for the vector kernel).
+  const double* coefficients() const { return coefficients_.data(); }
+  /// Phi(x) from the coefficients `c` (the one evaluation of the table, so the
+  /// scalar path and occupancy_kernel.cpp agree bitwise).
+  static double at(const double* c, double x) {
     const double s = (x - kLo) * kPerUnit;
     int i = static_cast<int>(s);
     i = i < 0 ? 0 : (i >= kIntervals ? kIntervals - 1 : i);
     const double t = s - i;
-    const auto& c = coefficients_[static_cast<std::size_t>(i)];
-    return c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+    const int q = 4 * i;  // indexed reads, which vectorize as gathers
+    return c[q] + t * (c[q + 1] + t * (c[q + 2] + t * c[q + 3]));
   }
 
  private:
-  std::vector<std::array<double, 4>> coefficients_;
+  std::vector<double> coefficients_;
 };
 
 /// The table (built on first use; thread-safe).

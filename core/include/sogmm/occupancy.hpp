@@ -23,12 +23,13 @@
 // and the state is the largest of free (1 - U)(1 - q), occupied (1 - U) q and
 // unknown U (ties go to unknown, then occupied).
 //
-// Cost: a frame index (a uniform grid over the frames' frustum boxes) gives
-// each point the frames whose frustum box holds it, and only frames that see
+// Cost: a frame index (a uniform grid whose cells list the frames whose
+// widened frustum meets them) gives each point the frames that may see it,
+// and only frames that see
 // at least one query point are rendered, once until the components change
 // (Map::frame_depth keeps the renders between calls). So the first call
 // after an insert costs O(frames seen x pixels x components near a ray) for
-// the renders, and every call O(n x frames whose box holds a point) for the
+// the renders, and every call O(n x frames listed in a point's cell) for the
 // lookups at worst; per block of 64 points the frames whose surface is more
 // than h + 9 sigma from every point of the block are decided once (spec/api.md
 // 4.9 has the bound this cut puts on the answer), so a point asks only the

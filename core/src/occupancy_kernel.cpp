@@ -1,0 +1,125 @@
+// The occupancy frame kernel, compiled once per instruction set (see
+// occupancy_kernel.hpp for why every width gives the scalar path's bits).
+// Two vector passes: every point is projected and compared with the render
+// (most are more than the band in front of the surface, or behind it, and
+// are done there); the few within the band are gathered into a short list
+// whose Phi terms are evaluated in a second pass, then added point by point.
+#include <cmath>
+
+#include "occupancy_evidence.hpp"
+#include "occupancy_kernel.hpp"
+#include "occupancy_phi.hpp"
+
+#ifndef SOGMM_ISA
+#error "compile with -DSOGMM_ISA=<name>"
+#endif
+
+namespace sogmm::detail::SOGMM_ISA {
+namespace {
+
+constexpr int B = kOccupancyBlock;
+
+// Evidence::phi as selects (x is held inside the table's range first, so
+// its index is defined; inside, the table sees x itself).
+inline double phi(const double* c, double x) {
+  const double inside = x < PhiTable::kLo ? PhiTable::kLo : (x > PhiTable::kHi ? PhiTable::kHi : x);
+  const double table = PhiTable::at(c, inside);
+  return x < -kExactSigmas ? 0.0 : (x > kExactSigmas ? 1.0 : table);
+}
+
+}  // namespace
+
+void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) {
+  const double r0 = f.r[0], r1 = f.r[1], r2 = f.r[2], r3 = f.r[3], r4 = f.r[4], r5 = f.r[5], r6 = f.r[6],
+               r7 = f.r[7], r8 = f.r[8], t0 = f.t[0], t1 = f.t[1], t2 = f.t[2];
+  const double fx = f.fx, fy = f.fy, cx = f.cx, cy = f.cy, zmin = f.depth_min, zmax = f.depth_max, band = f.band;
+  const double W = f.width, H = f.height;
+  const int columns = f.width;
+  const float* __restrict image = f.depth;
+  const double* __restrict x = lanes.x;
+  const double* __restrict y = lanes.y;
+  const double* __restrict z = lanes.z;
+  double* __restrict unknown = lanes.unknown;
+  double* __restrict whole_free = lanes.whole_free;
+  alignas(64) double depth[B], norm2[B], surface[B];
+  alignas(64) int pixel[B], seen[B], in_band[B];
+
+  // Pass 1, in three loops that each vectorize (a masked gather of floats
+  // indexed by ints between loops over doubles does not): FrameIndex::project
+  // (u = floor(a) is in [0, W) exactly when a is, and then equals its
+  // truncation), the render's depth there, and the cuts of occupancy.cpp's
+  // per-point loop.
+#pragma omp simd
+  for (int j = 0; j < count; ++j) {
+    const double p0 = r0 * x[j] + r1 * y[j] + r2 * z[j] + t0;
+    const double p1 = r3 * x[j] + r4 * y[j] + r5 * z[j] + t1;
+    const double p2 = r6 * x[j] + r7 * y[j] + r8 * z[j] + t2;
+    const double a = fx * p0 / p2 + cx + 0.5;
+    const double b = fy * p1 / p2 + cy + 0.5;
+    const bool in = p2 > zmin && p2 <= zmax && a >= 0 && b >= 0 && a < W && b < H;
+    seen[j] = in;
+    pixel[j] = static_cast<int>(in ? b : 0.0) * columns + static_cast<int>(in ? a : 0.0);
+    depth[j] = p2;
+    norm2[j] = p0 * p0 + p1 * p1 + p2 * p2;
+  }
+#pragma omp simd
+  for (int j = 0; j < count; ++j) surface[j] = image[pixel[j]];
+  int any_in_band = 0;
+#pragma omp simd reduction(| : any_in_band)
+  for (int j = 0; j < count; ++j) {
+    const double d = surface[j];
+    const bool surface_seen = seen[j] && d == d;  // NaN: no surface rendered, no evidence
+    const double gap = depth[j] - d;
+    const bool free_whole = surface_seen && gap < -band;
+    whole_free[j] = free_whole ? whole_free[j] + 1.0 : whole_free[j];
+    unknown[j] = free_whole ? 0.0 : unknown[j];
+    in_band[j] = surface_seen && !(gap < -band) && !(gap > band);
+    any_in_band |= in_band[j];
+  }
+  if (!any_in_band) return;  // the usual case: nothing for pass 2
+
+  // The points within the band, packed (contiguous loops vectorize where
+  // gathers by a list would not).
+  int list[B], k = 0;
+  alignas(64) double band_depth[B], band_norm2[B], band_surface[B];
+  for (int j = 0; j < count; ++j) {
+    list[k] = j;
+    band_depth[k] = depth[j];
+    band_norm2[k] = norm2[j];
+    band_surface[k] = surface[j];
+    k += in_band[j];
+  }
+
+  // Pass 2: Evidence::add for the points within the band.
+  const double h = f.thickness, sigma = f.sigma;
+  const double* __restrict c = f.phi;
+  alignas(64) double e_of[B], b_of[B], o_of[B];
+  alignas(64) int kind[B];  // 0: no evidence, 1: whole free, 2: e, b, o
+#pragma omp simd
+  for (int m = 0; m < k; ++m) {
+    const double ray = std::sqrt(band_norm2[m]) / band_depth[m];
+    const double r = band_depth[m] * ray, s = band_surface[m] * ray;
+    const double front = (r - s + h) / sigma;
+    const double back = (r - s - h) / sigma;
+    const double e = 1.0 - phi(c, front);
+    const double b = phi(c, back);
+    const double o = 1.0 - e - b;
+    kind[m] = front < -kExactSigmas ? 1 : (back > kExactSigmas ? 0 : 2);
+    e_of[m] = e;
+    b_of[m] = b;
+    o_of[m] = 0.0 < o ? o : 0.0;  // std::max(0.0, o)
+  }
+  for (int m = 0; m < k; ++m) {
+    const int j = list[m];
+    if (kind[m] == 1) {
+      whole_free[j] += 1.0;
+      unknown[j] = 0.0;
+    } else if (kind[m] == 2) {
+      unknown[j] *= b_of[m];
+      lanes.free[j] += e_of[m];
+      lanes.occupied[j] += o_of[m];
+    }
+  }
+}
+
+}  // namespace sogmm::detail::SOGMM_ISA
