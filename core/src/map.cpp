@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "component_precision.hpp"
 #include "map_state.hpp"
 #include "parallel.hpp"
 #include "sogmm/checked.hpp"
@@ -57,7 +58,9 @@ bool same_camera(const Camera& a, const Camera& b) {
 // (record_fit, as every front end writes it).
 Model batch_model(const Map::State& s, const FitResult& r, const Pose& pose, double bandwidth, bool from_rgbd) {
   Model batch;
-  batch.gmm = transform(r.gmm, pose);
+  // Rounded here, before anything records it: the map, its journal and so
+  // every delta hold the same rounded bits (MapOptions::component_precision).
+  batch.gmm = detail::round_to_precision(transform(r.gmm, pose), s.options.component_precision);
   FitOptions fo = s.options.fit;
   fo.bandwidth = bandwidth;
   record_fit(batch, r, fo);
@@ -113,6 +116,7 @@ void validate(const MapOptions& o) {
   require_option(OptionKey::MAP_NOVELTY_BANDWIDTH_SCALE, o.novelty_bandwidth_scale, "map: novelty_bandwidth_scale");
   require_option(OptionKey::MAP_FUSION_THRESHOLD, o.fusion_threshold, "map: fusion_threshold");
   require_option(OptionKey::MAP_REVISIT_REFIT_RATIO, o.revisit_refit_ratio, "map: revisit_refit_ratio");
+  require_option(OptionKey::MAP_COMPONENT_PRECISION, o.component_precision, "map: component_precision");
   require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
           "map: index_sigmas " + checked::exact(o.index_sigmas) + " is not in (0, 100]");
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,

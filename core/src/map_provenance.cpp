@@ -43,7 +43,8 @@ std::string options_text(const MapOptions& o) {
          " revisit_refit_ratio=" + checked::exact(o.revisit_refit_ratio) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
          " fusion_method=" + (o.fusion_method == FusionMethod::Hellinger ? "hellinger" : "kl") +
          " fusion_threshold=" + checked::exact(o.fusion_threshold) + " index_sigmas=" + checked::exact(o.index_sigmas) +
-         " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0);
+         " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0) +
+         " component_precision=" + checked::exact(o.component_precision);
 }
 
 // One count: decimal digits only. operator>> into an unsigned type reads a

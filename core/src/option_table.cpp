@@ -169,6 +169,12 @@ std::vector<OptionSpec> make_table() {
                     "how many of its latest revisions a map keeps the changes of, for deltas (sogmm_map_export_delta "
                     "since an older one is refused naming the oldest kept); 0: every revision since it was created or "
                     "loaded (memory grows with every fit)"),
+      SOGMM_F64_ROW(MAP_COMPONENT_PRECISION, map.component_precision, 0.0, 0.5, finite, "[0, 0.5] (0: off)",
+                    "standard deviations",
+                    "each fitted component is rounded before the map stores it so that its mean moves by at most this "
+                    "many of its standard deviations and its covariance's eigenvalues, in its own frame, by at most this "
+                    "fraction: zero low mantissa bits that deltas and map files compress away (bounds and why: "
+                    "MapOptions::component_precision); 0: full float32"),
       // ---- occupancy and distance to the surface ----
       SOGMM_F64_ROW(OCCUPANCY_SIGMA, occupancy.surface_sigma, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "m",

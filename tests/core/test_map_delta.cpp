@@ -73,8 +73,9 @@ struct KindCounts {
   }
 };
 
-MapOptions points_options(bool novelty, bool fusion) {
+MapOptions points_options(bool novelty, bool fusion, double precision = 0.0) {
   MapOptions o;
+  o.component_precision = precision;
   o.novelty = novelty;
   o.fusion = fusion;
   o.batch_size = 1500;  // some inserts only add pending points, some flush
@@ -85,10 +86,12 @@ MapOptions points_options(bool novelty, bool fusion) {
 TEST(MapDeltaTest, ReceiverIsBitwiseEqualAfterEveryDelta) {
   struct Case {
     bool novelty, fusion;
+    double precision;  // MapOptions::component_precision: rounded components travel as rounded
   };
-  for (const Case c : {Case{true, false}, Case{false, true}, Case{true, true}}) {
-    SCOPED_TRACE(std::string("novelty ") + (c.novelty ? "on" : "off") + ", fusion " + (c.fusion ? "on" : "off"));
-    Map sender(points_options(c.novelty, c.fusion));
+  for (const Case c : {Case{true, false, 0}, Case{false, true, 0}, Case{true, true, 0}, Case{false, true, 0.25}}) {
+    SCOPED_TRACE(std::string("novelty ") + (c.novelty ? "on" : "off") + ", fusion " + (c.fusion ? "on" : "off") +
+                 ", precision " + std::to_string(c.precision));
+    Map sender(points_options(c.novelty, c.fusion, c.precision));
     Map receiver;  // default options: a receiver's own options do not matter
     KindCounts kinds;
     // Each of three scenes seen twice, 3 mm apart: with novelty off fusion

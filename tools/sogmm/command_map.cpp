@@ -264,6 +264,10 @@ Command add_map_command(CLI::App& root) {
                   "refit what a frame sees when its explained points have this many times as many modes as the "
                   "map has components there, 0 or >= 1 (0: off)")
       ->capture_default_str();
+  app->add_option("--component-precision", s->options.component_precision,
+                  "round each fitted component so that it moves by at most this many of its standard deviations "
+                  "(zero low bits that deltas compress away), in [0, 0.5] (0: full float32)")
+      ->capture_default_str();
   app->add_flag("--no-novelty", s->no_novelty, "every point is new: fit each frame whole (append everything)");
   app->add_option("--fusion", s->fusion, "fuse close components: off, hellinger or kl")
       ->capture_default_str()

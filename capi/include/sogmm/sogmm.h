@@ -306,6 +306,12 @@ typedef int32_t sogmm_key;
  * revision since it was created or loaded (memory grows with every fit).
  * i64 (revisions), [0, 2^62]; default 0. */
 #define SOGMM_OPT_MAP_DELTA_HISTORY 609
+/* Each fitted component is rounded before the map stores it so that its mean moves by at most
+ * this many of its standard deviations and its covariance's eigenvalues, in its own frame, by at
+ * most this fraction: zero low mantissa bits that deltas and map files compress away (bounds and
+ * why: MapOptions::component_precision); 0: full float32.
+ * f64 (standard deviations), [0, 0.5] (0: off); default 0. */
+#define SOGMM_OPT_MAP_COMPONENT_PRECISION 630
 
 /* Occupancy and distance to the surface. Read by sogmm_map_occupancy_f32,
  * sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32. */
