@@ -75,6 +75,10 @@ int main(void) {
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_DECIMATION, 2));
   REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.05));
   REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_THREADS, 1));
+  /* The geometry alone, so no odometry: the one-plane frame below is then
+   * judged by the map only (with gray, the default, the odometry vouches
+   * for it; that rule is tested in tests/core/test_map_tracking.cpp). */
+  REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_REGISTRATION_USE_GRAY, 0));
   REQUIRE_OK(sogmm_map_create(&map, o));
   f0 = corner_frame(identity, 0);
   f1 = corner_frame(truth, 0);

@@ -113,10 +113,16 @@ double translation_error(const Pose& a, const Pose& b) {
   return std::sqrt(std::pow(a[3] - b[3], 2) + std::pow(a[7] - b[7], 2) + std::pow(a[11] - b[11], 2));
 }
 
-// Odometry runs only with gray.
+// Odometry runs only with gray (the default; said here, as the tests are of it).
 sogmm::RegistrationOptions gray() {
   sogmm::RegistrationOptions o;
   o.use_gray = true;
+  return o;
+}
+
+sogmm::RegistrationOptions geometry_only() {
+  sogmm::RegistrationOptions o;
+  o.use_gray = false;
   return o;
 }
 
@@ -170,7 +176,8 @@ TEST(MapTracking, AFrameTheMapCannotJudgeIsPosedByOdometry) {
   EXPECT_FALSE(u.inserted || u.odometry_ran);
   EXPECT_EQ(off.map.frames().size(), 1u);
   // Nor does odometry run without gray (the same map: the skip changed nothing).
-  const sogmm::TrackedFrame w = sogmm::track_backprojected(off.map, off.state, view_of(next), kCamera, kIdentity, {}, {}, 1);
+  const sogmm::TrackedFrame w =
+      sogmm::track_backprojected(off.map, off.state, view_of(next), kCamera, kIdentity, geometry_only(), {}, 1);
   EXPECT_FALSE(w.inserted || w.odometry_ran);
   EXPECT_EQ(off.map.frames().size(), 1u);
 }

@@ -116,7 +116,8 @@ def main() -> None:
     ap.add_argument("--max-cm", type=float, default=10.0)
     ap.add_argument("--repeats", type=int, default=5, help="timed calls per pair")
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--use-gray", action="store_true")
+    ap.add_argument("--no-gray", action="store_true",
+                    help="register with the geometry alone (use_gray=False; the library's default scores gray too)")
     ap.add_argument("--no-open3d", action="store_true")
     args = ap.parse_args()
     if not args.data.is_dir():
@@ -136,8 +137,11 @@ def main() -> None:
     for a, _ in PAIRS:
         if a not in models:
             models[a] = sogmm.SOGMM(bandwidth=0.02, seed=0).fit(points[a])
-    kw = dict(n_threads=args.threads, use_gray=args.use_gray)
-    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {args.use_gray}")
+    kw = dict(n_threads=args.threads)
+    if args.no_gray:
+        kw["use_gray"] = False
+    use_gray = kw.get("use_gray", bool(sogmm._ffi.DEFAULTS.registration_use_gray))
+    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {use_gray}")
     for a, b in PAIRS:
         times = []
         for _ in range(args.repeats):

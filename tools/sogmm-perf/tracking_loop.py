@@ -13,7 +13,7 @@ the worst frame, the first frame off by more than 1 cm and the wall time.
 
 Usage (from the repository root; the synthetic loop is written if missing):
     python3 tools/sogmm-perf/tracking_loop.py [--sogmm build/tools/sogmm/sogmm] [--loop-dir /tmp/sogmm_track]
-        [--frames 0:300] [-- MAP FLAGS...]   (e.g. -- --registration-gray)
+        [--frames 0:300] [-- MAP FLAGS...]   (e.g. -- --no-registration-gray)
 Prints a one-line summary and one JSON line.
 """
 import argparse

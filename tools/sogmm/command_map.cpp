@@ -238,9 +238,10 @@ Command add_map_command(CLI::App& root) {
   app->add_flag("--refine-poses", s->refine_poses,
                 "with --trajectory: register each frame to the map from its given pose (e.g. odometry) and insert\n"
                 "it at the pose found; a frame that does not register is skipped with a warning");
-  app->add_flag("--registration-gray", s->registration.use_gray,
-                "without --trajectory or with --refine-poses: register with gray too (the 4-D density; SOGMM_OPT_REGISTRATION_USE_GRAY),\n"
-                "which holds the pose where the geometry alone lets a frame slide (a wall, a floor)");
+  app->add_flag("--registration-gray,!--no-registration-gray", s->registration.use_gray,
+                "without --trajectory or with --refine-poses: register with gray too (the 4-D density; the default,\n"
+                "SOGMM_OPT_REGISTRATION_USE_GRAY), which holds the pose where the geometry alone lets a frame slide\n"
+                "(a wall, a floor); --no-registration-gray: the geometry alone (and no odometry)");
   app->add_flag("--no-odometry", s->no_odometry,
                 "tracking: insert only frames whose map registration converged (SOGMM_OPT_TRACKING_ODOMETRY 0); by\n"
                 "default a frame the map does not accept is registered to the last inserted frame too and inserted\n"

@@ -339,7 +339,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_REGISTRATION_OUTLIER_RATIO 802
 /* Registration: 1 scores gray too (the 4-D joint density: gray marginal times the conditional x
  * | gray), 0 the 3-D marginal.
- * i64, 0 or 1; default 0. */
+ * i64, 0 or 1; default 1. */
 #define SOGMM_OPT_REGISTRATION_USE_GRAY 803
 /* Registration: coarse-to-fine levels; level l smooths the target by COARSE_SIGMA / 2^l, the
  * last not at all.
@@ -1240,8 +1240,8 @@ typedef struct sogmm_registration_info {
 /* The rigid pose that best explains n source points (`points`: rows of x,
  * y, z, gray float32, in their own frame) under the model `target`:
  * pose_out (row-major 4 x 4) maps source points into the target's frame.
- * It maximises the points' log-likelihood under the target's 3-D marginal
- * (or, with REGISTRATION_USE_GRAY, its 4-D density) mixed with a uniform
+ * It maximises the points' log-likelihood under the target's 4-D density
+ * (REGISTRATION_USE_GRAY 1, the default; 0: its 3-D marginal) mixed with a uniform
  * outlier term, by EM / Gauss-Newton steps coarse to fine (formula and why:
  * core/include/sogmm/registration.hpp), from `init` (a rigid 4 x 4 pose;
  * NULL = identity). Always check info_out->status: pose_out is the last
@@ -1271,7 +1271,7 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
  * component, or when the frame would not be inserted (then it registers
  * again). The frame is inserted when the registration's status is
  * SOGMM_REGISTRATION_CONVERGED, or, with SOGMM_OPT_REGISTRATION_USE_GRAY and
- * SOGMM_OPT_TRACKING_ODOMETRY (default 1), when its registration to the
+ * SOGMM_OPT_TRACKING_ODOMETRY (both default 1), when its registration to the
  * last frame this call inserted into the map (odometry) converged and
  * either agrees with the map's pose (SOGMM_OPT_TRACKING_MAX_DISAGREEMENT:
  * then at the map's pose when its status is DEGENERATE, else at the

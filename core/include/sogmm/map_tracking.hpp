@@ -28,6 +28,15 @@
 // only when the odometry converged and either agrees with the map's pose
 // (within TrackingOptions::max_disagreement) or the map has too few inliers
 // to judge; the rule is decide_pose() below.
+//
+// A converged map registration is not checked against the odometry. On the
+// loop (frames 0-299, gray) the remaining error comes in a few jumps of
+// converged map poses (11.9 and 13.1 mm at frames 128 and 136; median step
+// error 0.09 mm), but inserting at the odometry's pose whenever the two
+// differed by more than 5 mm lost the track (from frame 67 every frame
+// disagreed and followed the odometry, 5.8 cm off by frame 80, and 219 were
+// skipped after), and a blend of the two
+// weighted by their information raised the ATE from 2.53 to 3.32 cm.
 #pragma once
 
 #include <cstdint>

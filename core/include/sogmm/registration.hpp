@@ -51,7 +51,13 @@ struct RegistrationOptions {
   /// eps: prior weight of the uniform outlier term, in [0, 1).
   double outlier_ratio = 0.1;
   /// true: score gray too (the 4-D joint density); false: the 3-D marginal.
-  bool use_gray = false;
+  /// On by default: on the shared living-room pairs gray recovered 95 of 100
+  /// starts up to 25 cm / 25 degrees off against 89 without (100 of 100 both
+  /// up to 10 cm / 10 degrees, no false success either way) in 16-17 instead
+  /// of 22-23 iterations, and tracking the synthetic loop needs it (a view
+  /// along a textured wall slides under geometry alone: 212 of 300 frames
+  /// inserted without gray, 300 with; README, Registration).
+  bool use_gray = true;
   /// Coarse-to-fine levels, >= 1; the last one uses the model unsmoothed.
   std::int32_t levels = 3;
   /// Smoothing standard deviation of the coarsest level (metres), > 0.

@@ -131,8 +131,9 @@ class Map(Queryable):
         depth_scale, depth_min, depth_trunc, decimate: back-projection of
             :meth:`insert_rgbd` frames (as :func:`sogmm.rgbd_to_points`).
         registration_use_gray: :meth:`track_rgbd` registers with gray too (the
-            4-D density, as :func:`sogmm.register`'s ``use_gray``), which holds
-            the pose where geometry alone lets a frame slide (a wall, a floor).
+            4-D density, as :func:`sogmm.register`'s ``use_gray``; the
+            default), which holds the pose where geometry alone lets a frame
+            slide (a wall, a floor); False: the geometry alone, no odometry.
         tracking_odometry: with ``registration_use_gray``, a frame the map
             does not accept is registered to the last frame :meth:`track_rgbd`
             inserted too, and inserted when the two poses agree (within
