@@ -264,6 +264,10 @@ Command add_map_command(CLI::App& root) {
                   "refit what a frame sees when its explained points have this many times as many modes as the "
                   "map has components there, 0 or >= 1 (0: off)")
       ->capture_default_str();
+  app->add_option("--free-space-carve", s->options.free_space_carve,
+                  "reshape a map component when this share of its samples lies where a frame sees past it, in "
+                  "[0, 0.5) (0: off)")
+      ->capture_default_str();
   app->add_flag("--no-novelty", s->no_novelty, "every point is new: fit each frame whole (append everything)");
   app->add_option("--fusion", s->fusion, "fuse close components: off, hellinger or kl")
       ->capture_default_str()
