@@ -108,7 +108,7 @@ TEST(MapCarve, OffOrNothingSeenPastLeavesTheComponentBitwise) {
 }
 
 TEST(MapCarve, OutOfRangeShareIsRefused) {
-  for (double bad : {-0.1, 0.5, 1.0, std::nan("")}) {
+  for (double bad : {-0.1, 0.51, 1.0, std::nan("")}) {
     MapOptions o = carve_options(bad);
     EXPECT_THROW(Map m(o), sogmm::Error) << bad;
   }

@@ -311,7 +311,7 @@ typedef int32_t sogmm_key;
  * covariance become the moments of its other samples, its weight stays; new components are
  * carved by every RGB-D frame inserted since the map was created or loaded, whose depth the map
  * keeps (why: MapOptions::free_space_carve); 0: off; not with MAP_WARM_START 1.
- * f64 (share of samples), in [0, 0.5); default 0.01. */
+ * f64 (share of samples), in [0, 0.5]; default 0.01. */
 #define SOGMM_OPT_MAP_FREE_SPACE_CARVE 620
 
 /* Occupancy and distance to the surface. Read by sogmm_map_occupancy_f32,
