@@ -47,6 +47,7 @@ const (
 	OptMapNoveltyBandwidthScale    Key = C.SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE
 	OptMapRevisitRefitRatio        Key = C.SOGMM_OPT_MAP_REVISIT_REFIT_RATIO
 	OptMapDeltaHistory             Key = C.SOGMM_OPT_MAP_DELTA_HISTORY
+	OptMapFreeSpaceCarve           Key = C.SOGMM_OPT_MAP_FREE_SPACE_CARVE
 	OptMapComponentPrecision       Key = C.SOGMM_OPT_MAP_COMPONENT_PRECISION
 	OptOccupancySigma              Key = C.SOGMM_OPT_OCCUPANCY_SIGMA
 	OptOccupancyThickness          Key = C.SOGMM_OPT_OCCUPANCY_THICKNESS

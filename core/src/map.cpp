@@ -95,6 +95,7 @@ Model world_of(const Map::State& s, const Model& model) {
 // components dropped, the refit's merged in, index and marginals rebuilt.
 Searchable after_refit(const Map::State& s, const detail::RevisitRefit& plan, const Pose& pose, bool from_rgbd) {
   Model batch = batch_model(s, plan.fit, pose, plan.bandwidth, from_rgbd);
+  detail::carve_by_seen_frames(s, batch.gmm);
   Model kept = s.model;
   kept.gmm = detail::without_components(s.model.gmm, plan.replaced);
   Gmm batch_gmm = batch.gmm;
@@ -117,6 +118,7 @@ void validate(const MapOptions& o) {
   require_option(OptionKey::MAP_FUSION_THRESHOLD, o.fusion_threshold, "map: fusion_threshold");
   require_option(OptionKey::MAP_REVISIT_REFIT_RATIO, o.revisit_refit_ratio, "map: revisit_refit_ratio");
   require_option(OptionKey::MAP_COMPONENT_PRECISION, o.component_precision, "map: component_precision");
+  require_option(OptionKey::MAP_FREE_SPACE_CARVE, o.free_space_carve, "map: free_space_carve");
   require(std::isfinite(o.index_sigmas) && o.index_sigmas > 0 && o.index_sigmas <= 100, ErrorCode::InvalidArgument,
           "map: index_sigmas " + checked::exact(o.index_sigmas) + " is not in (0, 100]");
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
@@ -271,9 +273,17 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
           "map: more than " + std::to_string(kMaxPoints) + " points pending");
   // Nothing is committed that a flush could not fit (issue 36).
   detail::require_flushable(s, novel, from_rgbd);
-  // Revisit refit (MapOptions::revisit_refit_ratio): fitted first, committed
-  // with the previous searchable map kept aside until the insert succeeds.
-  std::optional<Searchable> before_refit;
+  // Revisit refit (MapOptions::revisit_refit_ratio) and free-space carve
+  // (MapOptions::free_space_carve): computed first, committed with the
+  // previous searchable map kept aside until the insert succeeds.
+  std::optional<Searchable> before_change;
+  std::optional<detail::SeenFrame> seen;  // this frame's depth, for the carve
+  bool refit_ran = false;
+  auto keep_before = [&] {
+    if (!before_change)
+      before_change =
+          Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals), {}, std::move(s.world)};
+  };
   if (from_rgbd) {
     const auto t1 = std::chrono::steady_clock::now();
     std::optional<detail::RevisitRefit> plan = detail::plan_revisit_refit(s, points, pose, ll, dominant, f.index, progress);
@@ -285,12 +295,12 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       Searchable next = after_refit(s, *plan, pose, from_rgbd);
       s.journal.remove(plan->replaced);
       s.journal.merge(next.batch);
-      before_refit =
-          Searchable{std::move(s.model), std::move(s.index), std::move(s.marginals), {}, std::move(s.world)};
+      keep_before();
       s.model = std::move(next.model);
       s.index = std::move(next.index);
       s.marginals = std::move(next.marginals);
       s.world = std::move(next.world);
+      refit_ran = true;
       ++s.n_flushes;
       ++s.n_refits;
       ++s.revision;
@@ -298,22 +308,57 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
       f.flushed = true;  // ran a fit
       f.ms_merge += ms_since(t2);
     }
+    const auto t3 = std::chrono::steady_clock::now();
+    if (detail::carving(s.options) && s.camera)
+      seen.emplace(detail::SeenFrame{inverse_rigid(pose),
+                                     detail::DepthView(decimated(*s.camera, s.options.depth.decimate), s.options.depth,
+                                                       points)});
+    Gmm carved;
+    const std::vector<std::size_t> changed =
+        seen ? detail::plan_free_space_carve(s, *seen, carved) : std::vector<std::size_t>{};
+    if (!changed.empty()) {
+      // Index and marginals updated on copies (as fusion does in flush):
+      // only the carved components moved.
+      std::vector<detail::Marginal3> marginals = s.marginals;
+      ComponentIndex index = s.index;
+      for (std::size_t k : changed) {
+        marginals[k] = detail::marginal3(carved, k);
+        index.update(carved, k);
+      }
+      Model model = s.model;  // the refit's, when one ran: its components are carved too
+      model.gmm = std::move(carved);
+      s.journal.set(model.gmm, changed);
+      keep_before();
+      s.world = world_of(s, model);
+      s.model = std::move(model);
+      s.index = std::move(index);
+      s.marginals = std::move(marginals);
+      ++s.revision;
+    }
+    f.ms_novelty += ms_since(t3);  // a test of the frame's view, like the novelty test
   }
-  // Undoes the refit when a later step of this insert fails.
+  // Undoes the refit and the carve when a later step of this insert fails.
   auto undo_refit = [&] {
-    if (!before_refit) return;
-    s.model = std::move(before_refit->model);
-    s.index = std::move(before_refit->index);
-    s.marginals = std::move(before_refit->marginals);
-    s.world = std::move(before_refit->world);
-    --s.n_flushes;
-    --s.n_refits;
+    if (!before_change) return;
+    s.model = std::move(before_change->model);
+    s.index = std::move(before_change->index);
+    s.marginals = std::move(before_change->marginals);
+    s.world = std::move(before_change->world);
+    if (refit_ran) {
+      --s.n_flushes;
+      --s.n_refits;
+    }
     ++s.revision;  // the components changed back: never reuse what the refit's were
   };
   // From here on any failure (a failed or cancelled flush, which itself
   // commits nothing; an allocation) undoes the whole insert.
-  bool pushed_pending = false, pushed_frame = false;
+  bool pushed_pending = false, pushed_frame = false, pushed_seen = false;
   try {
+    // Before the flush: its new components are carved by this frame too.
+    if (seen) {
+      s.seen_frames.push_back(std::move(*seen));
+      pushed_seen = true;
+    }
     if (f.n_novel > 0) {
       s.pending.push_back(std::move(novel));
       pushed_pending = true;
@@ -326,6 +371,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
     // flush() records its fit and merge times on this frame's stats.
     if (s.n_pending > 0 && (!s.options.novelty || s.n_pending >= s.options.batch_size)) map.flush(progress);
   } catch (...) {
+    if (pushed_seen) s.seen_frames.pop_back();
     if (pushed_frame) s.frames.pop_back();
     if (pushed_pending) {
       s.pending.pop_back();
@@ -423,6 +469,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   const auto t1 = std::chrono::steady_clock::now();
 
   Model batch = batch_model(s, r, last, batch_options.bandwidth, from_rgbd);
+  detail::carve_by_seen_frames(s, batch.gmm);
   const std::size_t first = s.model.gmm.size();
   s.journal.merge(batch.gmm);
   Model merged = first == 0 ? std::move(batch) : merge(s.model, batch);

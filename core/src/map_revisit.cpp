@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "map_depth_view.hpp"
 #include "map_state.hpp"
 #include "parallel.hpp"
 #include "sogmm/camera.hpp"
@@ -14,66 +15,6 @@
 #include "sogmm/mean_shift.hpp"
 
 namespace sogmm::detail {
-namespace {
-
-// Relative depth tolerance of "on the observed surface": a world point whose
-// camera depth is within this fraction of the depth observed at its pixel
-// lies on what the frame sees (3%: 5 cm at 1.65 m, a few times the depth
-// noise and the thickness of surface components, and the same at any scale).
-constexpr double kSurfaceTolerance = 0.03;
-
-// Where a camera-frame point lies relative to the frame's depth image.
-enum class Seen { Outside, OnSurface, FreeSpace, Hidden };
-
-// The frame's observed depth per pixel of the decimated camera (the nearest
-// of its points: project_to_image's z-buffer), and the classification of
-// other points against it with the same pixel rule.
-class DepthView {
- public:
-  DepthView(const Camera& decimated_camera, const DepthOptions& depth, const PointsView& frame)
-      : cam_(decimated_camera), depth_(depth), observed_(observed_depth(frame, decimated_camera)) {}
-
-  Seen classify(const float* p) const {
-    std::size_t at = 0;
-    const double z = p[2];
-    if (!(z > depth_.depth_min && z <= depth_.depth_max) || !pixel(p, &at)) return Seen::Outside;
-    const double o = observed_[at];
-    if (!std::isfinite(o)) return Seen::Outside;  // no depth there: the frame says nothing
-    const double tol = kSurfaceTolerance * o;
-    if (z < o - tol) return Seen::FreeSpace;
-    if (z > o + tol) return Seen::Hidden;
-    return Seen::OnSurface;
-  }
-
- private:
-  bool pixel(const float* p, std::size_t* at) const {
-    const double z = p[2];
-    if (!(z > 0)) return false;
-    const double u = std::nearbyint(cam_.fx * p[0] / z + cam_.cx), v = std::nearbyint(cam_.fy * p[1] / z + cam_.cy);
-    if (!(u >= 0 && v >= 0 && u < cam_.width && v < cam_.height)) return false;
-    *at = static_cast<std::size_t>(v) * static_cast<std::size_t>(cam_.width) + static_cast<std::size_t>(u);
-    return true;
-  }
-
-  static std::vector<float> observed_depth(const PointsView& frame, const Camera& camera) {
-    std::vector<float> z(frame.size);
-    for (std::size_t i = 0; i < frame.size; ++i) z[i] = frame[i][2];
-    return project_to_image(frame, z.data(), camera, std::numeric_limits<float>::infinity());
-  }
-
-  Camera cam_;
-  DepthOptions depth_;
-  std::vector<float> observed_;
-};
-
-void to_camera(const Pose& world_to_camera, const float* w, float* c) {
-  for (int r = 0; r < 3; ++r)
-    c[r] = static_cast<float>(world_to_camera[4 * r] * w[0] + world_to_camera[4 * r + 1] * w[1] +
-                              world_to_camera[4 * r + 2] * w[2] + world_to_camera[4 * r + 3]);
-  c[3] = w[3];
-}
-
-}  // namespace
 
 std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const PointsView& points, const Pose& pose,
                                                const std::vector<double>& ll,

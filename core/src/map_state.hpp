@@ -9,6 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "map_depth_view.hpp"
 #include "map_journal.hpp"
 #include "map_renders.hpp"
 #include "sogmm/map.hpp"
@@ -189,7 +190,12 @@ struct Map::State {
   /// Bumped whenever the components change (a flush, a revisit refit or its
   /// undo): what is kept about them (renders) is valid for one revision.
   std::uint64_t revision = 0;
-  mutable detail::FrameRenders renders;  // filled by const queries (Map::frame_depth)
+  mutable detail::FrameRenders renders;
+  /// The observed depth of every RGB-D frame inserted since the map was
+  /// created or loaded, with free_space_carve on (not saved): new components
+  /// are carved by all of them (detail::carve_by_seen_frames). 4 bytes per
+  /// pixel of the decimated camera a frame (48 KiB at 128 x 96).
+  std::vector<detail::SeenFrame> seen_frames;  // filled by const queries (Map::frame_depth)
   /// The public revision and the changes deltas are cut from
   /// (sogmm/map_delta.hpp); unlike `revision` it also counts frames.
   detail::Journal journal;
@@ -214,6 +220,22 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
                                                const std::vector<double>& ll,
                                                const std::vector<std::int64_t>& dominant, std::uint64_t frame_index,
                                                const ProgressSink& progress);
+
+/// Whether inserts carve (MapOptions::free_space_carve): novelty on, a share
+/// above 0, no warm start.
+bool carving(const MapOptions& o);
+
+/// The free-space carve of one RGB-D frame (MapOptions::free_space_carve):
+/// the ids (ascending) of the map components it reshapes, and in `carved` the
+/// map's mixture with them reshaped (weights unchanged). Nothing when it does
+/// not apply: novelty off, share 0, a warm start, an empty map.
+std::vector<std::size_t> plan_free_space_carve(const Map::State& s, const SeenFrame& frame, Gmm& carved);
+
+/// The components of `batch` (new ones, in the map's frame) carved by every
+/// RGB-D frame the map has seen (State::seen_frames), in insert order: a
+/// component fitted from later views is held to the free space of earlier
+/// ones. Nothing when the carve does not apply.
+void carve_by_seen_frames(const Map::State& s, Gmm& batch);
 
 /// Error(InvalidArgument) naming both cameras when the map has a camera
 /// (fixed by its first RGB-D frame) and `camera` differs from it; `what`

@@ -165,6 +165,13 @@ std::vector<OptionSpec> make_table() {
                     "are replaced by a fit of those points plus samples of their mass it does not see (details and "
                     "why: MapOptions::revisit_refit_ratio); 0: off; no refit with N_COMPONENTS > 0 or MAP_WARM_START "
                     "1; a refit counts as a fit (flushed, n_flushes)"),
+      SOGMM_F64_ROW(MAP_FREE_SPACE_CARVE, map.free_space_carve, 0.0, 0.5, [](double v) { return v <= 0.5; },
+                    "in [0, 0.5]", "share of samples",
+                    "with MAP_NOVELTY 1, an RGB-D insert reshapes each map component on its surfaces that has at "
+                    "least this share of its samples where the frame sees past them (free space): mean and covariance "
+                    "become the moments of its other samples, its weight stays; new components are carved by every "
+                    "RGB-D frame inserted since the map was created or loaded, whose depth the map keeps (why: "
+                    "MapOptions::free_space_carve); 0: off; not with MAP_WARM_START 1"),
       SOGMM_I64_ROW(MAP_DELTA_HISTORY, map.delta_history, 0, std::int64_t{1} << 62, "[0, 2^62]", "revisions",
                     "how many of its latest revisions a map keeps the changes of, for deltas (sogmm_map_export_delta "
                     "since an older one is refused naming the oldest kept); 0: every revision since it was created or "

@@ -269,6 +269,10 @@ Command add_map_command(CLI::App& root) {
                   "round each fitted component so that it moves by at most this many of its standard deviations "
                   "(zero low bits that deltas compress away), in [0, 0.5] (0: full float32)")
       ->capture_default_str();
+  app->add_option("--free-space-carve", s->options.free_space_carve,
+                  "reshape a map component when this share of its samples lies where a frame sees past it, in "
+                  "[0, 0.5] (0: off)")
+      ->capture_default_str();
   app->add_flag("--no-novelty", s->no_novelty, "every point is new: fit each frame whole (append everything)");
   app->add_option("--fusion", s->fusion, "fuse close components: off, hellinger or kl")
       ->capture_default_str()

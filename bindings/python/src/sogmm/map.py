@@ -122,6 +122,13 @@ class Map(Queryable):
             it does not see (the map keeps the finest view of each surface, not
             the first; not with a fixed ``n_components`` or ``warm_start``;
             details in core/include/sogmm/map.hpp).
+        free_space_carve: in [0, 0.5] (default 0.01; 0: off): with novelty on,
+            a map component with at least this share of its samples where an
+            RGB-D frame sees past them (free space) is reshaped to the moments
+            of its other samples (weight kept), so that its tail past an
+            outline no longer stops that view's rays; new components are
+            carved by every RGB-D frame inserted since the map was created or
+            loaded (core/include/sogmm/map.hpp).
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
@@ -166,6 +173,7 @@ class Map(Queryable):
                  warm_start: bool = bool(_D.map_warm_start),
                  novelty_bandwidth_scale: float = _D.map_novelty_bandwidth_scale,
                  revisit_refit_ratio: float = _D.map_revisit_refit_ratio,
+                 free_space_carve: float = _D.map_free_space_carve,
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
                  registration_use_gray: bool = bool(_D.registration_use_gray),
@@ -177,6 +185,7 @@ class Map(Queryable):
         self._finalizer = None
         self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
+        self._carve = free_space_carve
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                            fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
                            tracking_odometry, tracking_max_disagreement, delta_history) as o:
@@ -204,6 +213,7 @@ class Map(Queryable):
         f64 = {_ffi.OPT_MAP_NOVELTY_THRESHOLD: novelty_threshold, _ffi.OPT_MAP_FUSION_THRESHOLD: fusion_threshold,
                _ffi.OPT_MAP_NOVELTY_BANDWIDTH_SCALE: novelty_bandwidth_scale,
                _ffi.OPT_MAP_REVISIT_REFIT_RATIO: revisit_refit_ratio,
+               _ffi.OPT_MAP_FREE_SPACE_CARVE: self._carve,
                _ffi.OPT_TRACKING_MAX_DISAGREEMENT: tracking_max_disagreement,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),

@@ -110,6 +110,7 @@ pub const SOGMM_OPT_MAP_WARM_START: sogmm_key = 606;
 pub const SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE: sogmm_key = 607;
 pub const SOGMM_OPT_MAP_REVISIT_REFIT_RATIO: sogmm_key = 608;
 pub const SOGMM_OPT_MAP_DELTA_HISTORY: sogmm_key = 609;
+pub const SOGMM_OPT_MAP_FREE_SPACE_CARVE: sogmm_key = 620;
 pub const SOGMM_OPT_MAP_COMPONENT_PRECISION: sogmm_key = 630;
 pub const SOGMM_OPT_OCCUPANCY_SIGMA: sogmm_key = 700;
 pub const SOGMM_OPT_OCCUPANCY_THICKNESS: sogmm_key = 701;
