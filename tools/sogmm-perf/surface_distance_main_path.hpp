@@ -22,7 +22,7 @@
 namespace sogmm_bench {
 
 // main's point order: Z-order of 5 cm cells (coarser beyond 2^20 cells).
-inline std::vector<std::size_t> main_z_order(const float* xyz, std::size_t n, int team) {
+inline std::vector<std::size_t> main_z_order(const float* xyz, std::size_t n) {
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k) lo[k] = hi[k] = xyz[k];
   for (std::size_t i = 0; i < n; ++i)
@@ -38,7 +38,7 @@ inline std::vector<std::size_t> main_z_order(const float* xyz, std::size_t n, in
     for (int k = 0; k < 3; ++k) c[k] = static_cast<std::uint64_t>((xyz[3 * i + k] - lo[k]) / cell);
     keyed[i] = {sogmm::detail::z_order_key(c[0], c[1], c[2]), i};
   }
-  sogmm::detail::parallel_sort(keyed, team);
+  sogmm::detail::sort_by_key(keyed);  // the same order as the std::sort it froze
   std::vector<std::size_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
   return order;
@@ -52,7 +52,7 @@ inline void main_surface_distance(const sogmm::Gmm& gmm, const float* xyz, std::
   constexpr std::size_t kBlock = 64;
   const int team = sogmm::detail::team_size(threads);
   const std::vector<Disc> discs = sogmm::detail::discs_of(gmm, disc_sigmas);
-  const std::vector<std::size_t> order = main_z_order(xyz, n, team);
+  const std::vector<std::size_t> order = main_z_order(xyz, n);
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::vector<std::pair<double, std::uint32_t>>> scratch(static_cast<std::size_t>(team));
   std::vector<std::vector<double>> bounds(static_cast<std::size_t>(team));
