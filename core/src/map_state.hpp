@@ -190,12 +190,12 @@ struct Map::State {
   /// Bumped whenever the components change (a flush, a revisit refit or its
   /// undo): what is kept about them (renders) is valid for one revision.
   std::uint64_t revision = 0;
-  mutable detail::FrameRenders renders;
+  mutable detail::FrameRenders renders;  // filled by const queries (Map::frame_depth)
   /// The observed depth of every RGB-D frame inserted since the map was
   /// created or loaded, with free_space_carve on (not saved): new components
   /// are carved by all of them (detail::carve_by_seen_frames). 4 bytes per
   /// pixel of the decimated camera a frame (48 KiB at 128 x 96).
-  std::vector<detail::SeenFrame> seen_frames;  // filled by const queries (Map::frame_depth)
+  std::vector<detail::SeenFrame> seen_frames;
   /// The public revision and the changes deltas are cut from
   /// (sogmm/map_delta.hpp); unlike `revision` it also counts frames.
   detail::Journal journal;
