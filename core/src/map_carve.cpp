@@ -21,24 +21,6 @@ constexpr double kMinOnSurface = 0.05;
 
 using Samples = std::array<std::array<double, 4>, kSamples>;
 
-// Cholesky factor (lower, row-major) of a symmetric 4 x 4 matrix; false when
-// it is not positive definite.
-bool cholesky4(const double a[16], double l[16]) {
-  for (int i = 0; i < 16; ++i) l[i] = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j <= i; ++j) {
-      double v = a[4 * i + j];
-      for (int k = 0; k < j; ++k) v -= l[4 * i + k] * l[4 * j + k];
-      if (i == j) {
-        if (!(v > 0) || !std::isfinite(v)) return false;
-        l[4 * i + i] = std::sqrt(v);
-      } else {
-        l[4 * i + j] = v / l[4 * j + j];
-      }
-    }
-  return true;
-}
-
 // kSamples standard normal 4-vectors (Box-Muller on mt19937_64, whose output
 // the standard fixes, so every platform draws the same), whitened: their mean
 // is 0 and their covariance I up to rounding. A component none of whose
@@ -64,7 +46,7 @@ const Samples& unit_samples() {
     for (const auto& row : s)
       for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j) cov[4 * i + j] += row[i] * row[j] / kSamples;
-    cholesky4(cov, l);  // 256 draws in 4-D: positive definite
+    stored_cholesky(cov, l);  // 256 draws in 4-D: positive definite
     for (auto& row : s)  // row <- L^-1 row (forward substitution)
       for (int i = 0; i < 4; ++i) {
         double v = row[i];
@@ -89,7 +71,7 @@ bool carve_one(const Gmm& g, std::size_t k, const DepthView& view, const Pose& t
   if (view.classify(c) == Seen::Outside) return false;  // the frame says nothing about its core
   double a[16], l[16];
   for (int i = 0; i < 16; ++i) a[i] = g.covariance(k)[i];
-  if (!cholesky4(a, l)) return false;
+  if (!stored_cholesky(a, l)) return false;
   const Samples& z = unit_samples();
   const std::size_t min_free = static_cast<std::size_t>(std::ceil(share * kSamples));
   const std::size_t min_on = static_cast<std::size_t>(std::ceil(kMinOnSurface * kSamples));
@@ -130,7 +112,7 @@ bool carve_one(const Gmm& g, std::size_t k, const DepthView& view, const Pose& t
     cov_out[i] = static_cast<float>(cov[i]);
     check[i] = cov_out[i];
   }
-  return cholesky4(check, l);
+  return stored_cholesky(check, l);  // the library's own test: the map stores only what validate() accepts
 }
 
 }  // namespace
