@@ -13,7 +13,8 @@ converged status with a pose outside those bounds (what must not happen).
 Times are medians of the calls (2 threads by default; the machine is shared,
 so the load average is printed).
 
-With Open3D importable (a venv with `pip install open3d==0.20.0`), the same
+With Open3D importable (a venv with `pip install open3d==0.19.0`; 0.20.0 also
+needs Debian's libusb-1.0-0), the same
 pairs run Open3D's multi-scale colored ICP (Park et al. 2017, the parameters of
 its tutorial: voxel 4/2/1 cm, 50/30/14 iterations) on the d = 1 clouds and
 its hybrid RGB-D odometry on the full images.
