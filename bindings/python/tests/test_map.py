@@ -341,3 +341,43 @@ def test_a_far_map_keeps_its_origin(tmp_path):
             m.set_origin([1.0, 2.0])
         m.set_origin([5.0e5, 0.5, 0.0])
         assert list(m.origin) == [5.0e5, 0.5, 0.0]
+
+
+def _map_of_one_frame(precision: float):
+    with sogmm.Map(novelty=False, component_precision=precision, **FIT) as m:
+        m.insert_points(frames()[0], POSES[1])
+        return m.export()
+
+
+def test_component_precision_rounds_each_mean_within_its_own_bound():
+    # Independent truth (component_precision.hpp): with novelty off the one
+    # fit is the same at both precisions (the rounding is applied after it),
+    # so each rounded mean is the full one moved by at most `precision`
+    # standard deviations in the component's own metric, and lies on a power
+    # of two grid q = 2^floor(log2(p / sqrt(trace(S^-1)))); q / 2 is checked so
+    # that a last-bit difference in numpy's trace cannot flip the grid. Both
+    # maps come from the same kernel's fit, so the bound holds on every kernel
+    # (SOGMM_ISA=sse2, avx2, default). Mutation tried: the option not passed
+    # to the C options (precision ignored) fails the "differs" assert.
+    p = 0.25
+    full, rounded = _map_of_one_frame(0.0), _map_of_one_frame(p)
+    assert rounded.n_components_ == full.n_components_ > 0
+    assert rounded.means_.tobytes() != full.means_.tobytes()
+    for k in range(full.n_components_):
+        s = full.covariances_[k].astype(np.float64)
+        t = np.trace(np.linalg.inv(s))
+        q = 2.0 ** math.floor(math.log2(p / math.sqrt(t)))
+        m = rounded.means_[k].astype(np.float64)
+        np.testing.assert_array_equal(np.round(m / (q / 2)), m / (q / 2))
+        d = m - full.means_[k].astype(np.float64)
+        assert float(d @ np.linalg.solve(s, d)) <= p * p * (1 + 1e-9)
+        # The covariance moves by at most the fraction p of its eigenvalues.
+        lam = np.linalg.eigvalsh(np.linalg.solve(np.linalg.cholesky(s), np.linalg.solve(
+            np.linalg.cholesky(s), rounded.covariances_[k].astype(np.float64)).T))
+        assert np.all(np.abs(lam - 1) <= p + 1e-6)
+
+
+def test_component_precision_out_of_range_raises():
+    for bad in (-0.1, 0.6, float("nan"), float("inf")):
+        with pytest.raises(sogmm.InvalidArgumentError, match="component_precision"):
+            sogmm.Map(component_precision=bad)

@@ -473,6 +473,8 @@ OPTION_NAMES = {
     OPT_MAP_NOVELTY_THRESHOLD: "novelty_threshold",
     OPT_MAP_NOVELTY_BANDWIDTH_SCALE: "novelty_bandwidth_scale",
     OPT_MAP_REVISIT_REFIT_RATIO: "revisit_refit_ratio",
+    OPT_MAP_FREE_SPACE_CARVE: "free_space_carve",
+    OPT_MAP_COMPONENT_PRECISION: "component_precision",
     OPT_MAP_BATCH_SIZE: "batch_size",
     OPT_MAP_FUSION: "fusion",
     OPT_MAP_FUSION_METHOD: "fusion",

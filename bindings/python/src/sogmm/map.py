@@ -129,6 +129,13 @@ class Map(Queryable):
             outline no longer stops that view's rays; new components are
             carved by every RGB-D frame inserted since the map was created or
             loaded (core/include/sogmm/map.hpp).
+        component_precision: in [0, 0.5] standard deviations (default 0: off,
+            full float32): each fitted component is rounded before the map
+            stores it, its mean by at most this many of its standard
+            deviations and its covariance's eigenvalues by at most this
+            fraction, so that the low mantissa bits are zeros that deltas and
+            map files compress away (bounds: MapOptions::component_precision,
+            core/include/sogmm/map.hpp).
         fusion: None/"off", "hellinger" or "kl": fuse new components into
             close existing ones (distance below ``fusion_threshold``).
         fusion_threshold: Hellinger distance in [0, 1] or symmetric KL in nats.
@@ -174,6 +181,7 @@ class Map(Queryable):
                  novelty_bandwidth_scale: float = _D.map_novelty_bandwidth_scale,
                  revisit_refit_ratio: float = _D.map_revisit_refit_ratio,
                  free_space_carve: float = _D.map_free_space_carve,
+                 component_precision: float = _D.map_component_precision,
                  depth_scale: float = _D.depth_scale, depth_min: float = _D.depth_min,
                  depth_trunc: float = _D.depth_max, decimate: int = _D.decimation,
                  registration_use_gray: bool = bool(_D.registration_use_gray),
@@ -186,6 +194,7 @@ class Map(Queryable):
         self._guard = _UseGuard()
         self._depth = (depth_scale, depth_min, depth_trunc, decimate)
         self._carve = free_space_carve
+        self._precision = component_precision
         with self._options(novelty, novelty_threshold, batch_size, fusion, fusion_threshold, warm_start,
                            fit_params, novelty_bandwidth_scale, revisit_refit_ratio, registration_use_gray,
                            tracking_odometry, tracking_max_disagreement, delta_history) as o:
@@ -214,6 +223,7 @@ class Map(Queryable):
                _ffi.OPT_MAP_NOVELTY_BANDWIDTH_SCALE: novelty_bandwidth_scale,
                _ffi.OPT_MAP_REVISIT_REFIT_RATIO: revisit_refit_ratio,
                _ffi.OPT_MAP_FREE_SPACE_CARVE: self._carve,
+               _ffi.OPT_MAP_COMPONENT_PRECISION: self._precision,
                _ffi.OPT_TRACKING_MAX_DISAGREEMENT: tracking_max_disagreement,
                _ffi.OPT_DEPTH_SCALE: depth_scale, _ffi.OPT_DEPTH_MIN: depth_min, _ffi.OPT_DEPTH_MAX: depth_trunc}
         i64 = {_ffi.OPT_MAP_NOVELTY: int(bool(novelty)), _ffi.OPT_MAP_BATCH_SIZE: int(batch_size),
