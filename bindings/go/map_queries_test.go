@@ -234,7 +234,10 @@ func TestModelQueryContexts(t *testing.T) {
 }
 
 // OptMapNoveltyBandwidthScale is range-checked and reaches the map's fits: a
-// finer scale gives the same batch more components.
+// finer scale gives the same batch more components. The batch is two frames
+// of the same size 3 m apart (h = 1/2 of its point pairs from one frame, so
+// it is fitted at 0.05 x (s + (1 - s) / 4)); one frame alone would be fitted
+// at the bandwidth itself, whatever the scale.
 func TestNoveltyBandwidthScale(t *testing.T) {
 	for _, bad := range []float64{0, 1.5} {
 		if _, err := NewOptions(F64(OptMapNoveltyBandwidthScale, bad)); err == nil {
@@ -244,8 +247,10 @@ func TestNoveltyBandwidthScale(t *testing.T) {
 	count := func(scale float64) uint64 {
 		m := newTestMap(t, Bandwidth(0.05), I64(OptMapBatchSize, 100000), F64(OptMapNoveltyBandwidthScale, scale))
 		defer m.Close()
-		if err := m.InsertPoints(context.Background(), twoBlobs(600), yawPose(0, 0, 0, 0)); err != nil {
-			t.Fatal(err)
+		for _, x := range []float64{0, 3} {
+			if err := m.InsertPoints(context.Background(), twoBlobs(600), yawPose(0, x, 0, 0)); err != nil {
+				t.Fatal(err)
+			}
 		}
 		if err := m.Flush(context.Background()); err != nil {
 			t.Fatal(err)

@@ -458,7 +458,7 @@ std::size_t Map::flush(const ProgressSink& progress) {
   // Novel points: a finer mode count (MapOptions::novelty_bandwidth_scale
   // says why).
   FitOptions batch_options = s.options.fit;
-  if (s.options.novelty) batch_options.bandwidth *= s.options.novelty_bandwidth_scale;
+  batch_options.bandwidth = detail::batch_bandwidth(s.options, s.pending);
   // Warm start: the last fit moved from its camera to this batch's
   // (world <- previous camera, then this camera <- world).
   const bool warm = s.options.warm_start && s.previous_fit.size() > 0;

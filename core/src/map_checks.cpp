@@ -70,7 +70,7 @@ void require_flushable(const Map::State& s, const PendingFrame& novel, bool from
   // The flush fits the batch in the camera frame of its latest frame (this
   // one) at the batch bandwidth: the mode count's range rule on exactly those
   // (float32) points decides whether it can.
-  const double bandwidth = fit.bandwidth * (s.options.novelty ? s.options.novelty_bandwidth_scale : 1.0);
+  const double bandwidth = batch_bandwidth(s.options, s.pending, &novel);
   const PointCloud cloud = batch_cloud(s.pending, &novel);
   try {
     require_mode_count_range(range_gray_features(cloud.view()), bandwidth);

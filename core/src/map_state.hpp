@@ -146,6 +146,17 @@ struct PendingFrame {
 /// from_depth_image when they are one RGB-D frame's.
 PointCloud batch_cloud(const std::vector<PendingFrame>& pending, const PendingFrame* extra = nullptr);
 
+/// The share of the ordered point pairs of a batch (the pending frames, and
+/// `extra` when given) whose two points come from the same frame:
+/// h = sum n_f^2 / N^2 (1 for one frame, 1/F for F frames of equal size).
+double same_view_share(const std::vector<PendingFrame>& pending, const PendingFrame* extra = nullptr);
+
+/// The bandwidth the batch of `pending` (and `extra`) is fitted with:
+/// bandwidth x (s + (1 - s) h^2), s = novelty_bandwidth_scale and h =
+/// same_view_share; the bandwidth itself with novelty off.
+double batch_bandwidth(const MapOptions& options, const std::vector<PendingFrame>& pending,
+                       const PendingFrame* extra = nullptr);
+
 /// Error(InvalidArgument) naming the point and axis unless every world
 /// coordinate (3 per point) of a frame is within float32 range.
 void require_float32_world(const std::vector<double>& world, bool from_rgbd);

@@ -156,8 +156,10 @@ std::vector<OptionSpec> make_table() {
                     "sogmm_fit_points_f32); meant for MAP_NOVELTY 0; needs N_INIT 1"),
       SOGMM_F64_ROW(MAP_NOVELTY_BANDWIDTH_SCALE, map.novelty_bandwidth_scale, 0.0, 1.0,
                     [](double v) { return v > 0; }, "in (0, 1]", "",
-                    "with MAP_NOVELTY 1 the batches of novel points are fitted with BANDWIDTH times this (with MAP_NOVELTY "
-                    "0 each frame with the bandwidth itself; why: MapOptions::novelty_bandwidth_scale)"),
+                    "with MAP_NOVELTY 1 a batch of novel points is fitted with BANDWIDTH times s + (1 - s) h^2, s this "
+                    "scale and h the share of the batch's point pairs from one frame (sum n_f^2 / N^2: 1 for one "
+                    "frame), and a revisit refit with BANDWIDTH times s (with MAP_NOVELTY 0 each frame with the "
+                    "bandwidth itself; why: MapOptions::novelty_bandwidth_scale)"),
       SOGMM_F64_ROW(MAP_REVISIT_REFIT_RATIO, map.revisit_refit_ratio, 0.0, kInf,
                     [](double v) { return v == 0 || (std::isfinite(v) && v >= 1); }, "0 (off) or >= 1, finite", "",
                     "with MAP_NOVELTY 1, an RGB-D insert refits the map components on its surfaces when its explained "

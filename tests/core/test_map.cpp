@@ -301,10 +301,13 @@ TEST(MapTest, NoveltyScoreIsLocalToEachPoint) {
   EXPECT_EQ(one[0], both[1]);
 }
 
-// With novelty on, the batches are fitted with the bandwidth times
-// novelty_bandwidth_scale; with novelty off, each frame with the bandwidth.
-// With identity poses a batch of two frames is their points one after the
-// other, so the map must hold exactly fit() of that cloud at that bandwidth.
+// With novelty on, a batch is fitted with the bandwidth times
+// s + (1 - s) h^2, s = novelty_bandwidth_scale and h the share of the batch's
+// point pairs that come from one frame (sum n_f^2 / N^2); with novelty off,
+// each frame with the bandwidth. With identity poses a batch of frames is
+// their points one after the other, so the map must hold exactly fit() of
+// that cloud at that bandwidth. Hand-computed h: one frame 1; two frames of
+// 3000 points 1/2.
 TEST(MapTest, NovelPointsAreFittedWithTheScaledBandwidth) {
   const std::vector<float> a = make_frame(3000, 8), b = make_frame(3000, 9, 2.0);
   std::vector<float> both(a);
@@ -314,7 +317,7 @@ TEST(MapTest, NovelPointsAreFittedWithTheScaledBandwidth) {
     MapOptions o = options(true, false);
     o.novelty_bandwidth_scale = scale;
     sogmm::FitOptions f = o.fit;
-    f.bandwidth = o.fit.bandwidth * scale;
+    f.bandwidth = o.fit.bandwidth * (scale + (1 - scale) * 0.25);  // h = 1/2
     Map pooled(o);
     pooled.insert_points(view(a), kIdentity);
     pooled.insert_points(view(b), kIdentity);
@@ -323,18 +326,29 @@ TEST(MapTest, NovelPointsAreFittedWithTheScaledBandwidth) {
     ASSERT_EQ(pooled.size(), want.gmm.size());
     EXPECT_EQ(pooled.model().gmm.means, want.gmm.means);
     EXPECT_EQ(pooled.model().gmm.covariances, want.gmm.covariances);
+    // One all-novel frame (h = 1), e.g. a map's first insert: the bandwidth
+    // itself, as that frame's own fit.
     Map single(o);
     single.insert_points(view(a), kIdentity);
     single.flush();
-    EXPECT_EQ(single.model().gmm.means, sogmm::fit(view(a), f).gmm.means);
+    EXPECT_EQ(single.model().gmm.means, sogmm::fit(view(a), o.fit).gmm.means);
     // Novelty off (append everything): the bandwidth itself.
     o.novelty = false;
     Map append(o);
     append.insert_points(view(a), kIdentity);
     EXPECT_EQ(append.model().gmm.means, sogmm::fit(view(a), o.fit).gmm.means);
   }
-  // The scales give different mode counts here, so the test tells them apart.
+  // The bandwidths give different mode counts here, so the test tells them
+  // apart: the scale itself (0.7) and s + (1 - s) h^2 at h = 1/2 (0.775).
+  // Other h (0.82, 0.1) are hand-checked in test_map_batch_bandwidth.cpp.
   sogmm::FitOptions f = options(true, false).fit;
+  std::vector<std::size_t> k;
+  for (double x : {0.7, 0.775}) {
+    sogmm::FitOptions g = f;
+    g.bandwidth = f.bandwidth * x;
+    k.push_back(sogmm::fit(view(both), g).gmm.size());
+  }
+  EXPECT_NE(k[0], k[1]);
   const std::size_t k1 = sogmm::fit(view(both), f).gmm.size();
   f.bandwidth *= 0.5;
   EXPECT_LT(k1, sogmm::fit(view(both), f).gmm.size());

@@ -76,24 +76,35 @@ TEST(MapValidity, APoseBeyondFloat32IsRefusedAtTheInsert) {
   EXPECT_NO_THROW(map.insert_points(view(a), translated(3.0e38)));
 }
 
-// One finite point 2e6 m away. A fit of the same points at 0.02 succeeds,
-// the map's did not: with novelty on a batch is fitted at bandwidth x
-// novelty_bandwidth_scale (0.014), and 2e6 m is 1.4e8 bandwidths there, over
-// the mode count's 1e8. The insert now applies the fit's own rule at the
-// batch bandwidth: it fails exactly when a fit at that bandwidth fails.
+// One finite point 2e6 m away. A fit of the same points at 0.02 succeeds; at
+// 0.0155 it fails (1.29e8 bandwidths, over the mode count's 1e8). The insert
+// applies the fit's own rule at the batch bandwidth: it fails exactly when a
+// fit at that bandwidth fails. Alone, the frame is a batch of one view,
+// fitted at the bandwidth itself (0.02: accepted); after another frame of
+// 300 points the batch (h = (300^2 + 301^2) / 601^2) is fitted at
+// 0.02 x (0.7 + 0.3 h^2) = 0.0155 (refused).
 TEST(MapValidity, AFarPointIsJudgedAsTheFitAtTheBatchBandwidthJudgesIt) {
   std::vector<float> pts = wall(300, 4);
   pts.insert(pts.end(), {2.0e6f, 0.0f, 0.0f, 0.5f});
+  std::vector<float> other = wall(300, 5);  // 1 m aside: no point near a pending one
+  for (std::size_t i = 0; i < other.size(); i += 4) other[i] += 1.0f;
+  std::vector<float> pooled(other);
+  pooled.insert(pooled.end(), pts.begin(), pts.end());
   MapOptions o = explicit_flushes();
+  const double h = (300.0 * 300.0 + 301.0 * 301.0) / (601.0 * 601.0);
   sogmm::FitOptions batch = o.fit;
-  batch.bandwidth = o.fit.bandwidth * o.novelty_bandwidth_scale;
-  expect_error([&] { sogmm::fit(view(pts), batch); }, ErrorCode::Limit, {"larger bandwidth"}, "fit at 0.014");
+  batch.bandwidth = o.fit.bandwidth * (0.7 + 0.3 * h * h);
+  expect_error([&] { sogmm::fit(view(pooled), batch); }, ErrorCode::Limit, {"larger bandwidth"}, "fit at 0.0155");
   EXPECT_NO_THROW(sogmm::fit(view(pts), o.fit));  // at 0.02
+  Map alone(o);
+  EXPECT_NO_THROW(alone.insert_points(view(pts), kIdentity));
+  EXPECT_EQ(alone.pending(), 301u);
   Map novel(o);
+  novel.insert_points(view(other), kIdentity);
   expect_error([&] { novel.insert_points(view(pts), kIdentity); }, ErrorCode::Limit,
-               {"batch bandwidth 0.01399", "range"}, "map at 0.014");
-  EXPECT_EQ(novel.pending(), 0u);
-  EXPECT_EQ(novel.frames().size(), 0u);
+               {"batch bandwidth 0.0155", "range"}, "map at 0.0155");
+  EXPECT_EQ(novel.pending(), 300u);
+  EXPECT_EQ(novel.frames().size(), 1u);
   o.novelty = false;  // every frame fitted at the bandwidth itself, as sogmm::fit
   Map append(o);
   append.insert_points(view(pts), kIdentity);

@@ -97,26 +97,37 @@ TEST(CapiMapValidity, FarPosesFailAtTheInsertNotAtALaterFlush) {
   EXPECT_EQ(m.stats().n_pending, 0);
 }
 
-// One point 2e6 m away: the map fits novel points at bandwidth x 0.7 = 0.014,
-// where 2e6 m is 1.4e8 bandwidths (the mode count takes 1e8); so does
-// sogmm_fit_points_f32 at 0.014, while at 0.02 both accept it.
+// One point 2e6 m away. A batch of one frame is fitted at the bandwidth
+// itself (0.02), where sogmm_fit_points_f32 accepts it too; after a frame of
+// 300 other points the batch (two frames, h = (300^2 + 301^2) / 601^2 of its
+// point pairs from one frame) is fitted at 0.02 x (0.7 + 0.3 h^2) = 0.0155,
+// where 2e6 m is 1.29e8 bandwidths (the mode count takes 1e8): refused, as
+// sogmm_fit_points_f32 refuses those points at 0.0155.
 TEST(CapiMapValidity, AFarPointIsJudgedAsAFitAtTheBatchBandwidth) {
   std::vector<float> pts = wall(300, 3);
   pts.insert(pts.end(), {2.0e6f, 0.0f, 0.0f, 0.5f});
-  const std::size_t n = pts.size() / 4;
+  std::vector<float> other = wall(300, 4);  // 1 m aside: no point near a pending one
+  for (std::size_t i = 0; i < other.size(); i += 4) other[i] += 1.0f;
+  std::vector<float> pooled(other);
+  pooled.insert(pooled.end(), pts.begin(), pts.end());
+  const double h = (300.0 * 300.0 + 301.0 * 301.0) / (601.0 * 601.0);
   sogmm_options* o = nullptr;
   ASSERT_EQ(sogmm_options_create(&o), SOGMM_OK);
-  ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02 * 0.7), SOGMM_OK);
+  ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02 * (0.7 + 0.3 * h * h)), SOGMM_OK);
   sogmm_model* fitted = nullptr;
-  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, nullptr, o), SOGMM_E_LIMIT);
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pooled.data(), pooled.size() / 4, nullptr, o), SOGMM_E_LIMIT);
   ASSERT_EQ(sogmm_options_set_f64(o, SOGMM_OPT_BANDWIDTH, 0.02), SOGMM_OK);
-  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), n, nullptr, o), SOGMM_OK) << last_error();
+  EXPECT_EQ(sogmm_fit_points_f32(&fitted, pts.data(), pts.size() / 4, nullptr, o), SOGMM_OK) << last_error();
   sogmm_model_free(fitted);
   sogmm_options_free(o);
+  MapHandle alone;
+  EXPECT_EQ(alone.insert(pts, translated(0)), SOGMM_OK) << last_error();
   MapHandle m;
+  ASSERT_EQ(m.insert(other, translated(0)), SOGMM_OK) << last_error();
   EXPECT_EQ(m.insert(pts, translated(0)), SOGMM_E_LIMIT);
-  EXPECT_TRUE(has(last_error(), "batch bandwidth 0.01399")) << last_error();
-  EXPECT_EQ(m.stats().n_frames, 0);
+  EXPECT_TRUE(has(last_error(), "batch bandwidth 0.0155")) << last_error();
+  EXPECT_EQ(m.stats().n_frames, 1);
+  EXPECT_EQ(m.stats().n_pending, 300);
 }
 
 // fx = fy = 1e-30 on the first RGB-D frame: refused, and the camera is not fixed.

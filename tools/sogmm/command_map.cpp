@@ -212,8 +212,8 @@ Command add_map_command(CLI::App& root) {
   app->footer(
       "Each frame's points are moved to the world with the frame's camera-to-world pose and scored with the\n"
       "3-D log-likelihood of the map's local components; points below --threshold are novel. Once --batch\n"
-      "novel points are pending they are fitted (the usual self-organizing fit at --bandwidth times\n"
-      "--novelty-bandwidth-scale) and merged. A frame whose explained points have --revisit-refit-ratio\n"
+      "novel points are pending they are fitted (the usual self-organizing fit at --bandwidth times a scale\n"
+      "from --novelty-bandwidth-scale) and merged. A frame whose explained points have --revisit-refit-ratio\n"
       "times as many modes as the map has components on its surfaces refits them (its points plus samples\n"
       "of what it does not see replace them). With --fusion new\n"
       "components close to existing ones (Hellinger or symmetric KL distance below --fusion-threshold) are\n"
@@ -259,7 +259,8 @@ Command add_map_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--batch", s->options.batch_size, "novel points that trigger a fit")->capture_default_str();
   app->add_option("--novelty-bandwidth-scale", s->options.novelty_bandwidth_scale,
-                  "novel points are fitted with --bandwidth times this, in (0, 1] (--no-novelty: the bandwidth)")
+                  "s in (0, 1]: a batch of novel points is fitted with --bandwidth times s + (1 - s) h^2, h the share of "
+                  "its point pairs from one frame (1 for one frame); a revisit refit with s (--no-novelty: the bandwidth)")
       ->capture_default_str();
   app->add_option("--revisit-refit-ratio", s->options.revisit_refit_ratio,
                   "refit what a frame sees when its explained points have this many times as many modes as the "

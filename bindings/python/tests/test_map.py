@@ -193,14 +193,17 @@ def test_warm_start_fits_each_frame_from_the_previous_fit():
 @pytest.mark.parametrize("scale", [1.0, 0.5])
 def test_novel_points_are_fitted_with_the_scaled_bandwidth(scale):
     # Two frames in one batch, identity poses: the batch is the frames' points
-    # one after the other, fitted at bandwidth x novelty_bandwidth_scale.
+    # one after the other, fitted at bandwidth x (s + (1 - s) h^2), with s the
+    # novelty_bandwidth_scale and h = 1/2 the share of its point pairs from
+    # one frame (two frames of the same size).
     a, b = blobs(n_per=300, seed=0), blobs(n_per=300, seed=1) + np.float32([3, 0, 0, 0])
+    assert len(a) == len(b)
     with sogmm.Map(novelty_bandwidth_scale=scale, batch_size=100000, **FIT) as m:
         m.insert_points(a, np.eye(4))
         m.insert_points(b, np.eye(4))
         m.flush()
         got = m.export()
-    fit = dict(FIT, bandwidth=FIT["bandwidth"] * scale)
+    fit = dict(FIT, bandwidth=FIT["bandwidth"] * (scale + (1 - scale) * 0.25))
     want = sogmm.SOGMM(**fit).fit(np.concatenate([a, b]))
     assert got.n_components_ == want.n_components_
     assert got.means_.tobytes() == want.means_.tobytes()

@@ -290,8 +290,10 @@ typedef int32_t sogmm_key;
  * sogmm_fit_points_f32); meant for MAP_NOVELTY 0; needs N_INIT 1.
  * i64, 0 or 1; default 0. */
 #define SOGMM_OPT_MAP_WARM_START 606
-/* With MAP_NOVELTY 1 the batches of novel points are fitted with BANDWIDTH times this (with
- * MAP_NOVELTY 0 each frame with the bandwidth itself; why: MapOptions::novelty_bandwidth_scale).
+/* With MAP_NOVELTY 1 a batch of novel points is fitted with BANDWIDTH times s + (1 - s) h^2, s
+ * this scale and h the share of the batch's point pairs from one frame (sum n_f^2 / N^2: 1 for
+ * one frame), and a revisit refit with BANDWIDTH times s (with MAP_NOVELTY 0 each frame with the
+ * bandwidth itself; why: MapOptions::novelty_bandwidth_scale).
  * f64, in (0, 1]; default 0.7. */
 #define SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE 607
 /* With MAP_NOVELTY 1, an RGB-D insert refits the map components on its surfaces when its
@@ -908,8 +910,8 @@ SOGMM_API void sogmm_map_free(sogmm_map* map);
  * would trigger on fewer than K points -> SOGMM_E_INVALID_ARG; else a batch
  * (the pending points and this frame's new ones, in this frame's camera
  * frame) whose range or gray values span more than 1e8 batch bandwidths
- * (SOGMM_OPT_BANDWIDTH, times SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE with
- * novelty on), the rule a fit of those points at that bandwidth applies ->
+ * (SOGMM_OPT_BANDWIDTH, with novelty on times the batch's scale from
+ * SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE), the rule a fit of those points at that bandwidth applies ->
  * SOGMM_E_LIMIT (e.g. a pose far from the pending frames': flush first). A
  * fit this insert triggers that fails anyway or is cancelled
  * (sogmm_map_set_progress) -> its status, and the insert is undone: the map

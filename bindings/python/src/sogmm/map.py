@@ -111,10 +111,12 @@ class Map(Queryable):
             local map is below it are new (default 3.0, the authors').
         batch_size: new points that trigger a fit (default 12288: one frame
             decimated by 5).
-        novelty_bandwidth_scale: with novelty on, the batches of new points are
-            fitted with the bandwidth times this, in (0, 1] (default 0.7: a map
-            component serves closer views than the one it was fitted from, and
-            a batch pools the slivers of many frames; core/include/sogmm/map.hpp).
+        novelty_bandwidth_scale: s in (0, 1] (default 0.7): with novelty on, a
+            batch of new points is fitted with the bandwidth times
+            s + (1 - s) h^2, h the share of its point pairs from one frame (1
+            for a batch of one frame, ~0.1 for the slivers of many), since a map
+            component serves closer views than the one it was fitted from and
+            a batch pools the slivers of many frames; core/include/sogmm/map.hpp.
         revisit_refit_ratio: 0 (off) or >= 1 (default 1.25): an RGB-D frame
             whose points the map explains, with at least this many times as
             many modes as the map has components on its surfaces, replaces

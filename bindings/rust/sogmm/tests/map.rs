@@ -287,7 +287,14 @@ fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
         let e = Options::builder().map_novelty_bandwidth_scale(bad).build().unwrap_err();
         assert_eq!(e.status(), Status::InvalidArg, "{bad}: {e}");
     }
-    // The same frame as one batch: a finer scale gives strictly more components.
+    // Two frames of the same size, 3 m apart, as one batch (h = 1/2 of its
+    // point pairs from one frame, so the batch bandwidth is 0.05 x
+    // (s + (1 - s) / 4)): a finer scale gives strictly more components. (One
+    // frame alone is fitted at the bandwidth itself, whatever the scale.)
+    let second: Vec<f32> = blobs(3000, 8)
+        .chunks(4)
+        .flat_map(|p| [p[0] + 3.0, p[1], p[2], p[3]])
+        .collect();
     let count = |scale: f64| {
         let o = Options::builder()
             .map_batch_size(100_000)
@@ -298,6 +305,7 @@ fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
             .unwrap();
         let mut map = Map::new(Some(&o)).unwrap();
         map.insert_points(&blobs(3000, 7), &IDENTITY).unwrap();
+        map.insert_points(&second, &IDENTITY).unwrap();
         map.flush().unwrap();
         map.stats().unwrap().n_components
     };
