@@ -64,7 +64,8 @@ def _parser() -> argparse.ArgumentParser:
                     help="novelty threshold (nats): points whose 3-D log-likelihood is below it are new")
     mg.add_argument("--batch", type=int, default=m.batch_size, help="novel points that trigger a fit")
     mg.add_argument("--novelty-bandwidth-scale", type=float, default=m.novelty_bandwidth_scale,
-                    help="novel points are fitted with --bandwidth times this, in (0, 1]")
+                    help="s in (0, 1]: a batch of novel points is fitted with --bandwidth times s + (1 - s) h^2, "
+                         "h the share of its point pairs from one frame")
     mg.add_argument("--revisit-refit-ratio", type=float, default=m.revisit_refit_ratio,
                     help="refit what a frame sees when its explained points have this many times as many modes "
                          "as the map has components there, 0 (off) or >= 1")

@@ -239,10 +239,23 @@ impl OptionsBuilder {
         map_novelty(bool) => SOGMM_OPT_MAP_NOVELTY as i64 i64::from;
         /// Map: points with a 3-D log-likelihood below this (nats) are novel (default 3.0).
         map_novelty_threshold(f64) => SOGMM_OPT_MAP_NOVELTY_THRESHOLD as f64 |v| v;
-        /// Map: with novelty on, the batches of novel points are fitted with the
-        /// bandwidth times this, in (0, 1] (default 0.7); outside: `build` fails
-        /// with `Status::InvalidArg`.
+        /// Map: s in (0, 1] (default 0.7): with novelty on, a batch of novel
+        /// points is fitted with the bandwidth times s + (1 - s) h^2, h the
+        /// share of its point pairs from one frame (1 for a batch of one
+        /// frame), and a revisit refit with the bandwidth times s; outside:
+        /// `build` fails with `Status::InvalidArg`.
         map_novelty_bandwidth_scale(f64) => SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE as f64 |v| v;
+        /// Map: the free-space carve, in [0, 0.5] (default 0.01; 0 = off): an
+        /// RGB-D insert reshapes a map component when at least this share of
+        /// its samples lies where the frame sees past it; outside: `build`
+        /// fails with `Status::InvalidArg`.
+        map_free_space_carve(f64) => SOGMM_OPT_MAP_FREE_SPACE_CARVE as f64 |v| v;
+        /// Map: every fitted component is rounded before the map stores it, so
+        /// that its mean moves by at most this many of its own standard
+        /// deviations and its covariance's eigenvalues by at most this fraction
+        /// (default 0 = off; smaller deltas); outside the range: `build` fails
+        /// with `Status::InvalidArg`.
+        map_component_precision(f64) => SOGMM_OPT_MAP_COMPONENT_PRECISION as f64 |v| v;
         /// Map: an RGB-D insert whose explained points have at least this many
         /// times as many modes as the map has components on its surfaces
         /// replaces those components by a fit of its points plus samples of

@@ -314,6 +314,50 @@ fn novelty_bandwidth_scale_is_checked_and_reaches_the_map() {
 }
 
 #[test]
+fn free_space_carve_and_component_precision_are_checked_and_reach_the_map() {
+    for bad in [-0.1, 0.6, f64::NAN] {
+        let e = Options::builder().map_free_space_carve(bad).build().unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "carve {bad}: {e}");
+        let e = Options::builder().map_component_precision(bad).build().unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "precision {bad}: {e}");
+    }
+    // One frame fitted with and without rounding (novelty off: the same fit,
+    // rounded after it): the rounded means differ from the plain fit's, and
+    // each moves by at most 0.25 of its component's standard deviations in
+    // the component's own metric, so along each axis by at most 0.25 sqrt(S_ii)
+    // (the rounding happens after the fit, so this holds on every kernel).
+    let build = |precision: f64| {
+        let o = map_builder(false)
+            .bandwidth(0.05)
+            .map_component_precision(precision)
+            .build()
+            .unwrap();
+        let mut map = Map::new(Some(&o)).unwrap();
+        map.insert_points(&blobs(3000, 7), &IDENTITY).unwrap();
+        map.flush().unwrap();
+        map.export().unwrap()
+    };
+    let (plain, rounded) = (build(0.0), build(0.25));
+    assert_eq!(plain.n_components(), rounded.n_components());
+    let (mp, mr, cp) = (
+        plain.means().unwrap(),
+        rounded.means().unwrap(),
+        plain.covariances().unwrap(),
+    );
+    assert_ne!(mp, mr, "precision 0.25 changed no mean");
+    for k in 0..plain.n_components() {
+        for d in 0..4 {
+            let sigma = (cp[16 * k + 5 * d] as f64).sqrt();
+            let moved = (mp[4 * k + d] as f64 - mr[4 * k + d] as f64).abs();
+            assert!(
+                moved <= 0.25 * sigma * (1.0 + 1e-6),
+                "component {k} axis {d} moved {moved} > 0.25 x {sigma}"
+            );
+        }
+    }
+}
+
+#[test]
 fn revisit_refit_ratio_is_checked_and_reaches_the_map() {
     for bad in [0.5, -1.0, f64::NAN, f64::INFINITY] {
         let e = Options::builder().map_revisit_refit_ratio(bad).build().unwrap_err();
