@@ -35,7 +35,11 @@ import sys
 def delta_times(deltas_dir, csv_path, fps):
     """(creation time in s, bytes) of each delta, in order, and the number of
     keyframes. Refuses a directory whose count does not match the CSV."""
+    if not os.path.isdir(deltas_dir):
+        sys.exit("%s: not a folder of deltas" % deltas_dir)
     names = sorted(n for n in os.listdir(deltas_dir) if n.startswith("delta-") and n.endswith(".sogmm"))
+    if not names:
+        sys.exit("%s holds no delta-*.sogmm file" % deltas_dir)
     sizes = [os.path.getsize(os.path.join(deltas_dir, n)) for n in names]
     with open(csv_path, newline="") as f:
         rows = list(csv.DictReader(f))
