@@ -5,11 +5,12 @@ import "C"
 
 import (
 	"context"
+	"runtime"
 	"unsafe"
 )
 
-// Rigid registration of a point cloud to a model (issue 32; sogmm.h,
-// sogmm_register_points_f32). Options (nil = defaults): OptRegistration*,
+// Rigid registration of a point cloud or of a model to a model (issue 32;
+// sogmm.h, sogmm_register_points_f32, sogmm_register_model). Options (nil = defaults): OptRegistration*,
 // Threads; progress StageRegistration.
 
 const (
@@ -19,7 +20,8 @@ const (
 	RegistrationDegenerate   = C.SOGMM_REGISTRATION_DEGENERATE    // some directions are unobservable
 )
 
-// Registration is what RegisterPoints returns (sogmm_registration_info).
+// Registration is what RegisterPoints and RegisterModel return
+// (sogmm_registration_info).
 type Registration struct {
 	Pose          [16]float64 // row-major 4 x 4, source to target frame
 	Status        int         // Registration* constant: check it before using Pose
@@ -50,6 +52,34 @@ func (m *Model) RegisterPoints(ctx context.Context, points []float32, init *[16]
 		return struct{}{}, m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
 			return C.sogmm_register_points_f32(p, floats(points), C.size_t(n), initPtr, op,
 				(*C.double)(unsafe.Pointer(&pose[0])), &info)
+		})
+	})
+	if err != nil {
+		return nil, err
+	}
+	return registrationOf(pose, &info), nil
+}
+
+// RegisterModel gives the rigid pose that best explains the model source
+// (e.g. a frame's own fit, in its own frame) under m: distribution to
+// distribution (D2D), each source component scored by the closed-form
+// overlap of its Gaussian with m's and counted as the points it stands for;
+// figures per point stood for. Otherwise as RegisterPoints. A source standing
+// for fewer than OptRegistrationMinPoints points is ErrInvalidData.
+func (m *Model) RegisterModel(ctx context.Context, source *Model, init *[16]float64, o *Options) (*Registration, error) {
+	if source == nil || source.ptr == nil {
+		return nil, ErrClosed
+	}
+	defer runtime.KeepAlive(source)
+	var pose [16]float64
+	info := newRegistrationInfo()
+	var initPtr *C.double
+	if init != nil {
+		initPtr = (*C.double)(unsafe.Pointer(&init[0]))
+	}
+	_, err := withProgress(ctx, o, func(o *Options) (struct{}, error) {
+		return struct{}{}, m.do(o, func(p *C.sogmm_model, op *C.sogmm_options) C.sogmm_status {
+			return C.sogmm_register_model(p, source.ptr, initPtr, op, (*C.double)(unsafe.Pointer(&pose[0])), &info)
 		})
 	})
 	if err != nil {

@@ -35,6 +35,9 @@ struct Component {
   double log_norm = 0.0;    // log((1 - eps) pi_k) - log det(2 pi Sigma) / 2
   Eigen::Vector3d gain;     // use_gray: Sigma_xg / s_gg (conditional mean slope); else 0
   double mu_g = 0.0, inv_sgg = 0.0, log_norm_g = 0.0;  // use_gray: the gray marginal
+  Eigen::Matrix4d cov;      // the smoothed 4-D covariance (a model source adds its own to it)
+  double mu_gray = 0.0;     // the gray mean
+  double log_weight = 0.0;  // log((1 - eps) pi_k)
 };
 
 // The target smoothed by s: its components and an index over their boxes.
@@ -59,6 +62,9 @@ Level make_level(const Gmm& gmm, double s, double eps, bool use_gray) {
     Component& k = level.comps[m];
     const float* mu = gmm.mean(m);
     k.mu = Eigen::Vector3d(mu[0], mu[1], mu[2]);
+    k.cov = cov;
+    k.mu_gray = mu[3];
+    k.log_weight = std::log((1.0 - eps) * double(gmm.weights[m]));
     Eigen::Matrix3d spatial = cov.topLeftCorner<3, 3>();
     k.gain.setZero();
     k.log_norm = std::log((1.0 - eps) * double(gmm.weights[m]));
@@ -103,6 +109,7 @@ struct Scratch {
   std::vector<std::uint32_t> ids;
   std::vector<double> logp;
   std::vector<Eigen::Vector3d> res;
+  std::vector<Eigen::Matrix3d> prec;  // a model source: each pair's own precision
   ComponentIndex::Cursor cursor;
 };
 
@@ -112,40 +119,91 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return s;
 }
 
-// One point's share: x is the transformed point, c the perturbation centre.
-void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Vector3d& c,
-                 double log_outlier, bool use_gray, bool spread, Scratch& s, Sums& out) {
-  const double xyz[3] = {x(0), x(1), x(2)};
-  level.index.query_point(xyz, s.ids, s.cursor);
+// The log-density of a model source's component (transformed mean x, gray,
+// covariance `spread4` in the target frame) under target component k: the
+// Gaussian-Gaussian overlap integral N(x; mu_k, Sigma_k + S), split as the
+// point case is (gray marginal, then the conditional spatial Gaussian).
+// Sets the residual and the pair's spatial precision.
+double pair_log_density(const Component& k, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d& spread4,
+                        bool use_gray, Eigen::Vector3d& r, Eigen::Matrix3d& prec) {
+  const Eigen::Matrix4d c = k.cov + spread4;
+  Eigen::Matrix3d spatial = c.topLeftCorner<3, 3>();
+  r = x - k.mu;
+  double lp = k.log_weight;
+  if (use_gray) {
+    const double cgg = c(3, 3);
+    const Eigen::Vector3d gain = c.block<3, 1>(0, 3) / cgg;
+    spatial -= gain * c.block<1, 3>(3, 0);
+    const double dg = gray - k.mu_gray;
+    r -= gain * dg;
+    lp += -0.5 * (kLog2Pi + std::log(cgg)) - 0.5 * dg * dg / cgg;
+  }
+  // Sigma_k + S is positive definite when Sigma_k is (S is positive
+  // semidefinite): the factor exists.
+  const Eigen::LLT<Eigen::Matrix3d> llt(spatial);
+  prec = llt.solve(Eigen::Matrix3d::Identity());
+  lp -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
+  return lp - 0.5 * r.dot(prec * r);
+}
+
+// One source item's share, counted `weight` times: x is the transformed
+// point (a model source: its component's mean, with its covariance `spread4`
+// in the target frame; a point: spread4 null), c the perturbation centre.
+void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d* spread4,
+                 double weight, const Eigen::Vector3d& c, double log_outlier, bool use_gray, bool spread,
+                 Scratch& s, Sums& out) {
+  if (spread4) {
+    // The components whose box meets the source component's own 3-sigma
+    // box: a superset of those within 3 sigma of the sum of both covariances
+    // (sqrt(a + b) <= sqrt(a) + sqrt(b) per axis).
+    Box3 box;
+    for (int d = 0; d < 3; ++d) {
+      const double half = 3.0 * std::sqrt(std::max((*spread4)(d, d), 0.0));
+      box.lo[d] = x(d) - half;
+      box.hi[d] = x(d) + half;
+    }
+    level.index.query_box(box, s.ids);
+  } else {
+    const double xyz[3] = {x(0), x(1), x(2)};
+    level.index.query_point(xyz, s.ids, s.cursor);
+  }
   s.logp.resize(s.ids.size());
   s.res.resize(s.ids.size());
+  if (spread4) s.prec.resize(s.ids.size());
   double top = log_outlier;
   for (std::size_t j = 0; j < s.ids.size(); ++j) {
     const Component& k = level.comps[s.ids[j]];
-    Eigen::Vector3d r = x - k.mu;
-    double lp = k.log_norm;
-    if (use_gray) {
-      const double dg = gray - k.mu_g;
-      r -= k.gain * dg;
-      lp += k.log_norm_g - 0.5 * dg * dg * k.inv_sgg;
+    double lp;
+    if (spread4) {
+      lp = pair_log_density(k, x, gray, *spread4, use_gray, s.res[j], s.prec[j]);
+    } else {
+      Eigen::Vector3d r = x - k.mu;
+      lp = k.log_norm;
+      if (use_gray) {
+        const double dg = gray - k.mu_g;
+        r -= k.gain * dg;
+        lp += k.log_norm_g - 0.5 * dg * dg * k.inv_sgg;
+      }
+      lp -= 0.5 * r.dot(k.prec * r);
+      s.res[j] = r;
     }
-    lp -= 0.5 * r.dot(k.prec * r);
-    s.res[j] = r;
     s.logp[j] = lp;
     top = std::max(top, lp);
   }
   double total = std::exp(log_outlier - top);
   for (double lp : s.logp) total += std::exp(lp - top);
   const double lse = top + std::log(total);
-  out.log_likelihood += lse;
+  out.log_likelihood += weight * lse;
   const double w_out = std::exp(log_outlier - lse);
   const bool inlier = w_out < 0.5;
-  if (inlier) out.inliers += 1.0;
+  if (inlier) out.inliers += weight;
   Mat36 jac;
   jac.leftCols<3>() = -skew(x - c);
   jac.rightCols<3>().setIdentity();
   // J is the same for every component of the point: sum the weighted
   // precisions and precision-weighted residuals first, then one J^T W J.
+  // (A model source's covariance is held at the current pose within a step:
+  // the Gauss-Newton step moves its mean.)
   Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
   Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
   Vec6 gbar = Vec6::Zero();
@@ -153,20 +211,20 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
   for (std::size_t j = 0; j < s.ids.size(); ++j) {
     const double w = std::exp(s.logp[j] - lse);
     if (w < 1e-12) continue;
-    const Eigen::Matrix3d& p = level.comps[s.ids[j]].prec;
+    const Eigen::Matrix3d& p = spread4 ? s.prec[j] : level.comps[s.ids[j]].prec;
     const Eigen::Vector3d pr = p * s.res[j];
     wp += w * p;
     wpr += w * pr;
-    if (inlier) out.mahalanobis += w * s.res[j].dot(pr);
+    if (inlier) out.mahalanobis += weight * w * s.res[j].dot(pr);
     if (spread) {
       const Vec6 g = jac.transpose() * pr;
       gbar += w * g;
       ggt.noalias() += w * g * g.transpose();
     }
   }
-  out.hessian.noalias() += jac.transpose() * wp * jac;
-  out.gradient.noalias() += jac.transpose() * wpr;
-  if (spread) out.spread += ggt - gbar * gbar.transpose();
+  out.hessian.noalias() += weight * (jac.transpose() * wp * jac);
+  out.gradient.noalias() += weight * (jac.transpose() * wpr);
+  if (spread) out.spread += weight * (ggt - gbar * gbar.transpose());
 }
 
 // The pose as R, t.
@@ -218,18 +276,23 @@ const char* status_name(RegistrationStatus status) {
   return "unknown";
 }
 
-RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
-                                   const std::array<double, 16>& init, const RegistrationOptions& options,
-                                   int threads, const ProgressSink& progress) {
-  validate(options);
-  validate(target);
-  const std::string pose_error = rigid_pose_error(init);
-  require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
-  require(n >= static_cast<std::uint64_t>(options.min_points), ErrorCode::InvalidData,
-          "registration: " + std::to_string(n) + " source points, fewer than min_points = " +
-              std::to_string(options.min_points));
-  require(points != nullptr, ErrorCode::InvalidArgument, "registration: null points");
-  detail::require_finite_rows(points, n, 4, "source points for registration");
+namespace {
+
+// What is registered: n rows of (x, y, z, gray); a model source adds each
+// row's 4 x 4 covariance and the number of points it stands for.
+struct Source {
+  const float* rows = nullptr;
+  std::size_t n = 0;
+  const float* covariances = nullptr;  // null: points
+  std::vector<double> weights;         // empty: each row counts once
+  double weight(std::size_t i) const { return weights.empty() ? 1.0 : weights[i]; }
+};
+
+RegistrationResult register_source(const Gmm& target, const Source& src, const std::array<double, 16>& init,
+                                   const RegistrationOptions& options, int threads, const ProgressSink& progress) {
+  const float* points = src.rows;
+  const std::size_t n = src.n;
+  const bool model_source = src.covariances != nullptr;
   const ProgressScope scope(progress);
   const int team = detail::team_size(threads);
   const double eps = options.outlier_ratio;
@@ -247,14 +310,25 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   for (int k = 0; k < 3; ++k) volume *= std::max(span.hi[k] - span.lo[k], 1e-3);
   const double log_outlier = eps > 0 ? std::log(eps / volume) : -std::numeric_limits<double>::infinity();
 
-  // The source's centroid and RMS radius (pose invariant: the step's scale).
+  // The source's centroid and RMS radius (pose invariant: the step's scale);
+  // a model source's are those of the points it stands for.
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) centroid += Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]);
-  centroid /= double(n);
+  double total_weight = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    centroid += src.weight(i) * Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]);
+    total_weight += src.weight(i);
+  }
+  centroid /= total_weight;
   double radius2 = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-    radius2 += (Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]) - centroid).squaredNorm();
-  const double radius = std::max(std::sqrt(radius2 / double(n)), 1e-6);
+  for (std::size_t i = 0; i < n; ++i) {
+    double spread2 = (Eigen::Vector3d(points[4 * i], points[4 * i + 1], points[4 * i + 2]) - centroid).squaredNorm();
+    if (model_source) {
+      const float* c = src.covariances + 16 * i;
+      spread2 += double(c[0]) + double(c[5]) + double(c[10]);
+    }
+    radius2 += src.weight(i) * spread2;
+  }
+  const double radius = std::max(std::sqrt(radius2 / total_weight), 1e-6);
 
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
   std::vector<Sums> partial;
@@ -271,9 +345,22 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
       for (std::size_t v = blk * kBlock; v < std::min(used, (blk + 1) * kBlock); ++v) {
-        const float* p = points + 4 * v * stride;
+        const std::size_t i = v * stride;
+        const float* p = points + 4 * i;
         const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
-        score_point(level, x, p[3], c, log_outlier, options.use_gray, spread, sc, s);
+        if (!model_source) {
+          score_point(level, x, p[3], nullptr, 1.0, c, log_outlier, options.use_gray, spread, sc, s);
+          continue;
+        }
+        // The component's covariance in the target frame: diag(R, 1) S diag(R, 1)^T.
+        Eigen::Matrix4d cov;
+        const float* f = src.covariances + 16 * i;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) cov(a, b) = 0.5 * (double(f[4 * a + b]) + double(f[4 * b + a]));
+        Eigen::Matrix4d rot = Eigen::Matrix4d::Identity();
+        rot.topLeftCorner<3, 3>() = pose.r;
+        const Eigen::Matrix4d moved = rot * cov * rot.transpose();
+        score_point(level, x, p[3], &moved, src.weight(i), c, log_outlier, options.use_gray, spread, sc, s);
       }
       partial[blk] = s;
     });
@@ -291,14 +378,14 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   for (std::int32_t l = 0; l < levels; ++l) {
     const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
     // Level l of L uses every 2^(L-1-l)-th point (at most 4x fewer), keeping at least min_points.
-    std::size_t stride = std::size_t{1} << std::min(levels - 1 - l, 2);
+    std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(levels - 1 - l, 2);
     while (stride > 1 && n / stride < static_cast<std::size_t>(options.min_points)) stride /= 2;
     level = make_level(target, s, eps, options.use_gray);
     converged = false;
     for (std::int32_t it = 0; it < options.max_iter && !converged; ++it) {
       const Sums sums = evaluate(level, pose, false, stride);
       ++result.iterations;
-      detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / double((n + stride - 1) / stride));
+      detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / (model_source ? total_weight : double((n + stride - 1) / stride)));
       const double scale = sums.hessian.diagonal().maxCoeff();
       if (!(scale > 0)) break;  // no point near the target: nothing to move towards
       const Vec6 step = -(sums.hessian + 1e-9 * scale * Mat6::Identity()).ldlt().solve(sums.gradient);
@@ -339,8 +426,8 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   result.pose = array_of(pose);
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) result.information[6 * i + j] = 0.5 * (info(i, j) + info(j, i));
-  result.log_likelihood = fin.log_likelihood / double(n);
-  result.inlier_ratio = fin.inliers / double(n);
+  result.log_likelihood = fin.log_likelihood / total_weight;  // total_weight = n for points
+  result.inlier_ratio = fin.inliers / total_weight;
   result.rmse = fin.inliers > 0 ? std::sqrt(fin.mahalanobis / (3.0 * fin.inliers)) : 0.0;
   if (!converged)
     result.status = RegistrationStatus::NotConverged;
@@ -351,6 +438,49 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   else
     result.status = RegistrationStatus::Converged;
   return result;
+}
+
+}  // namespace
+
+RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options,
+                                   int threads, const ProgressSink& progress) {
+  validate(options);
+  validate(target);
+  const std::string pose_error = rigid_pose_error(init);
+  require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
+  require(n >= static_cast<std::uint64_t>(options.min_points), ErrorCode::InvalidData,
+          "registration: " + std::to_string(n) + " source points, fewer than min_points = " +
+              std::to_string(options.min_points));
+  require(points != nullptr, ErrorCode::InvalidArgument, "registration: null points");
+  detail::require_finite_rows(points, n, 4, "source points for registration");
+  Source src;
+  src.rows = points;
+  src.n = n;
+  return register_source(target, src, init, options, threads, progress);
+}
+
+RegistrationResult register_model(const Gmm& target, const Gmm& source, const std::array<double, 16>& init,
+                                  const RegistrationOptions& options, int threads, const ProgressSink& progress) {
+  validate(options);
+  validate(target);
+  require(source.size() > 0, ErrorCode::InvalidData, "registration: the source model has no component");
+  validate(source);
+  const std::string pose_error = rigid_pose_error(init);
+  require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
+  // Each component stands for its share of the points the model was fitted
+  // on (a model without a support size: one point per component).
+  const double support = source.support_size > 0 ? double(source.support_size) : double(source.size());
+  require(support >= double(options.min_points), ErrorCode::InvalidData,
+          "registration: the source model stands for " + std::to_string(static_cast<std::uint64_t>(support)) +
+              " points, fewer than min_points = " + std::to_string(options.min_points));
+  Source src;
+  src.rows = source.means.data();
+  src.n = source.size();
+  src.covariances = source.covariances.data();
+  src.weights.resize(source.size());
+  for (std::size_t j = 0; j < source.size(); ++j) src.weights[j] = double(source.weights[j]) * support;
+  return register_source(target, src, init, options, threads, progress);
 }
 
 }  // namespace sogmm

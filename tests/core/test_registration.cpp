@@ -14,51 +14,18 @@
 #include "sogmm/inference.hpp"
 #include "sogmm/registration.hpp"
 #include "pose_util.hpp"
+#include "registration_scenes.hpp"
 #include "test_util.hpp"
 
 namespace {
 
 using sogmm::RegistrationStatus;
 using Pose = std::array<double, 16>;
+using sogmm_test::planes;
 using sogmm_test::pose_error;
+using sogmm_test::rigid;
 
 constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-// Flat components tiling the unit square of each listed plane through the
-// origin (0: x = 0, 1: y = 0, 2: z = 0): in-plane sigma 4 cm, normal 3 mm,
-// gray varying across the plane.
-sogmm::Gmm planes(std::initializer_list<int> normals, Eigen::Vector3d shift = Eigen::Vector3d::Zero()) {
-  std::vector<std::pair<Eigen::Vector4d, Eigen::Matrix4d>> comps;
-  for (int axis : normals)
-    for (int a = 0; a < 10; ++a)
-      for (int b = 0; b < 10; ++b) {
-        Eigen::Vector4d mu = Eigen::Vector4d::Zero();
-        Eigen::Matrix4d cov = Eigen::Matrix4d::Zero();
-        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-        mu(u) = 0.05 + 0.1 * a;
-        mu(v) = 0.05 + 0.1 * b;
-        mu.head<3>() += shift;
-        mu(3) = 0.2 + 0.06 * a + 0.01 * b;
-        cov(u, u) = cov(v, v) = 0.04 * 0.04;
-        cov(axis, axis) = 0.003 * 0.003;
-        cov(3, 3) = 0.01 * 0.01;
-        comps.emplace_back(mu, cov);
-      }
-  sogmm::Gmm g;
-  g.resize(comps.size());
-  for (std::size_t k = 0; k < comps.size(); ++k)
-    sogmm_test::set_component(g, k, 1.0 / double(comps.size()), comps[k].first, comps[k].second);
-  g.support_size = 1;
-  return g;
-}
-
-// The pose rotating by `deg` about `axis` and then translating by `t`.
-Eigen::Matrix4d rigid(double deg, Eigen::Vector3d axis, Eigen::Vector3d t) {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180, axis.normalized()).toRotationMatrix();
-  m.topRightCorner<3, 1>() = t;
-  return m;
-}
 
 // `n` points of `g` (seeded), moved by `move` (rows x, y, z, gray).
 std::vector<float> samples(const sogmm::Gmm& g, std::size_t n, const Eigen::Matrix4d& move) {

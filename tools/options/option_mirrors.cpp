@@ -47,7 +47,7 @@ const std::map<int, Group>& groups() {
            "the novelty test) and the RGB-D keys (sogmm_map_insert_frame)"}},
       {7, {"Occupancy and distance to the surface",
            "sogmm_map_occupancy_f32, sogmm_model_surface_distance_f32, sogmm_map_surface_distance_f32"}},
-      {8, {"Registration", "sogmm_register_points_f32"}},
+      {8, {"Registration", "sogmm_register_points_f32 and sogmm_register_model"}},
   };
   return g;
 }

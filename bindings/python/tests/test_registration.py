@@ -1,13 +1,14 @@
-"""sogmm.register (issue 32): points sampled from a corner of three planes and
-moved by a known pose register back to it; a single plane is degenerate in
-its three in-plane directions; bad input raises."""
+"""sogmm.register (issue 32): points sampled from a corner of three planes, and
+the corner model itself (model to model, D2D), moved by a known pose register
+back to it; a single plane is degenerate in its three in-plane directions; bad
+input raises."""
 import numpy as np
 import pytest
 
 import sogmm
 
 
-def planes(normals):
+def planes(normals, support_size=1):
     """Flat components tiling the unit square of each plane (0: x = 0, 1: y = 0, 2: z = 0)."""
     w, mu, cov = [], [], []
     for axis in normals:
@@ -24,7 +25,8 @@ def planes(normals):
                 mu.append(m)
                 cov.append(c)
     w = np.array(w) / len(w)
-    return sogmm.GMM.from_arrays(w.astype(np.float32), np.array(mu, np.float32), np.array(cov, np.float32), 1)
+    return sogmm.GMM.from_arrays(w.astype(np.float32), np.array(mu, np.float32), np.array(cov, np.float32),
+                                 support_size)
 
 
 def rigid(deg, axis, t):
@@ -80,3 +82,17 @@ def test_bad_input():
         sogmm.register(src[:, :3], model)
     with pytest.raises(sogmm.InvalidArgumentError, match="outlier_ratio"):
         sogmm.register(src, model, outlier_ratio=1.0)
+
+
+def test_model_to_model_recovers_a_known_pose():
+    model = planes([0, 1, 2], support_size=30000)
+    truth = rigid(5.0, [1, 2, 3], [0.02, -0.01, 0.03])
+    pose, info = sogmm.register(model.transform(np.linalg.inv(truth)), model)
+    assert info["status"] == "converged"
+    # The optimum of a model against its own moved copy, up to the copy's
+    # float rounding (< 1 um in the core's test).
+    assert np.abs(pose - truth).max() < 1e-4
+    assert info["inlier_ratio"] > 0.95 and info["unobservable"] == 0
+    # A source model standing for one point: fewer than min_points.
+    with pytest.raises(sogmm.InvalidDataError, match="min_points"):
+        sogmm.register(planes([0, 1, 2]), model)

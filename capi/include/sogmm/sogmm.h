@@ -335,7 +335,7 @@ typedef int32_t sogmm_key;
  * f64 (standard deviations), in (0, 10]; default 2. */
 #define SOGMM_OPT_SURFACE_DISC_SIGMAS 702
 
-/* Registration. Read by sogmm_register_points_f32. */
+/* Registration. Read by sogmm_register_points_f32 and sogmm_register_model. */
 /* Registration: EM / Gauss-Newton iterations per coarse-to-fine level.
  * i64 (iterations), [1, 2^31-1]; default 30. */
 #define SOGMM_OPT_REGISTRATION_MAX_ITER 800
@@ -1265,6 +1265,24 @@ typedef struct sogmm_registration_info {
 SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, const float* points, size_t n,
                                                  const double* init, const sogmm_options* options,
                                                  double* pose_out, sogmm_registration_info* info_out);
+
+/* The rigid pose that best explains the model `source` (a fit of a frame,
+ * in its own frame) under the model `target`: distribution-to-distribution
+ * (D2D) registration. Each source component is scored by the closed-form
+ * overlap of its Gaussian, moved by the pose, with each target component
+ * (formula: core/include/sogmm/registration.hpp, register_model), counted
+ * as many times as the points it stands for (weight x support size); the
+ * outlier term, levels, options, outputs, status and progress are those of
+ * sogmm_register_points_f32, the figures per point stood for. A source of a
+ * few hundred components registers in a fraction of its points' time.
+ * Errors: NULL target, source, pose_out or info_out -> SOGMM_E_NULL_ARG;
+ * info_out->struct_size too small, a non-rigid or non-finite init ->
+ * SOGMM_E_INVALID_ARG; a source without components or standing for fewer
+ * than REGISTRATION_MIN_POINTS points -> SOGMM_E_INVALID_DATA. Nothing is
+ * written on error. */
+SOGMM_API sogmm_status sogmm_register_model(const sogmm_model* target, const sogmm_model* source,
+                                            const double* init, const sogmm_options* options, double* pose_out,
+                                            sogmm_registration_info* info_out);
 
 /* Tracking: inserts an RGB-D `frame` into `map` at the camera-to-world pose
  * that registration to the map finds (sogmm_register_points_f32's method,

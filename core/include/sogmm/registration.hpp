@@ -1,5 +1,6 @@
-// Rigid registration of a point cloud to a model (issue 32): the pose that
-// best explains the source points (x, y, z, gray) under a target Gmm.
+// Rigid registration of a point cloud or of a fitted model to a model (issue
+// 32): the pose that best explains the source points (x, y, z, gray), or the
+// source model's components (register_model, D2D), under a target Gmm.
 //
 // The objective. The transformed source points x_i = R p_i + t are scored by
 // the target's 3-D marginal mixed with a uniform outlier density:
@@ -123,6 +124,26 @@ struct RegistrationResult {
 RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
                                    const std::array<double, 16>& init, const RegistrationOptions& options = {},
                                    int threads = 0, const ProgressSink& progress = {});
+
+/// Registers a fitted model `source` to `target` (distribution to
+/// distribution, D2D), starting at `init` (source to target frame, as in
+/// register_points). Each source component j is scored as a point at its
+/// transformed mean whose density under target component k is the closed
+/// form of the Gaussian overlap, N(R m_j + t; mu_k, Sigma_k + diag(R, 1)
+/// S_j diag(R, 1)^T) (4-D with use_gray, the spatial marginal otherwise),
+/// counted pi_j x support_size times (the points it stands for; one per
+/// component when support_size is 0), with the same outlier term,
+/// coarse-to-fine levels, Gauss-Newton steps (the source covariance held at
+/// the current rotation within a step), figures and status as
+/// register_points; the log-likelihood and inlier ratio are per point stood
+/// for. A frame's fit registers in a fraction of its points' time: its
+/// components are few. Errors: as register_points for the target, options
+/// and init; a source without components, or standing for fewer than
+/// min_points points -> Error(InvalidData); an invalid source -> validate()'s
+/// error.
+RegistrationResult register_model(const Gmm& target, const Gmm& source, const std::array<double, 16>& init,
+                                  const RegistrationOptions& options = {}, int threads = 0,
+                                  const ProgressSink& progress = {});
 
 /// Name of a status ("converged", "not converged", "low fitness", "degenerate").
 const char* status_name(RegistrationStatus status);

@@ -247,6 +247,7 @@ _DECLARATIONS: dict[str, tuple[object, list[object]]] = {
     "sogmm_model_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
     "sogmm_map_collision_probability": (STATUS, [HANDLE, F64_IN, F64_IN, c_size_t, HANDLE, F64_OUT]),
     "sogmm_register_points_f32": (STATUS, [HANDLE, F32_IN, c_size_t, c_void_p, HANDLE, F64_OUT, c_void_p]),
+    "sogmm_register_model": (STATUS, [HANDLE, HANDLE, c_void_p, HANDLE, F64_OUT, c_void_p]),
     "sogmm_model_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,
                                         HANDLE, F32_OUT, F32_OUT, F32_OUT]),
     "sogmm_map_render_f32": (STATUS, [HANDLE, c_uint32, c_uint32, c_double, c_double, c_double, c_double, F64_IN,

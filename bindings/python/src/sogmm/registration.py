@@ -1,4 +1,5 @@
-"""Rigid registration of a point cloud to a model (``sogmm_register_points_f32``)."""
+"""Rigid registration of a point cloud (``sogmm_register_points_f32``) or of a model
+(``sogmm_register_model``, distribution to distribution) to a model."""
 from __future__ import annotations
 
 import ctypes
@@ -27,17 +28,22 @@ class RegistrationInfo(ctypes.Structure):
     ]
 
 
-def register(source_points, target_model: GMM, init=None, *, progress: ProgressArg = None,
+def register(source, target_model: GMM, init=None, *, progress: ProgressArg = None,
              max_iter: int = _D.registration_max_iter, tol: float = _D.registration_tol,
              outlier_ratio: float = _D.registration_outlier_ratio, use_gray: bool = bool(_D.registration_use_gray),
              levels: int = _D.registration_levels, coarse_sigma: float = _D.registration_coarse_sigma,
              min_inlier_ratio: float = _D.registration_min_inlier_ratio,
              degeneracy_ratio: float = _D.registration_degeneracy_ratio,
              min_points: int = _D.registration_min_points, n_threads: int = _D.threads) -> tuple[np.ndarray, dict]:
-    """The rigid pose that best explains ``source_points`` under ``target_model``.
+    """The rigid pose that best explains ``source`` under ``target_model``.
 
     Args:
-        source_points: (N, 4) rows of x, y, z, gray in the source's own frame.
+        source: (N, 4) rows of x, y, z, gray in the source's own frame, or a
+            fitted GMM (e.g. a frame's own fit, in its own frame): then each
+            of its components is scored by the closed-form overlap of its
+            Gaussian with the target's (distribution to distribution, D2D),
+            counted as many times as the points it stands for, and the
+            figures are per point stood for.
         target_model: a fitted GMM (or a Map's exported model).
         init: 4 x 4 rigid initial guess, source to target frame (None = identity).
 
@@ -51,7 +57,7 @@ def register(source_points, target_model: GMM, init=None, *, progress: ProgressA
     only when converged: check ``info["status"]``. Bad input raises
     (InvalidArgumentError, InvalidDataError) as the C call does.
     """
-    x = _rows(source_points, (4,), "source_points")
+    x = None if isinstance(source, GMM) else _rows(source, (4,), "source")
     start = None if init is None else np.ascontiguousarray(_pose(init))
     pose = np.empty(16, dtype=np.float64)
     info = RegistrationInfo(struct_size=ctypes.sizeof(RegistrationInfo))
@@ -62,9 +68,13 @@ def register(source_points, target_model: GMM, init=None, *, progress: ProgressA
            _ffi.OPT_REGISTRATION_LEVELS: levels, _ffi.OPT_REGISTRATION_MIN_POINTS: min_points,
            _ffi.OPT_THREADS: n_threads}
     with _ffi.Options(f64=f64, i64=i64) as o:
-        call_with_progress(o, progress, lambda: _ffi.lib.sogmm_register_points_f32(
-            target_model._h(), x, x.shape[0], None if start is None else start.ctypes.data, o.ptr, pose,
-            ctypes.byref(info)))
+        init_ptr = None if start is None else start.ctypes.data
+        if x is None:
+            call_with_progress(o, progress, lambda: _ffi.lib.sogmm_register_model(
+                target_model._h(), source._h(), init_ptr, o.ptr, pose, ctypes.byref(info)))
+        else:
+            call_with_progress(o, progress, lambda: _ffi.lib.sogmm_register_points_f32(
+                target_model._h(), x, x.shape[0], init_ptr, o.ptr, pose, ctypes.byref(info)))
     return pose.reshape(4, 4), info_dict(info)
 
 

@@ -214,7 +214,8 @@ pub const SOGMM_MAP_FRAME_MS_MERGE: sogmm_key = 20152;
 pub const SOGMM_TYPE_F64: i32 = 0;
 pub const SOGMM_TYPE_I64: i32 = 1;
 
-/// The figures of one registration (sogmm_register_points_f32). Set
+/// The figures of one registration (sogmm_register_points_f32,
+/// sogmm_register_model). Set
 /// `struct_size` to `size_of::<sogmm_registration_info>()` before the call.
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
@@ -432,6 +433,14 @@ extern "C" {
         target: *const sogmm_model,
         points: *const f32,
         n: usize,
+        init: *const f64,
+        options: *const sogmm_options,
+        pose_out: *mut f64,
+        info_out: *mut sogmm_registration_info,
+    ) -> sogmm_status;
+    pub fn sogmm_register_model(
+        target: *const sogmm_model,
+        source: *const sogmm_model,
         init: *const f64,
         options: *const sogmm_options,
         pose_out: *mut f64,

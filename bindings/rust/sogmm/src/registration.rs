@@ -1,5 +1,5 @@
-//! Rigid registration of a point cloud to a model (issue 32; sogmm.h,
-//! `sogmm_register_points_f32`). Options (None = defaults):
+//! Rigid registration of a point cloud or of a model to a model (issue 32;
+//! sogmm.h, `sogmm_register_points_f32`, `sogmm_register_model`). Options (None = defaults):
 //! `SOGMM_OPT_REGISTRATION_*`, `SOGMM_OPT_THREADS`; progress
 //! `Stage::Registration`.
 use sogmm_sys as sys;
@@ -71,6 +71,31 @@ impl Model {
                     pose.as_mut_ptr(),
                     &mut info,
                 )
+            })
+        })?;
+        Ok(registration_of(pose, &info))
+    }
+
+    /// The rigid pose that best explains the model `source` (e.g. a frame's
+    /// own fit, in its own frame) under this model: distribution to
+    /// distribution (D2D), each source component scored by the closed-form
+    /// overlap of its Gaussian with this model's and counted as the points
+    /// it stands for; figures per point stood for. Otherwise as
+    /// `register_points`. Errors: a source standing for fewer than
+    /// `SOGMM_OPT_REGISTRATION_MIN_POINTS` points is `InvalidData`.
+    pub fn register_model(
+        &self,
+        source: &Model,
+        init: Option<&Pose>,
+        options: Option<&Options>,
+    ) -> Result<Registration> {
+        let mut pose: Pose = [0.0; 16];
+        let mut info = empty_info();
+        let init_ptr = init.map_or(std::ptr::null(), |p| p.as_ptr());
+        with_progress(options, |o| {
+            // SAFETY: two live model handles, init 16 doubles or NULL, room for 16 doubles and the sized struct.
+            check(unsafe {
+                sys::sogmm_register_model(self.raw(), source.raw(), init_ptr, o, pose.as_mut_ptr(), &mut info)
             })
         })?;
         Ok(registration_of(pose, &info))

@@ -1,10 +1,11 @@
-//! `Model::register_points` (issue 32): points sampled from a corner of three
-//! planes and moved by -t register back to the translation t; a NaN initial
-//! pose is an invalid argument.
+//! `Model::register_points` and `Model::register_model` (issue 32): points
+//! sampled from a corner of three planes, and the corner model itself, moved
+//! by -t register back to the translation t; a NaN initial pose is an
+//! invalid argument, a source model standing for too few points invalid data.
 use sogmm::{Model, Pose, Queryable, RegistrationStatus, Status};
 
 /// Flat components tiling the unit squares of the planes x = 0, y = 0, z = 0.
-fn corner() -> Model {
+fn corner(support_size: u64) -> Model {
     let (mut w, mut mu, mut cov) = (Vec::new(), Vec::new(), Vec::new());
     for axis in 0..3 {
         for a in 0..5 {
@@ -25,12 +26,12 @@ fn corner() -> Model {
             }
         }
     }
-    Model::from_arrays(&w, &mu, &cov, 1).unwrap()
+    Model::from_arrays(&w, &mu, &cov, support_size).unwrap()
 }
 
 #[test]
 fn recovers_a_translation() {
-    let model = corner();
+    let model = corner(1);
     let t = [0.02f32, -0.01, 0.03];
     let mut pts = model.sample(3000, 1, 4, None).unwrap();
     for row in pts.chunks_mut(4) {
@@ -51,4 +52,24 @@ fn recovers_a_translation() {
     nan[3] = f64::NAN;
     let e = model.register_points(&pts, Some(&nan), None).unwrap_err();
     assert_eq!(e.status(), Status::InvalidArg);
+}
+
+#[test]
+fn model_to_model_recovers_a_translation() {
+    let model = corner(30000);
+    let t = [0.02f64, -0.01, 0.03];
+    let back: Pose = [1., 0., 0., -t[0], 0., 1., 0., -t[1], 0., 0., 1., -t[2], 0., 0., 0., 1.];
+    let moved = model.transform(&back).unwrap();
+    let r = model.register_model(&moved, None, None).unwrap();
+    assert_eq!(r.status, RegistrationStatus::Converged);
+    // The optimum of a model against its own moved copy: t up to the copy's
+    // float rounding (< 1 um in the core's test).
+    for k in 0..3 {
+        assert!((r.pose[4 * k + 3] - t[k]).abs() < 1e-4, "{:?}", r.pose);
+        assert!((r.pose[5 * k] - 1.0).abs() < 1e-6);
+    }
+    assert!(r.inlier_ratio > 0.95 && r.unobservable == 0);
+    let e = model.register_model(&corner(1), None, None).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidData);
+    assert!(e.message().contains("min_points"), "{}", e.message());
 }
