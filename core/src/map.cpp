@@ -124,7 +124,7 @@ void validate(const MapOptions& o) {
   require(o.fusion_method == FusionMethod::Hellinger || o.fusion_method == FusionMethod::KL,
           ErrorCode::InvalidArgument, "map: unknown fusion method");
   require_usable_bandwidth(o.fit.bandwidth);
-  require_usable_bandwidth(o.fit.bandwidth * o.novelty_bandwidth_scale);
+  require_usable_bandwidth(detail::refit_bandwidth(o));  // the smallest any batch or refit fits with
   // A triggered fit of a fixed K needs K points: a smaller batch could only
   // flush when one insert happened to bring K.
   require(!o.novelty || o.fit.n_components <= o.batch_size, ErrorCode::InvalidArgument,

@@ -1,5 +1,6 @@
-// The bandwidth a map batch is fitted with: MapOptions::novelty_bandwidth_scale
-// applied in proportion to how much the batch pools different views.
+// The bandwidths a map fits novel points and revisits with:
+// MapOptions::novelty_bandwidth_scale applied in proportion to how much a
+// batch pools different views, and to every revisit refit.
 #include "map_state.hpp"
 
 namespace sogmm::detail {
@@ -27,5 +28,7 @@ double batch_bandwidth(const MapOptions& o, const std::vector<PendingFrame>& pen
   const double s = o.novelty_bandwidth_scale;
   return o.fit.bandwidth * (s + (1.0 - s) * h * h);
 }
+
+double refit_bandwidth(const MapOptions& o) { return o.fit.bandwidth * o.novelty_bandwidth_scale; }
 
 }  // namespace sogmm::detail

@@ -61,7 +61,7 @@ std::optional<RevisitRefit> plan_revisit_refit(const Map::State& s, const Points
   // the progress sink: an insert that runs no fit calls none; it takes
   // milliseconds).
   FitOptions fo = o.fit;
-  fo.bandwidth *= o.novelty_bandwidth_scale;
+  fo.bandwidth = refit_bandwidth(o);
   {
     const detail::ScopedOmpThreads threads(team_size(fo.em.threads));
     if (static_cast<double>(count_modes(cloud.view(), fo).size()) < needed) return std::nullopt;

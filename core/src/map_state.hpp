@@ -157,6 +157,14 @@ double same_view_share(const std::vector<PendingFrame>& pending, const PendingFr
 double batch_bandwidth(const MapOptions& options, const std::vector<PendingFrame>& pending,
                        const PendingFrame* extra = nullptr);
 
+/// The bandwidth a revisit refit is fitted with (map_revisit.cpp): bandwidth
+/// x s, s = novelty_bandwidth_scale. A refit pools the frame's points with
+/// samples of the replaced components' mass from many views, so it keeps
+/// the pooled batches' scale (fitting it at the bandwidth itself, or by the
+/// frame's share of its points, cost the 300-frame loop 1.5-2.7 dB of
+/// held-out PSNR on its worst frame: README, section 6).
+double refit_bandwidth(const MapOptions& options);
+
 /// Error(InvalidArgument) naming the point and axis unless every world
 /// coordinate (3 per point) of a frame is within float32 range.
 void require_float32_world(const std::vector<double>& world, bool from_rgbd);
