@@ -170,7 +170,8 @@ std::vector<OptionSpec> make_table() {
       SOGMM_F64_ROW(MAP_FREE_SPACE_CARVE, map.free_space_carve, 0.0, 0.5, [](double v) { return v <= 0.5; },
                     "in [0, 0.5]", "share of samples",
                     "with MAP_NOVELTY 1, an RGB-D insert reshapes each map component on its surfaces that has at "
-                    "least this share of its samples where the frame sees past them (free space): mean and covariance "
+                    "least this share of its 256 samples (rounded up to whole samples: the default is one) where the "
+                    "frame sees past them (free space): mean and covariance "
                     "become the moments of its other samples, its weight stays; new components are carved by every "
                     "RGB-D frame inserted since the map was created or loaded, whose depth the map keeps (why: "
                     "MapOptions::free_space_carve); 0: off; not with MAP_WARM_START 1"),

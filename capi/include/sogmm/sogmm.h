@@ -309,11 +309,12 @@ typedef int32_t sogmm_key;
  * i64 (revisions), [0, 2^62]; default 0. */
 #define SOGMM_OPT_MAP_DELTA_HISTORY 609
 /* With MAP_NOVELTY 1, an RGB-D insert reshapes each map component on its surfaces that has at
- * least this share of its samples where the frame sees past them (free space): mean and
- * covariance become the moments of its other samples, its weight stays; new components are
- * carved by every RGB-D frame inserted since the map was created or loaded, whose depth the map
- * keeps (why: MapOptions::free_space_carve); 0: off; not with MAP_WARM_START 1.
- * f64 (share of samples), in [0, 0.5]; default 0.01. */
+ * least this share of its 256 samples (rounded up to whole samples: the default is one) where
+ * the frame sees past them (free space): mean and covariance become the moments of its other
+ * samples, its weight stays; new components are carved by every RGB-D frame inserted since the
+ * map was created or loaded, whose depth the map keeps (why: MapOptions::free_space_carve); 0:
+ * off; not with MAP_WARM_START 1.
+ * f64 (share of samples), in [0, 0.5]; default 0.002. */
 #define SOGMM_OPT_MAP_FREE_SPACE_CARVE 620
 /* Each fitted component is rounded before the map stores it so that its mean moves by at most
  * this many of its standard deviations and its covariance's eigenvalues, in its own frame, by at

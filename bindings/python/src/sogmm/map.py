@@ -124,7 +124,8 @@ class Map(Queryable):
             it does not see (the map keeps the finest view of each surface, not
             the first; not with a fixed ``n_components`` or ``warm_start``;
             details in core/include/sogmm/map.hpp).
-        free_space_carve: in [0, 0.5] (default 0.01; 0: off): with novelty on,
+        free_space_carve: in [0, 0.5] (default 0.002, one of the 256
+            samples; 0: off): with novelty on,
             a map component with at least this share of its samples where an
             RGB-D frame sees past them (free space) is reshaped to the moments
             of its other samples (weight kept), so that its tail past an

@@ -245,10 +245,10 @@ impl OptionsBuilder {
         /// frame), and a revisit refit with the bandwidth times s; outside:
         /// `build` fails with `Status::InvalidArg`.
         map_novelty_bandwidth_scale(f64) => SOGMM_OPT_MAP_NOVELTY_BANDWIDTH_SCALE as f64 |v| v;
-        /// Map: the free-space carve, in [0, 0.5] (default 0.01; 0 = off): an
-        /// RGB-D insert reshapes a map component when at least this share of
-        /// its samples lies where the frame sees past it; outside: `build`
-        /// fails with `Status::InvalidArg`.
+        /// Map: the free-space carve, in [0, 0.5] (default 0.002, one of the
+        /// 256 samples; 0 = off): an RGB-D insert reshapes a map component
+        /// when at least this share of its samples lies where the frame sees
+        /// past it; outside: `build` fails with `Status::InvalidArg`.
         map_free_space_carve(f64) => SOGMM_OPT_MAP_FREE_SPACE_CARVE as f64 |v| v;
         /// Map: every fitted component is rounded before the map stores it, so
         /// that its mean moves by at most this many of its own standard
