@@ -6,6 +6,10 @@
 // whose Phi terms are evaluated in a second pass, then added point by point.
 #include <cmath>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 #include "occupancy_evidence.hpp"
 #include "occupancy_kernel.hpp"
 #include "occupancy_phi.hpp"
@@ -80,8 +84,25 @@ void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) 
 
   // The points within the band, packed (contiguous loops vectorize where
   // gathers by a list would not).
-  int list[B], k = 0;
+  alignas(64) int list[B];
+  int k = 0;
   alignas(64) double band_depth[B], band_norm2[B], band_surface[B];
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+  // Eight lanes at a time, compressed in registers and stored whole (a
+  // compressing store to memory is microcoded on some CPUs): the lanes past
+  // the packed ones are overwritten or never read, and k + 8 <= j + 8 <= B.
+  for (int j = 0; j < count; j += 8) {
+    const __m256i flags = _mm256_load_si256(reinterpret_cast<const __m256i*>(in_band + j));
+    const __mmask8 valid = count - j >= 8 ? 0xff : static_cast<__mmask8>((1u << (count - j)) - 1u);
+    const __mmask8 m = static_cast<__mmask8>(_mm256_test_epi32_mask(flags, flags) & valid);
+    const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(list + k), _mm256_maskz_compress_epi32(m, index));
+    _mm512_storeu_pd(band_depth + k, _mm512_maskz_compress_pd(m, _mm512_load_pd(depth + j)));
+    _mm512_storeu_pd(band_norm2 + k, _mm512_maskz_compress_pd(m, _mm512_load_pd(norm2 + j)));
+    _mm512_storeu_pd(band_surface + k, _mm512_maskz_compress_pd(m, _mm512_load_pd(surface + j)));
+    k += __builtin_popcount(m);
+  }
+#else
   for (int j = 0; j < count; ++j) {
     list[k] = j;
     band_depth[k] = depth[j];
@@ -89,6 +110,7 @@ void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) 
     band_surface[k] = surface[j];
     k += in_band[j];
   }
+#endif
 
   // Pass 2: Evidence::add for the points within the band.
   const double h = f.thickness, sigma = f.sigma;
