@@ -1295,7 +1295,13 @@ SOGMM_API sogmm_status sogmm_register_model(const sogmm_model* target, const sog
  * a caller that skips frames passes its own guess). The map's first frame
  * (no component, nothing pending) is inserted at the guess (NULL: the
  * identity) without registration. The target is the map's components and
- * its pending points; pending points are flushed first when the map has no
+ * its pending points; only the frame's points that some inserted frame saw
+ * are registered (placed by the guess, at least 8 pixels inside that frame's
+ * image through this frame's intrinsics), or all of them when those are
+ * fewer than half, and all of them once more when the frame would otherwise
+ * not be inserted (the map's edge pulled points in new space back and the
+ * pose lagged behind the motion);
+ * pending points are flushed first when the map has no
  * component, or when the frame would not be inserted (then it registers
  * again). The frame is inserted when the registration's status is
  * SOGMM_REGISTRATION_CONVERGED, or, with SOGMM_OPT_REGISTRATION_USE_GRAY and

@@ -29,10 +29,18 @@
 // (within TrackingOptions::max_disagreement) or the map has too few inliers
 // to judge; the rule is decide_pose() below.
 //
-// A converged map registration is not checked against the odometry. On the
-// loop (frames 0-299, gray) the remaining error comes in a few jumps of
-// converged map poses (11.9 and 13.1 mm at frames 128 and 136; median step
-// error 0.09 mm), but inserting at the odometry's pose whenever the two
+// Only the points some inserted frame has seen are registered to the map
+// (core/src/tracking_overlap.hpp; the whole frame when they are fewer than
+// half of it, and once more when the frame would not be inserted): the map's edge
+// components pulled a view's points in new space back into the mapped
+// space, so the pose lagged behind the motion; on the loop (frames 0-299,
+// gray) every error step over 2 mm before the return to the start was such
+// a lag along the motion (18.5
+// and 12.4 mm at frames 129 and 136 after a flush and a refit), ATE 2.55 cm,
+// and 0.56 cm with the rule (README, Registration).
+//
+// A converged map registration is not checked against the odometry. Before
+// the rule above, on the loop, inserting at the odometry's pose whenever the two
 // differed by more than 5 mm lost the track (from frame 67 every frame
 // disagreed and followed the odometry, 5.8 cm off by frame 80, and 219 were
 // skipped after), and a blend of the two
