@@ -62,6 +62,7 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
                                                  const double* init, const sogmm_options* options,
                                                  double* pose_out, sogmm_registration_info* info_out) {
   SOGMM_TRY {
+    sogmm_capi::require_nonnull(target, "target");
     sogmm_capi::require_nonnull(points, "points");
     sogmm_capi::run_registration(target, init, options, pose_out, info_out,
                                  [&](const std::array<double, 16>& start, const sogmm_options& o) {
@@ -77,6 +78,7 @@ SOGMM_API sogmm_status sogmm_register_model(const sogmm_model* target, const sog
                                             const double* init, const sogmm_options* options, double* pose_out,
                                             sogmm_registration_info* info_out) {
   SOGMM_TRY {
+    sogmm_capi::require_nonnull(target, "target");
     sogmm_capi::require_nonnull(source, "source");
     sogmm_capi::run_registration(target, init, options, pose_out, info_out,
                                  [&](const std::array<double, 16>& start, const sogmm_options& o) {

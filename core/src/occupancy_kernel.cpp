@@ -22,6 +22,9 @@ namespace sogmm::detail::SOGMM_ISA {
 namespace {
 
 constexpr int B = kOccupancyBlock;
+// The AVX-512 packing below stores whole groups of 8 lanes: it needs B to be
+// a multiple of 8 to stay inside the arrays.
+static_assert(B % 8 == 0, "the occupancy block must be a whole number of 8-lane groups");
 
 // Evidence::phi as selects (x is held inside the table's range first, so
 // its index is defined; inside, the table sees x itself).

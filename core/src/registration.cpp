@@ -25,7 +25,11 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 constexpr double kLog2Pi = 1.8378770664093453;
-constexpr std::size_t kBlock = 256;  // points per partial sum: fixed, so sums do not depend on threads
+// Items per partial sum: fixed, so sums do not depend on threads. A model
+// source has few items, each costing a 3 x 3 factor per component pair:
+// smaller blocks let every thread work.
+constexpr std::size_t kBlock = 256;
+constexpr std::size_t kModelBlock = 16;
 
 // One component as a level scores it: the (conditional) spatial Gaussian and
 // the constant terms of its log-density.
@@ -139,8 +143,10 @@ double pair_log_density(const Component& k, const Eigen::Vector3d& x, double gra
     lp += -0.5 * (kLog2Pi + std::log(cgg)) - 0.5 * dg * dg / cgg;
   }
   // Sigma_k + S is positive definite when Sigma_k is (S is positive
-  // semidefinite): the factor exists.
+  // semidefinite), but rounding can still break a near-singular sum.
   const Eigen::LLT<Eigen::Matrix3d> llt(spatial);
+  require(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0, ErrorCode::Numeric,
+          "registration: a target component plus a source component's covariance is not positive definite");
   prec = llt.solve(Eigen::Matrix3d::Identity());
   lp -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
   return lp - 0.5 * r.dot(prec * r);
@@ -190,6 +196,10 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
     s.logp[j] = lp;
     top = std::max(top, lp);
   }
+  // No component's box holds the item and no outlier term (outlier_ratio
+  // 0): it has no density to move towards and is left out of every sum
+  // (not an inlier), instead of making them NaN.
+  if (top == -std::numeric_limits<double>::infinity()) return;
   double total = std::exp(log_outlier - top);
   for (double lp : s.logp) total += std::exp(lp - top);
   const double lse = top + std::log(total);
@@ -335,7 +345,8 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   // Every `stride`-th point (coarse levels need fewer: their targets are smooth).
   auto evaluate = [&](const Level& level, const Rigid& pose, bool spread, std::size_t stride) {
     const Eigen::Vector3d c = pose.r * centroid + pose.t;
-    const std::size_t used = (n + stride - 1) / stride, blocks = (used + kBlock - 1) / kBlock;
+    const std::size_t block = model_source ? kModelBlock : kBlock;
+    const std::size_t used = (n + stride - 1) / stride, blocks = (used + block - 1) / block;
     partial.assign(blocks, Sums{});
     // A cursor remembers a cell of the index it last read: each level has its
     // own index (rebuilt per level), so every evaluation starts fresh cursors
@@ -344,7 +355,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
     detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
-      for (std::size_t v = blk * kBlock; v < std::min(used, (blk + 1) * kBlock); ++v) {
+      for (std::size_t v = blk * block; v < std::min(used, (blk + 1) * block); ++v) {
         const std::size_t i = v * stride;
         const float* p = points + 4 * i;
         const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;

@@ -155,6 +155,43 @@ TEST(RegistrationModel, ThreadCountDoesNotChangeTheAnswer) {
   EXPECT_EQ(a.iterations, b.iterations);
 }
 
+// Without an outlier term (outlier_ratio 0) an item no target box holds has
+// no density at all: it is left out of the sums (not an inlier) instead of
+// making the pose and the figures NaN, for a model and for points alike.
+TEST(RegistrationModel, AnItemNoComponentReachesIsLeftOutWithoutAnOutlierTerm) {
+  Eigen::Matrix4d cov = Eigen::Matrix4d::Zero();
+  cov.diagonal() << 0.02 * 0.02, 0.03 * 0.03, 0.01 * 0.01, 0.05 * 0.05;
+  const sogmm::Gmm target = single({0.4, -0.1, 1.2, 0.5}, cov);
+  sogmm::Gmm source;
+  source.resize(2);
+  sogmm_test::set_component(source, 0, 0.5, {0.35, -0.08, 1.17, 0.5}, cov);
+  sogmm_test::set_component(source, 1, 0.5, {5.0, 5.0, 5.0, 0.5}, cov);  // metres from every box
+  source.support_size = 1000;
+  sogmm::RegistrationOptions o;
+  o.outlier_ratio = 0.0;
+  o.levels = 1;
+  o.use_gray = false;
+  const sogmm::RegistrationResult r = sogmm::register_model(target, source, kIdentity, o);
+  // The near component's mean lands on the target's (the far one pulls
+  // nothing; which rigid motion does it is not unique with one pair).
+  for (int i = 0; i < 3; ++i) {
+    double moved = r.pose[4 * i + 3];
+    for (int j = 0; j < 3; ++j) moved += r.pose[4 * i + j] * double(source.mean(0)[j]);
+    EXPECT_NEAR(moved, double(target.mean(0)[i]), 1e-9);
+  }
+  EXPECT_TRUE(std::isfinite(r.log_likelihood));
+  EXPECT_DOUBLE_EQ(r.inlier_ratio, 0.5);
+  for (double v : r.information) EXPECT_TRUE(std::isfinite(v));
+  // The same with points: 200 at the source's near mean, one far away.
+  std::vector<float> pts;
+  for (int k = 0; k < 200; ++k) pts.insert(pts.end(), source.mean(0), source.mean(0) + 4);
+  pts.insert(pts.end(), source.mean(1), source.mean(1) + 4);
+  const sogmm::RegistrationResult p = sogmm::register_points(target, pts.data(), 201, kIdentity, o);
+  EXPECT_TRUE(std::isfinite(p.log_likelihood));
+  EXPECT_NEAR(p.inlier_ratio, 200.0 / 201.0, 1e-12);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(std::isfinite(p.pose[4 * i + 3]));
+}
+
 TEST(RegistrationModel, BadInput) {
   const sogmm::Gmm target = corner();
   using sogmm::ErrorCode;

@@ -96,3 +96,16 @@ def test_model_to_model_recovers_a_known_pose():
     # A source model standing for one point: fewer than min_points.
     with pytest.raises(sogmm.InvalidDataError, match="min_points"):
         sogmm.register(planes([0, 1, 2]), model)
+
+
+def test_the_old_keyword_still_works_with_a_warning():
+    model = planes([0, 1, 2])
+    src = model.sample(500, seed=4)
+    with pytest.warns(DeprecationWarning, match="source_points"):
+        old, _ = sogmm.register(source_points=src, target_model=model)
+    new, _ = sogmm.register(src, model)
+    assert np.array_equal(old, new)
+    with pytest.raises(TypeError, match="both"):
+        sogmm.register(src, model, source_points=src)
+    with pytest.raises(TypeError, match="target_model"):
+        sogmm.register(src)

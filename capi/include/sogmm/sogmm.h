@@ -1271,8 +1271,10 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
  * in its own frame) under the model `target`: distribution-to-distribution
  * (D2D) registration. Each source component is scored by the closed-form
  * overlap of its Gaussian, moved by the pose, with each target component
- * (formula: core/include/sogmm/registration.hpp, register_model), counted
- * as many times as the points it stands for (weight x support size); the
+ * (formula: core/include/sogmm/registration.hpp, register_model; each
+ * step holds the source covariances at the current rotation, as GICP does),
+ * counted as many times as the points it stands for (weight x support size,
+ * a support size of 0 taken as the number of components); the
  * outlier term, levels, options, outputs, status and progress are those of
  * sogmm_register_points_f32, the figures per point stood for. A source of a
  * few hundred components registers in a fraction of its points' time.

@@ -37,7 +37,8 @@
 // gray) every error step over 2 mm before the return to the start was such
 // a lag along the motion (18.5
 // and 12.4 mm at frames 129 and 136 after a flush and a refit), ATE 2.55 cm,
-// and 0.56 cm with the rule (README, Registration).
+// and 0.56 cm with the rule (0.63 cm with the one-sample free-space carve
+// of MapOptions::free_space_carve; README, Registration).
 //
 // A converged map registration is not checked against the odometry. Before
 // the rule above, on the loop, inserting at the odometry's pose whenever the two

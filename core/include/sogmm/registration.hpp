@@ -131,11 +131,13 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
 /// transformed mean whose density under target component k is the closed
 /// form of the Gaussian overlap, N(R m_j + t; mu_k, Sigma_k + diag(R, 1)
 /// S_j diag(R, 1)^T) (4-D with use_gray, the spatial marginal otherwise),
-/// counted pi_j x support_size times (the points it stands for; one per
-/// component when support_size is 0), with the same outlier term,
-/// coarse-to-fine levels, Gauss-Newton steps (the source covariance held at
-/// the current rotation within a step), figures and status as
-/// register_points; the log-likelihood and inlier ratio are per point stood
+/// counted pi_j x support_size times (the points it stands for; a
+/// support_size of 0 is taken as the number of components), with the same
+/// outlier term, coarse-to-fine levels, Gauss-Newton steps, figures and
+/// status as register_points. Each step holds the source covariances at the
+/// current rotation (the change of log det(Sigma_k + R S_j R^T) with R is
+/// not followed), so the pose returned is a fixed point of that step, as in
+/// GICP, not exactly the maximum of the overlap objective; the log-likelihood and inlier ratio are per point stood
 /// for. A frame's fit registers in a fraction of its points' time: its
 /// components are few. Errors: as register_points for the target, options
 /// and init; a source without components, or standing for fewer than

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ctypes
+import warnings
 
 import numpy as np
 
@@ -28,7 +29,7 @@ class RegistrationInfo(ctypes.Structure):
     ]
 
 
-def register(source, target_model: GMM, init=None, *, progress: ProgressArg = None,
+def register(source=None, target_model: GMM = None, init=None, *, source_points=None, progress: ProgressArg = None,
              max_iter: int = _D.registration_max_iter, tol: float = _D.registration_tol,
              outlier_ratio: float = _D.registration_outlier_ratio, use_gray: bool = bool(_D.registration_use_gray),
              levels: int = _D.registration_levels, coarse_sigma: float = _D.registration_coarse_sigma,
@@ -46,6 +47,8 @@ def register(source, target_model: GMM, init=None, *, progress: ProgressArg = No
             figures are per point stood for.
         target_model: a fitted GMM (or a Map's exported model).
         init: 4 x 4 rigid initial guess, source to target frame (None = identity).
+        source_points: the keyword this argument had before it also took a
+            model; deprecated (a DeprecationWarning), use ``source``.
 
     Returns ``(pose, info)``: ``pose`` a 4 x 4 float64 array mapping source
     points into the target frame; ``info`` a dict with ``status``
@@ -57,6 +60,13 @@ def register(source, target_model: GMM, init=None, *, progress: ProgressArg = No
     only when converged: check ``info["status"]``. Bad input raises
     (InvalidArgumentError, InvalidDataError) as the C call does.
     """
+    if source_points is not None:
+        if source is not None:
+            raise TypeError("register() got both source and source_points: pass source only")
+        warnings.warn("register(source_points=...) is deprecated: pass source=", DeprecationWarning, stacklevel=2)
+        source = source_points
+    if source is None or target_model is None:
+        raise TypeError("register() needs a source (points or a GMM) and a target_model")
     x = None if isinstance(source, GMM) else _rows(source, (4,), "source")
     start = None if init is None else np.ascontiguousarray(_pose(init))
     pose = np.empty(16, dtype=np.float64)
