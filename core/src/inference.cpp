@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "covariance_storage.hpp"
 #include "gmm_eigen.hpp"
 #include "progress.hpp"
 #include "sogmm/checked.hpp"
@@ -117,9 +118,8 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
     // (Eigen's aliasing), reading entries it already overwrote, and left the
     // map's covariances asymmetric by ~1e-23, so that a saved map was stored
     // in the FULL layout and its reload differed (fuzz_map, issue 36).
-    const Mat4 c = 0.5 * (moved + moved.transpose());
+    const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> c = 0.5 * (moved + moved.transpose());
     for (int i = 0; i < 4; ++i) out.means[4 * k + i] = static_cast<float>(mu[i]);
-    for (int i = 0; i < 16; ++i) out.covariances[16 * k + i] = static_cast<float>(c(i / 4, i % 4));
     // A finite pose can still move a mean out of float32 range (a translation
     // of 1e39): an error here rather than a model that no later call accepts.
     // (Messages are built only on failure: a map has tens of thousands of components.)
@@ -130,10 +130,23 @@ Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose) {
                                                     checked::exact(mu[i]) + ", beyond the float32 range");
     }
     for (int i = 0; i < 16; ++i) {
-      if (!std::isfinite(out.covariances[16 * k + i]))
+      if (!(std::fabs(c(i / 4, i % 4)) <= static_cast<double>(std::numeric_limits<float>::max())))
         throw Error(ErrorCode::InvalidArgument, "pose makes the covariance of component " + std::to_string(k) +
-                                                    " non-finite in float32 (entry " + std::to_string(i) + " = " +
+                                                    " beyond the float32 range (entry " + std::to_string(i) + " = " +
                                                     checked::exact(c(i / 4, i % 4)) + ")");
+    }
+    // Stored as the EM stores its covariances: the nearest float32 rounding
+    // when it is positive definite and within 1e-9 nats (every component of
+    // an ordinary scene: the bits of plain rounding), otherwise the float32
+    // matrix nearest in divergence that is. A thin component turned by a
+    // pose can round to an indefinite matrix (its small eigenvalue is below
+    // the rounding of its large entries), and such a model could not be
+    // saved, scored or sampled (fuzz_api found one: a fit, a transform, a save).
+    try {
+      detail::store_covariance(c.data(), &out.covariances[16 * k]);
+    } catch (const Error& e) {
+      throw Error(ErrorCode::Numeric, "pose: the moved covariance of component " + std::to_string(k) +
+                                          " cannot be stored in float32 (" + e.what() + ")");
     }
   }
   return out;

@@ -2,6 +2,7 @@
 // invariance), paper byte count, and validate().
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
@@ -152,6 +153,47 @@ TEST(Transform, CovariancesAreExactlySymmetric) {
           ASSERT_EQ(c[4 * i + j], c[4 * j + i]) << "rotation " << n << " component " << k << " entry " << i << j;
     }
   }
+}
+
+// A thin component (a 100 m x 100 m sheet 1 cm thick, gray variance 1: its
+// spatial eigenvalues 1e4 and 1e-4 are 1e8 apart, past float32's 2^24) is
+// exact in float32 while axis-aligned; turned by a pose, rounding R Sigma R^T
+// entry by entry loses the small eigenvalue, and for some rotations gives an
+// indefinite matrix that could then not be saved, scored or sampled (fuzz_api:
+// a fit, a transform, a save failing not_spd). Every rotation must give a
+// valid model, and its thin direction must stay thin: the stored matrix's
+// variance along the rotated normal within a factor 4 of 1e-4 (a float32
+// step of an entry near 1e4 is 2^-10 = 9.8e-4, ten times that variance, so
+// plain rounding misses it by up to tens of times or makes it negative; the
+// store picks the roundings whose errors cancel along the normal). The same
+// on every kernel: transform is scalar double arithmetic.
+TEST(Transform, ThinComponentStaysValidAndThinUnderEveryRotation) {
+  sogmm::Gmm thin;
+  thin.resize(1);
+  set_component(thin, 0, 1.0, Eigen::Vector4d(1.0, 2.0, 3.0, 0.5),
+                Eigen::Vector4d(1e4, 1e4, 1e-4, 1.0).asDiagonal().toDenseMatrix());
+  thin.support_size = 10;
+  ASSERT_NO_THROW(sogmm::validate(thin));
+  int was_indefinite = 0;
+  for (int n = 0; n < 200; ++n) {
+    const Eigen::Vector3d axis(std::sin(0.37 * n), std::cos(0.91 * n), 0.3 + std::sin(1.3 * n));
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(0.031 * n + 0.1, axis.normalized()).toRotationMatrix();
+    const sogmm::Gmm b = sogmm::transform(thin, pose_of(r, Eigen::Vector3d(0.5, -1.0, 2.0)));
+    ASSERT_NO_THROW(sogmm::validate(b)) << "rotation " << n;
+    // What plain rounding of R Sigma R^T would have stored (counted to show
+    // the case is reached: the test is void if no rotation needs the store).
+    Eigen::Matrix4d a = Eigen::Matrix4d::Identity();
+    a.topLeftCorner<3, 3>() = r;
+    const Eigen::Matrix4d exact = a * cov_of(thin, 0) * a.transpose();
+    const Eigen::Matrix4d plain = exact.cast<float>().cast<double>();
+    if (Eigen::LLT<Eigen::Matrix4d>(0.5 * (plain + plain.transpose())).info() != Eigen::Success) ++was_indefinite;
+    Eigen::Vector4d normal = Eigen::Vector4d::Zero();
+    normal.head<3>() = r.col(2);
+    const double along = normal.dot(cov_of(b, 0) * normal);
+    EXPECT_GT(along, 0.25e-4) << "rotation " << n;
+    EXPECT_LT(along, 4e-4) << "rotation " << n;
+  }
+  EXPECT_GT(was_indefinite, 0) << "no rotation made plain rounding indefinite: the case is not exercised";
 }
 
 TEST(Transform, DensityAndRegressionInvariant) {

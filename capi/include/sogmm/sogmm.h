@@ -796,7 +796,9 @@ SOGMM_API sogmm_status sogmm_model_merge(sogmm_model** out, const sogmm_model* a
 
 /* New model = `model` moved by the rigid transform `pose` (16 doubles,
  * row-major [R t; 0 1], rules as sogmm_model_set_pose): means -> R mu + t,
- * spatial covariance blocks rotated. Metadata is copied; a stored pose P
+ * spatial covariance blocks rotated (each rounded to the float32 matrix
+ * nearest it that is positive definite, as a fit stores its own, so any valid
+ * model moves to a valid one). Metadata is copied; a stored pose P
  * becomes P * pose^-1 so that the result still maps to the same world. A
  * moved mean or covariance (or the new pose) that is not finite ->
  * SOGMM_E_INVALID_ARG. */

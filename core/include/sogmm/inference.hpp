@@ -88,7 +88,11 @@ Gmm merge(const Gmm& a, const Gmm& b);
 /// mu_xyz -> R mu_xyz + t, Sigma_xx -> R Sigma_xx R^T, Sigma_gx -> Sigma_gx R^T.
 /// Throws Error(InvalidArgument) unless rigid_pose_error(pose) is empty
 /// (sogmm/model.hpp), or when a moved mean or covariance is not finite in
-/// float32 (e.g. a translation of 1e39). The identity returns `gmm` bit for bit.
+/// float32 (e.g. a translation of 1e39). Each moved covariance is stored in
+/// float32 as the EM stores its own (plain rounding when that is positive
+/// definite and within 1e-9 nats, else the nearest rounding that is), so a
+/// thin component stays a valid one under any rotation. The identity returns
+/// `gmm` bit for bit.
 Gmm transform(const Gmm& gmm, const std::array<double, 16>& pose);
 
 /// Bytes of the model as the paper counts them: 4 M (1 + 10 + 4).
