@@ -1,7 +1,9 @@
 // The invariant every model handle satisfies, checked by the fuzz targets that
 // make models through the C API: M >= 1, finite weights >= 0 summing to 1
 // within 1e-4, finite means and covariances with a positive diagonal (no NaN
-// or Inf model ever exists). A violation aborts (see FUZZ_CHECK).
+// or Inf model ever exists), and arrays that sogmm_model_from_arrays_f32
+// accepts (every covariance positive definite as stored). A violation aborts
+// (see FUZZ_CHECK).
 #pragma once
 
 #include <cmath>
@@ -32,6 +34,13 @@ inline std::size_t check_model(const sogmm_model* model) {
   for (float v : cov) FUZZ_CHECK(std::isfinite(v));
   for (std::size_t k = 0; k < m; ++k)
     for (int i = 0; i < 4; ++i) FUZZ_CHECK(cov[16 * k + 5 * i] > 0);  // diagonal of an SPD matrix
+  // Valid by the library's own test (each covariance's symmetric part positive
+  // definite by the Cholesky a file reader makes): the handle rebuilt from its
+  // own arrays. A call that makes a handle no later call accepts is then caught
+  // where it made it, not at a later save (a rotated thin component once was).
+  sogmm_model* rebuilt = nullptr;
+  FUZZ_CHECK(sogmm_model_from_arrays_f32(&rebuilt, m, w.data(), mu.data(), cov.data(), 0) == SOGMM_OK);
+  sogmm_model_free(rebuilt);
   return m;
 }
 
