@@ -465,14 +465,23 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
     // extrapolated one only when it keeps its reg_covar floors.
     std::vector<float> one(kParamStride);
     std::vector<double> one_exact(kParamStride);
-    const detail::EmLoad load = [&](Working& cur, bool extrapolated) {
+    const detail::EmLoad load = [&](Working& cur, const Working* fallback) {
+      bool replaced = false;
       for (std::size_t k = 0; k < m; ++k) {
-        if (!pack_component(cur, k, one.data(), one_exact.data())) return false;
-        if (!extrapolated) continue;
-        Eigen::Matrix4d above = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&cur.covariance[16 * k]);
-        for (int i = 0; i < 4; ++i) above(i, i) -= reg[i];
-        if (Eigen::LLT<Eigen::Matrix4d>(above).info() != Eigen::Success) return false;
+        bool ok = pack_component(cur, k, one.data(), one_exact.data());
+        if (ok && fallback) {
+          Eigen::Matrix4d above = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(&cur.covariance[16 * k]);
+          for (int i = 0; i < 4; ++i) above(i, i) -= reg[i];
+          ok = Eigen::LLT<Eigen::Matrix4d>(above).info() == Eigen::Success;
+        }
+        if (ok) continue;
+        if (!fallback) return false;
+        std::copy_n(&fallback->mean[4 * k], 4, &cur.mean[4 * k]);
+        std::copy_n(&fallback->covariance[16 * k], 16, &cur.covariance[16 * k]);
+        cur.log_weight[k] = fallback->log_weight[k];
+        replaced = true;
       }
+      if (replaced) detail::renormalise_log_weights(cur.log_weight);
       shift = pack_all(cur, reg, data_scale2, params, exact);
       return true;
     };

@@ -21,8 +21,6 @@ constexpr double kStepMax0 = 1.0;
 constexpr double kStepFactor = 4.0;
 // A step length this close to 1 is the plain step (t2 itself).
 constexpr double kPlain = 1.01;
-// Pull-backs of an extrapolation that is not a model before taking t2.
-constexpr int kMaxPullBacks = 8;
 // Log-weights below this (a component without weight, e.g. a warm start's
 // zero weights at -1e30) make differences that mean nothing: plain step.
 constexpr double kLowestLogWeight = -700.0;
@@ -96,13 +94,17 @@ Working squarem_extrapolate(const Working& t0, const Working& t1, const Working&
               mix(t0.log_weight, t1.log_weight, t2.log_weight)};
   // Weights through their logarithms (the softmax parameterisation): any
   // extrapolated log-weights are a distribution once renormalised.
-  double top = -std::numeric_limits<double>::infinity();
-  for (double l : out.log_weight) top = std::max(top, l);
-  double sum = 0.0;
-  for (double l : out.log_weight) sum += std::exp(l - top);
-  const double log_sum = top + std::log(sum);
-  for (double& l : out.log_weight) l -= log_sum;
+  renormalise_log_weights(out.log_weight);
   return out;
+}
+
+void renormalise_log_weights(std::vector<double>& log_weight) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (double l : log_weight) top = std::max(top, l);
+  double sum = 0.0;
+  for (double l : log_weight) sum += std::exp(l - top);
+  const double log_sum = top + std::log(sum);
+  for (double& l : log_weight) l -= log_sum;
 }
 
 void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,
@@ -137,14 +139,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
       continue;
     }
     Working next = squarem_extrapolate(t0, t1, w, a);
-    bool loaded = load(next, true);
-    for (int pull = 0; !loaded && pull < kMaxPullBacks; ++pull) {
-      a = 0.5 * (a + 1.0);
-      if (!(a > kPlain)) break;
-      next = squarem_extrapolate(t0, t1, w, a);
-      loaded = load(next, true);
-    }
-    if (!loaded) continue;  // no extrapolation was a model: t2 is still current
+    load(next, &w);
     t2.mean.swap(w.mean);
     t2.covariance.swap(w.covariance);
     t2.log_weight.swap(w.log_weight);
@@ -160,7 +155,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
       ++report.extrapolations_rejected;
       if (capped) step_max = std::max(kStepMax0, step_max / kStepFactor);
       w = t2;
-      load(w, false);
+      load(w, nullptr);
       report.iterations = iter;
     }
   }

@@ -18,20 +18,24 @@ namespace sogmm::detail {
 /// log-likelihood per point) and writes the M-step's model into `w`, which
 /// becomes current.
 using EmPass = std::function<double(Working& w)>;
-/// Makes `w` the current model; returns false and changes nothing when `w`
-/// is not a model (a covariance not positive definite, a non-finite
-/// constant) or, with `extrapolated`, lies outside the set the M-step maps
-/// into (a covariance minus the reg_covar diagonal not positive definite):
-/// from there the next M-step, which adds the floors back, could lower the
-/// likelihood.
-using EmLoad = std::function<bool(Working& w, bool extrapolated)>;
+/// Makes `w` the current model. With `fallback` (an extrapolation, and the
+/// M-step's model it extrapolates from): every component of `w` that is not
+/// a component (a covariance not positive definite, a non-finite constant)
+/// or lies outside the set the M-step maps into (a covariance minus the
+/// reg_covar diagonal not positive definite: from there the next M-step,
+/// which adds the floors back, could lower the likelihood) is replaced by
+/// `fallback`'s, the log-weights renormalised, and it returns true. Without:
+/// returns false and changes nothing when `w` is not a model.
+using EmLoad = std::function<bool(Working& w, const Working* fallback)>;
 
 /// Runs EM from the current model `w` with SQUAREM steps until
 /// |change of the log-likelihood| < options.tol or options.max_iter passes.
-/// Safeguards: an extrapolated model that is not a model is pulled back
-/// towards t2 (a halved, down to the plain step), and one whose
-/// log-likelihood is below t1's is rejected (the run continues from t2, as
-/// plain EM would). The model returned in `w` is always an M-step's (its
+/// Safeguards: a component whose extrapolation is not one, or leaves its
+/// reg_covar floors, takes the plain step (t2's) while the others
+/// extrapolate (a component of fewer points than dimensions sits on its
+/// floor and would otherwise stop every extrapolation of the model), and an
+/// extrapolated model whose log-likelihood is below t1's is rejected (the run
+/// continues from t2, as plain EM would). The model returned in `w` is always an M-step's (its
 /// floors and the depth floor hold). The EM step after a kept extrapolation
 /// may lower the likelihood slightly (the M-step's reg_covar floors: see
 /// EmOptions::acceleration). `on_iteration`
@@ -43,6 +47,9 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
 /// The extrapolated model t0 + 2 a r + a^2 v (log-weights renormalised).
 /// Exposed for its test.
 Working squarem_extrapolate(const Working& t0, const Working& t1, const Working& t2, double a);
+
+/// Subtracts log(sum exp(l)) from every l, so the weights sum to 1.
+void renormalise_log_weights(std::vector<double>& log_weight);
 
 /// |r| / |v| in the Fisher metric of t0 (sum over components of
 /// w_k (dmu^T S^-1 dmu + tr((S^-1 dS)^2) / 2 + dlogw^2), w_k, S = t0's weight

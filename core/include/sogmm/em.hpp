@@ -63,11 +63,14 @@ struct EmOptions {
   /// F(t0), t2 = F(t1), the model is extrapolated along them (t0 + 2a r +
   /// a^2 v, r = t1 - t0, v = t2 - 2 t1 + t0, a = |r| / |v| in t0's Fisher
   /// metric, capped by a schedule that grows while steps succeed) and one EM
-  /// step is taken from there. An extrapolation that is not a model (a
-  /// covariance not positive definite, or not above its reg_covar floors)
-  /// is pulled back towards t2, and one
-  /// whose log-likelihood is below t1's is rejected, the run continuing from
-  /// t2 as plain EM would. The model returned is an M-step's. Limit: the EM
+  /// step is taken from there. A component whose extrapolation is not one
+  /// (a covariance not positive definite, or not above its reg_covar floors,
+  /// as for a component of fewer points than dimensions) takes the plain
+  /// step t2 while the others extrapolate, and an extrapolation whose
+  /// log-likelihood is below t1's is rejected, the run continuing from t2 as
+  /// plain EM would (measured on livingroom frame 0, d = 5, bandwidth 0.02,
+  /// seeds 0-4: 43.6 passes against plain EM's 55.6, likelihood, held-out
+  /// likelihood and PSNR within the seed spread). The model returned is an M-step's. Limit: the EM
   /// step after a kept extrapolation is not an ascent step (the M-step adds
   /// the reg_covar floors back), so the reported log-likelihood can fall
   /// there (measured: up to 2.5e-4 nats/point on a synthetic scene, where
