@@ -2,7 +2,7 @@
 #include "depth_tiles.hpp"
 
 #include <algorithm>
-#include <cmath>
+#include <limits>
 
 namespace sogmm::detail {
 
@@ -21,19 +21,32 @@ void widen(DepthTiles::Range& r, const DepthTiles::Range& by) {
 DepthTiles::DepthTiles(const std::vector<float>& depth, int width, int height)
     : columns_((width + kTile - 1) / kTile),
       tiles_(static_cast<std::size_t>(columns_) * static_cast<std::size_t>((height + kTile - 1) / kTile)) {
-  for (int v = 0; v < height; ++v)
-    for (int u = 0; u < width; ++u) {
-      const float d = depth[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)];
-      Range pixel;
-      if (std::isnan(d)) {
-        pixel.any_empty = true;
-      } else {
-        pixel.lo = pixel.hi = d;
-        pixel.any_surface = true;
+  // Tile by tile, as selects that vectorize (a NaN compares false, so it
+  // moves neither bound), instead of a branch per pixel: every occupancy
+  // call builds the tiles of every frame it reads. The same ranges: min and
+  // max are exact.
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int v0 = 0; v0 < height; v0 += kTile)
+    for (int u0 = 0; u0 < width; u0 += kTile) {
+      float lo = inf, hi = -inf;
+      bool empty = false;
+      for (int v = v0; v < std::min(height, v0 + kTile); ++v) {
+        const float* row = depth.data() + static_cast<std::size_t>(v) * static_cast<std::size_t>(width);
+        for (int u = u0; u < std::min(width, u0 + kTile); ++u) {
+          const float d = row[u];
+          lo = d < lo ? d : lo;
+          hi = d > hi ? d : hi;
+          empty = empty || d != d;
+        }
       }
-      widen(tiles_[static_cast<std::size_t>(v / kTile) * static_cast<std::size_t>(columns_) +
-                   static_cast<std::size_t>(u / kTile)],
-            pixel);
+      Range& t = tiles_[static_cast<std::size_t>(v0 / kTile) * static_cast<std::size_t>(columns_) +
+                        static_cast<std::size_t>(u0 / kTile)];
+      t.any_empty = empty;
+      t.any_surface = lo <= hi;  // some pixel is not NaN (an infinite depth included)
+      if (t.any_surface) {
+        t.lo = lo;
+        t.hi = hi;
+      }
     }
 }
 

@@ -120,6 +120,12 @@ const std::vector<std::uint32_t>* FrameIndex::candidates(const double x[3]) cons
   return large_.empty() ? nullptr : &large_;
 }
 
+bool FrameIndex::one_cell(const double lo[3], const double hi[3]) const {
+  for (int i = 0; i < 3; ++i)
+    if (cell(lo[i], i) != cell(hi[i], i)) return false;
+  return true;
+}
+
 // occupancy_kernel.cpp repeats this arithmetic (same operations, same order).
 Projection FrameIndex::project(std::uint32_t f, const double x[3]) const {
   const FrameView& v = views_[f];

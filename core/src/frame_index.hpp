@@ -52,6 +52,11 @@ class FrameIndex {
   /// The frames whose widened frustum meets the grid cell of `x` (a superset
   /// of those that see it), in increasing order.
   const std::vector<std::uint32_t>* candidates(const double x[3]) const;
+  /// True when every point of the box [lo, hi] falls in the grid cell of
+  /// `lo` (then candidates() is the same list for all of them: a point's
+  /// cell is monotone in each coordinate, as floor of correctly rounded
+  /// operations).
+  bool one_cell(const double lo[3], const double hi[3]) const;
   /// The projection of world point `x` into frame f.
   Projection project(std::uint32_t f, const double x[3]) const;
   /// Frame f's world-to-camera transform, the camera and the depth range

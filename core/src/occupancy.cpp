@@ -70,7 +70,7 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
 
   // Blocks of points near each other (Z-order), with their boxes and the
   // frames listed in the grid cells of their points (sorted).
-  const std::vector<std::size_t> order = detail::z_ordered(xyz, n, 3, team);
+  const std::vector<std::size_t> order = detail::z_ordered_coarse(xyz, n, 3, team);
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::array<double, 6>> box(blocks);
   std::vector<std::vector<std::uint32_t>> frames(blocks);
@@ -78,7 +78,6 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   detail::parallel_for(blocks, team, 16, [&](std::size_t blk, int) {
     const std::size_t first = blk * kBlock, last = std::min(n, first + kBlock);
     auto& b = box[blk];
-    const std::vector<std::uint32_t>* previous = nullptr;
     for (std::size_t j = first; j < last; ++j) {
       double x[3];
       world_point(xyz, order[j], x);
@@ -86,6 +85,13 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
         b[k] = j == first ? x[k] : std::min(b[k], x[k]);
         b[3 + k] = j == first ? x[k] : std::max(b[3 + k], x[k]);
       }
+    }
+    // Most blocks lie in one grid cell: one look-up gives every point's list.
+    const bool one_cell = index.one_cell(b.data(), b.data() + 3);
+    const std::vector<std::uint32_t>* previous = nullptr;
+    for (std::size_t j = first; j < (one_cell ? first + 1 : last); ++j) {
+      double x[3];
+      world_point(xyz, order[j], x);
       const auto* list = index.candidates(x);
       if (list == nullptr || list == previous) continue;
       previous = list;

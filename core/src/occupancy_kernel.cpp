@@ -10,6 +10,12 @@
 #include <immintrin.h>
 #endif
 
+#if defined(__GNUC__) && !defined(__clang__)
+// GCC 12's AVX-512 intrinsics start from _mm512_undefined_pd() and warn that
+// it "may be used uninitialized" (GCC bug 105593, fixed in 13): not ours.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+
 #include "occupancy_evidence.hpp"
 #include "occupancy_kernel.hpp"
 #include "occupancy_phi.hpp"
@@ -120,6 +126,60 @@ void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) 
   const double* __restrict c = f.phi;
   alignas(64) double e_of[B], b_of[B], o_of[B];
   alignas(64) int kind[B];  // 0: no evidence, 1: whole free, 2: e, b, o
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+  // Eight packed lanes at a time with the table's four coefficients of a
+  // lane read by one 32-byte load and transposed in registers (four gathers
+  // of one double a lane each, which the compiler splits into scalar loads,
+  // were most of this pass). The same operations in the same order as
+  // phi() and the loop below; lanes past k hold stale values whose results
+  // are never read (their table index is clamped like any other).
+  const __m512d kLo = _mm512_set1_pd(PhiTable::kLo), kHi = _mm512_set1_pd(PhiTable::kHi);
+  const __m512d per_unit = _mm512_set1_pd(PhiTable::kPerUnit), cut = _mm512_set1_pd(kExactSigmas);
+  const __m512d minus_cut = _mm512_set1_pd(-kExactSigmas), one = _mm512_set1_pd(1.0), zero = _mm512_setzero_pd();
+  const __m512i low = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13), high = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+  const auto table = [&](__m512d x) {
+    const __m512d inside = _mm512_mask_blend_pd(
+        _mm512_cmp_pd_mask(x, kLo, _CMP_LT_OQ), _mm512_mask_blend_pd(_mm512_cmp_pd_mask(x, kHi, _CMP_GT_OQ), x, kHi),
+        kLo);
+    const __m512d s = _mm512_mul_pd(_mm512_sub_pd(inside, kLo), per_unit);
+    __m256i i = _mm512_cvttpd_epi32(s);
+    i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(PhiTable::kIntervals - 1));
+    const __m512d t = _mm512_sub_pd(s, _mm512_cvtepi32_pd(i));
+    alignas(32) int q[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(q), _mm256_slli_epi32(i, 2));
+    const auto pair = [&](int a, int b) {
+      return _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_loadu_pd(c + q[a])), _mm256_loadu_pd(c + q[b]), 1);
+    };
+    const __m512d r04 = pair(0, 4), r15 = pair(1, 5), r26 = pair(2, 6), r37 = pair(3, 7);
+    const __m512d t0 = _mm512_unpacklo_pd(r04, r15), t1 = _mm512_unpackhi_pd(r04, r15);
+    const __m512d t2 = _mm512_unpacklo_pd(r26, r37), t3 = _mm512_unpackhi_pd(r26, r37);
+    const __m512d c0 = _mm512_permutex2var_pd(t0, low, t2), c1 = _mm512_permutex2var_pd(t1, low, t3);
+    const __m512d c2 = _mm512_permutex2var_pd(t0, high, t2), c3 = _mm512_permutex2var_pd(t1, high, t3);
+    const __m512d v = _mm512_add_pd(c0, _mm512_mul_pd(t, _mm512_add_pd(c1, _mm512_mul_pd(t, _mm512_add_pd(c2, _mm512_mul_pd(t, c3))))));
+    return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(x, minus_cut, _CMP_LT_OQ),
+                                _mm512_mask_blend_pd(_mm512_cmp_pd_mask(x, cut, _CMP_GT_OQ), v, one), zero);
+  };
+  const __m512d hv = _mm512_set1_pd(h), sigmav = _mm512_set1_pd(sigma);
+  for (int m = 0; m < k; m += 8) {
+    const __m512d p2 = _mm512_load_pd(band_depth + m);
+    const __m512d ray = _mm512_div_pd(_mm512_sqrt_pd(_mm512_load_pd(band_norm2 + m)), p2);
+    const __m512d gap = _mm512_sub_pd(_mm512_mul_pd(p2, ray), _mm512_mul_pd(_mm512_load_pd(band_surface + m), ray));
+    const __m512d front = _mm512_div_pd(_mm512_add_pd(gap, hv), sigmav);
+    const __m512d back = _mm512_div_pd(_mm512_sub_pd(gap, hv), sigmav);
+    const __m512d e = _mm512_sub_pd(one, table(front));
+    const __m512d b = table(back);
+    const __m512d o = _mm512_sub_pd(_mm512_sub_pd(one, e), b);
+    const __mmask8 whole = _mm512_cmp_pd_mask(front, minus_cut, _CMP_LT_OQ);
+    const __mmask8 none = _mm512_cmp_pd_mask(back, cut, _CMP_GT_OQ);
+    const __m256i two = _mm256_set1_epi32(2);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(kind + m),
+                       _mm256_mask_blend_epi32(whole, _mm256_mask_blend_epi32(none, two, _mm256_setzero_si256()),
+                                               _mm256_set1_epi32(1)));
+    _mm512_store_pd(e_of + m, e);
+    _mm512_store_pd(b_of + m, b);
+    _mm512_store_pd(o_of + m, _mm512_mask_blend_pd(_mm512_cmp_pd_mask(zero, o, _CMP_LT_OQ), zero, o));
+  }
+#else
 #pragma omp simd
   for (int m = 0; m < k; ++m) {
     const double ray = std::sqrt(band_norm2[m]) / band_depth[m];
@@ -134,6 +194,7 @@ void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) 
     b_of[m] = b;
     o_of[m] = 0.0 < o ? o : 0.0;  // std::max(0.0, o)
   }
+#endif
   for (int m = 0; m < k; ++m) {
     const int j = list[m];
     if (kind[m] == 1) {

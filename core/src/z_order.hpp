@@ -58,13 +58,10 @@ inline void sort_by_key(std::vector<std::pair<std::uint64_t, std::size_t>>& v) {
   }
 }
 
-/// The permutation of n points (rows of `width` floats, x y z first) along a
-/// Z-order curve over their bounding box (2^16 cells a side), ties in index
-/// order. Keys run on `team` threads, the sort on one (sort_by_key): the
-/// order is the same for any team.
-inline std::vector<std::size_t> z_ordered(const float* points, std::size_t n, int width, int team) {
-  if (n == 0) return {};
-  double lo[3], hi[3];
+/// The bounding box of n points (rows of `width` floats, x y z first) and
+/// the scale that maps its longest side onto `cells` - 1 (0 for one point).
+inline double z_box(const float* points, std::size_t n, int width, double cells, double lo[3]) {
+  double hi[3];
   for (int j = 0; j < 3; ++j) lo[j] = hi[j] = points[j];
   for (std::size_t i = 1; i < n; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -73,17 +70,73 @@ inline std::vector<std::size_t> z_ordered(const float* points, std::size_t n, in
     }
   double extent = 0.0;
   for (int j = 0; j < 3; ++j) extent = std::max(extent, hi[j] - lo[j]);
-  const double scale = extent > 0 ? 65535.0 / extent : 0.0;
+  return extent > 0 ? (cells - 1.0) / extent : 0.0;
+}
+
+/// The Z-order key of point i's cell in the box of z_box (cells a side).
+inline std::uint64_t z_key(const float* points, std::size_t i, int width, const double lo[3], double scale,
+                           double cells) {
+  std::uint32_t c[3];
+  for (int j = 0; j < 3; ++j)
+    c[j] = static_cast<std::uint32_t>(std::clamp((points[width * i + j] - lo[j]) * scale, 0.0, cells - 1.0));
+  return z_order_key(c[0], c[1], c[2]);
+}
+
+/// The permutation of n points (rows of `width` floats, x y z first) along a
+/// Z-order curve over their bounding box (2^16 cells a side), ties in index
+/// order. Keys run on `team` threads, the sort on one (sort_by_key): the
+/// order is the same for any team.
+inline std::vector<std::size_t> z_ordered(const float* points, std::size_t n, int width, int team) {
+  if (n == 0) return {};
+  constexpr double kCells = 65536.0;
+  double lo[3];
+  const double scale = z_box(points, n, width, kCells, lo);
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
-  parallel_for(n, team, 4096, [&](std::size_t i, int) {
-    std::uint32_t c[3];
-    for (int j = 0; j < 3; ++j)
-      c[j] = static_cast<std::uint32_t>(std::clamp((points[width * i + j] - lo[j]) * scale, 0.0, 65535.0));
-    keyed[i] = {z_order_key(c[0], c[1], c[2]), i};
-  });
+  parallel_for(n, team, 4096, [&](std::size_t i, int) { keyed[i] = {z_key(points, i, width, lo, scale, kCells), i}; });
   sort_by_key(keyed);
   std::vector<std::size_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
+}
+
+/// A cheaper Z-order for callers whose answers do not depend on the order,
+/// only their speed (occupancy: a point's sums run in frame order whatever
+/// its block): 2^10 cells a side (a millimetre or so on a room, finer than
+/// the points of a block of 64 lie apart), the 30-bit key and the index
+/// packed in one word, and three 10-bit radix passes over the key's bits
+/// (stable, so ties stay in index order: the order is unique, whatever the
+/// team). Against z_ordered's six 8-bit passes over (key, index) pairs of
+/// 16 bytes: on 614,400 points it was a sixth of an occupancy query
+/// (single-threaded, while the other thread waits). n >= 2^34: z_ordered.
+inline std::vector<std::size_t> z_ordered_coarse(const float* points, std::size_t n, int width, int team) {
+  constexpr int kAxisBits = 10, kPassBits = 10, kIndexBits = 64 - 3 * kAxisBits;
+  constexpr double kCells = 1 << kAxisBits;
+  if (n >> kIndexBits) return z_ordered(points, n, width, team);
+  if (n == 0) return {};
+  double lo[3];
+  const double scale = z_box(points, n, width, kCells, lo);
+  std::vector<std::uint64_t> word(n), other(n);
+  parallel_for(n, team, 4096, [&](std::size_t i, int) {
+    word[i] = z_key(points, i, width, lo, scale, kCells) << kIndexBits | static_cast<std::uint64_t>(i);
+  });
+  constexpr std::size_t kDigits = std::size_t{1} << kPassBits;
+  for (int pass = 0; pass < 3 * kAxisBits / kPassBits; ++pass) {
+    const int shift = kIndexBits + kPassBits * pass;
+    std::vector<std::size_t> count(kDigits, 0);
+    for (std::uint64_t w : word) ++count[(w >> shift) & (kDigits - 1)];
+    if (count[(word[0] >> shift) & (kDigits - 1)] == n) continue;  // one digit value: the order stands
+    std::size_t at = 0;
+    for (std::size_t& c : count) {
+      const std::size_t k = c;
+      c = at;
+      at += k;
+    }
+    for (std::uint64_t w : word) other[count[(w >> shift) & (kDigits - 1)]++] = w;
+    word.swap(other);
+  }
+  std::vector<std::size_t> order(n);
+  constexpr std::uint64_t kIndexMask = (std::uint64_t{1} << kIndexBits) - 1;
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::size_t>(word[i] & kIndexMask);
   return order;
 }
 

@@ -14,7 +14,13 @@
 // lattice's 175,500 points leave 12 in the last block, so the AVX-512
 // kernel's packing of in-band lanes (eight at a time, masked past the
 // block's end) runs on a partial group too; mutation: its packed lane
-// index without the group's offset j makes points differ.
+// index without the group's offset j makes points differ. A block whose box
+// lies in one cell of the frame index reads one list for all its points
+// (FrameIndex::one_cell); mutation: one_cell true for every box makes 59
+// points differ. The AVX-512 kernel reads the Phi table's four
+// coefficients of a lane with one load and a transpose (default kernel);
+// mutation: coefficient 2 taken from the transpose's low half makes 7312
+// points differ.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -28,6 +28,19 @@ void expect_as_std_sort(const std::vector<std::uint64_t>& keys, const char* what
   EXPECT_EQ(radix, reference) << what;
 }
 
+// The box of n rows of `width` floats (x y z first), recomputed here, and
+// the scale of its longest side onto `cells` - 1.
+double box_scale(const std::vector<float>& rows, int width, double cells, double lo[3]) {
+  double hi[3] = {-1e9, -1e9, -1e9};
+  for (int j = 0; j < 3; ++j) lo[j] = 1e9;
+  for (std::size_t i = 0; i < rows.size() / static_cast<std::size_t>(width); ++i)
+    for (int j = 0; j < 3; ++j) {
+      lo[j] = std::min<double>(lo[j], rows[width * i + j]);
+      hi[j] = std::max<double>(hi[j], rows[width * i + j]);
+    }
+  return (cells - 1.0) / std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+}
+
 }  // namespace
 
 TEST(ZOrder, RadixSortIsStdSortOfKeyIndexPairs) {
@@ -62,13 +75,8 @@ TEST(ZOrder, PointOrderIsTheSameForEveryTeam) {
   std::vector<std::size_t> sorted = one;
   std::sort(sorted.begin(), sorted.end());
   for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(sorted[i], i);
-  double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
-  for (std::size_t i = 0; i < n; ++i)
-    for (int j = 0; j < 3; ++j) {
-      lo[j] = std::min<double>(lo[j], rows[4 * i + j]);
-      hi[j] = std::max<double>(hi[j], rows[4 * i + j]);
-    }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}), scale = 65535.0 / extent;
+  double lo[3];
+  const double scale = box_scale(rows, 4, 65536.0, lo);
   auto key = [&](std::size_t i) {
     std::uint32_t c[3];
     for (int j = 0; j < 3; ++j) c[j] = static_cast<std::uint32_t>(std::clamp((rows[4 * i + j] - lo[j]) * scale, 0.0, 65535.0));
@@ -78,4 +86,36 @@ TEST(ZOrder, PointOrderIsTheSameForEveryTeam) {
     const auto a = std::make_pair(key(one[i - 1]), one[i - 1]), b = std::make_pair(key(one[i]), one[i]);
     ASSERT_LT(a, b) << "at " << i;
   }
+}
+
+// The coarse order of occupancy (z_ordered_coarse): exactly std::sort's order
+// of (key, index) with keys of 2^10 cells a side recomputed here, the same
+// for every team. The points repeat cells (ties by index) and span all three
+// 10-bit passes. Mutation: a pass that shifts by kPassBits * pass without the
+// index bits' offset, or keys of 2^16 cells, break the order asserted here.
+TEST(ZOrder, CoarseOrderIsStdSortOfItsKeysForEveryTeam) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<float> u(-3.0f, 1.0f);
+  std::vector<float> rows;
+  for (int i = 0; i < 30000; ++i) {
+    const float x = (i % 3 == 0) ? -0.25f : u(rng), y = u(rng), z = (i % 11 == 0) ? 0.75f : u(rng);
+    rows.insert(rows.end(), {x, y, z});
+  }
+  const std::size_t n = rows.size() / 3;
+  const auto one = sogmm::detail::z_ordered_coarse(rows.data(), n, 3, 1);
+  EXPECT_EQ(sogmm::detail::z_ordered_coarse(rows.data(), n, 3, 2), one);
+  double lo[3];
+  const double scale = box_scale(rows, 3, 1024.0, lo);
+  Keyed reference(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t c[3];
+    for (int j = 0; j < 3; ++j)
+      c[j] = static_cast<std::uint32_t>(std::clamp((rows[3 * i + j] - lo[j]) * scale, 0.0, 1023.0));
+    reference[i] = {sogmm::detail::z_order_key(c[0], c[1], c[2]), i};
+  }
+  std::sort(reference.begin(), reference.end());
+  ASSERT_EQ(one.size(), n);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(one[i], reference[i].second) << "at " << i;
+  EXPECT_TRUE(sogmm::detail::z_ordered_coarse(rows.data(), 0, 3, 2).empty());
+  EXPECT_EQ(sogmm::detail::z_ordered_coarse(rows.data(), 1, 3, 2), std::vector<std::size_t>{0});
 }
