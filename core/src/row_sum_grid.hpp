@@ -162,10 +162,12 @@ class RowSumGrid {
 
   // A lookup table for the sorted indices keys[begin, end): entry g - keys[begin]
   // is the position of the first key >= g. Returns its offset in table_, or
-  // kNoTable when it would be more than 8 entries per key.
+  // kNoTable when it would have more than 4 entries per key and 16 more (so
+  // the tables hold at most 12 entries per point, in a cloud of rows of two
+  // cells 22 apart; a frame's rows are mostly occupied, ~1-2 per key).
   std::uint32_t tabulate(const std::vector<std::uint32_t>& keys, std::uint32_t begin, std::uint32_t end) {
     const std::uint64_t span = std::uint64_t{keys[end - 1]} - keys[begin] + 1;
-    if (span > 8 * std::uint64_t{end - begin} + 64) return kNoTable;
+    if (span > 4 * std::uint64_t{end - begin} + 16) return kNoTable;
     const auto offset = static_cast<std::uint32_t>(table_.size());
     std::uint32_t at = begin;
     for (std::uint64_t g = keys[begin]; g <= keys[end - 1]; ++g) {
