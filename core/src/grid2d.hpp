@@ -97,55 +97,12 @@ class Grid2d {
   template <typename Visit>
   std::size_t for_each_within(double x, double y, double radius, Visit&& visit) const {
     const double r2 = radius * radius;
-    return for_each_cell(x, y, r2, [&](const Slot& c, bool) {
+    return for_each_cell(x, y, r2, [&](const Slot& c) {
       for (std::uint32_t k = c.begin; k < c.end; ++k) {
         const double dx = sorted_[2 * k] - x, dy = sorted_[2 * k + 1] - y;
         if (dx * dx + dy * dy <= r2) visit(order_[k]);
       }
     });
-  }
-
-  /// Adds the coordinates of the points for_each_within would visit to sx and
-  /// sy and their number to count, in the same order (so the sums are the
-  /// same bit for bit), and returns the same cost. Faster: the points a cell
-  /// holds are read in place, a cell whose box lies inside the disc is summed
-  /// without distance tests, and in the others the tests are gathered before
-  /// the additions so that their outcome is not a branch per point.
-  std::size_t sum_within(double x, double y, double radius, double& sx, double& sy, std::size_t& count) const {
-    const double r2 = radius * radius;
-    double ax = sx, ay = sy;
-    std::size_t m = count;
-    const std::size_t examined = for_each_cell(x, y, r2, [&](const Slot& c, bool inside) {
-      const double* p = sorted_.data();
-      if (inside) {
-        for (std::uint32_t k = c.begin; k < c.end; ++k) {
-          ax += p[2 * k];
-          ay += p[2 * k + 1];
-        }
-        m += c.end - c.begin;
-        return;
-      }
-      constexpr std::uint32_t kChunk = 64;
-      std::uint32_t hit[kChunk];
-      for (std::uint32_t k0 = c.begin; k0 < c.end; k0 += kChunk) {
-        const std::uint32_t k1 = std::min(c.end, k0 + kChunk);
-        std::uint32_t h = 0;
-        for (std::uint32_t k = k0; k < k1; ++k) {
-          const double dx = p[2 * k] - x, dy = p[2 * k + 1] - y;
-          hit[h] = k;
-          h += dx * dx + dy * dy <= r2 ? 1u : 0u;
-        }
-        for (std::uint32_t t = 0; t < h; ++t) {
-          ax += p[2 * hit[t]];
-          ay += p[2 * hit[t] + 1];
-        }
-        m += h;
-      }
-    });
-    sx = ax;
-    sy = ay;
-    count = m;
-    return examined;
   }
 
  private:
@@ -161,14 +118,12 @@ class Grid2d {
     double lo_x, hi_x, lo_y, hi_y;
   };
 
-  // Calls on_cell(slot, inside) for the occupied cells among the 3 x 3 around
+  // Calls on_cell(slot) for the occupied cells among the 3 x 3 around
   // (x, y), in row-major order, except those whose box is farther than
-  // sqrt(r2) from (x, y); `inside` when the whole box is within sqrt(r2).
-  // Both tests are exact for the per-point test dx * dx + dy * dy <= r2 with
-  // dx = px - x: rounding is monotone, so the gap to the box as computed is
-  // never larger, and the distance to the far corner never smaller, than a
-  // member point's as computed. Returns the number of points in the cells
-  // visited.
+  // sqrt(r2) from (x, y). The test is exact for the per-point test dx * dx +
+  // dy * dy <= r2 with dx = px - x: rounding is monotone, so the gap to the
+  // box as computed is never larger than a member point's distance as
+  // computed. Returns the number of points in the cells visited.
   template <typename OnCell>
   std::size_t for_each_cell(double x, double y, double r2, OnCell&& on_cell) const {
     const std::int64_t ix = cx(x), iy = cy(y);
@@ -181,9 +136,8 @@ class Grid2d {
         const double lx = b.lo_x - x, hx = b.hi_x - x, ly = b.lo_y - y, hy = b.hi_y - y;
         const double gap_x = lx > 0 ? lx : (hx < 0 ? hx : 0.0), gap_y = ly > 0 ? ly : (hy < 0 ? hy : 0.0);
         if (gap_x * gap_x + gap_y * gap_y > r2) continue;
-        const double far_x = std::max(lx * lx, hx * hx), far_y = std::max(ly * ly, hy * hy);
         examined += c.end - c.begin;
-        on_cell(c, far_x + far_y <= r2);
+        on_cell(c);
       }
     }
     return examined;

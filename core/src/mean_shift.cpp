@@ -3,11 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <string>
 #include <utility>
 
 #include "grid2d.hpp"
+#include "row_sum_grid.hpp"
 #include "parallel.hpp"
 #include "progress.hpp"
 #include "sogmm/checked.hpp"
@@ -79,13 +79,16 @@ std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, B
     return anchor == BinAnchor::Zero ? checked::to_int<std::int64_t>(std::nearbyint(v / bandwidth), "bin index")
                                      : checked::floor_to_int<std::int64_t>((v - lo) / bandwidth + 0.5, "bin index");
   };
-  std::map<std::pair<std::int64_t, std::int64_t>, int> occupied;  // ordered: seeds in a fixed order
-  for (std::size_t i = 0; i < xy.size(); i += 2) occupied[{cell(xy[i], min_x), cell(xy[i + 1], min_y)}] = 1;
+  // The occupied cells in ascending (x, y) order: seeds in a fixed order.
+  std::vector<std::pair<std::int64_t, std::int64_t>> occupied(xy.size() / 2);
+  for (std::size_t i = 0; i < xy.size(); i += 2) occupied[i / 2] = {cell(xy[i], min_x), cell(xy[i + 1], min_y)};
+  std::sort(occupied.begin(), occupied.end());
+  occupied.erase(std::unique(occupied.begin(), occupied.end()), occupied.end());
   std::vector<double> seeds;
   seeds.reserve(2 * occupied.size());
-  for (const auto& kv : occupied) {
-    seeds.push_back(kv.first.first * bandwidth + min_x);
-    seeds.push_back(kv.first.second * bandwidth + min_y);
+  for (const auto& c : occupied) {
+    seeds.push_back(c.first * bandwidth + min_x);
+    seeds.push_back(c.second * bandwidth + min_y);
   }
   return seeds;
 }
@@ -141,7 +144,11 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
           "mean shift max_iter and stop_fraction must be >= 0");
   const std::size_t n = xy.size() / 2;
   detail::progress_poll();  // serial set-up: a report (and a cancel) between its steps
-  const detail::Grid2d grid(xy.data(), n, bandwidth);
+  // Cells of a quarter bandwidth: most of a disc is then whole cells, while
+  // the rows and cells walked per query stay few (at d = 1 a query tests ~410
+  // points one by one instead of Grid2d's ~1,800; halves and eighths were
+  // slower).
+  const detail::RowSumGrid grid(xy.data(), n, bandwidth, 4);
   detail::progress_poll();
   const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
@@ -156,7 +163,7 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
     for (int it = 0;; ++it) {
       double sx = 0.0, sy = 0.0;
       std::size_t count = 0;
-      checks[s] += grid.sum_within(mx, my, bandwidth, sx, sy, count);
+      checks[s] += grid.sum_within(mx, my, bandwidth * bandwidth, sx, sy, count);
       within = count;
       if (count == 0) break;
       const double nx = sx / count, ny = sy / count;

@@ -2,10 +2,13 @@
 // reference written out here from the header's description: bin seeds, each
 // seed moved to the mean of every point within the bandwidth (found by testing
 // all N points), converged seeds ordered by strength and near duplicates
-// dropped. The one thing the reference takes from the implementation is the
-// order of each sum, which the header fixes (cells of side `bandwidth` from
-// the data minimum in row-major order, points in index order within a cell),
-// so centres and strengths must agree bit for bit.
+// dropped. The implementation adds the coordinates in an order of its own
+// (runs of whole cells as differences of running sums, issue 35), so the
+// reference's means may differ from it by rounding: strengths must agree
+// exactly and centres to 1e-12 (sums of at most 1,500 values below 5, each
+// mean off by a few ulps of its sum, far below the 1e-3 bandwidth stop). On
+// dyadic values every sum is exact in any order, and there centres must agree
+// bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -34,7 +37,7 @@ sogmm::MeanShiftResult brute_force_mean_shift(const std::vector<double>& xy, dou
     min_y = std::min(min_y, xy[2 * i + 1]);
     max_x = std::max(max_x, xy[2 * i]);
   }
-  // Summation order: (row-major cell key, index).
+  // Summation order (any fixed one): (row-major cell key, index).
   const auto nx = static_cast<std::int64_t>(std::floor((max_x - min_x) / h)) + 1;
   std::vector<std::int64_t> key(n);
   for (std::size_t i = 0; i < n; ++i)
@@ -87,11 +90,18 @@ sogmm::MeanShiftResult brute_force_mean_shift(const std::vector<double>& xy, dou
   return r;
 }
 
-void expect_same_as_brute_force(const std::vector<double>& xy, double h, const char* what) {
+// `tolerance` 0: centres bit for bit (dyadic data).
+void expect_same_as_brute_force(const std::vector<double>& xy, double h, const char* what, double tolerance = 0.0) {
   const sogmm::MeanShiftResult got = sogmm::mean_shift_flat(xy, h);
   const sogmm::MeanShiftResult want = brute_force_mean_shift(xy, h);
   EXPECT_EQ(got.strengths, want.strengths) << what << ", bandwidth " << h;
-  EXPECT_EQ(got.centers, want.centers) << what << ", bandwidth " << h;
+  ASSERT_EQ(got.centers.size(), want.centers.size()) << what << ", bandwidth " << h;
+  for (std::size_t i = 0; i < got.centers.size(); ++i) {
+    if (tolerance == 0.0)
+      EXPECT_EQ(got.centers[i], want.centers[i]) << what << ", bandwidth " << h << ", centre value " << i;
+    else
+      EXPECT_NEAR(got.centers[i], want.centers[i], tolerance) << what << ", bandwidth " << h << ", centre value " << i;
+  }
 }
 
 // Blobs of different spread and size over a uniform background, like the
@@ -113,9 +123,9 @@ std::vector<double> random_cloud(std::uint64_t seed, std::size_t n) {
 
 }  // namespace
 
-TEST(MeanShiftReference, RandomCloudsMatchBruteForceBitForBit) {
+TEST(MeanShiftReference, RandomCloudsMatchBruteForce) {
   for (std::uint64_t seed : {1u, 2u, 3u})
-    for (double h : {0.02, 0.05, 0.13}) expect_same_as_brute_force(random_cloud(seed, 1500), h, "random cloud");
+    for (double h : {0.02, 0.05, 0.13}) expect_same_as_brute_force(random_cloud(seed, 1500), h, "random cloud", 1e-12);
 }
 
 TEST(MeanShiftReference, QuantisedValuesOnCellEdgesMatchBruteForce) {

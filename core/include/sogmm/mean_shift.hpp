@@ -26,10 +26,11 @@ struct MeanShiftOptions {
 struct MeanShiftResult {
   std::vector<double> centers;        ///< K x 2 row-major
   std::vector<std::size_t> strengths; ///< points within bandwidth of each centre
-  /// Cost of the run: the points each neighbour query examined (including
-  /// duplicate suppression's), i.e. those of the grid cells whose bounding box
-  /// the query's disc reaches. Deterministic and independent of the thread
-  /// count, so tests can bound cost without a clock.
+  /// Cost of the run: the points each neighbour query examined one by one
+  /// (including duplicate suppression's), i.e. those of the grid cells whose
+  /// bounds the query's disc reaches without containing them, plus, for the
+  /// flat mean shift, one per run of cells it took whole. Deterministic and
+  /// independent of the thread count, so tests can bound cost without a clock.
   std::uint64_t neighbour_checks = 0;
   std::size_t size() const { return strengths.size(); }
 };
@@ -57,9 +58,13 @@ void require_mode_count_range(const std::vector<double>& points2d, double bandwi
 /// to the mean of the points within distance `bandwidth` until it moves
 /// <= 1e-3 bandwidth or after 300 steps; converged seeds are ordered by the
 /// number of points within bandwidth (most first) and a seed within bandwidth
-/// of an already kept one is dropped. Radius queries use a sparse grid of cell
-/// size `bandwidth` (only occupied cells are stored), so the cost does not
-/// depend on the bounding box: a far outlier adds one cell and one mode.
+/// of an already kept one is dropped. Radius queries use a sparse grid of
+/// cells a quarter bandwidth wide (only occupied cells and rows are stored)
+/// that adds a run of cells wholly inside the disc as one difference of
+/// running sums, so the cost does not depend on the bounding box (a far
+/// outlier adds one cell and one mode) and most of a disc costs no per-point
+/// test. The points counted are exactly those within the bandwidth; the order
+/// of the additions is the grid's, fixed by the data and the query.
 /// Runs in parallel over seeds; the result does not depend on the thread
 /// count. Throws Error(InvalidArgument) for a bandwidth that is
 /// not bandwidth_is_usable, Error(InvalidData) for empty or non-finite data.
