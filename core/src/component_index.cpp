@@ -227,16 +227,26 @@ void ComponentIndex::query_box(const Box3& box, std::vector<std::uint32_t>& out)
       if (boxes_[k].intersects(box)) out.push_back(static_cast<std::uint32_t>(k));
     return;
   }
+  // As query_point: the entries' float boxes (supersets) against the box
+  // rounded outward reject most misses from contiguous memory; the double
+  // boxes decide.
+  const float flo[3] = {down(box.lo[0]), down(box.lo[1]), down(box.lo[2])};
+  const float fhi[3] = {up(box.hi[0]), up(box.hi[1]), up(box.hi[2])};
   for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
     for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
       for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
         const auto it = cells_.find(pack(x, y, z));
         if (it == cells_.end()) continue;
-        for (const Entry& e : it->second)
-          if (boxes_[e.id].intersects(box)) out.push_back(e.id);
+        for (const Entry& e : it->second) {
+          const bool meets = (fhi[0] >= e.lo[0]) & (flo[0] <= e.hi[0]) & (fhi[1] >= e.lo[1]) &
+                             (flo[1] <= e.hi[1]) & (fhi[2] >= e.lo[2]) & (flo[2] <= e.hi[2]);
+          if (meets && boxes_[e.id].intersects(box)) out.push_back(e.id);
+        }
       }
   for (std::uint32_t id : large_)
     if (boxes_[id].intersects(box)) out.push_back(id);
+  // One cell's ids are ascending and distinct already (cells are kept sorted).
+  if (lo == hi && large_.empty()) return;
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

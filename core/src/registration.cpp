@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "finite_rows.hpp"
 #include "parallel.hpp"
 #include "progress.hpp"
+#include "registration_candidates.hpp"
 #include "sogmm/component_index.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/model.hpp"
@@ -25,11 +27,19 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 constexpr double kLog2Pi = 1.8378770664093453;
+// exp(x) rounds to +0 for x <= kExpZero (its smallest subnormal is
+// exp(-745.13)); exp(x) < 1e-12 for x < kNegligibleExponent.
+constexpr double kExpZero = -746.0;
+constexpr double kNegligibleExponent = -28.0;
 // Items per partial sum: fixed, so sums do not depend on threads. A model
 // source has few items, each costing a 3 x 3 factor per component pair:
 // smaller blocks let every thread work.
 constexpr std::size_t kBlock = 256;
 constexpr std::size_t kModelBlock = 16;
+// How far (metres, per axis) a point may move before its candidate
+// components are looked up again (detail::CandidateCache): a level's first
+// steps move it by centimetres, its last ones by fractions of a millimetre.
+constexpr double kCandidateMargin = 0.01;
 
 // One component as a level scores it: the (conditional) spatial Gaussian and
 // the constant terms of its log-density.
@@ -114,7 +124,6 @@ struct Scratch {
   std::vector<double> logp;
   std::vector<Eigen::Vector3d> res;
   std::vector<Eigen::Matrix3d> prec;  // a model source: each pair's own precision
-  ComponentIndex::Cursor cursor;
 };
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -152,27 +161,27 @@ double pair_log_density(const Component& k, const Eigen::Vector3d& x, double gra
   return lp - 0.5 * r.dot(prec * r);
 }
 
+// The components a model source's item tests: those whose box meets the
+// source component's own 3-sigma box, a superset of those within 3 sigma of
+// the sum of both covariances (sqrt(a + b) <= sqrt(a) + sqrt(b) per axis).
+void model_candidates(const Level& level, const Eigen::Vector3d& x, const Eigen::Matrix4d& spread4,
+                      std::vector<std::uint32_t>& ids) {
+  Box3 box;
+  for (int d = 0; d < 3; ++d) {
+    const double half = 3.0 * std::sqrt(std::max(spread4(d, d), 0.0));
+    box.lo[d] = x(d) - half;
+    box.hi[d] = x(d) + half;
+  }
+  level.index.query_box(box, ids);
+}
+
 // One source item's share, counted `weight` times: x is the transformed
 // point (a model source: its component's mean, with its covariance `spread4`
-// in the target frame; a point: spread4 null), c the perturbation centre.
+// in the target frame; a point: spread4 null), c the perturbation centre,
+// s.ids the components it tests (ascending).
 void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d* spread4,
                  double weight, const Eigen::Vector3d& c, double log_outlier, bool use_gray, bool spread,
                  Scratch& s, Sums& out) {
-  if (spread4) {
-    // The components whose box meets the source component's own 3-sigma
-    // box: a superset of those within 3 sigma of the sum of both covariances
-    // (sqrt(a + b) <= sqrt(a) + sqrt(b) per axis).
-    Box3 box;
-    for (int d = 0; d < 3; ++d) {
-      const double half = 3.0 * std::sqrt(std::max((*spread4)(d, d), 0.0));
-      box.lo[d] = x(d) - half;
-      box.hi[d] = x(d) + half;
-    }
-    level.index.query_box(box, s.ids);
-  } else {
-    const double xyz[3] = {x(0), x(1), x(2)};
-    level.index.query_point(xyz, s.ids, s.cursor);
-  }
   s.logp.resize(s.ids.size());
   s.res.resize(s.ids.size());
   if (spread4) s.prec.resize(s.ids.size());
@@ -200,8 +209,11 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
   // 0): it has no density to move towards and is left out of every sum
   // (not an inlier), instead of making them NaN.
   if (top == -std::numeric_limits<double>::infinity()) return;
+  // exp of an exponent below -746 is +0 (and costs libm's slow underflow
+  // path): such a term adds nothing, so it is skipped with the same sum.
   double total = std::exp(log_outlier - top);
-  for (double lp : s.logp) total += std::exp(lp - top);
+  for (double lp : s.logp)
+    if (lp - top > kExpZero) total += std::exp(lp - top);
   const double lse = top + std::log(total);
   out.log_likelihood += weight * lse;
   const double w_out = std::exp(log_outlier - lse);
@@ -219,6 +231,9 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
   Vec6 gbar = Vec6::Zero();
   Mat6 ggt = Mat6::Zero();
   for (std::size_t j = 0; j < s.ids.size(); ++j) {
+    // Responsibilities below 1e-12 are dropped; exp(-28) < 7e-13, so the
+    // exponent alone decides most of them without calling exp.
+    if (s.logp[j] - lse < kNegligibleExponent) continue;
     const double w = std::exp(s.logp[j] - lse);
     if (w < 1e-12) continue;
     const Eigen::Matrix3d& p = spread4 ? s.prec[j] : level.comps[s.ids[j]].prec;
@@ -343,15 +358,14 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
   std::vector<Sums> partial;
   // Every `stride`-th point (coarse levels need fewer: their targets are smooth).
-  auto evaluate = [&](const Level& level, const Rigid& pose, bool spread, std::size_t stride) {
+  // A point's candidates: `cands` (built on the coarsest level) filtered by
+  // `level`'s own boxes.
+  auto evaluate = [&](const Level& level, detail::CandidateCache& cands, const Rigid& pose, bool spread,
+                      std::size_t stride) {
     const Eigen::Vector3d c = pose.r * centroid + pose.t;
     const std::size_t block = model_source ? kModelBlock : kBlock;
     const std::size_t used = (n + stride - 1) / stride, blocks = (used + block - 1) / block;
     partial.assign(blocks, Sums{});
-    // A cursor remembers a cell of the index it last read: each level has its
-    // own index (rebuilt per level), so every evaluation starts fresh cursors
-    // (a kept one read a freed cell of the previous level's index: ASan).
-    for (Scratch& sc : scratch) sc.cursor = ComponentIndex::Cursor{};
     detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
@@ -360,6 +374,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
         const float* p = points + 4 * i;
         const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
         if (!model_source) {
+          cands.query(i, x, level.index, sc.ids);
           score_point(level, x, p[3], nullptr, 1.0, c, log_outlier, options.use_gray, spread, sc, s);
           continue;
         }
@@ -371,6 +386,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
         Eigen::Matrix4d rot = Eigen::Matrix4d::Identity();
         rot.topLeftCorner<3, 3>() = pose.r;
         const Eigen::Matrix4d moved = rot * cov * rot.transpose();
+        model_candidates(level, x, moved, sc.ids);
         score_point(level, x, p[3], &moved, src.weight(i), c, log_outlier, options.use_gray, spread, sc, s);
       }
       partial[blk] = s;
@@ -385,16 +401,20 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   const std::int32_t levels = options.levels;
   detail::progress_begin(Stage::Registration, std::uint64_t(levels) * std::uint64_t(options.max_iter));
   bool converged = false;
-  Level level;
+  // The coarsest level is kept: the candidate cache is built on its index.
+  Level coarsest, finer;
+  std::optional<detail::CandidateCache> cands;
   for (std::int32_t l = 0; l < levels; ++l) {
     const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
     // Level l of L uses every 2^(L-1-l)-th point (at most 4x fewer), keeping at least min_points.
     std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(levels - 1 - l, 2);
     while (stride > 1 && n / stride < static_cast<std::size_t>(options.min_points)) stride /= 2;
-    level = make_level(target, s, eps, options.use_gray);
+    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray);
+    const Level& level = l == 0 ? coarsest : finer;
+    if (l == 0) cands.emplace(coarsest.index, model_source ? 0 : n, kCandidateMargin);
     converged = false;
     for (std::int32_t it = 0; it < options.max_iter && !converged; ++it) {
-      const Sums sums = evaluate(level, pose, false, stride);
+      const Sums sums = evaluate(level, *cands, pose, false, stride);
       ++result.iterations;
       detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / (model_source ? total_weight : double((n + stride - 1) / stride)));
       const double scale = sums.hessian.diagonal().maxCoeff();
@@ -413,7 +433,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   }
 
   // The figures at the final pose, on the unsmoothed model.
-  const Sums fin = evaluate(level, pose, true, 1);
+  const Sums fin = evaluate(levels == 1 ? coarsest : finer, *cands, pose, true, 1);
   const Mat6 info_c = fin.hessian - fin.spread;  // about the centroid c
   const Eigen::Vector3d c = pose.r * centroid + pose.t;
   // xi_origin = A xi_c with A = [I 0; [c]x I]: information_origin = A^-T info_c A^-1.
