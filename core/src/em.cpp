@@ -460,13 +460,13 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   };
 
   if (options.acceleration == EmAcceleration::Squarem) {
-    // Makes a model current (detail::EmLoad): only when every component
-    // packs as it is, so pack_all then changes nothing in it, and an
-    // extrapolated one only when it keeps its reg_covar floors.
+    // Makes a model current (detail::EmLoad): a component packs as it is
+    // (so pack_all then changes nothing in it) and, extrapolated, keeps its
+    // reg_covar floors, or is replaced by the fallback's (t2's) component.
     std::vector<float> one(kParamStride);
     std::vector<double> one_exact(kParamStride);
     const detail::EmLoad load = [&](Working& cur, const Working* fallback) {
-      bool replaced = false;
+      std::size_t replaced = 0;
       for (std::size_t k = 0; k < m; ++k) {
         bool ok = pack_component(cur, k, one.data(), one_exact.data());
         if (ok && fallback) {
@@ -479,9 +479,10 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         std::copy_n(&fallback->mean[4 * k], 4, &cur.mean[4 * k]);
         std::copy_n(&fallback->covariance[16 * k], 16, &cur.covariance[16 * k]);
         cur.log_weight[k] = fallback->log_weight[k];
-        replaced = true;
+        ++replaced;
       }
-      if (replaced) detail::renormalise_log_weights(cur.log_weight);
+      if (replaced == m) return false;  // nothing extrapolated: the fallback is current already
+      if (replaced > 0) detail::renormalise_log_weights(cur.log_weight);
       shift = pack_all(cur, reg, data_scale2, params, exact);
       return true;
     };

@@ -139,7 +139,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
       continue;
     }
     Working next = squarem_extrapolate(t0, t1, w, a);
-    load(next, &w);
+    if (!load(next, &w)) continue;  // no component extrapolated: t2 stays current
     t2.mean.swap(w.mean);
     t2.covariance.swap(w.covariance);
     t2.log_weight.swap(w.log_weight);

@@ -24,7 +24,8 @@ using EmPass = std::function<double(Working& w)>;
 /// or lies outside the set the M-step maps into (a covariance minus the
 /// reg_covar diagonal not positive definite: from there the next M-step,
 /// which adds the floors back, could lower the likelihood) is replaced by
-/// `fallback`'s, the log-weights renormalised, and it returns true. Without:
+/// `fallback`'s and the log-weights renormalised; it returns false (and
+/// `fallback` stays current) when every component was replaced. Without:
 /// returns false and changes nothing when `w` is not a model.
 using EmLoad = std::function<bool(Working& w, const Working* fallback)>;
 

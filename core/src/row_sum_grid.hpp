@@ -17,7 +17,10 @@
 // monotone, so the computed gap to a box is never larger, and the computed
 // distance to its far side never smaller, than a member point's. So the set
 // of points counted is exactly Grid2d's; only the order of the additions
-// differs (whole runs of cells enter as differences of running sums).
+// differs (whole runs of cells enter as differences of running sums of the
+// coordinates less the cloud's lowest, plus their count times it, so a
+// mean's rounding follows the scene's extent, not its distance from the
+// origin).
 #pragma once
 
 #include <algorithm>
@@ -85,14 +88,18 @@ class RowSumGrid {
       c.hi_x = std::max(c.hi_x, px);
       c.end = static_cast<std::uint32_t>(k + 1);
     }
-    // Running sums of the cells within each row, from the row's first cell.
+    // Running sums of the cells within each row, from the row's first cell,
+    // of the coordinates less the cloud's lowest (min_x_, min_y_): a run's
+    // sum is then a difference of sums as large as the scene's extent times
+    // the row's points, not its distance from the origin times them (at an
+    // offset of 1e9 the plain sums' rounding would move a mean by ~1e-3).
     sums_.resize(cells_.size());
     for (const Row& row : rows_) {
       Sum run{};
       for (std::uint32_t c = row.cell_begin; c < row.cell_end; ++c) {
         for (std::uint32_t k = cells_[c].begin; k < cells_[c].end; ++k) {
-          run.x += points_[2 * k];
-          run.y += points_[2 * k + 1];
+          run.x += points_[2 * k] - min_x_;
+          run.y += points_[2 * k + 1] - min_y_;
         }
         run.count += cells_[c].end - cells_[c].begin;
         sums_[c] = run;
@@ -168,6 +175,9 @@ class RowSumGrid {
   std::uint32_t tabulate(const std::vector<std::uint32_t>& keys, std::uint32_t begin, std::uint32_t end) {
     const std::uint64_t span = std::uint64_t{keys[end - 1]} - keys[begin] + 1;
     if (span > 4 * std::uint64_t{end - begin} + 16) return kNoTable;
+    // Offsets are 32-bit (kNoTable the largest): past that, past ~3.6e8
+    // points, the rest keep the binary search rather than wrap.
+    if (table_.size() + span >= kNoTable) return kNoTable;
     const auto offset = static_cast<std::uint32_t>(table_.size());
     std::uint32_t at = begin;
     for (std::uint64_t g = keys[begin]; g <= keys[end - 1]; ++g) {
@@ -261,27 +271,23 @@ class RowSumGrid {
   }
 
   // Adds the cells [from, to) of `row` whole: their running sums'
-  // difference. Returns 1 (one run) or 0 (empty).
+  // difference, plus their count times the offset the sums left out.
+  // Returns 1 (one run) or 0 (empty).
   std::size_t add_run(const Row& row, std::uint32_t from, std::uint32_t to, Sum& acc) const {
     if (to <= from) return 0;
     const Sum& hi = sums_[to - 1];
-    if (from == row.cell_begin) {
-      acc.x += hi.x;
-      acc.y += hi.y;
-      acc.count += hi.count;
-    } else {
-      const Sum& lo = sums_[from - 1];
-      acc.x += hi.x - lo.x;
-      acc.y += hi.y - lo.y;
-      acc.count += hi.count - lo.count;
-    }
+    const Sum lo = from == row.cell_begin ? Sum{} : sums_[from - 1];
+    const std::size_t count = hi.count - lo.count;
+    acc.x += (hi.x - lo.x) + static_cast<double>(count) * min_x_;
+    acc.y += (hi.y - lo.y) + static_cast<double>(count) * min_y_;
+    acc.count += count;
     return 1;
   }
 
   std::vector<double> points_;  // x, y interleaved, by (row, cell, index)
   std::vector<Row> rows_;       // occupied rows, ascending in y
   std::vector<Cell> cells_;     // occupied cells, by row then x
-  std::vector<Sum> sums_;       // per cell: the row's cells up to and including it
+  std::vector<Sum> sums_;       // per cell: the row's cells up to and including it, less (min_x_, min_y_)
   std::vector<std::uint32_t> row_gy_;   // per row: its cell index along y
   std::vector<std::uint32_t> cell_gx_;  // per cell: its cell index along x
   std::vector<std::uint32_t> table_;    // the lookup tables (tabulate)

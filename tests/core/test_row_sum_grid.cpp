@@ -105,3 +105,34 @@ TEST(RowSumGrid, AnyRadiusStillExact) {
       }
   }
 }
+
+// Far from the origin the whole cells' running sums must not carry the
+// offset: 100,000 points 1 mm apart along a row at (1e9, 1e9), discs of
+// radius 5 mm (about 10 points, 6 of them in whole cells). Sums of plain
+// coordinates along the row reach 1e14, whose rounding (ulp 0.016) would
+// move a disc's mean by ~1e-3; the grid sums coordinates less the cloud's
+// lowest, so each mean must agree with brute force's (plain summation of
+// ~10 values near 1e9: ~1e-7) within 1e-6. Brute force's count must match
+// exactly (the same predicate on the same doubles). Plain double arithmetic:
+// the same on every kernel.
+TEST(RowSumGrid, MeansFarFromTheOriginKeepTheirPrecision) {
+  constexpr double kOffset = 1e9;
+  std::vector<double> xy;
+  for (int i = 0; i < 100000; ++i) {
+    xy.push_back(kOffset + 0.001 * i);
+    xy.push_back(kOffset + 0.0001 * (i % 7));
+  }
+  const double radius = 0.005;
+  const sogmm::detail::RowSumGrid grid(xy.data(), xy.size() / 2, radius, 4);
+  for (int q : {10, 5000, 50000, 99990}) {
+    const double x = kOffset + 0.001 * q + 0.0003, y = kOffset + 0.0002;
+    double sx = 0.0, sy = 0.0;
+    std::size_t count = 0;
+    grid.sum_within(x, y, radius * radius, sx, sy, count);
+    const Sums want = brute_force(xy, x, y, radius * radius);
+    ASSERT_EQ(count, want.count) << "query at point " << q;
+    ASSERT_GT(count, 5u);
+    EXPECT_NEAR(sx / count, want.x / want.count, 1e-6) << "query at point " << q;
+    EXPECT_NEAR(sy / count, want.y / want.count, 1e-6) << "query at point " << q;
+  }
+}
