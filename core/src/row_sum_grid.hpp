@@ -18,7 +18,7 @@
 // distance to its far side never smaller, than a member point's. So the set
 // of points counted is exactly Grid2d's; only the order of the additions
 // differs (whole runs of cells enter as differences of running sums of the
-// coordinates less the cloud's lowest, plus their count times it, so a
+// coordinates less their row's first point, plus their count times it, so a
 // mean's rounding follows the scene's extent, not its distance from the
 // origin).
 #pragma once
@@ -72,7 +72,7 @@ class RowSumGrid {
       const auto gx = static_cast<std::uint32_t>(keyed[k].first);
       const bool new_row = k == 0 || gy != static_cast<std::uint32_t>(keyed[k - 1].first >> 32);
       if (new_row) {
-        rows_.push_back(Row{py, py, static_cast<std::uint32_t>(cells_.size()), 0, kNoTable});
+        rows_.push_back(Row{py, py, static_cast<std::uint32_t>(cells_.size()), 0, kNoTable, px, py});
         row_gy_.push_back(gy);
       }
       if (new_row || keyed[k].first != keyed[k - 1].first) {
@@ -89,17 +89,18 @@ class RowSumGrid {
       c.end = static_cast<std::uint32_t>(k + 1);
     }
     // Running sums of the cells within each row, from the row's first cell,
-    // of the coordinates less the cloud's lowest (min_x_, min_y_): a run's
-    // sum is then a difference of sums as large as the scene's extent times
-    // the row's points, not its distance from the origin times them (at an
-    // offset of 1e9 the plain sums' rounding would move a mean by ~1e-3).
+    // of the coordinates less the row's first point: a run's sum is then a
+    // difference of sums as large as the scene's extent times the row's
+    // points, not its distance from the origin times them (at an offset of
+    // 1e9 the plain sums' rounding would move a mean by ~1e-3), and a run of
+    // one point, or of equal points, adds their coordinates exactly.
     sums_.resize(cells_.size());
     for (const Row& row : rows_) {
       Sum run{};
       for (std::uint32_t c = row.cell_begin; c < row.cell_end; ++c) {
         for (std::uint32_t k = cells_[c].begin; k < cells_[c].end; ++k) {
-          run.x += points_[2 * k] - min_x_;
-          run.y += points_[2 * k + 1] - min_y_;
+          run.x += points_[2 * k] - row.origin_x;
+          run.y += points_[2 * k + 1] - row.origin_y;
         }
         run.count += cells_[c].end - cells_[c].begin;
         sums_[c] = run;
@@ -145,6 +146,7 @@ class RowSumGrid {
     double lo_y, hi_y;                  // the box of the row's points in y
     std::uint32_t cell_begin, cell_end;  // its cells, ascending in x
     std::uint32_t table;                // offset of its lookup table in table_, or kNoTable
+    double origin_x, origin_y;          // its first point: what its running sums leave out
   };
   struct Cell {
     double lo_x, hi_x;        // the box of the cell's points in x
@@ -278,8 +280,8 @@ class RowSumGrid {
     const Sum& hi = sums_[to - 1];
     const Sum lo = from == row.cell_begin ? Sum{} : sums_[from - 1];
     const std::size_t count = hi.count - lo.count;
-    acc.x += (hi.x - lo.x) + static_cast<double>(count) * min_x_;
-    acc.y += (hi.y - lo.y) + static_cast<double>(count) * min_y_;
+    acc.x += (hi.x - lo.x) + static_cast<double>(count) * row.origin_x;
+    acc.y += (hi.y - lo.y) + static_cast<double>(count) * row.origin_y;
     acc.count += count;
     return 1;
   }
@@ -287,7 +289,7 @@ class RowSumGrid {
   std::vector<double> points_;  // x, y interleaved, by (row, cell, index)
   std::vector<Row> rows_;       // occupied rows, ascending in y
   std::vector<Cell> cells_;     // occupied cells, by row then x
-  std::vector<Sum> sums_;       // per cell: the row's cells up to and including it, less (min_x_, min_y_)
+  std::vector<Sum> sums_;       // per cell: the row's cells up to and including it, less the row's origin
   std::vector<std::uint32_t> row_gy_;   // per row: its cell index along y
   std::vector<std::uint32_t> cell_gx_;  // per cell: its cell index along x
   std::vector<std::uint32_t> table_;    // the lookup tables (tabulate)
