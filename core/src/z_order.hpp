@@ -29,33 +29,47 @@ inline std::uint64_t z_order_key(std::uint64_t c0, std::uint64_t c1, std::uint64
   return spread_bits(c0) | spread_bits(c1) << 1 | spread_bits(c2) << 2;
 }
 
-/// Sorts (key, index) pairs whose indices are 0..n-1 in order, as std::sort
-/// would sort the pairs: by key, ties by index. A least-significant-digit
-/// radix sort on the key, 8 bits a pass, is stable, so equal keys keep their
-/// ascending indices and the result is exactly std::sort's (the order is
-/// unique, whatever the thread count). Passes whose byte is the same for
-/// every key are skipped (a Z-order key of 2^16 cells a side has 48 bits).
-/// Why not std::sort: on 614,400 occupancy points it was 13% of a query
-/// (perf), a radix pass is one read and one scatter.
-inline void sort_by_key(std::vector<std::pair<std::uint64_t, std::size_t>>& v) {
+/// Sorts v stably by the low `key_bits` bits of key(e), a least-significant-
+/// digit radix sort of `digit_bits` a pass: one read counts every pass's
+/// digits, then each pass is one scatter, and a pass whose digit is the same
+/// for every element is skipped (the order stands). Stable, so elements of
+/// equal keys keep their order: the result is unique, whatever the threads.
+template <typename T, typename Key>
+void radix_sort(std::vector<T>& v, int key_bits, int digit_bits, Key key) {
   const std::size_t n = v.size();
   if (n < 2) return;
-  std::vector<std::size_t> count(8 * 256, 0);
-  for (const auto& e : v)
-    for (int b = 0; b < 8; ++b) ++count[256 * b + ((e.first >> (8 * b)) & 0xff)];
-  std::vector<std::pair<std::uint64_t, std::size_t>> other(n);
-  for (int b = 0; b < 8; ++b) {
-    std::size_t* c = &count[256 * static_cast<std::size_t>(b)];
-    if (c[(v[0].first >> (8 * b)) & 0xff] == n) continue;  // one byte value: the order stands
+  const std::size_t digits = std::size_t{1} << digit_bits;
+  const std::uint64_t mask = digits - 1;
+  const int passes = (key_bits + digit_bits - 1) / digit_bits;
+  std::vector<std::size_t> count(static_cast<std::size_t>(passes) * digits, 0);
+  for (const T& e : v) {
+    const std::uint64_t k = key(e);
+    for (int p = 0; p < passes; ++p) ++count[digits * p + ((k >> (digit_bits * p)) & mask)];
+  }
+  std::vector<T> other(n);
+  for (int p = 0; p < passes; ++p) {
+    const int shift = digit_bits * p;
+    std::size_t* c = &count[digits * p];
+    if (c[(key(v[0]) >> shift) & mask] == n) continue;
     std::size_t at = 0;
-    for (int d = 0; d < 256; ++d) {
+    for (std::size_t d = 0; d < digits; ++d) {
       const std::size_t k = c[d];
       c[d] = at;
       at += k;
     }
-    for (const auto& e : v) other[c[(e.first >> (8 * b)) & 0xff]++] = e;
+    for (const T& e : v) other[c[(key(e) >> shift) & mask]++] = e;
     v.swap(other);
   }
+}
+
+/// Sorts (key, index) pairs whose indices are 0..n-1 in order, as std::sort
+/// would sort the pairs: by key, ties by index (radix_sort is stable, so equal
+/// keys keep their ascending indices), 8 bits a pass (a Z-order key of 2^16
+/// cells a side has 48 bits: its top two passes are skipped).
+/// Why not std::sort: on 614,400 occupancy points it was 13% of a query
+/// (perf), a radix pass is one read and one scatter.
+inline void sort_by_key(std::vector<std::pair<std::uint64_t, std::size_t>>& v) {
+  radix_sort(v, 64, 8, [](const std::pair<std::uint64_t, std::size_t>& e) { return e.first; });
 }
 
 /// The bounding box of n points (rows of `width` floats, x y z first) and
@@ -115,25 +129,11 @@ inline std::vector<std::size_t> z_ordered_coarse(const float* points, std::size_
   if (n == 0) return {};
   double lo[3];
   const double scale = z_box(points, n, width, kCells, lo);
-  std::vector<std::uint64_t> word(n), other(n);
+  std::vector<std::uint64_t> word(n);
   parallel_for(n, team, 4096, [&](std::size_t i, int) {
     word[i] = z_key(points, i, width, lo, scale, kCells) << kIndexBits | static_cast<std::uint64_t>(i);
   });
-  constexpr std::size_t kDigits = std::size_t{1} << kPassBits;
-  for (int pass = 0; pass < 3 * kAxisBits / kPassBits; ++pass) {
-    const int shift = kIndexBits + kPassBits * pass;
-    std::vector<std::size_t> count(kDigits, 0);
-    for (std::uint64_t w : word) ++count[(w >> shift) & (kDigits - 1)];
-    if (count[(word[0] >> shift) & (kDigits - 1)] == n) continue;  // one digit value: the order stands
-    std::size_t at = 0;
-    for (std::size_t& c : count) {
-      const std::size_t k = c;
-      c = at;
-      at += k;
-    }
-    for (std::uint64_t w : word) other[count[(w >> shift) & (kDigits - 1)]++] = w;
-    word.swap(other);
-  }
+  radix_sort(word, 3 * kAxisBits, kPassBits, [](std::uint64_t w) { return w >> kIndexBits; });
   std::vector<std::size_t> order(n);
   constexpr std::uint64_t kIndexMask = (std::uint64_t{1} << kIndexBits) - 1;
   for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::size_t>(word[i] & kIndexMask);
