@@ -11,9 +11,10 @@ log-likelihood at most 0.05 below).
 
 Usage: seed_spread.py [--sogmm build/tools/sogmm/sogmm] [--data ../shared/data/rgbd]
                       [--seeds 20] [--n-init 1] [--csv out.csv]
-                      [--truncate NATS] [--em-acceleration none|squarem] [--case livingroom:0.02 ...]
+                      [--truncate NATS] [--em-acceleration none|squarem] [--tol TOL] [--case livingroom:0.02 ...]
 --truncate passes the truncated E-step's cutoff to every fit (0, the default:
-exact); --em-acceleration picks plain EM or SQUAREM (default: the library's); --case restricts the run to the given frame:bandwidth cases.
+exact); --em-acceleration picks plain EM or SQUAREM (default: the library's); --tol sets EM's
+tolerance on the mean log-likelihood (default: the library's); --case restricts the run to the given frame:bandwidth cases.
 """
 import argparse
 import csv
@@ -62,6 +63,7 @@ def main():
     ap.add_argument("--csv", help="also write every run to this CSV file")
     ap.add_argument("--truncate", type=float, default=0.0, help="truncated E-step cutoff in nats (0: exact)")
     ap.add_argument("--em-acceleration", choices=("none", "squarem"), help="EM acceleration of every fit")
+    ap.add_argument("--tol", type=float, help="EM tolerance of every fit (default: the library's)")
     ap.add_argument("--case", action="append", default=[], help="frame:bandwidth to run (repeatable; default all)")
     a = ap.parse_args()
     if not os.path.isdir(a.data):
@@ -86,7 +88,8 @@ def main():
         for seed in range(a.seeds):
             cmd = [a.sogmm, "eval"] + frame_args(a.data, frame) + [
                 "--decimate", "5", "--bandwidth", str(bw), "--seed", str(seed), "--n-init", str(a.n_init), "--truncate", str(a.truncate),
-                "--json"] + (["--em-acceleration", a.em_acceleration] if a.em_acceleration else [])
+                "--json"] + (["--em-acceleration", a.em_acceleration] if a.em_acceleration else []) + (
+                ["--tol", str(a.tol)] if a.tol is not None else [])
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
                 sys.exit("seed_spread: %s failed: %s" % (" ".join(cmd), p.stderr.strip()))
