@@ -61,4 +61,11 @@ Gmm round_to_precision(const Gmm& gmm, double precision) {
   return out;
 }
 
+Pose recorded_pose(const Pose& pose, double precision) {
+  if (!(precision > 0)) return pose;
+  Pose out = pose;
+  for (int i = 0; i < 12; ++i) out[i] = std::ldexp(std::nearbyint(std::ldexp(pose[i], -kPoseGridLog2)), kPoseGridLog2);
+  return out;
+}
+
 }  // namespace sogmm::detail

@@ -228,7 +228,7 @@ FrameStats insert_frame(Map::State& s, Map& map, const PointsView& points, const
   const Pose pose = detail::anchored(s.origin, world_pose);
   FrameStats f;
   f.index = s.frames.size();
-  f.pose = world_pose;
+  f.pose = detail::recorded_pose(world_pose, s.options.component_precision);
   f.n_points = points.size;
   const auto t0 = std::chrono::steady_clock::now();
   detail::PendingFrame novel;

@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "component_precision.hpp"
 #include "map_state.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
@@ -181,7 +182,7 @@ MapMergeStats Map::merge_map(const Map& other_map, const Pose& other_to_this) {
   for (const FrameStats& f : o.frames) {
     FrameStats g = f;
     g.index = frames.size();
-    g.pose = compose_poses(other_to_this, f.pose);
+    g.pose = detail::recorded_pose(compose_poses(other_to_this, f.pose), s.options.component_precision);
     // No warm start may take these frames for the batches of this map.
     g.n_components = 0;
     frames.push_back(g);

@@ -38,7 +38,18 @@ struct Tweaks {
   /// Key/values packed in the body (spec/format.md 2.5.1; the caller sets
   /// features bit 1): the metadata keeps only the entry that locates them.
   bool pack_key_values = false;
+  /// A map (a model with a `map_frames` entry) written as format 1.3, its
+  /// frame lines as the binary record (spec/format.md 2.3.2); false: as text,
+  /// as format 1.0 wrote it (for the tests that old map files still read).
+  bool compact_maps = true;
+  /// The frame record's locating value and stored bytes written as given
+  /// (hostile records for the tests of step 21 and the conformance vectors).
+  std::optional<std::string> frame_record_entry;
+  std::optional<std::vector<std::uint8_t>> frame_record_stored;
 };
+
+/// The format version of a map file with the frame record (bits 1 and 3).
+inline constexpr std::uint16_t kMinorFrameRecord = 3;
 
 /// The version and feature bits of a map delta (spec/format.md sections 2.5
 /// and 2.5.1): written as format 1.2 with features_required bit 0 and its

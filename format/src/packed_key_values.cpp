@@ -19,21 +19,43 @@ const ErrorCode F = ErrorCode::Format;
   fail(F, "bad_metadata", std::string("key ") + kPackedKeyValuesKey + ": " + why);
 }
 
-// Four decimal counts "codec stored decoded crc", digits only, 1-19 each.
-void parse_entry(const std::string& text, std::uint64_t (&out)[4]) {
+}  // namespace
+
+std::uint64_t body_range(const Header& header, const BodyLocator& loc, std::uint64_t end,
+                         const std::uint64_t (&array_ranges)[3][2], std::uint64_t decoded_so_far,
+                         const ReadOptions& options, const std::string& what) {
+  // The cap (each count below 10^19 or the cap, so no overflow).
+  if (loc.decoded > options.max_decoded_bytes || decoded_so_far > options.max_decoded_bytes - loc.decoded)
+    fail(ErrorCode::Limit, "limit",
+         "arrays and " + what + " declare " + std::to_string(decoded_so_far) + " + " + std::to_string(loc.decoded) +
+             " decoded bytes, over the cap of " + std::to_string(options.max_decoded_bytes));
+  if (loc.stored > end - body_start(header)) fail(F, "bad_layout", what + ": stored bytes lie outside the body");
+  const std::uint64_t begin = end - loc.stored;
+  if (loc.codec == kCodecNone && loc.stored != loc.decoded)
+    fail(F, "bad_layout", what + ": uncompressed but stored length differs from decoded length");
+  for (const auto& r : array_ranges) {
+    if (loc.stored > 0 && r[1] > 0 && begin < r[0] + r[1] && r[0] < end) fail(F, "bad_layout", what + " overlap an array");
+  }
+  return begin;
+}
+
+BodyLocator parse_locator(const char* key, const std::string& text) {
+  auto bad = [key](const std::string& why) { fail(F, "bad_metadata", std::string("key ") + key + ": " + why); };
+  std::uint64_t out[4];
   std::size_t at = 0;
   for (int i = 0; i < 4; ++i) {
     const std::size_t end = i < 3 ? text.find(' ', at) : text.size();
-    if (end == std::string::npos) bad_entry("'" + text + "' is not four counts separated by single spaces");
+    if (end == std::string::npos) bad("'" + text + "' is not four counts separated by single spaces");
     const std::string token = text.substr(at, end - at);
     if (token.empty() || token.size() > 19 || token.find_first_not_of("0123456789") != std::string::npos)
-      bad_entry("'" + text + "' is not four decimal counts");
+      bad("'" + text + "' is not four decimal counts");
     out[i] = std::stoull(token);
     at = end + 1;
   }
+  if (out[0] > 1) bad("codec " + std::to_string(out[0]) + " is not 0 (none) or 1 (zstd)");
+  if (out[3] > 0xFFFFFFFFu) bad("crc32c " + std::to_string(out[3]) + " is above 2^32 - 1");
+  return BodyLocator{out[0], out[1], out[2], out[3]};
 }
-
-}  // namespace
 
 PackedKeyValues pack_key_values(const std::vector<std::pair<std::string, std::string>>& entries,
                                 const WriteOptions& options) {
@@ -62,34 +84,20 @@ PackedKeyValues pack_key_values(const std::vector<std::pair<std::string, std::st
   return out;
 }
 
-void unpack_key_values(const Source& src, const Header& header, const std::uint64_t (&array_ranges)[3][2],
-                       std::uint64_t arrays_decoded, const ReadOptions& options, Model& model) {
+PackedExtent unpack_key_values(const Source& src, const Header& header, const std::uint64_t (&array_ranges)[3][2],
+                               std::uint64_t arrays_decoded, const ReadOptions& options, Model& model) {
   // 20a. the entry
   auto it = std::find_if(model.key_values.begin(), model.key_values.end(),
                          [](const auto& kv) { return kv.first == kPackedKeyValuesKey; });
   if (it == model.key_values.end()) bad_entry("missing, but feature bit 1 (packed_key_values) is set");
-  std::uint64_t v[4];
-  parse_entry(it->second, v);
-  const std::uint64_t codec = v[0], stored = v[1], decoded = v[2], crc = v[3];
-  if (codec > 1) bad_entry("codec " + std::to_string(codec) + " is not 0 (none) or 1 (zstd)");
-  if (crc > 0xFFFFFFFFu) bad_entry("crc32c " + std::to_string(crc) + " is above 2^32 - 1");
+  const BodyLocator loc = parse_locator(kPackedKeyValuesKey, it->second);
+  const std::uint64_t codec = loc.codec, stored = loc.stored, decoded = loc.decoded, crc = loc.crc;
   if (decoded < 2) bad_entry("decoded length " + std::to_string(decoded) + " holds no entry");
   model.key_values.erase(it);
-  // 20b. the cap, with the arrays' bytes (each below 10^19, so no overflow)
-  if (decoded > options.max_decoded_bytes || arrays_decoded > options.max_decoded_bytes - decoded)
-    fail(ErrorCode::Limit, "limit",
-         "arrays and packed key/values declare " + std::to_string(arrays_decoded) + " + " + std::to_string(decoded) +
-             " decoded bytes, over the cap of " + std::to_string(options.max_decoded_bytes));
-  // 20c. layout: the last stored bytes of the body
+  // 20b-c. the cap, and the last stored bytes of the body
   const std::uint64_t end = header.file_length - kTrailerSize;
-  if (stored > end - body_start(header)) fail(F, "bad_layout", "packed key/values: stored bytes lie outside the body");
-  const std::uint64_t begin = end - stored;
-  if (codec == kCodecNone && stored != decoded)
-    fail(F, "bad_layout", "packed key/values: uncompressed but stored length differs from decoded length");
-  for (const auto& r : array_ranges) {
-    if (stored > 0 && r[1] > 0 && begin < r[0] + r[1] && r[0] < end)
-      fail(F, "bad_layout", "packed key/values overlap an array");
-  }
+  const std::uint64_t begin =
+      body_range(header, loc, end, array_ranges, arrays_decoded, options, "packed key/values");
   // 20d-e. decoding and CRC-32C (the array pipeline on bytes)
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(decoded));
   decode_array(src, begin, stored, Shape{decoded, 1, 1},
@@ -108,6 +116,7 @@ void unpack_key_values(const Source& src, const Header& header, const std::uint6
     p = nul + 1;
   }
   for (std::size_t i = 0; i < strings.size(); i += 2) model.key_values.emplace_back(std::move(strings[i]), std::move(strings[i + 1]));
+  return PackedExtent{stored, decoded};
 }
 
 }  // namespace sogmm::format::detail

@@ -31,6 +31,26 @@ struct PackedKeyValues {
   std::pair<std::string, std::string> entry;
 };
 
+/// The entry that locates bytes in the body: "codec stored_length
+/// decoded_length crc32c" (spec/format.md 2.5.1 and 2.3.2).
+struct BodyLocator {
+  std::uint64_t codec = 0, stored = 0, decoded = 0, crc = 0;
+};
+
+/// Parses a locator value: four decimal counts of 1-19 digits separated by
+/// single spaces, codec 0 or 1, crc32c below 2^32; else FormatError
+/// "bad_metadata" naming `key`.
+BodyLocator parse_locator(const char* key, const std::string& text);
+
+/// Steps 20b-c / 21b-c: the cap (the located decoded bytes plus
+/// `decoded_so_far`), then the stored range [end - stored, end): inside the
+/// body, of the decoded length when raw, overlapping no array's range
+/// [offset, offset + stored_length). Returns its start; FormatError "limit"
+/// or "bad_layout" naming `what` otherwise.
+std::uint64_t body_range(const Header& header, const BodyLocator& loc, std::uint64_t end,
+                         const std::uint64_t (&array_ranges)[3][2], std::uint64_t decoded_so_far,
+                         const ReadOptions& options, const std::string& what);
+
 /// Packs `entries` (each key and value: UTF-8 without NUL, checked by the
 /// caller): key NUL value NUL, one entry after another, then zstd at
 /// options.zstd_level when options.compress and that is smaller, else raw.
@@ -43,7 +63,11 @@ PackedKeyValues pack_key_values(const std::vector<std::pair<std::string, std::st
 /// [offset, offset + stored_length) and the cap (minus `arrays_decoded`, the
 /// arrays' decoded bytes), decodes and verifies the bytes and appends their
 /// entries to model.key_values. Throws FormatError with the reasons of step 20.
-void unpack_key_values(const Source& src, const Header& header, const std::uint64_t (&array_ranges)[3][2],
-                       std::uint64_t arrays_decoded, const ReadOptions& options, Model& model);
+/// Returns the packed bytes' stored and decoded lengths.
+struct PackedExtent {
+  std::uint64_t stored = 0, decoded = 0;
+};
+PackedExtent unpack_key_values(const Source& src, const Header& header, const std::uint64_t (&array_ranges)[3][2],
+                               std::uint64_t arrays_decoded, const ReadOptions& options, Model& model);
 
 }  // namespace sogmm::format::detail

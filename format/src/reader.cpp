@@ -11,6 +11,7 @@
 #include "container.hpp"
 #include "crc32c.hpp"
 #include "decode.hpp"
+#include "frame_record.hpp"
 #include "packed_key_values.hpp"
 #include "schema.hpp"
 #include "sogmm/checked.hpp"
@@ -23,8 +24,8 @@ namespace {
 
 constexpr bool kBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
 // The features_required bits a map delta's reader knows (spec/format.md
-// sections 2.5 and 2.5.1); a model reader knows neither.
-constexpr std::uint64_t kDeltaFeatures = kKnownFeatures | kFeatureMapDelta | kFeaturePackedKeyValues;
+// sections 2.5 and 2.5.1): a model reader's and map_delta.
+constexpr std::uint64_t kDeltaFeatures = kKnownFeatures | kFeatureMapDelta;
 const char* const kNames[3] = {"weights", "means", "covariances"};
 
 // Steps 1-16: the header and the trailer first, then the metadata block, read
@@ -115,7 +116,8 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, 
   if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
   check_values(g, delta);  // 19
   if (!meta.packed && !delta) symmetrize(g);
-  if (meta.info.features_required & kFeaturePackedKeyValues) {  // 20 (a delta reader only knows the bit)
+  const std::uint64_t features = meta.info.features_required;
+  if (features & (kFeaturePackedKeyValues | kFeatureFrameRecord)) {
     Header h;
     h.file_length = meta.info.file_length;
     h.metadata_length = static_cast<std::uint32_t>(meta.info.metadata_length);
@@ -125,7 +127,13 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, 
       ranges[i][1] = meta.arrays[i].stored_length;
       decoded += meta.arrays[i].decoded_length;  // at most the cap (step 15)
     }
-    unpack_key_values(src, h, ranges, decoded, options, model);
+    std::uint64_t packed_begin = h.file_length - kTrailerSize;
+    if (features & kFeaturePackedKeyValues) {  // 20
+      const PackedExtent packed = unpack_key_values(src, h, ranges, decoded, options, model);
+      packed_begin -= packed.stored;
+      decoded += packed.decoded;  // with the arrays', at most the cap (step 20b)
+    }
+    if (features & kFeatureFrameRecord) unpack_frame_record(src, h, ranges, packed_begin, decoded, options, model);  // 21
   }
   if (info != nullptr) {
     *info = std::move(meta.info);

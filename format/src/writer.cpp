@@ -14,6 +14,7 @@
 #include "codec.hpp"
 #include "container.hpp"
 #include "crc32c.hpp"
+#include "frame_record.hpp"
 #include "internal.hpp"
 #include "packed_key_values.hpp"
 #include "schema.hpp"
@@ -176,7 +177,27 @@ EncodedArray encode_one(const std::vector<float>& values, std::uint64_t cols, co
 // padding after the last, then the end marker.
 class EncodedFile {
  public:
-  EncodedFile(const Model& model, const WriteOptions& options, const Tweaks& t) {
+  EncodedFile(const Model& model, const WriteOptions& options, const Tweaks& tweaks) {
+    // A map (a model with a `map_frames` text the record reproduces) is
+    // written as format 1.3: its frame lines as the binary frame record (bit
+    // 3) and every key/value packed in the body (bit 1; spec/format.md 2.3.2).
+    Tweaks t = tweaks;
+    std::vector<std::pair<std::string, std::string>> key_values;
+    if (t.compact_maps && t.features_required == 0 && !t.pack_key_values) {
+      auto it = std::find_if(model.key_values.begin(), model.key_values.end(),
+                             [](const auto& kv) { return kv.first == kMapFramesKey; });
+      std::optional<FrameRecord> record;
+      if (it != model.key_values.end()) record = encode_frame_record(it->second, options);
+      if (record) {
+        if (t.frame_record_entry) record->entry.second = *t.frame_record_entry;
+        frames_ = t.frame_record_stored ? *t.frame_record_stored : std::move(record->stored);
+        key_values = model.key_values;
+        key_values[static_cast<std::size_t>(it - model.key_values.begin())] = record->entry;
+        t.minor = std::max<std::uint16_t>(t.minor, kMinorFrameRecord);
+        t.features_required = kFeaturePackedKeyValues | kFeatureFrameRecord;
+        t.pack_key_values = true;
+      }
+    }
     MetadataBounds bounds;
     if (t.validate) {
       validate_for_write(model, (t.features_required & kFeatureMapDelta) != 0);
@@ -208,7 +229,7 @@ class EncodedFile {
     const std::size_t hint = static_cast<std::size_t>(std::min<std::uint64_t>(bounds.upper, kMetadataLengthLimit));
     if (t.pack_key_values) {
       // The entries go to the body; the metadata keeps the one that finds them.
-      packed_kv_ = pack_key_values(model.key_values, options);
+      packed_kv_ = pack_key_values(frames_.empty() ? model.key_values : key_values, options);
       Model stripped = model;
       stripped.key_values = {packed_kv_.entry};
       metadata_ = build_metadata(stripped, records, n_declared, packed, t, hint);
@@ -228,6 +249,7 @@ class EncodedFile {
       end += arrays_[i].stored.size();
       if (i < 2) end = pad8(end);
     }
+    end += frames_.size();            // right before the packed key/values (section 2.3.2)
     end += packed_kv_.stored.size();  // last in the body, unaligned (section 2.5.1)
     const bool patch[3] = {true, !t.means_offset, true};
     set_array_offsets(metadata_.data(), offsets, patch);
@@ -255,6 +277,7 @@ class EncodedFile {
       sink(arrays_[i].stored.data(), arrays_[i].stored.size());
       at += arrays_[i].stored.size();
     }
+    sink(frames_.data(), frames_.size());
     sink(packed_kv_.stored.data(), packed_kv_.stored.size());
     sink(kEndMagic.data(), kEndMagic.size());
   }
@@ -274,7 +297,8 @@ class EncodedFile {
   Header header_;
   flatbuffers::DetachedBuffer metadata_;
   EncodedArray arrays_[3];
-  PackedKeyValues packed_kv_;  // empty unless Tweaks::pack_key_values
+  std::vector<std::uint8_t> frames_;  // the frame record's stored bytes, empty unless a compact map
+  PackedKeyValues packed_kv_;         // empty unless Tweaks::pack_key_values
 };
 
 }  // namespace

@@ -125,7 +125,7 @@ TEST(Reject, MetadataThatFailsVerification) {
 TEST(Reject, FeaturesEncodingsAndMetadataValues) {
   const Model m = test::synthetic_model(6, 2);
   format::detail::Tweaks t;
-  t.features_required = 1u << 3;
+  t.features_required = 1u << 4;  // bits 0-3 are assigned (spec/format.md section 7); 4 is not
   expect_read_rejected(format::detail::encode(m, {}, t), ErrorCode::Format, "unsupported_feature");
   t = {};
   t.features_used = 1u << 3;  // optional features are ignored

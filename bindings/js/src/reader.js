@@ -15,6 +15,7 @@ import { decodeZstd } from './zstd.js';
 import { decodeStrings } from './strings.js';
 import { checkPose } from './pose.js';
 import { checkValues } from './values.js';
+import { FRAME_RECORD, PACKED_KEY_VALUES, unpackFrameRecord, unpackKeyValues } from './body_entries.js';
 
 export { SogmmError } from './errors.js';
 export { crc32c } from './crc32c.js';
@@ -26,7 +27,8 @@ const END = [0x53, 0x47, 0x4d, 0x4d]; // "SGMM"
 const HEADER = 32;
 const TRAILER = 4;
 export const DEFAULT_MAX_DECODED_BYTES = 2 ** 30;
-const KNOWN_FEATURES = 0n;
+// Format 1.3: bits 1 (packed key/values) and 3 (a map's frame record).
+const KNOWN_FEATURES = PACKED_KEY_VALUES | FRAME_RECORD;
 
 export const DTYPES = ['f32', 'f64'];
 export const ORDERS = ['component_major', 'column_major'];
@@ -184,7 +186,7 @@ function readHead(data, maxDecodedBytes, verifyChecksums) {
       }
     }
   });
-  return { m, major, minor, fileLength, metaLength, cols };
+  return { m, major, minor, fileLength, metaLength, cols, bodyStart, total };
 }
 
 const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
@@ -257,7 +259,7 @@ function canonicalBytes(bytes, rows, cols, width, split, columnMajor) {
 /** Reads a .sogmm file (Uint8Array) by spec/format.md section 9. */
 export function read(data, { maxDecodedBytes = DEFAULT_MAX_DECODED_BYTES, verifyChecksums = true, metadataOnly = false } = {}) {
   if (!(data instanceof Uint8Array)) data = new Uint8Array(data);
-  const { m, major, minor, fileLength, metaLength, cols } = readHead(data, maxDecodedBytes, verifyChecksums);
+  const { m, major, minor, fileLength, metaLength, cols, bodyStart, total } = readHead(data, maxDecodedBytes, verifyChecksums);
   const file = {
     format_version: `${major}.${minor}`, file_length: fileLength, metadata_length: metaLength,
     features_required: m.features_required, features_used: m.features_used,
@@ -283,6 +285,18 @@ export function read(data, { maxDecodedBytes = DEFAULT_MAX_DECODED_BYTES, verify
   model.weights = weights;
   model.means = means;
   model.covariances = checkValues(weights, means, stored, M, m.covariance_layout === 0);
+  // Steps 20 and 21: key/values whose bytes are in the body.
+  let end = fileLength - BigInt(TRAILER);
+  let decoded = total;
+  if (m.features_required & PACKED_KEY_VALUES) {
+    const p = unpackKeyValues(data, model.key_values, end, bodyStart, m.arrays, decoded, maxDecodedBytes, verifyChecksums);
+    model.key_values = p.keyValues;
+    end = p.begin;
+    decoded += p.decoded;
+  }
+  if (m.features_required & FRAME_RECORD) {
+    model.key_values = unpackFrameRecord(data, model.key_values, end, bodyStart, m.arrays, decoded, maxDecodedBytes, verifyChecksums);
+  }
   return model;
 }
 

@@ -25,7 +25,8 @@
 
 namespace sogmm::format {
 
-/// Format version this library writes (and the newest it knows).
+/// Format version this library writes for a model. The newest it knows is
+/// 1.3: a map is written as 1.3 (spec/format.md 2.3.2), a map delta as 1.2.
 inline constexpr std::uint16_t kFormatMajor = 1;
 inline constexpr std::uint16_t kFormatMinor = 0;
 

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -21,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frame_record.hpp"
 #include "internal.hpp"
 #include "schema.hpp"
 #include "sogmm/camera.hpp"
@@ -130,9 +132,94 @@ std::vector<std::uint8_t> uncompressed(const Model& m) {
   return fmt::to_bytes(m, o);
 }
 
+// Frame lines of a map (spec/format.md 2.3), as a map writes them ("%.17g"):
+// rotations and translations of every kind, -0, a subnormal, exponent forms,
+// counts up to 2^53.
+std::string map_frame_lines() {
+  const double poses[3][12] = {
+      {-0.2739592186924325, 0.021819345900466677, -0.96149376630215733, -0.31057997014702826, 8.33962904204855e-19,
+       -0.99974260932269809, -0.02268733357278151, 0.57301224384812977, -0.96174130954921133, -0.0062154041798138156,
+       0.27388870414358013, 2.1264800183565487},
+      {0, -1, 0, -0.0, 1, 0, 0, 2.5e-5, 0, 0, 1, 1e21},
+      {0.8, 0, 0.6, 6.103515625e-05, 0, 1, 0, -4.9406564584124654e-324, -0.6, 0, 0.8, 123456.78900000001}};
+  const char* counts[3][3] = {{"10674", "10674", "2"}, {"10700", "955", "167"}, {"9007199254740992", "1", "0"}};
+  std::string text;
+  char buf[40];
+  for (int i = 0; i < 3; ++i) {
+    text += std::to_string(i) + " " + counts[i][0] + " " + counts[i][1];
+    for (double v : poses[i]) {
+      std::snprintf(buf, sizeof buf, " %.17g", v);
+      text += buf;
+    }
+    text += std::string(" ") + counts[i][2] + "\n";
+  }
+  return text;
+}
+
+// The vectors of format 1.3's frame record (spec/format.md 2.3.2 and step
+// 21), appended to the manifest after the others were frozen.
+void frame_record_vectors() {
+  Model map = synthetic(5, 31);
+  map.key_values = {{"coordinate_frame", "world"}, {"map_frames", map_frame_lines()},
+                    {"map_options", "novelty=1 component_precision=0.5"}, {"map_id", "0123456789abcdef0123456789abcdef"},
+                    {"map_revision", "3"}};
+  valid("map_frame_record", fmt::to_bytes(map),
+        "format 1.3 map: map_frames as the binary frame record (bit 3, zstd), every key/value packed (bit 1)");
+  valid("map_frame_record_raw", uncompressed(map), "format 1.3 map, frame record and packed key/values uncompressed");
+  fmt::WriteOptions raw;
+  raw.compress = false;
+  const std::vector<double> rows = det::frame_rows(map.key_values[1].second);
+  const det::FrameRecord good = det::encode_frame_rows(rows, raw);
+  auto with = [&](const std::string& entry, const std::vector<std::uint8_t>& stored) {
+    det::Tweaks t;
+    t.frame_record_entry = entry;
+    t.frame_record_stored = stored;
+    return det::encode(map, {}, t);
+  };
+  const std::string crc = good.entry.second.substr(good.entry.second.rfind(' ') + 1);
+  invalid("frame_record_checksum", with("0 360 360 " + std::to_string(std::stoul(crc) ^ 1), good.stored), "format",
+          "checksum_mismatch", "frame record: CRC-32C of the canonical bytes does not match (step 21e)");
+  invalid("frame_record_length", with("0 352 352 " + crc, std::vector<std::uint8_t>(good.stored.begin(), good.stored.begin() + 352)),
+          "format", "bad_metadata", "frame record: decoded length 352 is not a multiple of 120 (step 21a)");
+  invalid("frame_record_raw_length", with("0 361 360 " + crc, good.stored), "format", "bad_layout",
+          "frame record: a raw record whose stored length is not its decoded length (step 21c)");
+  const det::FrameRecord zstd = det::encode_frame_rows(rows, {});
+  invalid("frame_record_overlap", with("1 " + std::to_string(zstd.stored.size() + 1) + " 360 " + crc, zstd.stored),
+          "format", "bad_layout", "frame record: one stored byte more reaches into the covariances (step 21c)");
+  invalid("frame_record_not_zstd", with("1 360 360 " + crc, good.stored), "format", "decompression_failed",
+          "frame record: codec zstd on bytes that are not a zstd frame (step 21d)");
+  std::vector<double> half = rows;
+  half[15] = 0.5;  // frame 1's n_points
+  const det::FrameRecord bad_count = det::encode_frame_rows(half, raw);
+  invalid("frame_record_count", with(bad_count.entry.second, bad_count.stored), "format", "bad_metadata",
+          "frame record: a point count of 0.5 (step 21f)");
+  det::Tweaks no_entry;
+  no_entry.compact_maps = false;
+  no_entry.minor = 3;
+  no_entry.features_required = 0xA;
+  no_entry.pack_key_values = true;
+  invalid("frame_record_missing", det::encode(map, {}, no_entry), "format", "bad_metadata",
+          "features_required bit 3 without a map_frame_record entry (step 21a)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--frame-record") {
+    // Only the frame record's vectors, with their manifest entries.
+    g_out = argv[2];
+    ::mkdir((g_out + "/valid").c_str(), 0755);
+    ::mkdir((g_out + "/invalid").c_str(), 0755);
+    try {
+      frame_record_vectors();
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+    std::ofstream additions(g_out + "/manifest_additions.json");
+    for (std::size_t i = 0; i < g_entries.size(); ++i) additions << g_entries[i] << (i + 1 < g_entries.size() ? ",\n" : "\n");
+    return 0;
+  }
   if (argc != 6) {
     std::cerr << "usage: " << argv[0] << " OUT_DIR DEPTH.u16 GRAY.f32 WIDTH HEIGHT\n";
     return 2;

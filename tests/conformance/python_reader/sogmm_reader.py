@@ -20,10 +20,12 @@ MAGIC = b"\x89SOG\r\n\x1a\n"
 END_MAGIC = b"SGMM"
 HEADER_SIZE = 32
 TRAILER_SIZE = 4
-KNOWN_FEATURES = 0
 MAP_DELTA_FEATURE = 1  # features_required bit 0: a map delta (section 2.5), known to a delta reader only
-PACKED_KEY_VALUES_FEATURE = 2  # bit 1: key/values packed in the body (section 2.5.1), known to a delta reader only
+PACKED_KEY_VALUES_FEATURE = 2  # bit 1: key/values packed in the body (section 2.5.1; format 1.3: any reader)
+FRAME_RECORD_FEATURE = 8  # bit 3: a map's frame lines as a binary record (section 2.3.2, format 1.3)
+KNOWN_FEATURES = PACKED_KEY_VALUES_FEATURE | FRAME_RECORD_FEATURE
 PACKED_KEY = "packed_key_values"
+FRAME_RECORD_KEY = "map_frame_record"
 DEFAULT_MAX_DECODED_BYTES = 1 << 30
 MAX_DEPTH = 64
 MAX_TABLES = 100000
@@ -526,7 +528,7 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     except (_Bad, struct.error) as e:
         _format("bad_metadata", f"FlatBuffers verification failed: {e}")
     # 10
-    known = KNOWN_FEATURES | (MAP_DELTA_FEATURE | PACKED_KEY_VALUES_FEATURE if delta else 0)
+    known = KNOWN_FEATURES | (MAP_DELTA_FEATURE if delta else 0)
     if md["features_required"] & ~known:
         _format("unsupported_feature", hex(md["features_required"]))
     if delta and not md["features_required"] & MAP_DELTA_FEATURE:
@@ -654,11 +656,82 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
     out["weights"] = weights
     out["means"] = [means[4 * k:4 * k + 4] for k in range(m)]
     out["covariances"] = mats
+    total = sum(rec["decoded_length"] for rec in md["arrays"])
+    packed_begin = file_length - TRAILER_SIZE
     if md["features_required"] & PACKED_KEY_VALUES_FEATURE:
-        total = sum(rec["decoded_length"] for rec in md["arrays"])
-        out["key_values"] = _unpack_key_values(data, file_length, body_start, md["arrays"], total,
-                                               max_decoded_bytes, verify_checksums, out["key_values"])
+        out["key_values"], stored, decoded = _unpack_key_values(
+            data, file_length, body_start, md["arrays"], total, max_decoded_bytes, verify_checksums, out["key_values"])
+        packed_begin -= stored
+        total += decoded
+    if md["features_required"] & FRAME_RECORD_FEATURE:
+        out["key_values"] = _unpack_frame_record(data, packed_begin, body_start, md["arrays"], total,
+                                                 max_decoded_bytes, verify_checksums, out["key_values"])
     return out
+
+
+def _locator(key, value):
+    """The four counts "codec stored_length decoded_length crc32c" of a locating entry (20a, 21a)."""
+    tokens = value.split(" ")
+    if len(tokens) != 4 or not all(t and len(t) <= 19 and t.isascii() and t.isdigit() for t in tokens):
+        _format("bad_metadata", f"{key} is not four decimal counts")
+    codec, stored, decoded, crc = (int(t) for t in tokens)
+    if codec > 1 or crc >= 1 << 32:
+        _format("bad_metadata", f"{key}: codec or crc32c out of range")
+    return codec, stored, decoded, crc
+
+
+def _body_range(end, codec, stored, decoded, body_start, arrays, decoded_so_far, cap, what):
+    """Steps 20b-c / 21b-c: the cap, and the stored range [end - stored, end)
+    inside the body, of the decoded length when raw, overlapping no array."""
+    if decoded_so_far + decoded > cap:
+        _fail("limit", "limit", f"arrays and {what} over the cap")
+    if stored > end - body_start:
+        _format("bad_layout", f"{what} outside the body")
+    begin = end - stored
+    if codec == 0 and stored != decoded:
+        _format("bad_layout", f"raw {what} length")
+    for rec in arrays:
+        if stored and rec["stored_length"] and begin < rec["offset"] + rec["stored_length"] and rec["offset"] < end:
+            _format("bad_layout", f"{what} overlaps an array")
+    return begin
+
+
+def _frame_line(index, row):
+    """A `map_frames` line from a record row (section 2.3.2): counts in decimal, pose entries as C's %.17g."""
+    counts = [int(row[0]), int(row[1])]
+    return " ".join([str(index), *map(str, counts), *("%.17g" % x for x in row[2:14]), str(int(row[14]))]) + "\n"
+
+
+def _unpack_frame_record(data, packed_begin, body_start, arrays, decoded_so_far, cap, verify_checksums, key_values):
+    """Step 21 (section 2.3.2): the frame record, right before the packed
+    key/values, replaces the first entry `map_frame_record` by `map_frames`."""
+    # 21a
+    at = next((i for i, (k, _) in enumerate(key_values) if k == FRAME_RECORD_KEY), None)
+    if at is None:
+        _format("bad_metadata", "bit 3 set, no map_frame_record entry")
+    codec, stored, decoded, crc = _locator(FRAME_RECORD_KEY, key_values[at][1])
+    if decoded == 0 or decoded % 120:
+        _format("bad_metadata", "map_frame_record: decoded length not a positive multiple of 120")
+    begin = _body_range(packed_begin, codec, stored, decoded, body_start, arrays, decoded_so_far, cap,
+                        "frame record")  # 21b-c
+    # 21d-e: the array pipeline, column-major and byte-stream split
+    rows = decoded // 120
+    raw = _decode(data[begin:packed_begin], {"dtype": 1, "codec": codec, "filter": 1, "order": 1}, rows, 15)
+    if verify_checksums and crc32c(raw) != crc:
+        _format("checksum_mismatch", "frame record CRC-32C")
+    # 21f
+    values = struct.unpack(f"<{rows * 15}d", raw)
+    lines = []
+    for r in range(rows):
+        row = values[15 * r:15 * r + 15]
+        for c, x in enumerate(row):
+            if c in (0, 1, 14):
+                if not (0 <= x <= 2.0 ** 53 and math.floor(x) == x):
+                    _format("bad_metadata", f"frame record: frame {r} column {c} is not a count")
+            elif not math.isfinite(x):
+                _format("bad_metadata", f"frame record: frame {r} column {c} is not finite")
+        lines.append(_frame_line(r, row))
+    return key_values[:at] + [["map_frames", "".join(lines)]] + key_values[at + 1:]
 
 
 def _unpack_key_values(data, file_length, body_start, arrays, arrays_decoded, cap, verify_checksums, key_values):
@@ -668,25 +741,12 @@ def _unpack_key_values(data, file_length, body_start, arrays, arrays_decoded, ca
     at = next((i for i, (k, _) in enumerate(key_values) if k == PACKED_KEY), None)
     if at is None:
         _format("bad_metadata", "bit 1 set, no packed_key_values entry")
-    tokens = key_values[at][1].split(" ")
-    if len(tokens) != 4 or not all(t and len(t) <= 19 and t.isascii() and t.isdigit() for t in tokens):
-        _format("bad_metadata", "packed_key_values is not four decimal counts")
-    codec, stored, decoded, crc = (int(t) for t in tokens)
-    if codec > 1 or crc >= 1 << 32 or decoded < 2:
-        _format("bad_metadata", "packed_key_values: codec, crc32c or decoded length out of range")
-    # 20b
-    if arrays_decoded + decoded > cap:
-        _fail("limit", "limit", "arrays and packed key/values over the cap")
-    # 20c
+    codec, stored, decoded, crc = _locator(PACKED_KEY, key_values[at][1])
+    if decoded < 2:
+        _format("bad_metadata", "packed_key_values: decoded length out of range")
     end = file_length - TRAILER_SIZE
-    if stored > end - body_start:
-        _format("bad_layout", "packed key/values outside the body")
-    begin = end - stored
-    if codec == 0 and stored != decoded:
-        _format("bad_layout", "raw packed key/values length")
-    for rec in arrays:
-        if stored and rec["stored_length"] and begin < rec["offset"] + rec["stored_length"] and rec["offset"] < end:
-            _format("bad_layout", "packed key/values overlap an array")
+    begin = _body_range(end, codec, stored, decoded, body_start, arrays, arrays_decoded, cap,
+                        "packed key/values")  # 20b-c
     # 20d-e
     raw = data[begin:end]
     if codec == 1:
@@ -703,4 +763,4 @@ def _unpack_key_values(data, file_length, body_start, arrays, arrays_decoded, ca
     except UnicodeDecodeError:
         _format("bad_metadata", "packed key/values: not UTF-8")
     rest = key_values[:at] + key_values[at + 1:]
-    return rest + [[text[i], text[i + 1]] for i in range(0, len(text), 2)]
+    return rest + [[text[i], text[i + 1]] for i in range(0, len(text), 2)], stored, decoded
