@@ -23,8 +23,11 @@ inline constexpr std::size_t kMinFileSize = kHeaderSize + kTrailerSize;
 /// Metadata blocks must be smaller than this: FlatBuffers' limit (offsets are
 /// 32-bit signed), FLATBUFFERS_MAX_BUFFER_SIZE, exclusive.
 inline constexpr std::uint64_t kMetadataLengthLimit = (std::uint64_t{1} << 31) - 1;
-/// Feature bits this reader knows (format 1.0 defines none).
-inline constexpr std::uint64_t kKnownFeatures = 0;
+/// features_required bit of a file whose arrays hold quantized component
+/// codes (spec/format.md section 5.7, format 1.4).
+inline constexpr std::uint64_t kFeatureQuantizedComponents = 4;
+/// Feature bits every reader of this library knows (a model's or a delta's).
+inline constexpr std::uint64_t kKnownFeatures = kFeatureQuantizedComponents;
 /// features_required bit of a map delta (spec/format.md sections 2.5 and 7):
 /// known only to the delta reader, so a model reader refuses a delta.
 inline constexpr std::uint64_t kFeatureMapDelta = 1;

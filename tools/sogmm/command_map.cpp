@@ -155,7 +155,11 @@ int run_map(MapState& s) {
   progress.finish();
   if (!s.trajectory_out.empty()) write_trajectory_log(s.trajectory_out, poses_used);
   const Model model = with_sequence_metadata(map.to_model(), in);
-  const std::uint64_t bytes = save_model(s.output, model);
+  // The map's component precision also selects the quantized arrays
+  // (spec/format.md 5.7) at the same bound.
+  format::WriteOptions write;
+  write.component_precision = s.options.component_precision;
+  const std::uint64_t bytes = save_model(s.output, model, write);
   const std::string frames = frame_list(in);
   const std::string csv_body = csv_text(rows);
   write_file_atomic(csv, csv_body.data(), csv_body.size());
