@@ -237,7 +237,9 @@ class EncodedFile {
     // Before any array is encoded: a file a reader would refuse is not written.
     if (t.validate) check_decoded_size(m, packed, options.float64, options.max_decoded_bytes);
     Tweaks tq = t;
-    const auto q = options.component_precision > 0 && m > 0 ? quantized(g, options.component_precision) : std::nullopt;
+    // A map delta keeps its floats: its receiver must reproduce the sender's bits.
+    const bool quantize_arrays = options.component_precision > 0 && m > 0 && (t.features_required & kFeatureMapDelta) == 0;
+    const auto q = quantize_arrays ? quantized(g, options.component_precision) : std::nullopt;
     if (q) {
       tq.features_required |= kFeatureQuantizedComponents;
       tq.minor = std::max(t.minor, kQuantizedMinor);

@@ -272,7 +272,8 @@ Command add_map_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--component-precision", s->options.component_precision,
                   "round each fitted component so that it moves by at most this many of its standard deviations "
-                  "(zero low bits that deltas compress away), in [0, 0.5] (0: full float32)")
+                  "(zero low bits that deltas compress away) and store the map file's components as integer codes "
+                  "within the same bound (spec/format.md 5.7, format 1.4), in [0, 0.5] (0: full float32)")
       ->capture_default_str();
   app->add_option("--free-space-carve", s->options.free_space_carve,
                   "reshape a map component when this share of its samples lies where a frame sees past it, in "
