@@ -25,7 +25,9 @@
 
 namespace sogmm::format {
 
-/// Format version this library writes (and the newest it knows).
+/// Format version this library writes for float arrays. A file with
+/// quantized components (WriteOptions::component_precision > 0) is written
+/// as 1.4 (spec/format.md 5.7), the newest version this library knows.
 inline constexpr std::uint16_t kFormatMajor = 1;
 inline constexpr std::uint16_t kFormatMinor = 0;
 
@@ -51,7 +53,10 @@ class FormatError : public Error {
 /// reject, metadata strings that are not valid UTF-8 or contain NUL included.
 /// An empty producer_version is written as sogmm::version_string().
 /// Covariances are stored packed (upper triangle) when every matrix is
-/// bit-exactly symmetric, else in full, so the round trip is always bit-exact.
+/// bit-exactly symmetric, else in full, so the round trip is bit-exact;
+/// with options.component_precision > 0 the components are stored as integer
+/// codes instead (format 1.4) and read back within that precision's bound
+/// (sogmm/file_options.hpp).
 std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options = {});
 
 /// Decodes and fully verifies the bytes of a .sogmm file.
