@@ -32,6 +32,7 @@ const (
 	OptZstdLevel                   Key = C.SOGMM_OPT_ZSTD_LEVEL
 	OptFloat64                     Key = C.SOGMM_OPT_FLOAT64
 	OptCompress                    Key = C.SOGMM_OPT_COMPRESS
+	OptArrayPrecision              Key = C.SOGMM_OPT_ARRAY_PRECISION
 	OptMaxDecodedBytes             Key = C.SOGMM_OPT_MAX_DECODED_BYTES
 	OptVerifyChecksums             Key = C.SOGMM_OPT_VERIFY_CHECKSUMS
 	OptSampleTruncation            Key = C.SOGMM_OPT_SAMPLE_TRUNCATION

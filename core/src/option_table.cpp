@@ -110,6 +110,13 @@ std::vector<OptionSpec> make_table() {
       SOGMM_I64_ROW(ZSTD_LEVEL, write.zstd_level, 1, 22, "[1, 22]", "", "zstd compression level of the arrays"),
       SOGMM_I64_ROW(FLOAT64, write.float64, 0, 1, "0 or 1", "", "1: store the arrays as float64"),
       SOGMM_I64_ROW(COMPRESS, write.compress, 0, 1, "0 or 1", "", "1: zstd-compress the arrays"),
+      SOGMM_F64_ROW(ARRAY_PRECISION, write.component_precision, 0.0, 0.5, finite, "[0, 0.5] (0: off)",
+                    "standard deviations",
+                    "> 0: store each component as integer codes (format 1.4, spec/format.md 5.7) that move its mean by "
+                    "at most this many of its standard deviations and its covariance's eigenvalues, in its own frame, "
+                    "by at most this fraction, as MAP_COMPONENT_PRECISION bounds them: 11-21 bytes a component on "
+                    "README section 7's maps instead of 30-40 (why: WriteOptions::component_precision); 0: float "
+                    "arrays, bit-exact"),
       // ---- reading .sogmm (the cap also bounds writing) ----
       // 0 restores the format library's default cap (kDefaultMaxDecodedBytes).
       OptionSpec{OptionKey::MAX_DECODED_BYTES, "SOGMM_OPT_MAX_DECODED_BYTES", OptionType::I64, 0.0,

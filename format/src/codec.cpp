@@ -45,10 +45,10 @@ void append_frame(std::vector<std::uint8_t>& out, ZSTD_CCtx* cctx, const std::ui
 }  // namespace
 
 std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonical, const Shape& shape,
-                                       const Encoding& e, int zstd_level) {
+                                       const Encoding& e, int zstd_level, bool one_frame) {
   std::vector<std::uint8_t> bytes =
       e.order == kOrderColumnMajor ? transpose(canonical, shape.rows, shape.cols, shape.width) : canonical;
-  if (e.filter == kFilterByteStreamSplit) bytes = split_streams(bytes, shape.width);
+  if (e.filter != kFilterNone) bytes = split_streams(bytes, shape.width);
   if (e.codec == kCodecNone) return bytes;
 
   const CCtx cctx = new_cctx();
@@ -58,7 +58,7 @@ std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonica
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_checksumFlag, 0);  // the format has its own CRC
   ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1);
   std::vector<std::uint8_t> out;
-  const std::size_t streams = e.filter == kFilterByteStreamSplit ? shape.width : 1;
+  const std::size_t streams = e.filter != kFilterNone && !one_frame ? shape.width : 1;
   const std::size_t stream_size = bytes.size() / streams;
   for (std::size_t k = 0; k < streams; ++k) append_frame(out, cctx.get(), bytes.data() + k * stream_size, stream_size);
   return out;

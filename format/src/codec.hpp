@@ -12,7 +12,7 @@ namespace sogmm::format::detail {
 // depend on generated code).
 enum : std::uint8_t { kDTypeF32 = 0, kDTypeF64 = 1 };
 enum : std::uint8_t { kOrderComponentMajor = 0, kOrderColumnMajor = 1 };
-enum : std::uint8_t { kFilterNone = 0, kFilterByteStreamSplit = 1 };
+enum : std::uint8_t { kFilterNone = 0, kFilterByteStreamSplit = 1, kFilterQuantized = 2 };
 enum : std::uint8_t { kCodecNone = 0, kCodecZstd = 1 };
 
 /// How one array is encoded.
@@ -32,8 +32,10 @@ struct Shape {
 
 /// Canonical bytes (component-major, little-endian) -> stored bytes.
 /// With the zstd codec and the byte-stream split, each of the `width`
-/// streams becomes its own zstd frame (frames are concatenated).
+/// streams becomes its own zstd frame (frames are concatenated), unless
+/// `one_frame`: then all streams go into one frame (quantized codes, whose
+/// arrays are small enough that a frame header per stream would show).
 std::vector<std::uint8_t> encode_array(const std::vector<std::uint8_t>& canonical, const Shape& shape,
-                                       const Encoding& encoding, int zstd_level);
+                                       const Encoding& encoding, int zstd_level, bool one_frame = false);
 
 }  // namespace sogmm::format::detail

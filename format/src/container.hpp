@@ -23,9 +23,13 @@ inline constexpr std::size_t kMinFileSize = kHeaderSize + kTrailerSize;
 /// Metadata blocks must be smaller than this: FlatBuffers' limit (offsets are
 /// 32-bit signed), FLATBUFFERS_MAX_BUFFER_SIZE, exclusive.
 inline constexpr std::uint64_t kMetadataLengthLimit = (std::uint64_t{1} << 31) - 1;
+/// features_required bit of a file whose arrays hold quantized component
+/// codes (spec/format.md section 5.7, format 1.4).
+inline constexpr std::uint64_t kFeatureQuantizedComponents = 4;
 /// Feature bits a model reader knows: 1 (packed_key_values) and 3
-/// (frame_record), both of format 1.3 map files (spec/format.md section 7).
-inline constexpr std::uint64_t kKnownFeatures = 2 | 8;
+/// (frame_record) of format 1.3 map files, 2 (quantized_components) of
+/// format 1.4 (spec/format.md section 7).
+inline constexpr std::uint64_t kKnownFeatures = 2 | kFeatureQuantizedComponents | 8;
 /// features_required bit of a map delta (spec/format.md sections 2.5 and 7):
 /// known only to the delta reader, so a model reader refuses a delta.
 inline constexpr std::uint64_t kFeatureMapDelta = 1;

@@ -72,7 +72,7 @@ class Scatter {
  public:
   Scatter(const Shape& s, const Encoding& e, std::uint8_t* out)
       : out_(out), total_(s.bytes()), rows_(s.rows), cols_(s.cols), width_(s.width), n_(s.rows * s.cols),
-        split_(e.filter == kFilterByteStreamSplit), column_major_(e.order == kOrderColumnMajor) {}
+        split_(e.filter != kFilterNone), column_major_(e.order == kOrderColumnMajor) {}
 
   bool identity() const { return !split_ && !column_major_; }
   std::uint64_t written() const { return written_; }

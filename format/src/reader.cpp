@@ -13,6 +13,7 @@
 #include "decode.hpp"
 #include "frame_record.hpp"
 #include "packed_key_values.hpp"
+#include "quantized_components.hpp"
 #include "schema.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/format.hpp"
@@ -94,6 +95,51 @@ void expand_upper_in_place(float* cov, std::uint64_t m) {
   }
 }
 
+// Little-endian bytes of float32 values, as section 5.2 orders them.
+std::uint32_t crc_of_floats(const float* v, std::size_t n) {
+  std::vector<std::uint8_t> bytes(4 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t bits;
+    std::memcpy(&bits, v + i, 4);
+    store_le<std::uint32_t>(&bytes[4 * i], bits);
+  }
+  return crc32c(bytes.data(), bytes.size());
+}
+
+// Steps 17, 17b and 18 of a file with quantized components (section 5.7):
+// every array's codes, then the model they decode to, then each array's
+// CRC-32C over the canonical float32 bytes of that model.
+void read_quantized(const Source& src, const ParsedMetadata& meta, std::uint64_t m, bool verify, Gmm& g) {
+  ComponentCodes codes;
+  for (int i = 0; i < 3; ++i) {
+    const ArrayRecord& r = meta.arrays[i];
+    const Shape shape{m, kCodeColumns[i], 4};
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(shape.bytes()));
+    decode_array(src, r.offset, r.stored_length, shape, Encoding{r.order, r.filter, r.codec}, bytes.data());
+    std::vector<std::int32_t>& c = codes.arrays[i];
+    c.resize(static_cast<std::size_t>(m * kCodeColumns[i]));
+    for (std::size_t t = 0; t < c.size(); ++t) c[t] = unzigzag(load_le<std::uint32_t>(&bytes[4 * t]));
+  }
+  dequantize(codes, m, g);
+  if (!verify) return;
+  std::vector<float> packed;
+  packed.reserve(static_cast<std::size_t>(10 * m));
+  for (std::uint64_t k = 0; k < m; ++k) {
+    for (int a = 0; a < 4; ++a) {
+      for (int b = a; b < 4; ++b) packed.push_back(g.covariances[16 * k + 4 * a + b]);
+    }
+  }
+  const std::uint32_t crcs[3] = {crc_of_floats(g.weights.data(), g.weights.size()),
+                                 crc_of_floats(g.means.data(), g.means.size()),
+                                 crc_of_floats(packed.data(), packed.size())};
+  for (int i = 0; i < 3; ++i) {
+    if (crcs[i] != meta.arrays[i].crc32c) {
+      fail(ErrorCode::Format, "checksum_mismatch",
+           std::string(kNames[i]) + ": CRC-32C of the decoded values does not match");
+    }
+  }
+}
+
 }  // namespace
 
 // The whole procedure. *info (if not null) gets the file information, with
@@ -110,10 +156,14 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, 
   Gmm& g = model.gmm;
   g.resize(static_cast<std::size_t>(m));
   float* const dest[3] = {g.weights.data(), g.means.data(), g.covariances.data()};
-  for (int i = 0; i < 3; ++i) {
-    read_array(src, meta.arrays[i], m, columns(i, meta.packed), options.verify_checksums, kNames[i], dest[i]);
+  if (meta.quantized) {
+    read_quantized(src, meta, m, options.verify_checksums, g);
+  } else {
+    for (int i = 0; i < 3; ++i) {
+      read_array(src, meta.arrays[i], m, columns(i, meta.packed), options.verify_checksums, kNames[i], dest[i]);
+    }
+    if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
   }
-  if (meta.packed) expand_upper_in_place(g.covariances.data(), m);
   check_values(g, delta);  // 19
   if (!meta.packed && !delta) symmetrize(g);
   const std::uint64_t features = meta.info.features_required;

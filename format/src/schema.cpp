@@ -8,6 +8,7 @@
 
 #include "checks.hpp"
 #include "codec.hpp"
+#include "quantized_components.hpp"
 #include "wire.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/metadata_string.hpp"
@@ -35,7 +36,9 @@ flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<flatbuffers::String>
 
 const char* dtype_name(std::uint8_t v) { return v == kDTypeF64 ? "f64" : "f32"; }
 const char* order_name(std::uint8_t v) { return v == kOrderColumnMajor ? "column_major" : "component_major"; }
-const char* filter_name(std::uint8_t v) { return v == kFilterByteStreamSplit ? "byte_stream_split" : "none"; }
+const char* filter_name(std::uint8_t v) {
+  return v == kFilterQuantized ? "quantized" : v == kFilterByteStreamSplit ? "byte_stream_split" : "none";
+}
 const char* codec_name(std::uint8_t v) { return v == kCodecZstd ? "zstd" : "none"; }
 
 ArrayInfo to_info(const ArrayRecord& r) {
@@ -263,6 +266,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
   const auto layout = static_cast<std::uint8_t>(root->covariance_layout());
   if (layout > 1) fail(F, "unsupported_encoding", "unknown covariance layout " + std::to_string(layout));
   out.packed = layout == 0;
+  out.quantized = (root->features_required() & kFeatureQuantizedComponents) != 0;
   const fb::Array* arrays[3] = {root->weights(), root->means(), root->covariances()};
   for (int i = 0; i < 3; ++i) {
     out.arrays[i] = to_record(arrays[i]);
@@ -270,8 +274,18 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
     const std::string name = kArrayNames[i];
     if (r.dtype > 1) fail(F, "unsupported_encoding", name + ": unknown dtype " + std::to_string(r.dtype));
     if (r.order > 1) fail(F, "unsupported_encoding", name + ": unknown element order " + std::to_string(r.order));
-    if (r.filter > 1) fail(F, "unsupported_encoding", name + ": unknown filter " + std::to_string(r.filter));
+    if (r.filter > 2) fail(F, "unsupported_encoding", name + ": unknown filter " + std::to_string(r.filter));
     if (r.codec > 1) fail(F, "unsupported_encoding", name + ": unknown codec " + std::to_string(r.codec));
+    // Quantized codes (section 5.7) come with their feature bit, in all
+    // three arrays, as float32 packed covariances, and never without it.
+    if ((r.filter == kFilterQuantized) != out.quantized) {
+      fail(F, "unsupported_encoding",
+           name + (out.quantized ? ": filter is not QUANTIZED in a file with feature bit 2"
+                                 : ": filter QUANTIZED without feature bit 2"));
+    }
+    if (out.quantized && (r.dtype != kDTypeF32 || !out.packed)) {
+      fail(F, "unsupported_encoding", name + ": quantized components decode to float32, packed covariances only");
+    }
   }
 
   // 13. M
@@ -313,7 +327,7 @@ ParsedMetadata parse_metadata(const std::uint8_t* buf, const Header& h, const Re
     if (r.offset < body || r.offset > body_end || r.stored_length > body_end - r.offset) {
       fail(F, "bad_layout", name + ": stored bytes lie outside the body");
     }
-    if (r.codec == kCodecNone && r.stored_length != r.decoded_length) {
+    if (r.codec == kCodecNone && r.stored_length != filtered_length(out, i)) {
       fail(F, "bad_layout", name + ": uncompressed but stored length differs from decoded length");
     }
     for (int j = 0; j < i; ++j) {

@@ -9,6 +9,7 @@
 
 #include "container.hpp"
 #include "internal.hpp"
+#include "quantized_components.hpp"
 
 namespace sogmm::format::detail {
 
@@ -44,7 +45,17 @@ struct ParsedMetadata {
   FileInfo info;
   ArrayRecord arrays[3];
   bool packed = true;
+  bool quantized = false;  ///< features_required bit 2: the arrays hold codes (section 5.7)
 };
+
+/// Number of bytes the codec of array `which` yields: its decoded_length, or
+/// for quantized codes M x kCodeColumns[which] x 4 (at most 4/3 of it, so
+/// below 2^64 once step 14 has passed).
+inline std::uint64_t filtered_length(const ParsedMetadata& p, int which) {
+  return p.quantized ? p.arrays[which].decoded_length / (which == kWeights ? 1 : which == kMeans ? 4 : 10) *
+                           kCodeColumns[which]
+                     : p.arrays[which].decoded_length;
+}
 
 /// Steps 9-16: verifies the FlatBuffer, the features, the metadata values
 /// (strings included), the encodings, M, the declared lengths, the size cap

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -17,6 +18,7 @@
 #include "frame_record.hpp"
 #include "internal.hpp"
 #include "packed_key_values.hpp"
+#include "quantized_components.hpp"
 #include "schema.hpp"
 #include "strings.hpp"
 #include "sogmm/checked.hpp"
@@ -172,6 +174,51 @@ EncodedArray encode_one(const std::vector<float>& values, std::uint64_t cols, co
   return out;
 }
 
+// One array of a quantized file (section 5.7): its codes, zigzagged,
+// column-major and byte-stream split in one zstd frame (or raw when that is
+// smaller), declared by the canonical float32 bytes they decode to.
+EncodedArray encode_codes(const std::vector<std::int32_t>& codes, std::uint64_t cols,
+                          const std::vector<float>& decoded, const WriteOptions& options) {
+  EncodedArray out;
+  const std::vector<std::uint8_t> canonical = canonical_bytes(decoded, false);
+  out.record.dtype = kDTypeF32;
+  out.record.decoded_length = canonical.size();
+  out.record.crc32c = crc32c(canonical.data(), canonical.size());
+  std::vector<std::uint8_t> raw(4 * codes.size());
+  for (std::size_t i = 0; i < codes.size(); ++i) store_le<std::uint32_t>(&raw[4 * i], zigzag(codes[i]));
+  const Shape shape{codes.size() / cols, cols, 4};
+  Encoding e{kOrderColumnMajor, kFilterQuantized, kCodecNone};
+  out.stored = encode_array(raw, shape, e, options.zstd_level);
+  if (options.compress) {
+    e.codec = kCodecZstd;
+    std::vector<std::uint8_t> z = encode_array(raw, shape, e, options.zstd_level, true);
+    if (z.size() < out.stored.size()) {
+      out.stored = std::move(z);
+      out.record.codec = kCodecZstd;
+    }
+  }
+  out.record.order = e.order;
+  out.record.filter = e.filter;
+  out.record.stored_length = out.stored.size();
+  return out;
+}
+
+// The codes of `g` at `precision` and the model they decode to, when a reader
+// accepts that model (step 19); else nothing, and the writer stores floats.
+std::optional<std::pair<ComponentCodes, Gmm>> quantized(const Gmm& g, double precision) {
+  std::optional<ComponentCodes> codes = quantize(g, precision);
+  if (!codes) return std::nullopt;
+  Gmm decoded;
+  decoded.support_size = g.support_size;
+  try {
+    dequantize(*codes, g.size(), decoded);
+    check_values(decoded, false);
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+  return std::make_pair(std::move(*codes), std::move(decoded));
+}
+
 // An encoded file held as its parts, in file order: header, metadata block,
 // zero padding to 8, then the arrays, each at a multiple of 8 and without
 // padding after the last, then the end marker.
@@ -210,14 +257,28 @@ class EncodedFile {
     const bool packed = !t.force_full_layout && g.covariances.size() == 16 * m && bit_symmetric(g.covariances, m);
     // Before any array is encoded: a file a reader would refuse is not written.
     if (t.validate) check_decoded_size(m, packed, options.float64, options.max_decoded_bytes);
-    arrays_[kWeights] = encode_one(g.weights, 1, options);
-    arrays_[kMeans] = encode_one(g.means, 4, options);
-    arrays_[kCovariances] = encode_one(packed ? pack_upper(g.covariances, m) : g.covariances, packed ? 10 : 16, options);
+    Tweaks tq = t;
+    // A map delta keeps its floats: its receiver must reproduce the sender's bits.
+    const bool quantize_arrays = options.component_precision > 0 && m > 0 && (t.features_required & kFeatureMapDelta) == 0;
+    const auto q = quantize_arrays ? quantized(g, options.component_precision) : std::nullopt;
+    if (q) {
+      tq.features_required |= kFeatureQuantizedComponents;
+      tq.minor = std::max(t.minor, kQuantizedMinor);
+      arrays_[kWeights] = encode_codes(q->first.arrays[kWeights], 1, q->second.weights, options);
+      arrays_[kMeans] = encode_codes(q->first.arrays[kMeans], 5, q->second.means, options);
+      arrays_[kCovariances] = encode_codes(q->first.arrays[kCovariances], 14, pack_upper(q->second.covariances, m),
+                                           options);
+    } else {
+      arrays_[kWeights] = encode_one(g.weights, 1, options);
+      arrays_[kMeans] = encode_one(g.means, 4, options);
+      arrays_[kCovariances] =
+          encode_one(packed ? pack_upper(g.covariances, m) : g.covariances, packed ? 10 : 16, options);
+    }
     const std::uint64_t n_declared = t.n_components ? *t.n_components : m;
     ArrayRecord records[3];
     for (int i = 0; i < 3; ++i) {
       records[i] = arrays_[i].record;
-      if (t.lengths_follow_declared_m) records[i].decoded_length = n_declared * columns(i, packed) * (options.float64 ? 8 : 4);
+      if (t.lengths_follow_declared_m) records[i].decoded_length = n_declared * columns(i, packed || q) * (options.float64 ? 8 : 4);
       // A placeholder until the block's length is known: any non-zero value
       // makes the field present, so the block's length does not depend on it.
       records[i].offset = std::uint64_t{1} << 40;
@@ -232,9 +293,9 @@ class EncodedFile {
       packed_kv_ = pack_key_values(frames_.empty() ? model.key_values : key_values, options);
       Model stripped = model;
       stripped.key_values = {packed_kv_.entry};
-      metadata_ = build_metadata(stripped, records, n_declared, packed, t, hint);
+      metadata_ = build_metadata(stripped, records, n_declared, packed || q, tq, hint);
     } else {
-      metadata_ = build_metadata(model, records, n_declared, packed, t, hint);
+      metadata_ = build_metadata(model, records, n_declared, packed || q, tq, hint);
     }
     if (t.validate && metadata_.size() >= kMetadataLengthLimit) {
       fail(ErrorCode::Limit, "limit",
@@ -255,7 +316,7 @@ class EncodedFile {
     set_array_offsets(metadata_.data(), offsets, patch);
 
     header_.major = t.major;
-    header_.minor = t.minor;
+    header_.minor = tq.minor;
     header_.metadata_length = static_cast<std::uint32_t>(metadata_.size());  // < 2^31 (checked) or a test's tweak
     header_.metadata_crc32c = crc32c(metadata_.data(), metadata_.size());
     header_.file_length = end + kTrailerSize;

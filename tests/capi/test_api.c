@@ -715,6 +715,24 @@ static void test_save_load(void) {
         sogmm_model_free(r);
         sogmm_buffer_free(buf);
       }
+    /* quantized components (spec/format.md 5.7): a format 1.4 file that loads */
+    {
+      const unsigned char* d;
+      size_t n_before, n_after;
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_FLOAT64, 0));
+      REQUIRE_OK(sogmm_options_set_i64(o, SOGMM_OPT_COMPRESS, 1));
+      EXPECT_STATUS(sogmm_options_set_f64(o, SOGMM_OPT_ARRAY_PRECISION, 0.6), SOGMM_E_INVALID_ARG);
+      REQUIRE_OK(sogmm_options_set_f64(o, SOGMM_OPT_ARRAY_PRECISION, 0.5));
+      REQUIRE_OK(sogmm_model_save_to_memory(&buf, m, o));
+      d = (const unsigned char*)sogmm_buffer_data(buf);
+      EXPECT_TRUE(d[8] == 1 && d[9] == 0 && d[10] == 4 && d[11] == 0); /* format 1.4 */
+      REQUIRE_OK(sogmm_model_load_from_memory(&r, d, sogmm_buffer_size(buf), NULL));
+      REQUIRE_OK(sogmm_model_n_components(m, &n_before));
+      REQUIRE_OK(sogmm_model_n_components(r, &n_after));
+      EXPECT_TRUE(n_before == n_after);
+      sogmm_model_free(r);
+      sogmm_buffer_free(buf);
+    }
   }
   sogmm_options_free(o);
   remove(path);

@@ -48,7 +48,10 @@ int main(int argc, char** argv) {
     std::size_t m;
     sogmm::format::WriteOptions o;
   } samples[] = {{"c_f32_zstd", 300, {}}, {"c_f64_zstd", 40, {19, true, true}}, {"c_f32_raw", 5, {19, false, false}},
-                 {"c_level1", 100, {1, false, true}}};
+                 {"c_level1", 100, {1, false, true}},
+                 // Quantized components (spec/format.md 5.7): the Python reader's decoding formulas must give
+                 // the C++ reader's bits on the writer's codes.
+                 {"c_quantized", 300, {19, false, true, 0.25}}, {"c_quantized_raw", 30, {19, false, false, 0.5}}};
   for (const S& s : samples) {
     const sogmm::Model m = model(s.m, static_cast<unsigned>(s.m));
     const auto bytes = sogmm::format::to_bytes(m, s.o);

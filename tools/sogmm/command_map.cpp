@@ -155,7 +155,11 @@ int run_map(MapState& s) {
   progress.finish();
   if (!s.trajectory_out.empty()) write_trajectory_log(s.trajectory_out, poses_used);
   const Model model = with_sequence_metadata(map.to_model(), in);
-  const std::uint64_t bytes = save_model(s.output, model);
+  // The map's component precision also selects the quantized arrays
+  // (spec/format.md 5.7) at the same bound.
+  format::WriteOptions write;
+  write.component_precision = s.options.component_precision;
+  const std::uint64_t bytes = save_model(s.output, model, write);
   const std::string frames = frame_list(in);
   const std::string csv_body = csv_text(rows);
   write_file_atomic(csv, csv_body.data(), csv_body.size());
@@ -268,7 +272,8 @@ Command add_map_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--component-precision", s->options.component_precision,
                   "round each fitted component so that it moves by at most this many of its standard deviations "
-                  "(zero low bits that deltas compress away), in [0, 0.5] (0: full float32)")
+                  "(zero low bits that deltas compress away) and store the map file's components as integer codes "
+                  "within the same bound (spec/format.md 5.7, format 1.4), in [0, 0.5] (0: full float32)")
       ->capture_default_str();
   app->add_option("--free-space-carve", s->options.free_space_carve,
                   "reshape a map component when this share of its samples lies where a frame sees past it, in "

@@ -23,9 +23,9 @@ Model load_model(const std::string& path) {
   }
 }
 
-std::uint64_t save_model(const std::string& path, const Model& model) {
+std::uint64_t save_model(const std::string& path, const Model& model, const format::WriteOptions& options) {
   try {
-    format::save(path, model);
+    format::save(path, model, options);
   } catch (const Error& e) {
     rethrow_with_path(e, path);
   }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "sogmm/file_options.hpp"
 #include "sogmm/model.hpp"
 
 namespace sogmm::tools {
@@ -14,8 +15,8 @@ namespace sogmm::tools {
 /// Loads and verifies a .sogmm file; errors name the file (Io -> exit 4,
 /// Format/InvalidData/Numeric -> exit 3).
 Model load_model(const std::string& path);
-/// Saves atomically (format::save); returns the file size in bytes.
-std::uint64_t save_model(const std::string& path, const Model& model);
+/// Saves atomically (format::save) with `options`; returns the file size in bytes.
+std::uint64_t save_model(const std::string& path, const Model& model, const format::WriteOptions& options = {});
 
 /// A Model around a fit: its fit record (record_fit), CameraInfo
 /// (full-resolution intrinsics, decimation, depth scale and range), producer

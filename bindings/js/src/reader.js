@@ -16,6 +16,7 @@ import { decodeStrings } from './strings.js';
 import { checkPose } from './pose.js';
 import { checkValues } from './values.js';
 import { FRAME_RECORD, PACKED_KEY_VALUES, unpackFrameRecord, unpackKeyValues } from './body_entries.js';
+import { CODE_COLUMNS, dequantize } from './quantized.js';
 
 export { SogmmError } from './errors.js';
 export { crc32c } from './crc32c.js';
@@ -27,12 +28,14 @@ const END = [0x53, 0x47, 0x4d, 0x4d]; // "SGMM"
 const HEADER = 32;
 const TRAILER = 4;
 export const DEFAULT_MAX_DECODED_BYTES = 2 ** 30;
-// Format 1.3: bits 1 (packed key/values) and 3 (a map's frame record).
-const KNOWN_FEATURES = PACKED_KEY_VALUES | FRAME_RECORD;
+// Format 1.3: bits 1 (packed key/values) and 3 (a map's frame record);
+// format 1.4: bit 2 (quantized components, section 5.7).
+const QUANTIZED = 4n;
+const KNOWN_FEATURES = PACKED_KEY_VALUES | FRAME_RECORD | QUANTIZED;
 
 export const DTYPES = ['f32', 'f64'];
 export const ORDERS = ['component_major', 'column_major'];
-export const FILTERS = ['none', 'byte_stream_split'];
+export const FILTERS = ['none', 'byte_stream_split', 'quantized'];
 export const CODECS = ['none', 'zstd'];
 export const LAYOUTS = ['upper_packed', 'full'];
 export const ARRAY_NAMES = ['weights', 'means', 'covariances'];
@@ -161,6 +164,13 @@ function readHead(data, maxDecodedBytes, verifyChecksums) {
       formatError('unsupported_encoding', 'unknown dtype, order, filter or codec');
     }
   }
+  const quantized = (m.features_required & QUANTIZED) !== 0n;
+  for (const r of m.arrays) {
+    if ((r.filter === 2) !== quantized) formatError('unsupported_encoding', 'filter QUANTIZED and feature bit 2 disagree');
+    if (quantized && (r.dtype !== 0 || m.covariance_layout !== 0)) {
+      formatError('unsupported_encoding', 'quantized components decode to float32, packed');
+    }
+  }
   const M = m.n_components;
   if (M === 0n) fail('invalid_data', 'empty', 'the model has no components (M = 0)');
   const cols = [1, 4, m.covariance_layout === 0 ? 10 : 16];
@@ -179,14 +189,15 @@ function readHead(data, maxDecodedBytes, verifyChecksums) {
     if (r.offset % 8n !== 0n || r.offset < BigInt(bodyStart) || end > bodyEnd) {
       formatError('bad_layout', `${ARRAY_NAMES[i]} outside the body or misaligned`);
     }
-    if (r.codec === 0 && r.stored_length !== r.decoded_length) formatError('bad_layout', `${ARRAY_NAMES[i]}: raw array of the wrong length`);
+    const filtered = quantized ? M * BigInt(4 * CODE_COLUMNS[i]) : r.decoded_length;
+    if (r.codec === 0 && r.stored_length !== filtered) formatError('bad_layout', `${ARRAY_NAMES[i]}: raw array of the wrong length`);
     for (const o of m.arrays.slice(0, i)) {
       if (r.stored_length > 0n && o.stored_length > 0n && r.offset < o.offset + o.stored_length && o.offset < end) {
         formatError('bad_layout', `${ARRAY_NAMES[i]} overlaps an earlier array`);
       }
     }
   });
-  return { m, major, minor, fileLength, metaLength, cols, bodyStart, total };
+  return { m, major, minor, fileLength, metaLength, cols, bodyStart, total, quantized };
 }
 
 const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
@@ -256,10 +267,37 @@ function canonicalBytes(bytes, rows, cols, width, split, columnMajor) {
   return out;
 }
 
+// Steps 17, 17b and 18 of a file with quantized components (section 5.7):
+// every array's codes, the model they decode to, then each array's CRC-32C
+// over the little-endian float32 bytes of that model.
+function readQuantized(data, records, M, verifyChecksums) {
+  const codes = records.map((r, i) => {
+    const K = CODE_COLUMNS[i];
+    const stored = data.subarray(Number(r.offset), Number(r.offset + r.stored_length));
+    const bytes = r.codec === 1 ? decodeZstd(stored, M * K * 4) : stored;
+    const canonical = canonicalBytes(bytes, M, K, 4, true, r.order === 1);
+    const dv = new DataView(canonical.buffer, canonical.byteOffset, canonical.byteLength);
+    const out = new Int32Array(M * K);
+    for (let t = 0; t < M * K; t++) {
+      const z = dv.getUint32(4 * t, true);
+      out[t] = z % 2 === 0 ? z / 2 : -(z + 1) / 2;
+    }
+    return out;
+  });
+  const values = dequantize(codes, M);
+  values.forEach((v, i) => {
+    const bytes = new Uint8Array(4 * v.length);
+    const dv = new DataView(bytes.buffer);
+    v.forEach((x, t) => dv.setFloat32(4 * t, x, true));
+    if (verifyChecksums && crc32c(bytes) !== records[i].crc32c) formatError('checksum_mismatch', `${ARRAY_NAMES[i]} CRC-32C`);
+  });
+  return values;
+}
+
 /** Reads a .sogmm file (Uint8Array) by spec/format.md section 9. */
 export function read(data, { maxDecodedBytes = DEFAULT_MAX_DECODED_BYTES, verifyChecksums = true, metadataOnly = false } = {}) {
   if (!(data instanceof Uint8Array)) data = new Uint8Array(data);
-  const { m, major, minor, fileLength, metaLength, cols, bodyStart, total } = readHead(data, maxDecodedBytes, verifyChecksums);
+  const { m, major, minor, fileLength, metaLength, cols, bodyStart, total, quantized } = readHead(data, maxDecodedBytes, verifyChecksums);
   const file = {
     format_version: `${major}.${minor}`, file_length: fileLength, metadata_length: metaLength,
     features_required: m.features_required, features_used: m.features_used,
@@ -281,7 +319,8 @@ export function read(data, { maxDecodedBytes = DEFAULT_MAX_DECODED_BYTES, verify
   };
   if (metadataOnly) return model;
   const M = Number(m.n_components);
-  const [weights, means, stored] = ARRAY_NAMES.map((name, i) => decodeArray(data, m.arrays[i], M, cols[i], name, verifyChecksums));
+  const [weights, means, stored] = quantized ? readQuantized(data, m.arrays, M, verifyChecksums)
+    : ARRAY_NAMES.map((name, i) => decodeArray(data, m.arrays[i], M, cols[i], name, verifyChecksums));
   model.weights = weights;
   model.means = means;
   model.covariances = checkValues(weights, means, stored, M, m.covariance_layout === 0);

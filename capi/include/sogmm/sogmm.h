@@ -235,6 +235,13 @@ typedef int32_t sogmm_key;
 /* 1: zstd-compress the arrays.
  * i64, 0 or 1; default 1. */
 #define SOGMM_OPT_COMPRESS 302
+/* > 0: store each component as integer codes (format 1.4, spec/format.md 5.7) that move its mean
+ * by at most this many of its standard deviations and its covariance's eigenvalues, in its own
+ * frame, by at most this fraction, as MAP_COMPONENT_PRECISION bounds them: 11-21 bytes a
+ * component on README section 7's maps instead of 30-40 (why:
+ * WriteOptions::component_precision); 0: float arrays, bit-exact.
+ * f64 (standard deviations), [0, 0.5] (0: off); default 0. */
+#define SOGMM_OPT_ARRAY_PRECISION 303
 
 /* Reading .sogmm. Read by sogmm_model_load, sogmm_model_load_from_memory, sogmm_map_load;
  * MAX_DECODED_BYTES also the saves. */

@@ -17,6 +17,14 @@ struct WriteOptions {
   int zstd_level = 19;   ///< zstd compression level, 1..22 (clamped)
   bool float64 = false;  ///< store arrays as float64 (exact widening of the float32 values)
   bool compress = true;  ///< false: arrays stored raw (no filter, no codec), component-major
+  /// > 0: store each component as integer codes (spec/format.md section 5.7,
+  /// format 1.4) that move its mean by at most this many of its standard
+  /// deviations and its covariance's eigenvalues, in its own frame, by at
+  /// most this fraction (the bound of MapOptions::component_precision); a
+  /// few bytes per component instead of 60. 0: float arrays, bit-exact. A
+  /// model the codes cannot hold (a zero weight, an extreme condition
+  /// number) is stored as floats.
+  double component_precision = 0;
   /// Refuse (Error(Limit), nothing written) a model whose arrays would decode
   /// to more bytes than this. The default is the reader's default cap, so a
   /// file a default reader would refuse is never written silently; raise it

@@ -200,6 +200,8 @@ struct MapOptions {
   /// default: on the synthetic loop 0.25 cuts the mean delta by 34% (9,390
   /// to 6,202 bytes) with held-out PSNR inside the map's seed spread, but an
   /// F-score at 1 cm 0.001-0.004 lower on two seeds (README section 8).
+  /// `sogmm map` also writes its file with WriteOptions::component_precision
+  /// at this value (quantized arrays, spec/format.md 5.7).
   double component_precision = 0.0;
 };
 

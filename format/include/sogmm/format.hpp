@@ -25,8 +25,10 @@
 
 namespace sogmm::format {
 
-/// Format version this library writes for a model. The newest it knows is
-/// 1.3: a map is written as 1.3 (spec/format.md 2.3.2), a map delta as 1.2.
+/// Format version this library writes for a model of float arrays. The
+/// newest it knows is 1.4: a map is written as 1.3 (spec/format.md 2.3.2), a
+/// file with quantized components (WriteOptions::component_precision > 0) as
+/// 1.4 (spec/format.md 5.7), a map delta as 1.2.
 inline constexpr std::uint16_t kFormatMajor = 1;
 inline constexpr std::uint16_t kFormatMinor = 0;
 
@@ -52,7 +54,10 @@ class FormatError : public Error {
 /// reject, metadata strings that are not valid UTF-8 or contain NUL included.
 /// An empty producer_version is written as sogmm::version_string().
 /// Covariances are stored packed (upper triangle) when every matrix is
-/// bit-exactly symmetric, else in full, so the round trip is always bit-exact.
+/// bit-exactly symmetric, else in full, so the round trip is bit-exact;
+/// with options.component_precision > 0 the components are stored as integer
+/// codes instead (format 1.4) and read back within that precision's bound
+/// (sogmm/file_options.hpp).
 std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options = {});
 
 /// Decodes and fully verifies the bytes of a .sogmm file.

@@ -24,6 +24,7 @@
 
 #include "frame_record.hpp"
 #include "internal.hpp"
+#include "sogmm_generated.h"
 #include "schema.hpp"
 #include "sogmm/camera.hpp"
 #include "sogmm/fit.hpp"
@@ -463,6 +464,38 @@ int main(int argc, char** argv) {
     invalid("f64_underflows_float32", b, "numeric", "not_spd",
             "float64 covariance diag(1e-50, 1e-3, 1e-3, 1e-3): positive definite in binary64, singular once rounded to "
             "binary32");
+
+    // Quantized components (spec/format.md 5.7, format 1.4, feature bit 2).
+    fmt::WriteOptions quant;
+    quant.component_precision = 0.5;
+    valid("quantized_components", fmt::to_bytes(synthetic(12, 21), quant),
+          "format 1.4, feature bit 2: twelve components stored as the integer codes of section 5.7 (zstd); the dump "
+          "is the float32 model the decoding formulas give");
+    quant.compress = false;
+    const std::vector<std::uint8_t> raw_codes = fmt::to_bytes(synthetic(5, 22), quant);
+    valid("quantized_components_raw", raw_codes,
+          "format 1.4, feature bit 2: five components' codes stored raw (column-major, byte-stream split, no codec)");
+    {
+      // Covariance code f (column 0) of component 1 set to 17: codes are
+      // column-major and byte-stream split, so its 4 bytes are at n i + 1.
+      const fmt::FileInfo info = fmt::read_info(raw_codes.data(), raw_codes.size());
+      std::vector<std::uint8_t> bad_f = raw_codes;
+      const std::uint64_t n = 5 * 14;
+      const std::uint32_t z = 2 * 17;  // zigzag(17)
+      for (int byte = 0; byte < 4; ++byte) bad_f[info.covariances.offset + byte * n + 1] = static_cast<std::uint8_t>(z >> (8 * byte));
+      invalid("quantized_code_out_of_range", bad_f, "invalid_data", "bad_quantization",
+              "covariance code f of component 1 is 17, above its range [0, 16] (section 5.7, step 17b)");
+    }
+    {
+      // The codes of a quantized file declared without feature bit 2: written
+      // with the bit, then the bit cleared in the metadata (its CRC refreshed).
+      std::vector<std::uint8_t> b2 = raw_codes;
+      auto* root = sogmm::fb::GetMutableSogmmFile(b2.data() + 32);
+      if (!root->mutate_features_required(0)) throw std::runtime_error("features_required not present");
+      det::refresh_metadata_crc(b2);
+      invalid("quantized_filter_without_feature", b2, "format", "unsupported_encoding",
+              "arrays with filter 2 (QUANTIZED) in a file whose features_required lacks bit 2 (step 12)");
+    }
 
     std::ofstream manifest(g_out + "/manifest.json");
     manifest << "{\n  \"format\": \"sogmm-conformance\",\n  \"manifest_version\": 1,\n"

@@ -20,10 +20,11 @@ MAGIC = b"\x89SOG\r\n\x1a\n"
 END_MAGIC = b"SGMM"
 HEADER_SIZE = 32
 TRAILER_SIZE = 4
+QUANTIZED_FEATURE = 4  # bit 2: quantized components (section 5.7, format 1.4)
 MAP_DELTA_FEATURE = 1  # features_required bit 0: a map delta (section 2.5), known to a delta reader only
 PACKED_KEY_VALUES_FEATURE = 2  # bit 1: key/values packed in the body (section 2.5.1; format 1.3: any reader)
 FRAME_RECORD_FEATURE = 8  # bit 3: a map's frame lines as a binary record (section 2.3.2, format 1.3)
-KNOWN_FEATURES = PACKED_KEY_VALUES_FEATURE | FRAME_RECORD_FEATURE
+KNOWN_FEATURES = PACKED_KEY_VALUES_FEATURE | QUANTIZED_FEATURE | FRAME_RECORD_FEATURE
 PACKED_KEY = "packed_key_values"
 FRAME_RECORD_KEY = "map_frame_record"
 DEFAULT_MAX_DECODED_BYTES = 1 << 30
@@ -205,7 +206,7 @@ class _Table:
 # ---------------------------------------------------------------- schema
 DTYPES = {0: ("f32", 4, "f"), 1: ("f64", 8, "d")}
 ORDERS = {0: "component_major", 1: "column_major"}
-FILTERS = {0: "none", 1: "byte_stream_split"}
+FILTERS = {0: "none", 1: "byte_stream_split", 2: "quantized"}
 CODECS = {0: "none", 1: "zstd"}
 LAYOUTS = {0: "upper_packed", 1: "full"}
 ARRAY_NAMES = ("weights", "means", "covariances")
@@ -446,13 +447,13 @@ def _zstd_frames(stored, expected):
     return bytes(out)
 
 
-def _decode(stored, rec, rows, cols):
-    _, w, _ = DTYPES[rec["dtype"]]
+def _decode(stored, rec, rows, cols, width=None):
+    w = width or DTYPES[rec["dtype"]][1]
     n = rows * cols
     if rec["codec"] == 1:
         _zstd_structure(stored)
     data = _zstd_frames(stored, n * w) if rec["codec"] == 1 else bytes(stored)
-    if rec["filter"] == 1:  # byte k of element i is at k * n + i
+    if rec["filter"] in (1, 2):  # byte k of element i is at k * n + i
         joined = bytearray(n * w)
         for k in range(w):
             joined[k::w] = data[k * n:(k + 1) * n]
@@ -466,6 +467,84 @@ def _decode(stored, rec, rows, cols):
                 comp[dst:dst + w] = data[src:src + w]
         data = bytes(comp)
     return data
+
+
+# ---------------------------------------------------------------- quantized components (section 5.7)
+CODE_COLUMNS = (1, 5, 14)
+
+
+def _bad_code(k, what):
+    _fail("invalid_data", "bad_quantization", f"component {k}: {what}")
+
+
+def _mf(c, f):
+    """(F + (c mod F)) 2^(floor(c / F) - f) and its exponent floor(c / F)."""
+    big = 1 << f
+    e = c // big
+    return math.ldexp(float(big + c % big), e - f), e
+
+
+def _dequantize(codes, m):
+    """Section 5.7: the float32 weights, means and packed covariances of the codes."""
+    cw, cm, cc = codes
+    omega = []
+    for k in range(m):
+        o, e = _mf(cw[k], 3)
+        if not -126 <= e <= 0:
+            _bad_code(k, "weight code out of range")
+        omega.append(o)
+    total = 0.0
+    for o in omega:
+        total += o
+    weights = [_round_f32(o / total) for o in omega]
+    means, cov = [], []
+    for k in range(m):
+        f, c0, c1, c2, cv, r, u, Y, Z, T, sb, B0, B1, B2 = cc[14 * k:14 * k + 14]
+        if not 0 <= f <= 16:
+            _bad_code(k, "f out of range")
+        lam = []
+        for c in (c0, c1, c2, cv):
+            val, e = _mf(c, f)
+            if not -126 <= e <= 127:
+                _bad_code(k, "variance code out of range")
+            lam.append(val)
+        v = lam.pop()
+        if not 0 <= r <= 24:
+            _bad_code(k, "r out of range")
+        if not 0 <= u <= 24:
+            _bad_code(k, "u out of range")
+        if Y * Y + Z * Z > 4 ** r:
+            _bad_code(k, "tilt codes of norm above 1")
+        if not -(1 << u) <= T <= 1 << u:
+            _bad_code(k, "turn code out of range")
+        if not 0 <= sb <= 40:
+            _bad_code(k, "s out of range")
+        y, z, t = math.ldexp(float(Y), -r), math.ldexp(float(Z), -r), math.ldexp(float(T), -u)
+        w = math.sqrt(1 - (y * y + z * z))
+        a0, a1, a2, a3 = w, w * t, y + z * t, z - y * t
+        n = ((a0 * a0 + a1 * a1) + a2 * a2) + a3 * a3
+        q = 2 / n
+        R = [[1 - q * (a2 * a2 + a3 * a3), q * (a1 * a2 - a0 * a3), q * (a1 * a3 + a0 * a2)],
+             [q * (a1 * a2 + a0 * a3), 1 - q * (a1 * a1 + a3 * a3), q * (a2 * a3 - a0 * a1)],
+             [q * (a1 * a3 - a0 * a2), q * (a2 * a3 + a0 * a1), 1 - q * (a1 * a1 + a2 * a2)]]
+        beta = [math.ldexp(float(B), -sb) for B in (B0, B1, B2)]
+        S = [[0.0] * 4 for _ in range(4)]
+        for a in range(3):
+            for b in range(a, 3):
+                S[a][b] = ((lam[0] * R[a][0]) * R[b][0] + (lam[1] * R[a][1]) * R[b][1]) + (lam[2] * R[a][2]) * R[b][2]
+        tau = [math.sqrt(lam[i]) * beta[i] for i in range(3)]
+        for a in range(3):
+            S[a][3] = math.sqrt(v) * ((R[a][0] * tau[0] + R[a][1] * tau[1]) + R[a][2] * tau[2])
+        S[3][3] = v * (1 + ((beta[0] * beta[0] + beta[1] * beta[1]) + beta[2] * beta[2]))
+        cov.extend(_round_f32(S[i][j]) for i, j in UPPER)
+        e, U0, U1, U2, G = cm[5 * k:5 * k + 5]
+        if not 0 <= e <= 40:
+            _bad_code(k, "e out of range")
+        h = math.ldexp(1.0, -e)
+        yt = [math.sqrt(lam[i]) * (U * h) for i, U in enumerate((U0, U1, U2))]
+        means.extend(_round_f32((R[a][0] * yt[0] + R[a][1] * yt[1]) + R[a][2] * yt[2]) for a in range(3))
+        means.append(_round_f32(math.sqrt(v) * (G * h)))
+    return [weights, means, cov]
 
 
 def _cholesky_ok(a):
@@ -561,6 +640,12 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         if (rec["dtype"] not in DTYPES or rec["order"] not in ORDERS or rec["filter"] not in FILTERS
                 or rec["codec"] not in CODECS):
             _format("unsupported_encoding", "unknown enum value")
+    quantized = bool(md["features_required"] & QUANTIZED_FEATURE)
+    for rec in md["arrays"]:
+        if (rec["filter"] == 2) != quantized:
+            _format("unsupported_encoding", "filter QUANTIZED and feature bit 2 disagree")
+        if quantized and (rec["dtype"] != 0 or md["covariance_layout"] != 0):
+            _format("unsupported_encoding", "quantized components decode to float32, packed")
     # 13
     m = md["n_components"]
     if m == 0 and not delta:
@@ -582,7 +667,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         off, n = rec["offset"], rec["stored_length"]
         if off % 8 or off < body_start or off + n > body_end:
             _format("bad_layout", "array outside the body or misaligned")
-        if rec["codec"] == 0 and n != rec["decoded_length"]:
+        filtered = m * CODE_COLUMNS[i] * 4 if quantized else rec["decoded_length"]
+        if rec["codec"] == 0 and n != filtered:
             _format("bad_layout", "raw array length")
         for other in md["arrays"][:i]:
             if n and other["stored_length"] and off < other["offset"] + other["stored_length"] \
@@ -611,7 +697,17 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         return out
     # 17-18
     values = []
-    for name, rec, c in zip(ARRAY_NAMES, md["arrays"], cols):
+    if quantized:  # 17, 17b, then 18 over the decoded float32 values (section 5.7)
+        codes = []
+        for rec, kc in zip(md["arrays"], CODE_COLUMNS):
+            raw = _decode(data[rec["offset"]:rec["offset"] + rec["stored_length"]], rec, m, kc, 4)
+            zz = struct.unpack(f"<{m * kc}I", raw)
+            codes.append([z >> 1 if z % 2 == 0 else -((z + 1) >> 1) for z in zz])
+        values = _dequantize(codes, m)
+        for name, rec, v in zip(ARRAY_NAMES, md["arrays"], values):
+            if verify_checksums and crc32c(struct.pack(f"<{len(v)}f", *v)) != rec["crc32c"]:
+                _format("checksum_mismatch", f"{name} CRC-32C")
+    for name, rec, c in zip(ARRAY_NAMES, md["arrays"], cols) if not quantized else ():
         raw = _decode(data[rec["offset"]:rec["offset"] + rec["stored_length"]], rec, m, c)
         if verify_checksums and crc32c(raw) != rec["crc32c"]:
             _format("checksum_mismatch", f"{name} CRC-32C")

@@ -95,6 +95,7 @@ pub const SOGMM_OPT_DECIMATION: sogmm_key = 203;
 pub const SOGMM_OPT_ZSTD_LEVEL: sogmm_key = 300;
 pub const SOGMM_OPT_FLOAT64: sogmm_key = 301;
 pub const SOGMM_OPT_COMPRESS: sogmm_key = 302;
+pub const SOGMM_OPT_ARRAY_PRECISION: sogmm_key = 303;
 pub const SOGMM_OPT_MAX_DECODED_BYTES: sogmm_key = 400;
 pub const SOGMM_OPT_VERIFY_CHECKSUMS: sogmm_key = 401;
 pub const SOGMM_OPT_SAMPLE_TRUNCATION: sogmm_key = 500;
