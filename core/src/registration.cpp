@@ -28,14 +28,19 @@ using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 constexpr double kLog2Pi = 1.8378770664093453;
 // exp(x) rounds to +0 for x <= kExpZero (its smallest subnormal is
-// exp(-745.13)); exp(x) < 1e-12 for x < kNegligibleExponent.
+// exp(-745.13)).
 constexpr double kExpZero = -746.0;
-constexpr double kNegligibleExponent = -28.0;
 // Items per partial sum: fixed, so sums do not depend on threads. A model
 // source has few items, each costing a 3 x 3 factor per component pair:
 // smaller blocks let every thread work.
 constexpr std::size_t kBlock = 256;
 constexpr std::size_t kModelBlock = 16;
+// The fewest points a coarse level scores. Every 16th of a 12k-point frame
+// (768) held the loop frames of the README's speed line (the same errors as
+// every 4th, 30-32 against 59 ms of CPU a call); 169 of the 2.7k points of
+// the one-wall frame of the tracking tests left the slide along the wall
+// still moving at the iteration cap (NotConverged, not Degenerate).
+constexpr std::size_t kCoarsePoints = 512;
 // How far (metres, per axis) a point may move before its candidate
 // components are looked up again (detail::CandidateCache): a level's first
 // steps move it by centimetres, its last ones by fractions of a millimetre.
@@ -121,7 +126,7 @@ struct Sums {
 
 struct Scratch {
   std::vector<std::uint32_t> ids;
-  std::vector<double> logp;
+  std::vector<double> term;  // each pair's log-density, then exp(it - the largest)
   std::vector<Eigen::Vector3d> res;
   std::vector<Eigen::Matrix3d> prec;  // a model source: each pair's own precision
 };
@@ -182,7 +187,7 @@ void model_candidates(const Level& level, const Eigen::Vector3d& x, const Eigen:
 void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d* spread4,
                  double weight, const Eigen::Vector3d& c, double log_outlier, bool use_gray, bool spread,
                  Scratch& s, Sums& out) {
-  s.logp.resize(s.ids.size());
+  s.term.resize(s.ids.size());
   s.res.resize(s.ids.size());
   if (spread4) s.prec.resize(s.ids.size());
   double top = log_outlier;
@@ -202,39 +207,46 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
       lp -= 0.5 * r.dot(k.prec * r);
       s.res[j] = r;
     }
-    s.logp[j] = lp;
+    s.term[j] = lp;
     top = std::max(top, lp);
   }
   // No component's box holds the item and no outlier term (outlier_ratio
   // 0): it has no density to move towards and is left out of every sum
   // (not an inlier), instead of making them NaN.
   if (top == -std::numeric_limits<double>::infinity()) return;
-  // exp of an exponent below -746 is +0 (and costs libm's slow underflow
-  // path): such a term adds nothing, so it is skipped with the same sum.
-  double total = std::exp(log_outlier - top);
-  for (double lp : s.logp)
-    if (lp - top > kExpZero) total += std::exp(lp - top);
+  // The terms exp(lp - top) replace the log-densities and each responsibility is
+  // its term over their total: one exp per pair, not two. exp of an exponent
+  // below -746 is +0 (and costs libm's slow underflow path): such a term
+  // adds nothing, so it is set to 0 without calling exp.
+  const double term_out = std::exp(log_outlier - top);
+  double total = term_out;
+  for (double& e : s.term) {
+    e = e - top > kExpZero ? std::exp(e - top) : 0.0;
+    total += e;
+  }
   const double lse = top + std::log(total);
+  const double inv_total = 1.0 / total;
   out.log_likelihood += weight * lse;
-  const double w_out = std::exp(log_outlier - lse);
+  const double w_out = term_out * inv_total;
   const bool inlier = w_out < 0.5;
   if (inlier) out.inliers += weight;
+  // J = [-[a]x, I] with a = x - c is the same for every component of the
+  // point: sum the weighted precisions W and precision-weighted residuals
+  // first, then one J^T W J. (A model source's covariance is held at the
+  // current pose within a step: the Gauss-Newton step moves its mean.)
+  const Eigen::Vector3d a = x - c;
   Mat36 jac;
-  jac.leftCols<3>() = -skew(x - c);
-  jac.rightCols<3>().setIdentity();
-  // J is the same for every component of the point: sum the weighted
-  // precisions and precision-weighted residuals first, then one J^T W J.
-  // (A model source's covariance is held at the current pose within a step:
-  // the Gauss-Newton step moves its mean.)
+  if (spread) {
+    jac.leftCols<3>() = -skew(a);
+    jac.rightCols<3>().setIdentity();
+  }
   Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
   Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
   Vec6 gbar = Vec6::Zero();
   Mat6 ggt = Mat6::Zero();
   for (std::size_t j = 0; j < s.ids.size(); ++j) {
-    // Responsibilities below 1e-12 are dropped; exp(-28) < 7e-13, so the
-    // exponent alone decides most of them without calling exp.
-    if (s.logp[j] - lse < kNegligibleExponent) continue;
-    const double w = std::exp(s.logp[j] - lse);
+    // Responsibilities below 1e-12 are dropped.
+    const double w = s.term[j] * inv_total;
     if (w < 1e-12) continue;
     const Eigen::Matrix3d& p = spread4 ? s.prec[j] : level.comps[s.ids[j]].prec;
     const Eigen::Vector3d pr = p * s.res[j];
@@ -247,8 +259,16 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
       ggt.noalias() += w * g * g.transpose();
     }
   }
-  out.hessian.noalias() += weight * (jac.transpose() * wp * jac);
-  out.gradient.noalias() += weight * (jac.transpose() * wpr);
+  // With S = [a]x (S v = a x v, S^T = -S) and M = S W:
+  // J^T W J = [-M S, M; M^T, W] and J^T v = [a x v; v].
+  const Eigen::Matrix3d sa = skew(a);
+  const Eigen::Matrix3d m = sa * wp;
+  out.hessian.topLeftCorner<3, 3>().noalias() -= weight * (m * sa);
+  out.hessian.topRightCorner<3, 3>().noalias() += weight * m;
+  out.hessian.bottomLeftCorner<3, 3>().noalias() += weight * m.transpose();
+  out.hessian.bottomRightCorner<3, 3>().noalias() += weight * wp;
+  out.gradient.head<3>() += weight * a.cross(wpr);
+  out.gradient.tail<3>() += weight * wpr;
   if (spread) out.spread += weight * (ggt - gbar * gbar.transpose());
 }
 
@@ -406,9 +426,12 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   std::optional<detail::CandidateCache> cands;
   for (std::int32_t l = 0; l < levels; ++l) {
     const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
-    // Level l of L uses every 2^(L-1-l)-th point (at most 4x fewer), keeping at least min_points.
-    std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(levels - 1 - l, 2);
-    while (stride > 1 && n / stride < static_cast<std::size_t>(options.min_points)) stride /= 2;
+    // Level l of L uses every 4^(L-1-l)-th point (at most 16x fewer), keeping
+    // at least kCoarsePoints and min_points: the coarse levels only bring the
+    // pose within the finest level's reach, which scores every point.
+    std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(2 * (levels - 1 - l), 4);
+    const auto fewest = std::max<std::size_t>(kCoarsePoints, static_cast<std::size_t>(options.min_points));
+    while (stride > 1 && n / stride < fewest) stride /= 2;
     (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray);
     const Level& level = l == 0 ? coarsest : finer;
     if (l == 0) cands.emplace(coarsest.index, model_source ? 0 : n, kCandidateMargin);

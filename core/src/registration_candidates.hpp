@@ -52,7 +52,11 @@ class CandidateCache {
         cube.lo[d] = x(d) - m;
         cube.hi[d] = x(d) + m;
       }
-      index_->query_box(cube, near_[i]);
+      // Queried into `out` and copied: one allocation of the exact size
+      // instead of a vector grown entry by entry for every new point.
+      index_->query_box(cube, out);
+      near_[i].assign(out.begin(), out.end());
+      out.clear();
       anchor_[i] = x;
       valid_[i] = 1;
     }

@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "sogmm/component_index.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/registration.hpp"
@@ -124,6 +125,77 @@ TEST(Registration, SinglePlaneIsDegenerate) {
   const Eigen::Matrix4d p = sogmm_test::pose_matrix(r.pose);
   EXPECT_NEAR(p(2, 3), 0.01, 1e-3);
   EXPECT_NEAR(std::asin(p(2, 1)) * 180 / M_PI, 2.0, 0.1);
+}
+
+// Two components 1 m apart (3-sigma boxes about 0.15 m wide) and no outlier
+// term: every point has one candidate and responsibility exactly 1, so
+// Louis' correction vanishes and the information about the origin is the
+// Gauss-Newton sum over the points x (at the returned pose) of J^T P_k J,
+// with J = [-[x]x, I] and P_k its component's spatial precision (with gray:
+// the conditional one, the inverse of the Schur complement of s_gg).
+// Computed here from the stored float covariances, independently of the
+// library's blockwise sum about the centroid; a sign or transpose slip in one
+// block of that sum (tried: the sign of the rotation-translation block,
+// which a single component's symmetric points cancel) breaks the 1e-9
+// relative bound, which leaves room for rounding only (no kernel-dispatched
+// code runs here, so every kernel gives the same sums).
+TEST(Registration, InformationIsTheGaussNewtonSum) {
+  Eigen::Matrix4d a;
+  a << 0.05, 0.01, 0.0, 0.0, -0.01, 0.03, 0.005, 0.0, 0.02, 0.0, 0.01, 0.0, 0.01, -0.02, 0.005, 0.05;
+  const Eigen::Vector4d mus[2] = {{0.3, -0.2, 1.5, 0.4}, {1.3, 0.1, 1.8, 0.6}};
+  const Eigen::Matrix4d flip = Eigen::Vector4d(1, -1, 1, 1).asDiagonal();
+  const Eigen::Matrix4d covs[2] = {a * a.transpose(), flip * a.transpose() * a * flip};
+  sogmm::Gmm g;
+  g.resize(2);
+  for (std::size_t k = 0; k < 2; ++k) sogmm_test::set_component(g, k, 0.5, mus[k], covs[k]);
+  g.support_size = 1;
+  // Per component a 7 x 7 x 7 grid mu + L u (L L^T the spatial covariance,
+  // u in [-1, 1]^3): Mahalanobis radius at most sqrt(3), so every point
+  // stays inside its own 3-sigma box near the identity, where this spread
+  // holds the pose. Gray varies along the grid.
+  std::vector<float> pts;
+  std::vector<Eigen::Matrix4d> stored(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    stored[k] = sogmm_test::cov_of(g, k);
+    stored[k] = 0.5 * (stored[k] + stored[k].transpose()).eval();
+    const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(stored[k].topLeftCorner<3, 3>()).matrixL();
+    for (int i = -3; i <= 3; ++i)
+      for (int j = -3; j <= 3; ++j)
+        for (int l = -3; l <= 3; ++l) {
+          const Eigen::Vector3d x = mus[k].head<3>() + chol * Eigen::Vector3d(i, j, l) / 3.0;
+          for (int d = 0; d < 3; ++d) pts.push_back(float(x(d)));
+          pts.push_back(float(mus[k](3) + 0.01 * (i - j + l)));
+        }
+  }
+  const std::size_t n = pts.size() / 4, per = n / 2;
+  for (bool gray : {false, true}) {
+    sogmm::RegistrationOptions o;
+    o.use_gray = gray;
+    o.outlier_ratio = 0.0;
+    o.levels = 1;
+    const sogmm::RegistrationResult r =
+        sogmm::register_points(g, pts.data(), n, sogmm_test::pose_array(rigid(1.0, {0, 0, 1}, {0.002, 0, 0})), o);
+    ASSERT_EQ(r.status, RegistrationStatus::Converged) << sogmm::status_name(r.status);
+    const Eigen::Matrix4d pose = sogmm_test::pose_matrix(r.pose);
+    Eigen::Matrix<double, 6, 6> expected = Eigen::Matrix<double, 6, 6>::Zero();
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::size_t k = p / per;
+      Eigen::Matrix3d spatial = stored[k].topLeftCorner<3, 3>();
+      if (gray) spatial -= stored[k].block<3, 1>(0, 3) * stored[k].block<1, 3>(3, 0) / stored[k](3, 3);
+      const Eigen::Vector3d x =
+          pose.topLeftCorner<3, 3>() * Eigen::Vector3d(pts[4 * p], pts[4 * p + 1], pts[4 * p + 2]) +
+          pose.topRightCorner<3, 1>();
+      const double xyz[3] = {x(0), x(1), x(2)};
+      ASSERT_TRUE(sogmm::component_box(g, k, 3.0).contains(xyz));
+      ASSERT_FALSE(sogmm::component_box(g, 1 - k, 3.0).contains(xyz));
+      Eigen::Matrix<double, 3, 6> jac;
+      jac << 0, x(2), -x(1), 1, 0, 0, -x(2), 0, x(0), 0, 1, 0, x(1), -x(0), 0, 0, 0, 1;
+      expected += jac.transpose() * spatial.inverse() * jac;
+    }
+    Eigen::Matrix<double, 6, 6> info;
+    for (int i = 0; i < 36; ++i) info(i / 6, i % 6) = r.information[i];
+    EXPECT_LT((info - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff()) << "gray " << gray;
+  }
 }
 
 // A start beyond the target's reach does not come back as a good pose.
