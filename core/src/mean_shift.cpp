@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -159,9 +160,18 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   // the rows and cells walked per query stay few (at d = 1 a query tests ~410
   // points one by one instead of Grid2d's ~1,800; halves and eighths were
   // slower).
-  const detail::RowSumGrid grid(xy.data(), n, bandwidth, 4);
+  // The grid and the seeds are independent serial work (sorts of all the
+  // points): one on each of two threads.
+  std::optional<detail::RowSumGrid> built;
+  std::vector<double> seeds;
+  detail::parallel_for(2, detail::team_size(0), 1, [&](std::size_t job, int) {
+    if (job == 0)
+      built.emplace(xy.data(), n, bandwidth, 4);
+    else
+      seeds = bin_seeds(xy, bandwidth, options.anchor);
+  });
+  const detail::RowSumGrid& grid = *built;
   detail::progress_poll();
-  const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
   const double stop = options.stop_fraction * bandwidth;
   std::vector<Mode> modes(n_seeds);
