@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include "row_sum_grid.hpp"
 #include "parallel.hpp"
 #include "progress.hpp"
+#include "z_order.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 
@@ -80,15 +82,25 @@ std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, B
                                      : checked::floor_to_int<std::int64_t>((v - lo) / bandwidth + 0.5, "bin index");
   };
   // The occupied cells in ascending (x, y) order: seeds in a fixed order.
-  std::vector<std::pair<std::int64_t, std::int64_t>> occupied(xy.size() / 2);
-  for (std::size_t i = 0; i < xy.size(); i += 2) occupied[i / 2] = {cell(xy[i], min_x), cell(xy[i + 1], min_y)};
-  std::sort(occupied.begin(), occupied.end());
-  occupied.erase(std::unique(occupied.begin(), occupied.end()), occupied.end());
+  // check_inputs bounds each axis's extent by 1e8 bandwidths, so a cell's
+  // offset from the lowest cell fits 32 bits, and the key (x offset << 32 |
+  // y offset) orders cells as (x, y) pairs: the radix sort_by_key then gives
+  // std::sort's order of the cells (std::sort of the pairs was ~10% of the
+  // mode count's serial time at d = 1).
+  const std::size_t n = xy.size() / 2;
+  std::vector<std::int64_t> cx(n), cy(n);
+  for (std::size_t i = 0; i < n; ++i) cx[i] = cell(xy[2 * i], min_x), cy[i] = cell(xy[2 * i + 1], min_y);
+  const std::int64_t lo_x = *std::min_element(cx.begin(), cx.end()), lo_y = *std::min_element(cy.begin(), cy.end());
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(n);
+  for (std::size_t i = 0; i < n; ++i)
+    keyed[i] = {static_cast<std::uint64_t>(cx[i] - lo_x) << 32 | static_cast<std::uint64_t>(cy[i] - lo_y), i};
+  detail::sort_by_key(keyed);
   std::vector<double> seeds;
-  seeds.reserve(2 * occupied.size());
-  for (const auto& c : occupied) {
-    seeds.push_back(c.first * bandwidth + min_x);
-    seeds.push_back(c.second * bandwidth + min_y);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0 && keyed[k].first == keyed[k - 1].first) continue;
+    const std::size_t i = keyed[k].second;
+    seeds.push_back(cx[i] * bandwidth + min_x);
+    seeds.push_back(cy[i] * bandwidth + min_y);
   }
   return seeds;
 }
@@ -148,9 +160,18 @@ MeanShiftResult mean_shift_flat(const std::vector<double>& xy, double bandwidth,
   // the rows and cells walked per query stay few (at d = 1 a query tests ~410
   // points one by one instead of Grid2d's ~1,800; halves and eighths were
   // slower).
-  const detail::RowSumGrid grid(xy.data(), n, bandwidth, 4);
+  // The grid and the seeds are independent serial work (sorts of all the
+  // points): one on each of two threads.
+  std::optional<detail::RowSumGrid> built;
+  std::vector<double> seeds;
+  detail::parallel_for(2, detail::team_size(0), 1, [&](std::size_t job, int) {
+    if (job == 0)
+      built.emplace(xy.data(), n, bandwidth, 4);
+    else
+      seeds = bin_seeds(xy, bandwidth, options.anchor);
+  });
+  const detail::RowSumGrid& grid = *built;
   detail::progress_poll();
-  const std::vector<double> seeds = bin_seeds(xy, bandwidth, options.anchor);
   const std::size_t n_seeds = seeds.size() / 2;
   const double stop = options.stop_fraction * bandwidth;
   std::vector<Mode> modes(n_seeds);

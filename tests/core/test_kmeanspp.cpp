@@ -120,3 +120,18 @@ TEST(KmeansPlusPlus, LargeCloudSameCentresForOneTwoThreeThreads) {
   }
   omp_set_num_threads(saved);
 }
+
+TEST(KmeansPlusPlus, SameCentresAsBruteForceForEveryTreeShape) {
+  // Each step's work is split over the k-d tree's parts (the nodes three
+  // levels down, or leaves above that): from N <= 16 (the root is a leaf,
+  // one part) through N = 129 (eight parts, the last ones leaves of 16 and
+  // 17 points), so every shape of the tree's top is seeded and compared.
+  // Exact equality of indices holds under every SOGMM_ISA: k-means++ calls
+  // no dispatched kernel, and its gains are sums of the same double terms.
+  const std::vector<float> frame = frame_cloud();
+  for (std::size_t n : {1u, 2u, 16u, 17u, 40u, 65u, 129u}) {
+    const std::vector<float> cloud(frame.begin(), frame.begin() + 4 * n);
+    for (std::size_t k : {std::size_t{1}, std::min<std::size_t>(n, 5), n})
+      expect_same_as_brute_force(cloud, k, 7);
+  }
+}
