@@ -86,7 +86,9 @@ TrackedFrame track_backprojected(Map& map, TrackingState& state, const PointsVie
     // The odometry's next target (none when odometry cannot run, or when the
     // frame's cells are empty).
     state.cells = odometry ? detail::odometry_target(points) : Gmm{};
-    state.pose = pose;
+    // The pose as the map recorded it (on its precision's grid when
+    // component_precision > 0), which holds_last_frame compares with.
+    state.pose = map.frames().back().pose;
     state.n_frames = map.frames().size();
     return t;
   };

@@ -114,9 +114,11 @@ std::vector<OptionSpec> make_table() {
                     "standard deviations",
                     "> 0: store each component as integer codes (format 1.4, spec/format.md 5.7) that move its mean by "
                     "at most this many of its standard deviations and its covariance's eigenvalues, in its own frame, "
-                    "by at most this fraction, as MAP_COMPONENT_PRECISION bounds them: 11-21 bytes a component on "
-                    "README section 7's maps instead of 30-40 (why: WriteOptions::component_precision); 0: float "
-                    "arrays, bit-exact"),
+                    "by at most this fraction, as MAP_COMPONENT_PRECISION bounds them, and its weight by a factor of at "
+                    "most 1 +- 2^-4 before the weights are renormalised: 11-21 bytes a component on "
+                    "README section 7's maps instead of 30-40 (why: WriteOptions::component_precision). The bound "
+                    "is against the model saved: a model read from such a file and saved again is coded anew and "
+                    "may move by as much again. 0: float arrays, bit-exact"),
       // ---- reading .sogmm (the cap also bounds writing) ----
       // 0 restores the format library's default cap (kDefaultMaxDecodedBytes).
       OptionSpec{OptionKey::MAX_DECODED_BYTES, "SOGMM_OPT_MAX_DECODED_BYTES", OptionType::I64, 0.0,

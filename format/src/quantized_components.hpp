@@ -31,7 +31,7 @@ struct ComponentCodes {
 ///   - every eigenvalue of L^-1 S' L^-T lies in [1 - precision, 1 + precision];
 ///   - |L^-1 (m' - m)| <= precision (the mean moves by at most `precision`
 ///     standard deviations);
-///   - each weight is within a factor 1 +- 2^-6 of the original before the
+///   - each weight is within a factor 1 +- 2^-4 of the original before the
 ///     decoder renormalises the weights to sum 1.
 /// Every component is checked on its decoded float32 values before the codes
 /// are returned; std::nullopt when one cannot be (a zero or subnormal weight,

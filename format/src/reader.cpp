@@ -26,7 +26,13 @@ namespace {
 constexpr bool kBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
 // The features_required bits a map delta's reader knows (spec/format.md
 // sections 2.5 and 2.5.1): a model reader's and map_delta.
+// Every bit this library knows, a delta's included: what a delta reader and
+// a metadata-only read accept before telling a model from a delta.
 constexpr std::uint64_t kDeltaFeatures = kKnownFeatures | kFeatureMapDelta;
+// A delta keeps its floats and its frame lines as text (its digest covers
+// them; spec/format.md 2.5 and 7): quantized components (bit 2) and a frame
+// record (bit 3) are model features that a delta must not carry.
+constexpr std::uint64_t kModelOnlyFeatures = kFeatureQuantizedComponents | kFeatureFrameRecord;
 const char* const kNames[3] = {"weights", "means", "covariances"};
 
 // Steps 1-16: the header and the trailer first, then the metadata block, read
@@ -151,6 +157,9 @@ Model read_model(const Source& src, const ReadOptions& options, FileInfo* info, 
   ParsedMetadata meta = read_metadata(src, options, delta ? kDeltaFeatures : kKnownFeatures);
   if (delta && (meta.info.features_required & kFeatureMapDelta) == 0)
     fail(ErrorCode::Format, "not_a_delta", "the file is a model, not a map delta (feature bit 0 is not set)");
+  if (delta && (meta.info.features_required & kModelOnlyFeatures) != 0)
+    fail(ErrorCode::Format, "unsupported_feature",
+         "a map delta with feature bit 2 (quantized_components) or 3 (frame_record), which only a model may use");
   const std::uint64_t m = meta.info.n_components;  // its arrays fit the cap (step 15)
   Model model = std::move(meta.info.metadata);
   Gmm& g = model.gmm;

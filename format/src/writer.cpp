@@ -23,6 +23,7 @@
 #include "strings.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/format.hpp"
+#include "sogmm/options.hpp"
 
 namespace sogmm::format {
 namespace detail {
@@ -225,12 +226,19 @@ std::optional<std::pair<ComponentCodes, Gmm>> quantized(const Gmm& g, double pre
 class EncodedFile {
  public:
   EncodedFile(const Model& model, const WriteOptions& options, const Tweaks& tweaks) {
+    // The registry's range (a C API caller is checked when setting it; a C++
+    // caller here): infinity would code every component to nothing useful.
+    require_option(OptionKey::ARRAY_PRECISION, options.component_precision, "save: component_precision");
     // A map (a model with a `map_frames` text the record reproduces) is
     // written as format 1.3: its frame lines as the binary frame record (bit
     // 3) and every key/value packed in the body (bit 1; spec/format.md 2.3.2).
     Tweaks t = tweaks;
     std::vector<std::pair<std::string, std::string>> key_values;
-    if (t.compact_maps && t.features_required == 0 && !t.pack_key_values) {
+    // A model that holds the record's locating key itself keeps its text: a
+    // reader takes the first `map_frame_record` entry, which would be its own.
+    const bool holds_locator_key = std::any_of(model.key_values.begin(), model.key_values.end(),
+                                               [](const auto& kv) { return kv.first == kFrameRecordKey; });
+    if (t.compact_maps && t.features_required == 0 && !t.pack_key_values && !holds_locator_key) {
       auto it = std::find_if(model.key_values.begin(), model.key_values.end(),
                              [](const auto& kv) { return kv.first == kMapFramesKey; });
       std::optional<FrameRecord> record;

@@ -126,19 +126,20 @@ sogmm::RegistrationOptions geometry_only() {
   return o;
 }
 
-MapOptions corner_options() {
+MapOptions corner_options(double component_precision = 0) {
   MapOptions o;
   o.fit.bandwidth = 0.05;
   o.depth.decimate = 1;
+  o.component_precision = component_precision;
   return o;
 }
 
 // The map holds only part of frame 0 (as after discard_pending or a frame
 // whose surfaces were not all kept); the tracking state holds all of it.
 struct PartialMap {
-  Map map{corner_options()};
+  Map map;
   sogmm::TrackingState state;
-  explicit PartialMap(int kept) {
+  explicit PartialMap(int kept, double component_precision = 0) : map(corner_options(component_precision)) {
     // The map's part at every 3rd pixel: its fit stays cheap.
     const std::vector<float> part = corner(kIdentity, kept, 3), whole = corner(kIdentity, kAll);
     map.insert_backprojected(view_of(part), kCamera, kIdentity);
@@ -180,6 +181,23 @@ TEST(MapTracking, AFrameTheMapCannotJudgeIsPosedByOdometry) {
       sogmm::track_backprojected(off.map, off.state, view_of(next), kCamera, kIdentity, geometry_only(), {}, 1);
   EXPECT_FALSE(w.inserted || w.odometry_ran);
   EXPECT_EQ(off.map.frames().size(), 1u);
+}
+
+TEST(MapTracking, TheStateHoldsThePoseAsTheMapRecordedIt) {
+  // With component_precision > 0 the map records poses on a 2^-16 grid
+  // (component_precision.hpp): the state must hold that pose, not the
+  // estimate, or the odometry's "state holds the map's last frame" test
+  // fails from the next frame on and odometry never runs again.
+  PartialMap m(kFloor | kSide, 0.1);
+  const std::vector<float> next = corner(moved(), kAll);
+  const sogmm::TrackedFrame t =
+      sogmm::track_backprojected(m.map, m.state, view_of(next), kCamera, kIdentity, gray(), {}, 1);
+  ASSERT_TRUE(t.inserted);
+  EXPECT_EQ(m.state.pose, m.map.frames().back().pose);
+  // The estimate itself is off the grid (so the case is exercised), by at
+  // most half a grid step per entry.
+  EXPECT_NE(t.pose, m.map.frames().back().pose);
+  for (int i = 0; i < 12; ++i) EXPECT_LE(std::fabs(t.pose[i] - m.map.frames().back().pose[i]), std::ldexp(1.0, -17));
 }
 
 TEST(MapTracking, AFrameThatAgreesWithNeitherIsSkipped) {

@@ -110,6 +110,17 @@ TEST(FrameRecord, TextTheRecordCannotGiveBackStaysText) {
     EXPECT_EQ(info.format_minor, 0u);
     EXPECT_EQ(fmt::from_bytes(bytes.data(), bytes.size()).key_values, m.key_values);
   }
+  // A model that already holds a key `map_frame_record` (the record's
+  // locating key; a reader takes the first) keeps its text, wherever the key
+  // stands: compacted, it was refused by its own reader (bad_metadata).
+  for (const bool before : {true, false}) {
+    sogmm::Model m = map_model(good);
+    const std::pair<std::string, std::string> user{"map_frame_record", "hello"};
+    m.key_values.insert(before ? m.key_values.begin() : m.key_values.end(), user);
+    const std::vector<std::uint8_t> bytes = fmt::to_bytes(m);
+    EXPECT_EQ(fmt::read_info(bytes.data(), bytes.size()).features_required, 0u) << before;
+    EXPECT_EQ(fmt::from_bytes(bytes.data(), bytes.size()).key_values, m.key_values) << before;
+  }
 }
 
 // The plane scene seen from three turned and moved poses (entries that are

@@ -184,9 +184,10 @@ TEST(QuantizedComponents, EveryDecodedComponentKeepsTheBound) {
       worst_mean = std::max(worst_mean, b.mean_sigmas);
       worst_weight = std::max(worst_weight, std::abs(std::log(static_cast<double>(back.gmm.weights[k]) / model.gmm.weights[k])));
     }
-    // Weights: each within 1 +- 2^-4 before the common division, so any two
-    // keep their ratio within (1 + 2^-4) / (1 - 2^-4); the division moves all alike.
-    EXPECT_LE(worst_weight, 2 * std::log((1 + 1.0 / 16) / (1 - 1.0 / 16)));
+    // Weights: each within 1 +- 2^-4 before the common division, whose sum
+    // (of the original weights, summing to 1) is then within 1 +- 2^-4 too, so
+    // |log(w' / w)| <= log(1 + 2^-4) - log(1 - 2^-4).
+    EXPECT_LE(worst_weight, std::log((1 + 1.0 / 16) / (1 - 1.0 / 16)));
     EXPECT_GT(worst_mean, 0.25 * p) << "the grids are as coarse as the bound allows";
     if (p == 0.5) {
       EXPECT_LT(file.size(), 24u * model.gmm.size() + 2000) << "a few bytes per component";

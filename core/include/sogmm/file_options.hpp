@@ -20,10 +20,14 @@ struct WriteOptions {
   /// > 0: store each component as integer codes (spec/format.md section 5.7,
   /// format 1.4) that move its mean by at most this many of its standard
   /// deviations and its covariance's eigenvalues, in its own frame, by at
-  /// most this fraction (the bound of MapOptions::component_precision); a
-  /// few bytes per component instead of 60. 0: float arrays, bit-exact. A
-  /// model the codes cannot hold (a zero weight, an extreme condition
-  /// number) is stored as floats.
+  /// most this fraction (the bound of MapOptions::component_precision), and
+  /// its weight by a factor of at most 1 +- 2^-4 before the weights are
+  /// renormalised; a few bytes per component instead of 60. 0: float arrays,
+  /// bit-exact. A model the codes cannot hold (a zero weight, an extreme
+  /// condition number) is stored as floats. The codes decode to float32:
+  /// float64 has no effect on them. The bound is against the model saved: a
+  /// model read from such a file and saved again is coded anew and may move
+  /// by as much again. Range [0, 0.5] (SOGMM_OPT_ARRAY_PRECISION's).
   double component_precision = 0;
   /// Refuse (Error(Limit), nothing written) a model whose arrays would decode
   /// to more bytes than this. The default is the reader's default cap, so a

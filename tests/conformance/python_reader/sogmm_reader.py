@@ -612,6 +612,8 @@ def read(data, max_decoded_bytes=DEFAULT_MAX_DECODED_BYTES, verify_checksums=Tru
         _format("unsupported_feature", hex(md["features_required"]))
     if delta and not md["features_required"] & MAP_DELTA_FEATURE:
         _format("not_a_delta", "features_required bit 0 is not set")
+    if delta and md["features_required"] & (QUANTIZED_FEATURE | FRAME_RECORD_FEATURE):
+        _format("unsupported_feature", "a map delta with bit 2 or 3 (section 7: model features only)")
     # 11
     if md["dims"] != 4:
         _format("bad_metadata", "dims != 4")
