@@ -116,9 +116,10 @@ std::vector<OptionSpec> make_table() {
                     "at most this many of its standard deviations and its covariance's eigenvalues, in its own frame, "
                     "by at most this fraction, as MAP_COMPONENT_PRECISION bounds them, and its weight by a factor of at "
                     "most 1 +- 2^-4 before the weights are renormalised: 11-21 bytes a component on "
-                    "README section 7's maps instead of 30-40 (why: WriteOptions::component_precision). The bound "
-                    "is against the model saved: a model read from such a file and saved again is coded anew and "
-                    "may move by as much again. 0: float arrays, bit-exact"),
+                    "README section 7's maps instead of 30-40 (why: WriteOptions::component_precision). A model "
+                    "read from such a file and saved again keeps its components bit for bit (the writer finds their "
+                    "codes), but for a few (1-4%) whose equal eigenvalues leave their axes undetermined, coded anew "
+                    "within the bound (spec/format.md 5.7). 0: float arrays, bit-exact"),
       // ---- reading .sogmm (the cap also bounds writing) ----
       // 0 restores the format library's default cap (kDefaultMaxDecodedBytes).
       OptionSpec{OptionKey::MAX_DECODED_BYTES, "SOGMM_OPT_MAX_DECODED_BYTES", OptionType::I64, 0.0,

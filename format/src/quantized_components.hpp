@@ -36,7 +36,9 @@ struct ComponentCodes {
 /// Every component is checked on its decoded float32 values before the codes
 /// are returned; std::nullopt when one cannot be (a zero or subnormal weight,
 /// a covariance too ill-conditioned for the grids, codes beyond int32): the
-/// writer then stores floats.
+/// writer then stores floats. A model decoded from such codes gets those
+/// codes back (but for a few with equal eigenvalues, spec 5.7), so
+/// saving it again does not move it.
 std::optional<ComponentCodes> quantize(const Gmm& gmm, double precision);
 
 /// The model of section 5.7's formulas: fills `out` (resized to M

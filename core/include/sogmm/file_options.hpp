@@ -25,9 +25,11 @@ struct WriteOptions {
   /// renormalised; a few bytes per component instead of 60. 0: float arrays,
   /// bit-exact. A model the codes cannot hold (a zero weight, an extreme
   /// condition number) is stored as floats. The codes decode to float32:
-  /// float64 has no effect on them. The bound is against the model saved: a
-  /// model read from such a file and saved again is coded anew and may move
-  /// by as much again. Range [0, 0.5] (SOGMM_OPT_ARRAY_PRECISION's).
+  /// float64 has no effect on them. A model read from such a file and saved
+  /// again keeps its components bit for bit (the writer finds the codes they
+  /// were decoded from), but for a few (1-4% on real maps) whose equal
+  /// eigenvalues leave their axes undetermined (spec/format.md 5.7), which
+  /// are coded anew within the bound. Range [0, 0.5] (SOGMM_OPT_ARRAY_PRECISION's).
   double component_precision = 0;
   /// Refuse (Error(Limit), nothing written) a model whose arrays would decode
   /// to more bytes than this. The default is the reader's default cap, so a
