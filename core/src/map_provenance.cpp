@@ -11,6 +11,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/inference.hpp"
+#include "sogmm/shortest_decimal.hpp"
 #include "text_rows.hpp"
 
 namespace sogmm {
@@ -36,15 +37,17 @@ std::string frames_text(const std::vector<FrameStats>& frames, std::size_t first
 
 namespace {
 
+// The options as `name=value` pairs for people (spec/format.md 2.3), numbers
+// in their shortest round-trip form: 0.7, not 0.69999999999999996.
 std::string options_text(const MapOptions& o) {
-  return "novelty=" + std::to_string(o.novelty ? 1 : 0) + " novelty_threshold=" + checked::exact(o.novelty_threshold) +
+  return "novelty=" + std::to_string(o.novelty ? 1 : 0) + " novelty_threshold=" + shortest_decimal(o.novelty_threshold) +
          " batch_size=" + std::to_string(o.batch_size) +
-         " novelty_bandwidth_scale=" + checked::exact(o.novelty_bandwidth_scale) +
-         " revisit_refit_ratio=" + checked::exact(o.revisit_refit_ratio) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
+         " novelty_bandwidth_scale=" + shortest_decimal(o.novelty_bandwidth_scale) +
+         " revisit_refit_ratio=" + shortest_decimal(o.revisit_refit_ratio) + " fusion=" + std::to_string(o.fusion ? 1 : 0) +
          " fusion_method=" + (o.fusion_method == FusionMethod::Hellinger ? "hellinger" : "kl") +
-         " fusion_threshold=" + checked::exact(o.fusion_threshold) + " index_sigmas=" + checked::exact(o.index_sigmas) +
-         " bandwidth=" + checked::exact(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0) +
-         " component_precision=" + checked::exact(o.component_precision);
+         " fusion_threshold=" + shortest_decimal(o.fusion_threshold) + " index_sigmas=" + shortest_decimal(o.index_sigmas) +
+         " bandwidth=" + shortest_decimal(o.fit.bandwidth) + " warm_start=" + std::to_string(o.warm_start ? 1 : 0) +
+         " component_precision=" + shortest_decimal(o.component_precision);
 }
 
 // One count: decimal digits only. operator>> into an unsigned type reads a

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -12,6 +11,7 @@
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/model.hpp"
+#include "sogmm/shortest_decimal.hpp"
 
 namespace sogmm {
 namespace {
@@ -90,15 +90,6 @@ double gray_range(const PointsView& pts) {
   return robust > 0.0 ? robust : full;
 }
 
-std::string round_trip(double v) {
-  char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
-
 }  // namespace
 
 RegCovarFloors auto_reg_covar(const PointsView& points) {
@@ -123,7 +114,7 @@ RegCovarFloors resolve_reg_covar(const PointsView& points, const std::optional<d
 
 void record_reg_covar(Model& model, const RegCovarFloors& floors) {
   model.fit.reg_covar = floors.spatial;
-  set_value(model, kRegCovarGrayKey, round_trip(floors.gray));
+  set_value(model, kRegCovarGrayKey, shortest_decimal(floors.gray));
   set_value(model, kRegCovarSourceKey, floors.automatic ? "auto" : "user");
 }
 

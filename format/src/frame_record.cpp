@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "canonical_bytes.hpp"
 #include "codec.hpp"
 #include "crc32c.hpp"
 #include "decode.hpp"
@@ -78,16 +79,6 @@ bool parse_rows(const std::string& text, std::vector<double>& rows) {
   return !rows.empty();
 }
 
-std::vector<std::uint8_t> canonical_bytes(const std::vector<double>& rows) {
-  std::vector<std::uint8_t> out(rows.size() * 8);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &rows[i], 8);
-    store_le<std::uint64_t>(&out[8 * i], bits);
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<double> frame_rows(const std::string& text) {
@@ -108,7 +99,7 @@ std::optional<FrameRecord> encode_frame_record(const std::string& text, const Wr
 }
 
 FrameRecord encode_frame_rows(const std::vector<double>& rows, const WriteOptions& options) {
-  const std::vector<std::uint8_t> canonical = canonical_bytes(rows);
+  const std::vector<std::uint8_t> canonical = canonical_bytes<double>(rows.data(), rows.size());
   const Shape shape{rows.size() / kColumns, kColumns, 8};
   FrameRecord out;
   Encoding e = kLayout;

@@ -32,14 +32,20 @@ struct Tweaks {
   std::optional<std::uint64_t> means_offset;  ///< overrides the declared offset of the means
   std::optional<std::uint32_t> dims;          ///< overrides dims (written even when 4)
   std::optional<std::vector<std::string>> axis_units;  ///< overrides the axis units
+  /// Whether the axis lists are written: absent, the writer's rule (omitted
+  /// in files with feature bit 2 or 3, which are then format 1.5; spec/format.md
+  /// section 7); true, written as formats 1.0 to 1.4 wrote them (the
+  /// conformance vectors of those versions, the tests that such files read).
+  std::optional<bool> axis_lists;
   std::optional<std::vector<double>> raw_pose;         ///< pose vector written as is (any length)
   bool unknown_optional_fields = false;  ///< appends fields with ids unknown to format 1.0
   bool share_strings = false;  ///< key/value strings stored once and shared (FlatBuffers CreateSharedString)
   /// Key/values packed in the body (spec/format.md 2.5.1; the caller sets
   /// features bit 1): the metadata keeps only the entry that locates them.
   bool pack_key_values = false;
-  /// A map (a model with a `map_frames` entry) written as format 1.3, its
-  /// frame lines as the binary record (spec/format.md 2.3.2); false: as text,
+  /// A map (a model with a `map_frames` entry) written with its frame lines
+  /// as the binary record (format 1.3, 1.5 without the axis lists;
+  /// spec/format.md 2.3.2); false: as text,
   /// as format 1.0 wrote it (for the tests that old map files still read).
   bool compact_maps = true;
   /// The frame record's locating value and stored bytes written as given
@@ -50,6 +56,13 @@ struct Tweaks {
 
 /// The format version of a map file with the frame record (bits 1 and 3).
 inline constexpr std::uint16_t kMinorFrameRecord = 3;
+/// The format version from which a file with feature bit 2 or 3 may omit the
+/// fixed axis lists (spec/format.md section 7).
+inline constexpr std::uint16_t kMinorAxisListsOptional = 5;
+/// The feature bits whose files omit the axis lists: a file any reader of it
+/// reads identically without them (every 1.x reader reads absent lists as the
+/// fixed ones, spec/format.md section 4.2).
+inline constexpr std::uint64_t kFeaturesWithoutAxisLists = 4 | 8;
 
 /// The version and feature bits of a map delta (spec/format.md sections 2.5
 /// and 2.5.1): written as format 1.2 with features_required bit 0 and its

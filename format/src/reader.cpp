@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "canonical_bytes.hpp"
 #include "checks.hpp"
 #include "container.hpp"
 #include "crc32c.hpp"
@@ -101,14 +102,9 @@ void expand_upper_in_place(float* cov, std::uint64_t m) {
   }
 }
 
-// Little-endian bytes of float32 values, as section 5.2 orders them.
-std::uint32_t crc_of_floats(const float* v, std::size_t n) {
-  std::vector<std::uint8_t> bytes(4 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t bits;
-    std::memcpy(&bits, v + i, 4);
-    store_le<std::uint32_t>(&bytes[4 * i], bits);
-  }
+// CRC-32C of float32 values' canonical bytes (section 5.2).
+std::uint32_t crc_of_floats(const std::vector<float>& v) {
+  const std::vector<std::uint8_t> bytes = canonical_bytes<float>(v.data(), v.size());
   return crc32c(bytes.data(), bytes.size());
 }
 
@@ -128,16 +124,8 @@ void read_quantized(const Source& src, const ParsedMetadata& meta, std::uint64_t
   }
   dequantize(codes, m, g);
   if (!verify) return;
-  std::vector<float> packed;
-  packed.reserve(static_cast<std::size_t>(10 * m));
-  for (std::uint64_t k = 0; k < m; ++k) {
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a; b < 4; ++b) packed.push_back(g.covariances[16 * k + 4 * a + b]);
-    }
-  }
-  const std::uint32_t crcs[3] = {crc_of_floats(g.weights.data(), g.weights.size()),
-                                 crc_of_floats(g.means.data(), g.means.size()),
-                                 crc_of_floats(packed.data(), packed.size())};
+  const std::uint32_t crcs[3] = {crc_of_floats(g.weights), crc_of_floats(g.means),
+                                 crc_of_floats(pack_upper(g.covariances.data(), g.size()))};
   for (int i = 0; i < 3; ++i) {
     if (crcs[i] != meta.arrays[i].crc32c) {
       fail(ErrorCode::Format, "checksum_mismatch",

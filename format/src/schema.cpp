@@ -116,8 +116,12 @@ flatbuffers::DetachedBuffer build_metadata(const Model& model, const ArrayRecord
   const auto weights = build_array(b, arrays[kWeights]);
   const auto means = build_array(b, arrays[kMeans]);
   const auto covariances = build_array(b, arrays[kCovariances]);
-  const auto labels = build_strings(b, kAxisLabels);
-  const auto units = build_strings(b, t.axis_units ? *t.axis_units : kAxisUnits);
+  const bool axis_lists = t.axis_lists.value_or(true);
+  flatbuffers::Offset<flatbuffers::Vector<flatbuffers::Offset<flatbuffers::String>>> labels, units;
+  if (axis_lists) {
+    labels = build_strings(b, kAxisLabels);
+    units = build_strings(b, t.axis_units ? *t.axis_units : kAxisUnits);
+  }
   flatbuffers::Offset<fb::FitInfo> fit;
   if (model.fit.known) {
     const FitInfo& f = model.fit;
@@ -163,8 +167,10 @@ flatbuffers::DetachedBuffer build_metadata(const Model& model, const ArrayRecord
   root.add_covariances(covariances);
   root.add_features_required(t.features_required);
   root.add_features_used(t.features_used);
-  root.add_axis_labels(labels);
-  root.add_axis_units(units);
+  if (axis_lists) {
+    root.add_axis_labels(labels);
+    root.add_axis_units(units);
+  }
   if (!fit.IsNull()) root.add_fit(fit);
   if (!camera.IsNull()) root.add_camera(camera);
   if (!pose.IsNull()) root.add_pose(pose);

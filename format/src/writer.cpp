@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "canonical_bytes.hpp"
 #include "checks.hpp"
 #include "codec.hpp"
 #include "container.hpp"
@@ -29,25 +30,6 @@ namespace sogmm::format {
 namespace detail {
 namespace {
 
-// Canonical little-endian bytes of float values, as f32 or (exactly widened) f64.
-std::vector<std::uint8_t> canonical_bytes(const std::vector<float>& v, bool f64) {
-  std::vector<std::uint8_t> out(checked::bytes(v.size(), f64 ? 8 : 4, "array bytes"));
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (f64) {
-      std::uint64_t bits;
-      const double d = v[i];
-      std::memcpy(&bits, &d, 8);
-      store_le<std::uint64_t>(&out[i * 8], bits);
-    } else {
-      std::uint32_t bits;
-      std::memcpy(&bits, &v[i], 4);
-      store_le<std::uint32_t>(&out[i * 4], bits);
-    }
-  }
-  return out;
-}
-
-
 bool bit_symmetric(const std::vector<float>& cov, std::size_t m) {
   for (std::size_t k = 0; k < m; ++k) {
     const float* c = cov.data() + 16 * k;
@@ -58,17 +40,6 @@ bool bit_symmetric(const std::vector<float>& cov, std::size_t m) {
     }
   }
   return true;
-}
-
-std::vector<float> pack_upper(const std::vector<float>& cov, std::size_t m) {
-  std::vector<float> out;
-  out.reserve(10 * m);
-  for (std::size_t k = 0; k < m; ++k) {
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i; j < 4; ++j) out.push_back(cov[16 * k + 4 * i + j]);
-    }
-  }
-  return out;
 }
 
 // The writer's checks: what a reader would reject, a writer refuses.
@@ -154,7 +125,8 @@ struct EncodedArray {
 EncodedArray encode_one(const std::vector<float>& values, std::uint64_t cols, const WriteOptions& options) {
   EncodedArray out;
   const bool f64 = options.float64;
-  std::vector<std::uint8_t> canonical = canonical_bytes(values, f64);
+  std::vector<std::uint8_t> canonical =
+      f64 ? canonical_bytes<double>(values.data(), values.size()) : canonical_bytes<float>(values.data(), values.size());
   const Shape shape{values.size() / cols, cols, f64 ? 8u : 4u};
   out.record.dtype = f64 ? kDTypeF64 : kDTypeF32;
   out.record.decoded_length = canonical.size();
@@ -181,7 +153,7 @@ EncodedArray encode_one(const std::vector<float>& values, std::uint64_t cols, co
 EncodedArray encode_codes(const std::vector<std::int32_t>& codes, std::uint64_t cols,
                           const std::vector<float>& decoded, const WriteOptions& options) {
   EncodedArray out;
-  const std::vector<std::uint8_t> canonical = canonical_bytes(decoded, false);
+  const std::vector<std::uint8_t> canonical = canonical_bytes<float>(decoded.data(), decoded.size());
   out.record.dtype = kDTypeF32;
   out.record.decoded_length = canonical.size();
   out.record.crc32c = crc32c(canonical.data(), canonical.size());
@@ -274,13 +246,19 @@ class EncodedFile {
       tq.minor = std::max(t.minor, kQuantizedMinor);
       arrays_[kWeights] = encode_codes(q->first.arrays[kWeights], 1, q->second.weights, options);
       arrays_[kMeans] = encode_codes(q->first.arrays[kMeans], 5, q->second.means, options);
-      arrays_[kCovariances] = encode_codes(q->first.arrays[kCovariances], 14, pack_upper(q->second.covariances, m),
+      arrays_[kCovariances] = encode_codes(q->first.arrays[kCovariances], 14, pack_upper(q->second.covariances.data(), m),
                                            options);
     } else {
       arrays_[kWeights] = encode_one(g.weights, 1, options);
       arrays_[kMeans] = encode_one(g.means, 4, options);
       arrays_[kCovariances] =
-          encode_one(packed ? pack_upper(g.covariances, m) : g.covariances, packed ? 10 : 16, options);
+          encode_one(packed ? pack_upper(g.covariances.data(), m) : g.covariances, packed ? 10 : 16, options);
+    }
+    // The axis lists are fixed (spec/format.md 4.2): a file that only readers
+    // of format 1.3 on can read (bit 2 or 3) leaves them out, as format 1.5.
+    if (!tq.axis_lists) {
+      tq.axis_lists = (tq.features_required & kFeaturesWithoutAxisLists) == 0;
+      if (!*tq.axis_lists) tq.minor = std::max(tq.minor, kMinorAxisListsOptional);
     }
     const std::uint64_t n_declared = t.n_components ? *t.n_components : m;
     ArrayRecord records[3];

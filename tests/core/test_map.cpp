@@ -10,6 +10,7 @@
 
 #include "sogmm/inference.hpp"
 #include "sogmm/map.hpp"
+#include "sogmm/shortest_decimal.hpp"
 #include "sogmm/warm_start.hpp"
 #include "map_test_util.hpp"
 
@@ -181,6 +182,10 @@ TEST(MapTest, WarmStartSurvivesSaveAndLoad) {
   for (const auto& kv : saved.key_values)
     if (kv.first == sogmm::kMapOptionsKey) recorded = kv.second;
   EXPECT_NE(recorded.find("warm_start=1"), std::string::npos) << recorded;
+  // Numbers in their shortest round-trip form (fusion_threshold 0.3, not 0.29999999999999999).
+  EXPECT_NE(recorded.find(" fusion_threshold=" + sogmm::shortest_decimal(o.fusion_threshold) + " "), std::string::npos)
+      << recorded;
+  EXPECT_EQ(recorded.find("99999"), std::string::npos) << recorded;
   Map loaded = Map::from_model(saved, o);
   const std::size_t m = map.size();
   map.insert_points(view(frames[2]), poses[2]);

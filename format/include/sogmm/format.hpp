@@ -56,8 +56,10 @@ class FormatError : public Error {
 /// Covariances are stored packed (upper triangle) when every matrix is
 /// bit-exactly symmetric, else in full, so the round trip is bit-exact;
 /// with options.component_precision > 0 the components are stored as integer
-/// codes instead (format 1.4) and read back within that precision's bound
-/// (sogmm/file_options.hpp).
+/// codes instead (feature bit 2) and read back within that precision's bound
+/// (sogmm/file_options.hpp). A file with feature bit 2 or 3 (quantized
+/// components, a map's frame record) leaves out the fixed axis lists and is
+/// format 1.5 (spec/format.md section 7); any other is format 1.0.
 std::vector<std::uint8_t> to_bytes(const Model& model, const WriteOptions& options = {});
 
 /// Decodes and fully verifies the bytes of a .sogmm file.

@@ -127,10 +127,20 @@ std::vector<std::uint8_t> cut(std::vector<std::uint8_t> b, std::size_t n) {
   return b;
 }
 
-std::vector<std::uint8_t> uncompressed(const Model& m) {
+fmt::WriteOptions raw_options() {
   fmt::WriteOptions o;
   o.compress = false;
-  return fmt::to_bytes(m, o);
+  return o;
+}
+
+std::vector<std::uint8_t> uncompressed(const Model& m) { return fmt::to_bytes(m, raw_options()); }
+
+// A file as formats 1.3 and 1.4 wrote it, with the axis lists (their vectors
+// came out of this generator before format 1.5 let such files omit them).
+std::vector<std::uint8_t> with_axis_lists(const Model& m, const fmt::WriteOptions& o = {}) {
+  det::Tweaks t;
+  t.axis_lists = true;
+  return det::encode(m, o, t);
 }
 
 // Frame lines of a map (spec/format.md 2.3), as a map writes them ("%.17g"):
@@ -164,15 +174,16 @@ void frame_record_vectors() {
   map.key_values = {{"coordinate_frame", "world"}, {"map_frames", map_frame_lines()},
                     {"map_options", "novelty=1 component_precision=0.5"}, {"map_id", "0123456789abcdef0123456789abcdef"},
                     {"map_revision", "3"}};
-  valid("map_frame_record", fmt::to_bytes(map),
+  valid("map_frame_record", with_axis_lists(map),
         "format 1.3 map: map_frames as the binary frame record (bit 3, zstd), every key/value packed (bit 1)");
-  valid("map_frame_record_raw", uncompressed(map), "format 1.3 map, frame record and packed key/values uncompressed");
+  valid("map_frame_record_raw", with_axis_lists(map, raw_options()), "format 1.3 map, frame record and packed key/values uncompressed");
   fmt::WriteOptions raw;
   raw.compress = false;
   const std::vector<double> rows = det::frame_rows(map.key_values[1].second);
   const det::FrameRecord good = det::encode_frame_rows(rows, raw);
   auto with = [&](const std::string& entry, const std::vector<std::uint8_t>& stored) {
     det::Tweaks t;
+    t.axis_lists = true;
     t.frame_record_entry = entry;
     t.frame_record_stored = stored;
     return det::encode(map, {}, t);
@@ -195,6 +206,7 @@ void frame_record_vectors() {
   invalid("frame_record_count", with(bad_count.entry.second, bad_count.stored), "format", "bad_metadata",
           "frame record: a point count of 0.5 (step 21f)");
   det::Tweaks no_entry;
+  no_entry.axis_lists = true;
   no_entry.compact_maps = false;
   no_entry.minor = 3;
   no_entry.features_required = 0xA;
@@ -203,23 +215,47 @@ void frame_record_vectors() {
           "features_required bit 3 without a map_frame_record entry (step 21a)");
 }
 
+// The vectors of format 1.5 (spec/format.md section 7): files with bit 2 or 3
+// as the writer now writes them, without the fixed axis lists.
+void axis_lists_optional_vectors() {
+  Model map = synthetic(5, 31);
+  map.key_values = {{"coordinate_frame", "world"}, {"map_frames", map_frame_lines()},
+                    {"map_options", "novelty=1 component_precision=0.5"}, {"map_id", "0123456789abcdef0123456789abcdef"},
+                    {"map_revision", "3"}};
+  valid("map_without_axis_lists", fmt::to_bytes(map),
+        "format 1.5 map (bits 1 and 3, 0xA): the axis lists left out, read as the fixed lists");
+  fmt::WriteOptions quant;
+  quant.component_precision = 0.5;
+  valid("map_quantized_without_axis_lists", fmt::to_bytes(map, quant),
+        "format 1.5 map with quantized components (bits 1, 2 and 3, 0xE), without the axis lists");
+  valid("quantized_without_axis_lists", fmt::to_bytes(synthetic(12, 21), quant),
+        "format 1.5 model with quantized components (bit 2) and no key/values, without the axis lists");
+}
+
+// Writes one group of appended vectors into `out` with their manifest entries
+// (manifest_additions.json, to append by hand).
+int appended(const std::string& out, void (*vectors)()) {
+  g_out = out;
+  ::mkdir((g_out + "/valid").c_str(), 0755);
+  ::mkdir((g_out + "/invalid").c_str(), 0755);
+  try {
+    vectors();
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  std::ofstream additions(g_out + "/manifest_additions.json");
+  for (std::size_t i = 0; i < g_entries.size(); ++i) additions << g_entries[i] << (i + 1 < g_entries.size() ? ",\n" : "\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--axis-lists-optional") return appended(argv[2], axis_lists_optional_vectors);
   if (argc == 3 && std::string(argv[1]) == "--frame-record") {
     // Only the frame record's vectors, with their manifest entries.
-    g_out = argv[2];
-    ::mkdir((g_out + "/valid").c_str(), 0755);
-    ::mkdir((g_out + "/invalid").c_str(), 0755);
-    try {
-      frame_record_vectors();
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << "\n";
-      return 1;
-    }
-    std::ofstream additions(g_out + "/manifest_additions.json");
-    for (std::size_t i = 0; i < g_entries.size(); ++i) additions << g_entries[i] << (i + 1 < g_entries.size() ? ",\n" : "\n");
-    return 0;
+    return appended(argv[2], frame_record_vectors);
   }
   if (argc != 6) {
     std::cerr << "usage: " << argv[0] << " OUT_DIR DEPTH.u16 GRAY.f32 WIDTH HEIGHT\n";
@@ -468,11 +504,11 @@ int main(int argc, char** argv) {
     // Quantized components (spec/format.md 5.7, format 1.4, feature bit 2).
     fmt::WriteOptions quant;
     quant.component_precision = 0.5;
-    valid("quantized_components", fmt::to_bytes(synthetic(12, 21), quant),
+    valid("quantized_components", with_axis_lists(synthetic(12, 21), quant),
           "format 1.4, feature bit 2: twelve components stored as the integer codes of section 5.7 (zstd); the dump "
           "is the float32 model the decoding formulas give");
     quant.compress = false;
-    const std::vector<std::uint8_t> raw_codes = fmt::to_bytes(synthetic(5, 22), quant);
+    const std::vector<std::uint8_t> raw_codes = with_axis_lists(synthetic(5, 22), quant);
     valid("quantized_components_raw", raw_codes,
           "format 1.4, feature bit 2: five components' codes stored raw (column-major, byte-stream split, no codec)");
     {
