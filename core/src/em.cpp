@@ -317,6 +317,9 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       std::min(n_chunks, std::max(kWave, kWave * (detail::em_region_bytes() / (kWave * m * kStatStride * sizeof(double)))));
   const int threads = detail::team_size(options.threads);
   const detail::EmKernels& kernels = detail::em_kernels();
+  // The statistics' cut (see EmFinishFn): the truncation's, or none.
+  const float finish_nats =
+      truncated ? static_cast<float>(options.truncation_nats) : std::numeric_limits<float>::infinity();
 
   std::vector<float> params;
   std::vector<double> exact;
@@ -395,7 +398,8 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
                 touched.push_back(k);
                 std::fill(st + std::size_t{k} * kStatStride, st + (std::size_t{k} + 1) * kStatStride, 0.0);
               }
-            ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st);
+            ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st,
+                                 finish_nats);
             pairs += static_cast<double>(block.count) * ne;
             // Next iteration starts from the components some point of this
             // block still gives at least exp(-nats) of its best weight.

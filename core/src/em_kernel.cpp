@@ -2,7 +2,9 @@
 // em_kernel.hpp). The loops run over the points of a block with the
 // component's parameters broadcast, so the compiler vectorizes them at
 // whatever width the translation unit is compiled for.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "em_kernel.hpp"
@@ -54,14 +56,13 @@ float log_density_row(const Block& block, const T* q, float* __restrict lp, floa
 // flagged component: in float32 the second moments of a 1 km plane (entries
 // ~1e4 m^2) would carry errors far above its 1e-4 m^2 thickness.
 template <typename T>
-void add_statistics(const Block& block, const T* q, const float* __restrict e, const float* __restrict inv_sum,
-                    double* st) {
+void add_statistics(const Block& block, int first, int last, const T* q, const float* __restrict e,
+                    const float* __restrict inv_sum, double* st) {
   const float* __restrict px = block.xyzg[0];
   const float* __restrict py = block.xyzg[1];
   const float* __restrict pz = block.xyzg[2];
   const float* __restrict pg = block.xyzg[3];
   const T m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
-  const int count = block.count;
   // Two passes over the block, each with few enough accumulators to stay in
   // registers (15 at once spill on AVX2's 16 vector registers). Each
   // accumulator sees the same operations in the same order as in one pass;
@@ -69,7 +70,7 @@ void add_statistics(const Block& block, const T* q, const float* __restrict e, c
   // so the compiler never fuses it into its sum (which would round differently).
   T s0 = 0, s1 = 0, c00 = 0, c01 = 0, c02 = 0, c03 = 0;
 #pragma omp simd reduction(+ : s0, s1, c00, c01, c02, c03)
-  for (int p = 0; p < count; ++p) {
+  for (int p = first; p < last; ++p) {
     const T r = e[p] * inv_sum[p];
     const T d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
     const T r0 = r * d0;
@@ -82,7 +83,7 @@ void add_statistics(const Block& block, const T* q, const float* __restrict e, c
   }
   T s2 = 0, s3 = 0, s4 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
 #pragma omp simd reduction(+ : s2, s3, s4, c11, c12, c13, c22, c23, c33)
-  for (int p = 0; p < count; ++p) {
+  for (int p = first; p < last; ++p) {
     const T r = e[p] * inv_sum[p];
     const T d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
     const T r1 = r * d1, r2 = r * d2, r3 = r * d3;
@@ -113,6 +114,34 @@ void add_statistics(const Block& block, const T* q, const float* __restrict e, c
   st[14] += c33;
 }
 
+// exp(lp - max) in place over points [first, last) of one row, added to
+// `sum`; returns the largest value.
+float exp_row(float* __restrict e, const float* __restrict mx, float* __restrict sum, int first, int last) {
+  float emax = 0.0f;
+#pragma omp simd reduction(max : emax)
+  for (int p = first; p < last; ++p) {
+    const float v = fast_exp(e[p] - mx[p]);
+    e[p] = v;
+    sum[p] += v;
+    emax = v > emax ? v : emax;
+  }
+  return emax;
+}
+
+// The first and last of a row's `count` points whose lp - max is at least
+// -nats, in `lo`, `hi` (count, -1 when there is none).
+void near_points(const float* __restrict lp, const float* __restrict mx, int count, float nats, int& lo, int& hi) {
+  int l = count, h = -1;
+#pragma omp simd reduction(min : l) reduction(max : h)
+  for (int p = 0; p < count; ++p) {
+    const bool near = lp[p] - mx[p] >= -nats;
+    l = near && p < l ? p : l;
+    h = near && p > h ? p : h;
+  }
+  lo = l;
+  hi = h;
+}
+
 }  // namespace
 
 void em_log_density(const Block& block, const float* params, const double* exact, const std::uint32_t* components,
@@ -125,12 +154,19 @@ void em_log_density(const Block& block, const float* params, const double* exact
 }
 
 double em_finish(const Block& block, const float* params, const double* exact, const std::uint32_t* components,
-                 std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats) {
+                 std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats, float nats) {
   // row_max holds each row's largest log-density on entry (see em_kernel.hpp).
   const float* __restrict mx = max_lp;
   const int count = block.count;
   alignas(64) float sum[kBlock];
   alignas(64) float inv_sum[kBlock];
+  // Per row (the first kRangedRows; a truncated block evaluates a few dozen):
+  // the segments its exponentials and statistics run over, [segment_first,
+  // segment_last). Rows beyond, and every row of an exact pass, run over all
+  // points.
+  constexpr std::size_t kRangedRows = 4096;
+  std::uint8_t segment_first[kRangedRows], segment_last[kRangedRows];
+  const bool ranged = nats < std::numeric_limits<float>::infinity();
 
   // exp(lp - max) in place, and its sum per point (log-sum-exp). fast_exp is
   // exactly 0 below -87, so a row below every point's maximum by more than
@@ -143,33 +179,65 @@ double em_finish(const Block& block, const float* params, const double* exact, c
       row_max[i] = 0.0f;
       continue;
     }
-    float* __restrict e = rows + i * kBlock;
-    float emax = 0.0f;
-#pragma omp simd reduction(max : emax)
-    for (int p = 0; p < count; ++p) {
-      const float v = fast_exp(e[p] - mx[p]);
-      e[p] = v;
-      sum[p] += v;
-      emax = v > emax ? v : emax;
+    float* e = rows + i * kBlock;
+    if (ranged && i < kRangedRows) {
+      // Only the aligned segments from the first to the last point within
+      // nats of its maximum: every term left out (of the statistics and of
+      // the normalisers) is more than nats below its point's best.
+      int lo, hi;
+      near_points(e, mx, count, nats, lo, hi);
+      if (hi < lo) {  // no point within nats: the row adds nothing
+        row_max[i] = 0.0f;
+        continue;
+      }
+      segment_first[i] = static_cast<std::uint8_t>(lo / kSegment);
+      segment_last[i] = static_cast<std::uint8_t>(hi / kSegment + 1);
+      row_max[i] = exp_row(e, mx, sum, segment_first[i] * kSegment, std::min(count, segment_last[i] * kSegment));
+    } else {
+      row_max[i] = exp_row(e, mx, sum, 0, count);
     }
-    row_max[i] = emax;
+  }
+  // The log-likelihood: sum of max + log(sum) per point. The sums are in
+  // [1, n] (each point's largest term is exp(0) = 1), so the products of 16
+  // of them in double stay far from overflow (n < 2^64) and 16 logs per
+  // block replace 256: the log of a product of doubles differs from the sum
+  // of their logs by a few ulps of the block's total, far below the EM's
+  // tolerance. Lanes p mod 16 fix the order on every instruction set.
+  constexpr int kLanes = 16;
+  double product[kLanes], max_sum[kLanes];
+  for (int j = 0; j < kLanes; ++j) {
+    product[j] = 1.0;
+    max_sum[j] = 0.0;
+  }
+  int base = 0;
+  for (; base + kLanes <= count; base += kLanes)
+    for (int j = 0; j < kLanes; ++j) {
+      product[j] *= static_cast<double>(sum[base + j]);
+      max_sum[j] += static_cast<double>(mx[base + j]);
+    }
+  for (int j = 0; base + j < count; ++j) {
+    product[j] *= static_cast<double>(sum[base + j]);
+    max_sum[j] += static_cast<double>(mx[base + j]);
   }
   double log_likelihood = 0.0;
-  for (int p = 0; p < count; ++p) {
-    log_likelihood += static_cast<double>(mx[p]) + std::log(static_cast<double>(sum[p]));
-    inv_sum[p] = 1.0f / sum[p];
-  }
+  for (int j = 0; j < kLanes; ++j) log_likelihood += max_sum[j] + std::log(product[j]);
+  for (int p = 0; p < count; ++p) inv_sum[p] = 1.0f / sum[p];
 
   // Sufficient statistics centred at each component's mean. A component whose
   // responsibilities are all exactly 0 in this block adds nothing: skip it.
   for (std::size_t i = 0; i < n; ++i) {
     if (row_max[i] == 0.0f) continue;
+    int first = 0, last = count;
+    if (ranged && i < kRangedRows) {
+      first = segment_first[i] * kSegment;
+      last = std::min(count, segment_last[i] * kSegment);
+    }
     const std::size_t at = components[i] * static_cast<std::size_t>(kParamStride);
     double* st = stats + components[i] * kStatStride;
     if (params[at + 15] != 0.0f)
-      add_statistics(block, exact + at, rows + i * kBlock, inv_sum, st);
+      add_statistics(block, first, last, exact + at, rows + i * kBlock, inv_sum, st);
     else
-      add_statistics(block, params + at, rows + i * kBlock, inv_sum, st);
+      add_statistics(block, first, last, params + at, rows + i * kBlock, inv_sum, st);
   }
   return log_likelihood;
 }

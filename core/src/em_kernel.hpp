@@ -51,12 +51,23 @@ using EmLogDensityFn = void (*)(const Block& block, const float* params, const d
 /// throughout for flagged components, centred at their double mean) into
 /// `stats` (M x kStatStride, indexed by component). A row whose largest log-density
 /// is more than 87 below every point's maximum has responsibilities exactly 0
-/// in float and is skipped without changing the result. On return
-/// `row_lp_max[i]` holds the largest exp(lp - max) of row i (0 for skipped
-/// rows). Returns the sum of the points' log-likelihoods.
+/// in float and is skipped without changing the result. With a finite
+/// `nats` (the truncated E-step's), a row's exponentials and statistics run
+/// only over the aligned segments of kSegment points from its first to its
+/// last point whose log-density is within `nats` of that point's maximum:
+/// every term left out (of the normalisers and the statistics) is more than
+/// `nats` below its point's best (the truncation's guarantee), and a row with
+/// no such point is skipped. Infinite `nats`: every point (exact). On return
+/// `row_lp_max[i]` holds the largest exp(lp - max) of row i over its range
+/// (0 for skipped rows). Returns the sum of the points' log-likelihoods.
 using EmFinishFn = double (*)(const Block& block, const float* params, const double* exact,
                               const std::uint32_t* components, std::size_t n, float* rows, const float* max_lp,
-                              float* row_lp_max, double* stats);
+                              float* row_lp_max, double* stats, float nats);
+
+/// Points per segment of a row's statistics range (see EmFinishFn): one
+/// AVX-512 vector, so the range starts aligned on every instruction set and
+/// the terms left out do not depend on the vector width.
+inline constexpr int kSegment = 16;
 
 /// The truncated E-step's upper bounds (em_truncation.cpp) of the `m`
 /// components in `col` (BoundParams' 15 columns of m doubles) over the box
