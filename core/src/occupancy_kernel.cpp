@@ -219,9 +219,11 @@ void occupancy_frame(const OccupancyFrame& f, OccupancyLanes& lanes, int count) 
     const __m512d wf = _mm512_load_pd(whole_free + j);
     _mm512_store_pd(whole_free + j, _mm512_mask_add_pd(wf, whole, wf, one));
     const __m512d u = _mm512_mask_mov_pd(_mm512_load_pd(unknown + j), whole, zero);
-    _mm512_store_pd(unknown + j, _mm512_mask_mul_pd(u, evidence, u, _mm512_maskz_expand_pd(m, _mm512_loadu_pd(b_of + first))));
+    _mm512_store_pd(unknown + j,
+                    _mm512_mask_mul_pd(u, evidence, u, _mm512_maskz_expand_pd(m, _mm512_loadu_pd(b_of + first))));
     const __m512d fr = _mm512_load_pd(free + j);
-    _mm512_store_pd(free + j, _mm512_mask_add_pd(fr, evidence, fr, _mm512_maskz_expand_pd(m, _mm512_loadu_pd(e_of + first))));
+    _mm512_store_pd(free + j,
+                    _mm512_mask_add_pd(fr, evidence, fr, _mm512_maskz_expand_pd(m, _mm512_loadu_pd(e_of + first))));
     const __m512d oc = _mm512_load_pd(occupied + j);
     _mm512_store_pd(occupied + j,
                     _mm512_mask_add_pd(oc, evidence, oc, _mm512_maskz_expand_pd(m, _mm512_loadu_pd(o_of + first))));
