@@ -10,7 +10,10 @@
 //
 // Usage: sogmm-occupancy-octomap --sequence DIR [--map-frames 0:2] [--ray-frames 2]
 //          [--decimate 5] [--octomap-decimate 1] [--resolutions 0.02,0.05] [--threads 2] [--repeats 3]
-//          [--save-map FILE] [--map FILE] [--compare-main]
+//          [--save-map FILE] [--map FILE] [--compare-main] [--write-answers FILE]
+// --write-answers writes the scored points and this build's answers for a
+// byte-for-byte comparison with another build's: n float32 xyz triples,
+// then n float64 probabilities, then n uint8 states (little-endian, raw).
 // --map answers with a map saved by an earlier run's --save-map (no build;
 // the loop's map takes minutes); --resolutions none skips OctoMap.
 // Frame selections as `sogmm map --frames`: I, A:B or A:B:STEP. The synthetic
@@ -22,6 +25,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <stdexcept>
 #include <ctime>
 #include <numeric>
 #include <sstream>
@@ -166,7 +171,7 @@ void distance_rows(const sogmm::Map& map, const std::vector<float>& xyz, int thr
 
 int main(int argc, char** argv) {
   CLI::App app{"Occupancy of a SOGMM map against OctoMap on the rays of a held-out frame"};
-  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05", save_map, load_map;
+  std::string dir, map_frames = "0:2", ray_frames = "2", resolutions = "0.02,0.05", save_map, load_map, answers;
   int decimate = 5, octomap_decimate = 1, threads = 2, repeats = 3;
   bool compare_main = false, distance_only = false, cold = false;
   app.add_option("--sequence", dir, "Redwood folder: depth/, color/, intrinsics.json, trajectory.log")->required();
@@ -181,6 +186,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed repeats (median)")->capture_default_str();
   app.add_option("--save-map", save_map, "write the SOGMM map built from --map-frames here");
   app.add_option("--map", load_map, "answer with this saved map instead of building one (build time 0)");
+  app.add_option("--write-answers", answers,
+                 "write the points (n x 3 float32), then this build's probabilities (n float64) and states (n uint8)");
   app.add_flag("--compare-main", compare_main,
                "also time main's occupancy (a67de64: erfc, per-point projections) and block-scan surface distance "
                "(d33d204) on the "
@@ -253,6 +260,15 @@ int main(int argc, char** argv) {
     report(name, roc_auc(p, label), map_bytes, map_build, n, map_query);
     std::printf("occupancy: %.3f M points per CPU second (median CPU %.4f s per call, all threads; %d threads)\n",
                 n / map_cpu * 1e-6, map_cpu, threads);
+    if (!answers.empty()) {
+      std::vector<std::uint8_t> s(n);
+      occupancy(map, xyz.data(), n, p.data(), s.data(), {}, threads);
+      std::ofstream out(answers, std::ios::binary);
+      out.write(reinterpret_cast<const char*>(xyz.data()), static_cast<std::streamsize>(xyz.size() * sizeof(float)));
+      out.write(reinterpret_cast<const char*>(p.data()), static_cast<std::streamsize>(n * sizeof(double)));
+      out.write(reinterpret_cast<const char*>(s.data()), static_cast<std::streamsize>(n));
+      if (!out) throw std::runtime_error("cannot write " + answers);
+    }
     if (compare_main) {
       std::vector<double> pm(n);
       std::vector<std::uint8_t> sm(n), s(n);

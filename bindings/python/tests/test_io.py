@@ -131,3 +131,36 @@ def test_write_ply(fitted, tmp_path):
     with pytest.raises(sogmm.InvalidArgumentError):
         sogmm.write_ply(p, pts[:, :3])
     assert sogmm.read_ply(p).shape == (10, 4)  # a failed write leaves the old file
+
+
+def test_component_precision_codes_each_mean_within_its_bound(rgbd_model, tmp_path):
+    """SOGMM_OPT_ARRAY_PRECISION (``component_precision``; spec/api.md): at
+    precision P a saved component's mean moves by at most P of its own
+    standard deviations, |L^-1 (mu' - mu)| <= P with S = L L^T the saved
+    covariance. The encoder checks that bound on the decoded float32 values
+    before writing; numpy recomputes it in binary64 (its rounding, ~1e-15
+    relative, is inside the 1e-9 allowed). Mutation tried: the keyword passed
+    as the map's MAP_COMPONENT_PRECISION (630) leaves the file uncoded, and
+    the size and "some mean moved" checks fail."""
+    exact, coded = tmp_path / "exact.sogmm", tmp_path / "coded.sogmm"
+    rgbd_model.save(exact, component_precision=0)
+    rgbd_model.save(coded, component_precision=0.5)
+    assert coded.stat().st_size < exact.stat().st_size
+    assert rgbd_model.to_bytes(component_precision=0.5) == coded.read_bytes()
+    _assert_bit_exact(sogmm.load(exact), rgbd_model)  # 0: float arrays, bit-exact
+
+    back = sogmm.load(coded)
+    mu = rgbd_model.means_.astype(np.float64)
+    d = back.means_.astype(np.float64) - mu
+    lower = np.linalg.cholesky(rgbd_model.covariances_.astype(np.float64))
+    sigmas = np.linalg.norm(np.linalg.solve(lower, d[:, :, None])[:, :, 0], axis=1)
+    assert sigmas.max() <= 0.5 * (1 + 1e-9), sigmas.max()
+    assert sigmas.max() > 0, "the means were stored as codes, not bit for bit"
+
+    # Out of range: InvalidArgumentError naming the keyword, nothing written.
+    before = coded.read_bytes()
+    for bad in (0.7, -1.0, float("nan")):
+        with pytest.raises(sogmm.InvalidArgumentError, match="component_precision"):
+            rgbd_model.save(coded, component_precision=bad)
+        assert coded.read_bytes() == before
+    assert sorted(os.listdir(tmp_path)) == ["coded.sogmm", "exact.sogmm"]  # no temporary file left

@@ -466,6 +466,7 @@ OPTION_NAMES = {
     OPT_ZSTD_LEVEL: "zstd_level",
     OPT_FLOAT64: "float64",
     OPT_COMPRESS: "compress",
+    OPT_ARRAY_PRECISION: "component_precision",
     OPT_MAX_DECODED_BYTES: "max_decoded_bytes",
     OPT_VERIFY_CHECKSUMS: "verify_checksums",
     OPT_SAMPLE_TRUNCATION: "truncation",

@@ -28,8 +28,10 @@ _D = _ffi.DEFAULTS
 __all__ = ["GMM", "SOGMM", "load", "from_bytes"]
 
 
-def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = _D.max_decoded_bytes) -> _ffi.Options:
+def _write_options(float64: bool, compress: bool, zstd_level: int, max_decoded_bytes: int = _D.max_decoded_bytes,
+                   component_precision: float = _D.array_precision) -> _ffi.Options:
     return _ffi.Options(
+        f64={_ffi.OPT_ARRAY_PRECISION: component_precision},
         i64={_ffi.OPT_FLOAT64: int(bool(float64)), _ffi.OPT_COMPRESS: int(bool(compress)), _ffi.OPT_ZSTD_LEVEL: zstd_level,
              _ffi.OPT_MAX_DECODED_BYTES: max_decoded_bytes}
     )
@@ -341,23 +343,29 @@ class GMM(Queryable):
 
     # ---- files and bytes ---------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
-             zstd_level: int = _D.zstd_level, max_decoded_bytes: int = _D.max_decoded_bytes) -> None:
+             zstd_level: int = _D.zstd_level, max_decoded_bytes: int = _D.max_decoded_bytes,
+             component_precision: float = _D.array_precision) -> None:
         """Writes a .sogmm file atomically (temporary file + rename).
 
         Arrays decoding to more than ``max_decoded_bytes`` (0 = the 1 GiB that
         :func:`sogmm.load` accepts by default) raise LimitError, nothing
-        written: raise it here and in ``load`` together."""
+        written: raise it here and in ``load`` together.
+        ``component_precision`` > 0 (at most 0.5; SOGMM_OPT_ARRAY_PRECISION)
+        stores each component as integer codes that move its mean by at most
+        that many of its standard deviations (spec/api.md has the bounds); 0
+        stores float arrays, bit-exact. Out of range: InvalidArgumentError,
+        nothing written."""
         h = self._h()
         p = os.fsencode(os.fspath(path))
-        with _write_options(float64, compress, zstd_level, max_decoded_bytes) as o:
+        with _write_options(float64, compress, zstd_level, max_decoded_bytes, component_precision) as o:
             check(lib.sogmm_model_save(h, p, o.ptr))
 
     def to_bytes(self, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress), zstd_level: int = _D.zstd_level,
-                 max_decoded_bytes: int = _D.max_decoded_bytes) -> bytes:
-        """The bytes of a .sogmm file (``max_decoded_bytes`` as in :meth:`save`)."""
+                 max_decoded_bytes: int = _D.max_decoded_bytes, component_precision: float = _D.array_precision) -> bytes:
+        """The bytes of a .sogmm file (``max_decoded_bytes`` and ``component_precision`` as in :meth:`save`)."""
         h = self._h()
         buf = c_void_p()
-        with _write_options(float64, compress, zstd_level, max_decoded_bytes) as o:
+        with _write_options(float64, compress, zstd_level, max_decoded_bytes, component_precision) as o:
             check(lib.sogmm_model_save_to_memory(byref(buf), h, o.ptr))
         try:
             return _ffi.buffer_to_bytes(buf)

@@ -216,6 +216,12 @@ impl OptionsBuilder {
         float64(bool) => SOGMM_OPT_FLOAT64 as i64 i64::from;
         /// Compress arrays (default true).
         compress(bool) => SOGMM_OPT_COMPRESS as i64 i64::from;
+        /// Saves: > 0 stores each component as integer codes that move its mean
+        /// by at most this many of its own standard deviations (format 1.4;
+        /// bounds: SOGMM_OPT_ARRAY_PRECISION in sogmm.h); 0 = float arrays,
+        /// bit-exact (default); outside [0, 0.5]: `build` fails with
+        /// `Status::InvalidArg`.
+        array_precision(f64) => SOGMM_OPT_ARRAY_PRECISION as f64 |v| v;
         /// Cap on the arrays' decoded bytes when loading, and when saving (a model
         /// above it is refused: raise it on both sides); 0 = the format's 1 GiB.
         max_decoded_bytes(i64) => SOGMM_OPT_MAX_DECODED_BYTES as i64 |v| v;

@@ -370,3 +370,106 @@ fn squarem_reaches_the_fixed_point_in_fewer_passes() {
     assert_eq!(o.get_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION).unwrap(), 0);
     assert!(o.set_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION, 2).is_err());
 }
+
+/// `m` components like a map's: means spread over a metre, covariances
+/// A A^T / 100 + I / 1000 from a fixed linear congruential generator (all
+/// positive definite, conditions up to ~10^3), weights over a decade.
+fn varied_components(m: usize) -> Model {
+    let mut s: u64 = 2024;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 40) as f64 / (1u64 << 24) as f64) - 0.5 // [-0.5, 0.5)
+    };
+    let (mut w, mut mu, mut cov) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..m {
+        w.push((1.5 + next()) as f32);
+        mu.extend([next(), next(), 2.0 + next(), 0.5 + 0.5 * next()].map(|v| v as f32));
+        let a: Vec<f64> = (0..16).map(|_| next()).collect();
+        for i in 0..4 {
+            for j in 0..4 {
+                let aat: f64 = (0..4).map(|k| a[4 * i + k] * a[4 * j + k]).sum();
+                cov.push((aat / 100.0 + if i == j { 1e-3 } else { 0.0 }) as f32);
+            }
+        }
+    }
+    let total: f32 = w.iter().sum();
+    let w: Vec<f32> = w.iter().map(|v| v / total).collect();
+    Model::from_arrays(&w, &mu, &cov, 1000).unwrap()
+}
+
+/// |L^-1 d| for S = L L^T (4 x 4, row-major): the distance d in standard
+/// deviations of the Gaussian with covariance S.
+fn sigmas(s: &[f32], d: &[f64]) -> f64 {
+    let mut l = [0.0f64; 16];
+    for j in 0..4 {
+        let diag = s[5 * j] as f64 - (0..j).map(|k| l[4 * j + k] * l[4 * j + k]).sum::<f64>();
+        l[5 * j] = diag.sqrt();
+        for i in j + 1..4 {
+            let v = s[4 * i + j] as f64 - (0..j).map(|k| l[4 * i + k] * l[4 * j + k]).sum::<f64>();
+            l[4 * i + j] = v / l[5 * j];
+        }
+    }
+    let mut x = [0.0f64; 4];
+    for i in 0..4 {
+        x[i] = (d[i] - (0..i).map(|k| l[4 * i + k] * x[k]).sum::<f64>()) / l[5 * i];
+    }
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// SOGMM_OPT_ARRAY_PRECISION (sogmm.h, spec/api.md): at precision P a saved
+/// component's mean moves by at most P of its own standard deviations,
+/// |L^-1 (mu' - mu)| <= P with S = L L^T the saved covariance. The encoder
+/// checks that bound on the decoded float32 values before writing; this test
+/// recomputes it in binary64 (its own rounding, ~1e-15 relative, is inside
+/// the 1e-9 allowed). Mutation tried: the setter's f64 key swapped for the
+/// map's MAP_COMPONENT_PRECISION (630) leaves the file uncoded: the size and
+/// "some mean moved" checks fail.
+#[test]
+fn array_precision_codes_means_within_their_bound_and_refuses_out_of_range() {
+    let m = varied_components(40);
+    let dir = std::env::temp_dir();
+    let id = std::process::id();
+    let exact_path = dir.join(format!("sogmm-rust-exact-{id}.sogmm"));
+    let coded_path = dir.join(format!("sogmm-rust-coded-{id}.sogmm"));
+    let exact = Options::builder().array_precision(0.0).build().unwrap();
+    let coded = Options::builder().array_precision(0.5).build().unwrap();
+    m.save(&exact_path, Some(&exact)).unwrap();
+    m.save(&coded_path, Some(&coded)).unwrap();
+    let (exact_bytes, coded_bytes) = (std::fs::read(&exact_path).unwrap(), std::fs::read(&coded_path).unwrap());
+    assert!(
+        coded_bytes.len() < exact_bytes.len(),
+        "{} >= {}",
+        coded_bytes.len(),
+        exact_bytes.len()
+    );
+
+    let back = Model::load(&coded_path, None).unwrap();
+    assert_eq!(back.n_components(), m.n_components());
+    let (mu0, s0, mu1) = (m.means().unwrap(), m.covariances().unwrap(), back.means().unwrap());
+    let mut moved = 0;
+    for k in 0..m.n_components() {
+        let d: Vec<f64> = (0..4).map(|i| mu1[4 * k + i] as f64 - mu0[4 * k + i] as f64).collect();
+        let e = sigmas(&s0[16 * k..16 * k + 16], &d);
+        assert!(e <= 0.5 * (1.0 + 1e-9), "component {k}: {e} sigmas");
+        moved += usize::from(e > 0.0);
+    }
+    assert!(moved > 0, "the means were stored as codes, not bit for bit");
+    let exact_back = Model::load(&exact_path, None).unwrap();
+    assert_eq!(exact_back.means().unwrap(), mu0, "precision 0: float arrays, bit-exact");
+
+    // Out of range: the binding's InvalidArg, the options keep their value
+    // (a save with them writes the same bytes again) and the file is untouched.
+    let mut o = coded.clone();
+    for bad in [0.7, -1.0, f64::NAN] {
+        let e = Options::builder().array_precision(bad).build().unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "{bad}");
+        let e = o.set_f64(sogmm::sys::SOGMM_OPT_ARRAY_PRECISION, bad).unwrap_err();
+        assert_eq!(e.status(), Status::InvalidArg, "{bad}");
+        assert_eq!(o.get_f64(sogmm::sys::SOGMM_OPT_ARRAY_PRECISION).unwrap(), 0.5, "{bad}");
+        assert_eq!(std::fs::read(&coded_path).unwrap(), coded_bytes, "{bad}");
+    }
+    m.save(&exact_path, Some(&o)).unwrap();
+    assert_eq!(std::fs::read(&exact_path).unwrap(), coded_bytes);
+    std::fs::remove_file(&exact_path).unwrap();
+    std::fs::remove_file(&coded_path).unwrap();
+}
