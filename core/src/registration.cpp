@@ -13,6 +13,7 @@
 #include "parallel.hpp"
 #include "progress.hpp"
 #include "registration_candidates.hpp"
+#include "registration_kernel.hpp"
 #include "sogmm/component_index.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/model.hpp"
@@ -59,13 +60,47 @@ struct Component {
   double log_weight = 0.0;  // log((1 - eps) pi_k)
 };
 
-// The target smoothed by s: its components and an index over their boxes.
+// The target smoothed by s: its components, their boxes (an index over them
+// where a level looks components up), and each component's record for the
+// point source's pair kernel.
 struct Level {
   std::vector<Component> comps;
-  ComponentIndex index;
+  std::vector<Box3> boxes;  // component_box at ComponentIndex's default 3 sigma
+  ComponentIndex index;     // built when asked for
+  std::vector<double> records;  // detail::kPairRecord per component
 };
 
-Level make_level(const Gmm& gmm, double s, double eps, bool use_gray) {
+// Component k's record (registration_kernel.hpp's fields).
+void fill_record(const Component& k, double* r) {
+  using namespace detail;
+  for (int d = 0; d < 3; ++d) {
+    r[kMuX + d] = k.mu(d);
+    r[kGainX + d] = k.gain(d);
+  }
+  // The precision is symmetric up to the solve's rounding: its mean.
+  r[kP00] = k.prec(0, 0);
+  r[kP01] = 0.5 * (k.prec(0, 1) + k.prec(1, 0));
+  r[kP02] = 0.5 * (k.prec(0, 2) + k.prec(2, 0));
+  r[kP11] = k.prec(1, 1);
+  r[kP12] = 0.5 * (k.prec(1, 2) + k.prec(2, 1));
+  r[kP22] = k.prec(2, 2);
+  r[kMuGray] = k.mu_g;
+  r[kInvSgg] = k.inv_sgg;
+  r[kLogNorm] = k.log_norm;
+  r[kLogNormGray] = k.log_norm_g;
+}
+
+// A record's precision as a matrix.
+Eigen::Matrix3d record_precision(const double* r) {
+  using namespace detail;
+  Eigen::Matrix3d p;
+  p << r[kP00], r[kP01], r[kP02], r[kP01], r[kP11], r[kP12], r[kP02], r[kP12], r[kP22];
+  return p;
+}
+
+// `indexed`: also build the index (a point source looks up only the
+// coarsest level's, through detail::CandidateCache; finer levels need boxes).
+Level make_level(const Gmm& gmm, double s, double eps, bool use_gray, bool indexed) {
   Level level;
   Gmm smoothed = gmm;
   level.comps.resize(gmm.size());
@@ -102,7 +137,13 @@ Level make_level(const Gmm& gmm, double s, double eps, bool use_gray) {
     k.prec = llt.solve(Eigen::Matrix3d::Identity());
     k.log_norm -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
   }
-  level.index.build(smoothed);
+  level.boxes.resize(gmm.size());
+  for (std::size_t m = 0; m < gmm.size(); ++m)
+    level.boxes[m] = component_box(smoothed, m, ComponentIndex::kDefaultSigmas);
+  if (indexed) level.index.build(smoothed);
+  level.records.assign(gmm.size() * detail::kPairRecord, 0.0);
+  for (std::size_t m = 0; m < gmm.size(); ++m)
+    fill_record(level.comps[m], level.records.data() + m * detail::kPairRecord);
   return level;
 }
 
@@ -124,11 +165,23 @@ struct Sums {
   }
 };
 
+// A thread's pairs (source item, candidate component) as arrays: a model
+// source's item at a time, a point source's block at a time (the pair
+// kernel's inputs and outputs).
 struct Scratch {
   std::vector<std::uint32_t> ids;
+  std::vector<double> x, y, z, gray;  // a point source: the pair's point
+  std::vector<double> pair_top;       // a point source: the pair's point's largest log-density
   std::vector<double> term;  // each pair's log-density, then exp(it - the largest)
-  std::vector<Eigen::Vector3d> res;
+  std::vector<double> pr_x, pr_y, pr_z, quad;  // P r and r^T P r
   std::vector<Eigen::Matrix3d> prec;  // a model source: each pair's own precision
+  std::vector<std::size_t> first;     // a point source: each point's first pair, then the end
+  std::vector<Eigen::Vector3d> moved;  // a point source: the block's points at the pose
+  std::vector<std::uint32_t> query;   // CandidateCache::near's scratch
+  std::vector<double> top;            // a point source: each point's largest log-density
+  void resize(std::size_t count) {
+    for (auto* v : {&x, &y, &z, &gray, &pair_top, &term, &pr_x, &pr_y, &pr_z, &quad}) v->resize(count);
+  }
 };
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -180,50 +233,48 @@ void model_candidates(const Level& level, const Eigen::Vector3d& x, const Eigen:
   level.index.query_box(box, ids);
 }
 
-// One source item's share, counted `weight` times: x is the transformed
-// point (a model source: its component's mean, with its covariance `spread4`
-// in the target frame; a point: spread4 null), c the perturbation centre,
-// s.ids the components it tests (ascending).
-void score_point(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d* spread4,
-                 double weight, const Eigen::Vector3d& c, double log_outlier, bool use_gray, bool spread,
-                 Scratch& s, Sums& out) {
-  s.term.resize(s.ids.size());
-  s.res.resize(s.ids.size());
-  if (spread4) s.prec.resize(s.ids.size());
-  double top = log_outlier;
-  for (std::size_t j = 0; j < s.ids.size(); ++j) {
-    const Component& k = level.comps[s.ids[j]];
-    double lp;
-    if (spread4) {
-      lp = pair_log_density(k, x, gray, *spread4, use_gray, s.res[j], s.prec[j]);
-    } else {
-      Eigen::Vector3d r = x - k.mu;
-      lp = k.log_norm;
-      if (use_gray) {
-        const double dg = gray - k.mu_g;
-        r -= k.gain * dg;
-        lp += k.log_norm_g - 0.5 * dg * dg * k.inv_sgg;
-      }
-      lp -= 0.5 * r.dot(k.prec * r);
-      s.res[j] = r;
-    }
-    s.term[j] = lp;
-    top = std::max(top, lp);
+// A model source's item (its component's transformed mean x, gray, and
+// covariance `spread4` in the target frame) against the components s.ids:
+// each pair's log-density, P r, r^T P r and own precision P into s.
+// (A point source's come from the pair kernel.)
+void model_pairs(const Level& level, const Eigen::Vector3d& x, double gray, const Eigen::Matrix4d& spread4,
+                 bool use_gray, Scratch& s) {
+  const std::size_t count = s.ids.size();
+  s.resize(count);
+  s.prec.resize(count);
+  for (std::size_t j = 0; j < count; ++j) {
+    Eigen::Vector3d r;
+    s.term[j] = pair_log_density(level.comps[s.ids[j]], x, gray, spread4, use_gray, r, s.prec[j]);
+    const Eigen::Vector3d pr = s.prec[j] * r;
+    s.pr_x[j] = pr(0);
+    s.pr_y[j] = pr(1);
+    s.pr_z[j] = pr(2);
+    s.quad[j] = r.dot(pr);
   }
-  // No component's box holds the item and no outlier term (outlier_ratio
-  // 0): it has no density to move towards and is left out of every sum
-  // (not an inlier), instead of making them NaN.
-  if (top == -std::numeric_limits<double>::infinity()) return;
-  // The terms exp(lp - top) replace the log-densities and each responsibility is
-  // its term over their total: one exp per pair, not two. exp of an exponent
-  // below -746 is +0 (and costs libm's slow underflow path): such a term
-  // adds nothing, so it is set to 0 without calling exp.
+}
+
+// The largest of the outlier's and pairs [from, to)'s log-densities (-inf:
+// no component's box holds the item and there is no outlier term).
+double top_of(const Scratch& s, std::size_t from, std::size_t to, double log_outlier) {
+  double top = log_outlier;
+  for (std::size_t j = from; j < to; ++j) top = std::max(top, s.term[j]);
+  return top;
+}
+
+// One source item's share, counted `weight` times: x is the transformed
+// point (a model source: its component's mean), c the perturbation centre,
+// pairs [from, to) of s its candidates (ascending ids) with their terms
+// exp(log-density - top) in s.term (top: top_of's, finite), P r and r^T P r,
+// and precision_of(j) pair j's precision P. Each responsibility is its term
+// over their total: one exp per pair, not two.
+template <class PrecisionOf>
+void score_item(Scratch& s, std::size_t from, std::size_t to, double top, PrecisionOf precision_of,
+                const Eigen::Vector3d& x, double weight, const Eigen::Vector3d& c, double log_outlier, bool spread,
+                Sums& out) {
+  const double* term = s.term.data();
   const double term_out = std::exp(log_outlier - top);
   double total = term_out;
-  for (double& e : s.term) {
-    e = e - top > kExpZero ? std::exp(e - top) : 0.0;
-    total += e;
-  }
+  for (std::size_t j = from; j < to; ++j) total += term[j];
   const double lse = top + std::log(total);
   const double inv_total = 1.0 / total;
   out.log_likelihood += weight * lse;
@@ -235,24 +286,27 @@ void score_point(const Level& level, const Eigen::Vector3d& x, double gray, cons
   // first, then one J^T W J. (A model source's covariance is held at the
   // current pose within a step: the Gauss-Newton step moves its mean.)
   const Eigen::Vector3d a = x - c;
+  // The spread's terms are set (and summed) only when asked for: most
+  // evaluations do not use them.
   Mat36 jac;
+  Vec6 gbar;
+  Mat6 ggt;
   if (spread) {
     jac.leftCols<3>() = -skew(a);
     jac.rightCols<3>().setIdentity();
+    gbar.setZero();
+    ggt.setZero();
   }
   Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
   Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
-  Vec6 gbar = Vec6::Zero();
-  Mat6 ggt = Mat6::Zero();
-  for (std::size_t j = 0; j < s.ids.size(); ++j) {
+  for (std::size_t j = from; j < to; ++j) {
     // Responsibilities below 1e-12 are dropped.
-    const double w = s.term[j] * inv_total;
+    const double w = term[j] * inv_total;
     if (w < 1e-12) continue;
-    const Eigen::Matrix3d& p = spread4 ? s.prec[j] : level.comps[s.ids[j]].prec;
-    const Eigen::Vector3d pr = p * s.res[j];
-    wp += w * p;
+    const Eigen::Vector3d pr(s.pr_x[j], s.pr_y[j], s.pr_z[j]);
+    wp += w * precision_of(j);
     wpr += w * pr;
-    if (inlier) out.mahalanobis += weight * w * s.res[j].dot(pr);
+    if (inlier) out.mahalanobis += weight * w * s.quad[j];
     if (spread) {
       const Vec6 g = jac.transpose() * pr;
       gbar += w * g;
@@ -377,6 +431,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
 
   std::vector<Scratch> scratch(static_cast<std::size_t>(team));
   std::vector<Sums> partial;
+  const detail::RegistrationKernels& kernels = detail::registration_kernels();
   // Every `stride`-th point (coarse levels need fewer: their targets are smooth).
   // A point's candidates: `cands` (built on the coarsest level) filtered by
   // `level`'s own boxes.
@@ -389,15 +444,68 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
     detail::parallel_for(blocks, team, 1, [&](std::size_t blk, int thread) {
       Sums s;
       Scratch& sc = scratch[static_cast<std::size_t>(thread)];
-      for (std::size_t v = blk * block; v < std::min(used, (blk + 1) * block); ++v) {
+      const std::size_t first = blk * block, last = std::min(used, (blk + 1) * block);
+      if (!model_source) {
+        // The block's points moved once and their pairs listed (the
+        // candidates whose box on this level holds the point, kept without
+        // a branch per candidate), scored by the kernel in one pass, then
+        // summed point by point.
+        sc.first.clear();
+        sc.moved.clear();
+        std::size_t count = 0;
+        for (std::size_t v = first; v < last; ++v) {
+          const float* p = points + 4 * v * stride;
+          const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
+          const std::vector<std::uint32_t>& near = cands.near(v * stride, x, sc.query);
+          sc.first.push_back(count);
+          sc.moved.push_back(x);
+          if (sc.ids.size() < count + near.size()) {
+            sc.ids.resize(2 * (count + near.size()));
+            sc.resize(sc.ids.size());
+          }
+          const double xyz[3] = {x(0), x(1), x(2)};
+          for (std::uint32_t id : near) {
+            sc.ids[count] = id;
+            sc.x[count] = xyz[0];
+            sc.y[count] = xyz[1];
+            sc.z[count] = xyz[2];
+            sc.gray[count] = p[3];
+            // Box3::contains without a branch per bound (about half the
+            // candidates fail, unpredictably).
+            const Box3& b = level.boxes[id];
+            count += (xyz[0] >= b.lo[0]) & (xyz[0] <= b.hi[0]) & (xyz[1] >= b.lo[1]) & (xyz[1] <= b.hi[1]) &
+                     (xyz[2] >= b.lo[2]) & (xyz[2] <= b.hi[2]);
+          }
+        }
+        sc.first.push_back(count);
+        kernels.pairs(level.records.data(),
+                      {sc.ids.data(), sc.x.data(), sc.y.data(), sc.z.data(), sc.gray.data(), sc.term.data(),
+                       sc.pr_x.data(), sc.pr_y.data(), sc.pr_z.data(), sc.quad.data()},
+                      count);
+        // Each point's largest log-density beside its pairs, then every
+        // pair's term in one pass.
+        sc.top.resize(last - first);
+        for (std::size_t v = 0; v < last - first; ++v) {
+          sc.top[v] = top_of(sc, sc.first[v], sc.first[v + 1], log_outlier);
+          std::fill(sc.pair_top.begin() + sc.first[v], sc.pair_top.begin() + sc.first[v + 1], sc.top[v]);
+        }
+        kernels.terms(sc.term.data(), sc.pair_top.data(), sc.term.data(), count);
+        const auto precision_of = [&](std::size_t j) {
+          return record_precision(level.records.data() + std::size_t{detail::kPairRecord} * sc.ids[j]);
+        };
+        for (std::size_t v = 0; v < last - first; ++v) {
+          // As for a model source: an item with no density is left out.
+          if (sc.top[v] == -std::numeric_limits<double>::infinity()) continue;
+          score_item(sc, sc.first[v], sc.first[v + 1], sc.top[v], precision_of, sc.moved[v], 1.0, c, log_outlier,
+                     spread, s);
+        }
+        partial[blk] = s;
+        return;
+      }
+      for (std::size_t v = first; v < last; ++v) {
         const std::size_t i = v * stride;
         const float* p = points + 4 * i;
         const Eigen::Vector3d x = pose.r * Eigen::Vector3d(p[0], p[1], p[2]) + pose.t;
-        if (!model_source) {
-          cands.query(i, x, level.index, sc.ids);
-          score_point(level, x, p[3], nullptr, 1.0, c, log_outlier, options.use_gray, spread, sc, s);
-          continue;
-        }
         // The component's covariance in the target frame: diag(R, 1) S diag(R, 1)^T.
         Eigen::Matrix4d cov;
         const float* f = src.covariances + 16 * i;
@@ -407,7 +515,18 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
         rot.topLeftCorner<3, 3>() = pose.r;
         const Eigen::Matrix4d moved = rot * cov * rot.transpose();
         model_candidates(level, x, moved, sc.ids);
-        score_point(level, x, p[3], &moved, src.weight(i), c, log_outlier, options.use_gray, spread, sc, s);
+        model_pairs(level, x, p[3], moved, options.use_gray, sc);
+        // No component's box holds the item and no outlier term (outlier_ratio
+        // 0): it has no density to move towards and is left out of every sum
+        // (not an inlier), instead of making them NaN.
+        const double top = top_of(sc, 0, sc.ids.size(), log_outlier);
+        if (top == -std::numeric_limits<double>::infinity()) continue;
+        // exp of an exponent below -746 is +0 (and costs libm's slow
+        // underflow path): such a term adds nothing, so it is set to 0
+        // without calling exp.
+        for (double& e : sc.term) e = e - top > kExpZero ? std::exp(e - top) : 0.0;
+        score_item(sc, 0, sc.ids.size(), top, [&](std::size_t j) { return sc.prec[j]; }, x, src.weight(i), c,
+                   log_outlier, spread, s);
       }
       partial[blk] = s;
     });
@@ -432,7 +551,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
     std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(2 * (levels - 1 - l), 4);
     const auto fewest = std::max<std::size_t>(kCoarsePoints, static_cast<std::size_t>(options.min_points));
     while (stride > 1 && n / stride < fewest) stride /= 2;
-    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray);
+    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray, l == 0 || model_source);
     const Level& level = l == 0 ? coarsest : finer;
     if (l == 0) cands.emplace(coarsest.index, model_source ? 0 : n, kCandidateMargin);
     converged = false;

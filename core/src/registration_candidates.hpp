@@ -11,6 +11,8 @@
 // anchor (per axis), every box that holds it meets that cube, so filtering
 // the kept list by the exact box test gives exactly query_point's answer
 // (the same ids, ascending); a point that moves further is queried again.
+// So a component left out of a point's list has a box that does not hold
+// the point: beyond 3 sigma, as the index's culling proves.
 //
 // One cache serves every level: it is built on the coarsest level's index,
 // whose boxes hold the finer levels' boxes of the same components (same
@@ -36,13 +38,21 @@ class CandidateCache {
   CandidateCache(const ComponentIndex& index, std::size_t n, double margin)
       : index_(&index), margin_(margin), anchor_(n), near_(n), valid_(n, 0) {}
 
-  /// Sets `out` to the ids, ascending, of the components whose box in
-  /// `boxes` holds `x` (point i at the current pose): boxes.query_point's
-  /// answer. Every box of `boxes` must lie in the same component's box of
-  /// the cache's index. Calls for different i may run concurrently.
-  void query(std::size_t i, const Eigen::Vector3d& x, const ComponentIndex& boxes, std::vector<std::uint32_t>& out) {
-    out.clear();
-    if (!x.allFinite()) return;  // as query_point: no component
+  /// The ids, ascending, of the components of the cache's index whose box
+  /// meets the cube of half-width `margin` about point i's anchor, where x
+  /// (point i at the current pose) lies within `margin` of that anchor
+  /// (re-anchored at x first when it does not): a superset of the
+  /// components whose box holds x, for the cache's index and for any index
+  /// whose boxes lie in the same components' boxes of it. Filtering it by
+  /// such an index's box test gives exactly that index's query_point answer
+  /// (registration.cpp does, listing a block's pairs). A non-finite x has
+  /// no component (as query_point). Calls for different i may run
+  /// concurrently (each with its own `scratch`); the list is valid until
+  /// the next call for i.
+  const std::vector<std::uint32_t>& near(std::size_t i, const Eigen::Vector3d& x,
+                                         std::vector<std::uint32_t>& scratch) {
+    static const std::vector<std::uint32_t> kNone;
+    if (!x.allFinite()) return kNone;
     if (!valid_[i] || ((x - anchor_[i]).cwiseAbs().array() > margin_).any()) {
       // The cube is widened by a relative 1e-9 so that rounding in x - anchor
       // or in its bounds never drops a box that holds a point within margin.
@@ -52,17 +62,14 @@ class CandidateCache {
         cube.lo[d] = x(d) - m;
         cube.hi[d] = x(d) + m;
       }
-      // Queried into `out` and copied: one allocation of the exact size
+      // Queried into `scratch` and copied: one allocation of the exact size
       // instead of a vector grown entry by entry for every new point.
-      index_->query_box(cube, out);
-      near_[i].assign(out.begin(), out.end());
-      out.clear();
+      index_->query_box(cube, scratch);
+      near_[i].assign(scratch.begin(), scratch.end());
       anchor_[i] = x;
       valid_[i] = 1;
     }
-    const double xyz[3] = {x(0), x(1), x(2)};
-    for (std::uint32_t id : near_[i])
-      if (boxes.box(id).contains(xyz)) out.push_back(id);
+    return near_[i];
   }
 
  private:

@@ -1,11 +1,13 @@
 // The registration's candidate cache (core/src/registration_candidates.hpp):
-// at every step of seeded random walks its answer is exactly the index's own
-// query_point answer (the same ids, ascending), for the index it was built on
-// and for a finer index whose boxes lie inside it (as a registration's later
-// levels use it). No kernel-dispatched code runs: the comparisons are of
+// at every step of seeded random walks its list filtered by an index's box
+// test (what the registration's pair kernel does) is exactly that index's
+// own query_point answer (the same ids, ascending), for the index it was
+// built on and for a finer index whose boxes lie inside it (as a
+// registration's later levels use it). No kernel-dispatched code runs: the comparisons are of
 // integers from double box tests, identical under sse2, avx2 and avx512.
 // Mutations tried: never re-querying a moved point (no margin check), and
-// filtering by the cache's own boxes instead of the finer ones: each fails.
+// (when the filter was the cache's) filtering by the cache's own boxes
+// instead of the finer ones: each fails.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -19,6 +21,16 @@
 
 namespace {
 using namespace sogmm_test;
+
+// The cache's list for point i at x, filtered by `boxes`' box test.
+std::vector<std::uint32_t> held(sogmm::detail::CandidateCache& cache, std::size_t i, const Eigen::Vector3d& x,
+                                const sogmm::ComponentIndex& boxes, std::vector<std::uint32_t>& scratch) {
+  std::vector<std::uint32_t> out;
+  const double xyz[3] = {x(0), x(1), x(2)};
+  for (std::uint32_t id : cache.near(i, x, scratch))
+    if (boxes.box(id).contains(xyz)) out.push_back(id);
+  return out;
+}
 
 // 300 components in a 1 m cube with axis sigmas of 5 mm to 5 cm and a
 // random correlation; `extra` is added to each spatial variance (a
@@ -49,13 +61,13 @@ void expect_exact_along_walks(const sogmm::ComponentIndex& coarse, const sogmm::
   sogmm::detail::CandidateCache cache(coarse, n, 0.01);
   std::vector<Eigen::Vector3d> x(n);
   for (auto& p : x) p = Eigen::Vector3d(rng.uniform(), rng.uniform(), rng.uniform());
-  std::vector<std::uint32_t> got, want;
+  std::vector<std::uint32_t> want, scratch;
   std::size_t nonempty = 0;
   for (int step = 0; step < 60; ++step) {
     const double size = 1e-4 * std::pow(400.0, rng.uniform());
     for (std::size_t i = 0; i < n; ++i) {
       x[i] += size * Eigen::Vector3d(rng.normal(), rng.normal(), rng.normal()).normalized();
-      cache.query(i, x[i], fine, got);
+      const std::vector<std::uint32_t> got = held(cache, i, x[i], fine, scratch);
       const double xyz[3] = {x[i](0), x[i](1), x[i](2)};
       fine.query_point(xyz, want);
       ASSERT_EQ(got, want) << "point " << i << " step " << step;
@@ -83,9 +95,8 @@ TEST(RegistrationCandidates, NonFinitePointHasNoCandidate) {
   sogmm::ComponentIndex index;
   index.build(scene(0.0));
   sogmm::detail::CandidateCache cache(index, 1, 0.01);
-  std::vector<std::uint32_t> out{1, 2};
-  cache.query(0, Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0.5, 0.5), index, out);
-  EXPECT_TRUE(out.empty());
+  std::vector<std::uint32_t> scratch;
+  EXPECT_TRUE(cache.near(0, Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0.5, 0.5), scratch).empty());
 }
 
 }  // namespace
