@@ -53,10 +53,12 @@ using EmLogDensityFn = void (*)(const Block& block, const float* params, const d
 /// is more than 87 below every point's maximum has responsibilities exactly 0
 /// in float and is skipped without changing the result. On return
 /// `row_lp_max[i]` holds the largest exp(lp - max) of row i (0 for skipped
-/// rows). Returns the sum of the points' log-likelihoods.
+/// rows). Returns the sum of the points' log-likelihoods and adds the sum of
+/// their squares to `*squares` (the spread of the per-point log-likelihoods,
+/// for EmOptions::tol_standard_errors).
 using EmFinishFn = double (*)(const Block& block, const float* params, const double* exact,
                               const std::uint32_t* components, std::size_t n, float* rows, const float* max_lp,
-                              float* row_lp_max, double* stats);
+                              float* row_lp_max, double* stats, double* squares);
 
 /// The truncated E-step's upper bounds (em_truncation.cpp) of the `m`
 /// components in `col` (BoundParams' 15 columns of m doubles) over the box
