@@ -25,6 +25,7 @@ const (
 	OptNInit                       Key = C.SOGMM_OPT_N_INIT
 	OptDequantiseDepth             Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
 	OptEmAcceleration              Key = C.SOGMM_OPT_EM_ACCELERATION
+	OptTolStandardErrors           Key = C.SOGMM_OPT_TOL_STANDARD_ERRORS
 	OptDepthScale                  Key = C.SOGMM_OPT_DEPTH_SCALE
 	OptDepthMin                    Key = C.SOGMM_OPT_DEPTH_MIN
 	OptDepthMax                    Key = C.SOGMM_OPT_DEPTH_MAX

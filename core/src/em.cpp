@@ -55,6 +55,7 @@ void check_options(const EmOptions& o) {
   require_option(OptionKey::THREADS, std::int64_t{o.threads}, "EM threads");
   require_option(OptionKey::TRUNCATION_NATS, o.truncation_nats, "EM truncation_nats");
   require_option(OptionKey::EM_ACCELERATION, static_cast<std::int64_t>(o.acceleration), "EM acceleration");
+  require_option(OptionKey::TOL_STANDARD_ERRORS, o.tol_standard_errors, "EM tol_standard_errors");
 }
 
 // The frame the fit works in: the midpoint of the data's bounding box per
@@ -335,6 +336,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   std::vector<std::vector<std::uint32_t>> slot_touched(region_chunks);
   std::vector<char> slot_marked(region_chunks * m, 0);
   std::vector<double> slot_ll(region_chunks);
+  std::vector<double> slot_squares(region_chunks);  // of the points' log-likelihoods
   std::vector<double> slot_pairs(region_chunks);
   // Per thread: one block's log-density rows and row maxima, (kBlock + 1) x M
   // floats, so the scratch is threads x block, not waves x block.
@@ -353,6 +355,13 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   std::vector<float> next_params;
   std::vector<double> next_exact;
   int passes = 0;
+  double standard_error = 0.0;  // of the last pass's mean log-likelihood
+  // EM stops when a pass changes the mean log-likelihood by less than this
+  // (EmOptions::tol_standard_errors): the noise of the mean itself, when
+  // larger than tol, is a change no further pass can make meaningful.
+  const detail::EmTolerance tolerance = [&] {
+    return options.tol > 0 ? std::max(options.tol, options.tol_standard_errors * standard_error) : 0.0;
+  };
   // One E+M pass (detail::EmPass): the E-step of the packed model, the M-step
   // into `cur`, which is packed for the next pass.
   const detail::EmPass pass = [&](Working& cur) {
@@ -362,7 +371,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
     bool promoted = false;
     do {
       std::fill(stats.begin(), stats.end(), 0.0);
-      double total_ll = 0.0;
+      double total_ll = 0.0, total_squares = 0.0;
       iteration_pairs = 0.0;
       for (std::size_t wave_start = 0; wave_start < n_chunks; wave_start += region_chunks) {
         const std::size_t wave_chunks = std::min(region_chunks, n_chunks - wave_start);
@@ -375,7 +384,10 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
           float* row_max = scratch + m * kBlock;
           detail::TruncatedScan scan(bounds, options.truncation_nats, n_blocks);
           alignas(64) float max_lp[kBlock];
-          double ll = 0.0, pairs = 0.0;
+          double ll = 0.0, squares = 0.0, pairs = 0.0;
+          // The per-point logs for the spread cost 16 times the logs of the
+          // sum alone: only when the stopping rule reads them.
+          double* squares_or_null = options.tol_standard_errors > 0 ? &squares : nullptr;
           const std::size_t b0 = (wave_start + s) * blocks_per_chunk;
           const std::size_t b1 = std::min(n_blocks, b0 + blocks_per_chunk);
           for (std::size_t b = b0; b < b1; ++b) {
@@ -399,13 +411,14 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
                 std::fill(st + std::size_t{k} * kStatStride, st + (std::size_t{k} + 1) * kStatStride, 0.0);
               }
             ll += kernels.finish(block, params.data(), exact.data(), evaluated->data(), ne, scratch, max_lp, row_max, st,
-                                 finish_nats);
+                                 finish_nats, squares_or_null);
             pairs += static_cast<double>(block.count) * ne;
             // Next iteration starts from the components some point of this
             // block still gives at least exp(-nats) of its best weight.
             if (truncated) scan.remember(b, row_max, memory);
           }
           slot_ll[s] = ll;
+          slot_squares[s] = squares;
           slot_pairs[s] = pairs;
         });
         // Fixed-order reduction: chunk 0, 1, 2, ... whatever thread ran them.
@@ -416,10 +429,19 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
             slot_marked[s * m + k] = 0;
           }
           total_ll += slot_ll[s];
+          total_squares += slot_squares[s];
           iteration_pairs += slot_pairs[s];
         }
       }
       mean_ll = total_ll / static_cast<double>(n) + shift;
+      // The per-point log-likelihoods' variance (the shift moves them all
+      // alike), and the standard error of their mean.
+      if (options.tol_standard_errors > 0) {
+        const double unshifted = total_ll / static_cast<double>(n);
+        const double variance = std::max(0.0, total_squares / static_cast<double>(n) - unshifted * unshifted);
+        standard_error = std::sqrt(variance / static_cast<double>(n));
+        rep.standard_error = standard_error;
+      }
       require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
                                                               std::to_string(passes));
 
@@ -490,7 +512,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       shift = pack_all(cur, reg, data_scale2, params, exact);
       return true;
     };
-    detail::run_squarem(w, options, pass, load, rep, on_iteration);
+    detail::run_squarem(w, options, pass, load, tolerance, rep, on_iteration);
   } else {
     double previous = -std::numeric_limits<double>::infinity();
     for (int iter = 1; iter <= options.max_iter; ++iter) {
@@ -498,7 +520,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       rep.iterations = iter;
       rep.log_likelihood = mean_ll;
       if (on_iteration) on_iteration(iter, mean_ll);
-      if (std::fabs(mean_ll - previous) < options.tol) {
+      if (std::fabs(mean_ll - previous) < tolerance()) {
         rep.converged = true;
         break;
       }

@@ -107,8 +107,8 @@ void renormalise_log_weights(std::vector<double>& log_weight) {
   for (double& l : log_weight) l -= log_sum;
 }
 
-void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,
-                 const EmIterationCallback& on_iteration) {
+void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load,
+                 const EmTolerance& tolerance, EmReport& report, const EmIterationCallback& on_iteration) {
   double previous = -std::numeric_limits<double>::infinity();
   int iter = 0;
   // A kept pass: reported, and the convergence test against the last kept one.
@@ -116,7 +116,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
     report.iterations = iter;
     report.log_likelihood = ll;
     if (on_iteration) on_iteration(iter, ll);
-    report.converged = std::fabs(ll - previous) < options.tol;
+    report.converged = std::fabs(ll - previous) < tolerance();
     previous = ll;
     return report.converged;
   };

@@ -29,8 +29,12 @@ using EmPass = std::function<double(Working& w)>;
 /// returns false and changes nothing when `w` is not a model.
 using EmLoad = std::function<bool(Working& w, const Working* fallback)>;
 
+/// The convergence tolerance after the last pass (em.cpp: tol, or the last
+/// E-step's standard error times EmOptions::tol_standard_errors when larger).
+using EmTolerance = std::function<double()>;
+
 /// Runs EM from the current model `w` with SQUAREM steps until
-/// |change of the log-likelihood| < options.tol or options.max_iter passes.
+/// |change of the log-likelihood| < tolerance() or options.max_iter passes.
 /// Safeguards: a component whose extrapolation is not one, or leaves its
 /// reg_covar floors, takes the plain step (t2's) while the others
 /// extrapolate (a component of fewer points than dimensions sits on its
@@ -42,8 +46,8 @@ using EmLoad = std::function<bool(Working& w, const Working* fallback)>;
 /// EmOptions::acceleration). `on_iteration`
 /// sees every pass but the rejected ones (its numbers then skip one);
 /// report->iterations counts every pass.
-void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load, EmReport& report,
-                 const EmIterationCallback& on_iteration);
+void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const EmLoad& load,
+                 const EmTolerance& tolerance, EmReport& report, const EmIterationCallback& on_iteration);
 
 /// The extrapolated model t0 + 2 a r + a^2 v (log-weights renormalised).
 /// Exposed for its test.

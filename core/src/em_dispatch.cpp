@@ -11,7 +11,7 @@ namespace sogmm::detail {
   void em_log_density(const Block&, const float*, const double*, const std::uint32_t*, std::size_t, float*,    \
                       float*, float*);                                                                         \
   double em_finish(const Block&, const float*, const double*, const std::uint32_t*, std::size_t, float*,       \
-                   const float*, float*, double*, float);                                                      \
+                   const float*, float*, double*, float, double*);                                              \
   void em_upper_bounds(const double*, std::size_t, const float*, double*);                                     \
   }
 SOGMM_DECLARE_KERNELS(sse2)

@@ -154,7 +154,8 @@ void em_log_density(const Block& block, const float* params, const double* exact
 }
 
 double em_finish(const Block& block, const float* params, const double* exact, const std::uint32_t* components,
-                 std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats, float nats) {
+                 std::size_t n, float* rows, const float* max_lp, float* row_max, double* stats, float nats,
+                 double* squares) {
   // row_max holds each row's largest log-density on entry (see em_kernel.hpp).
   const float* __restrict mx = max_lp;
   const int count = block.count;
@@ -220,8 +221,19 @@ double em_finish(const Block& block, const float* params, const double* exact, c
     max_sum[j] += static_cast<double>(mx[base + j]);
   }
   double log_likelihood = 0.0;
-  for (int j = 0; j < kLanes; ++j) log_likelihood += max_sum[j] + std::log(product[j]);
-  for (int p = 0; p < count; ++p) inv_sum[p] = 1.0f / sum[p];
+  if (squares == nullptr) {
+    for (int j = 0; j < kLanes; ++j) log_likelihood += max_sum[j] + std::log(product[j]);
+    for (int p = 0; p < count; ++p) inv_sum[p] = 1.0f / sum[p];
+  } else {
+    double log_likelihood_squares = 0.0;
+    for (int p = 0; p < count; ++p) {
+      const double point_ll = static_cast<double>(mx[p]) + std::log(static_cast<double>(sum[p]));
+      log_likelihood += point_ll;
+      log_likelihood_squares += point_ll * point_ll;
+      inv_sum[p] = 1.0f / sum[p];
+    }
+    *squares += log_likelihood_squares;
+  }
 
   // Sufficient statistics centred at each component's mean. A component whose
   // responsibilities are all exactly 0 in this block adds nothing: skip it.

@@ -59,10 +59,14 @@ using EmLogDensityFn = void (*)(const Block& block, const float* params, const d
 /// `nats` below its point's best (the truncation's guarantee), and a row with
 /// no such point is skipped. Infinite `nats`: every point (exact). On return
 /// `row_lp_max[i]` holds the largest exp(lp - max) of row i over its range
-/// (0 for skipped rows). Returns the sum of the points' log-likelihoods.
+/// (0 for skipped rows). Returns the sum of the points' log-likelihoods
+/// (from 16 products of the points' sums, one log each); with `squares`
+/// non-null, from each point's own log instead, and adds the sum of their
+/// squares to `*squares` (the spread of the per-point log-likelihoods, for
+/// EmOptions::tol_standard_errors; 16 times the logs, so only when asked).
 using EmFinishFn = double (*)(const Block& block, const float* params, const double* exact,
                               const std::uint32_t* components, std::size_t n, float* rows, const float* max_lp,
-                              float* row_lp_max, double* stats, float nats);
+                              float* row_lp_max, double* stats, float nats, double* squares);
 
 /// Points per segment of a row's statistics range (see EmFinishFn): one
 /// AVX-512 vector, so the range starts aligned on every instruction set and

@@ -97,6 +97,11 @@ std::vector<OptionSpec> make_table() {
       SOGMM_I64_ROW(EM_ACCELERATION, fit.em.acceleration, 0, 1, "0 (plain EM) or 1 (SQUAREM)", "",
                     "0: plain EM; 1: SQUAREM steps (extrapolation along two EM steps, rejected when the "
                     "log-likelihood would fall), fewer iterations to the same tol"),
+      SOGMM_F64_ROW(TOL_STANDARD_ERRORS, fit.em.tol_standard_errors, 0.0, kInf, finite, ">= 0, finite",
+                    "standard errors",
+                    "c > 0: EM also stops when a pass changes the mean log-likelihood by less than c times its standard "
+                    "error (the per-point log-likelihoods' standard deviation over sqrt(N), from the same E-step), when "
+                    "that exceeds TOL; 0: TOL alone. TOL 0 still runs MAX_ITER iterations"),
       // ---- RGB-D back-projection ----
       SOGMM_F64_ROW(DEPTH_SCALE, depth.depth_scale, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v) && std::isfinite(1.0 / v); },
                     "> 0, finite, 1 / value finite", "raw units per metre",

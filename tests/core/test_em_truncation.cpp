@@ -136,8 +136,9 @@ std::vector<std::vector<std::uint32_t>> e_step(const Scene& s, sogmm::detail::Tr
           ++*skipped;
         }
     }
+    double squares = 0.0;
     kernels.finish(block, s.params.data(), s.exact.data(), list.data(), list.size(), rows.data(), max_lp, row_max,
-                   stats.data(), static_cast<float>(kNats));
+                   stats.data(), static_cast<float>(kNats), &squares);
     scan.remember(b, row_max, memory);
     lists.push_back(list);
   }

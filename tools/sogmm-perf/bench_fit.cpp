@@ -7,7 +7,9 @@
 // scikit-learn peer.
 //
 // Usage: sogmm_bench_fit --depth D --color C --intrinsics J --decimate d
-//        --bandwidth S [--threads T] [--depth-scale 1000] [--dump-points FILE]
+//        --bandwidth S [--threads T] [--depth-scale 1000] [--tol T] [--tol-standard-errors C]
+//        [--em-acceleration none|squarem]
+//        [--dump-points FILE]
 //
 // FLOP count per point-component pair per EM iteration: 80 (log-density 30,
 // exp and log-sum-exp 16 counting exp as 15 like the prototype, and
@@ -106,6 +108,17 @@ int main(int argc, char** argv) {
   app.add_option("--threads", fit_options.em.threads);
   app.add_option("--seed", fit_options.seed);
   app.add_option("--truncate", fit_options.em.truncation_nats, "truncated E-step cutoff in nats (0 = exact)");
+  app.add_option("--tol", fit_options.em.tol, "EM tolerance on the mean log-likelihood (default: the library's)");
+  app.add_option("--tol-standard-errors", fit_options.em.tol_standard_errors,
+                 "EM also stops below this many standard errors of the mean log-likelihood (default: the library's)");
+  app.add_option_function<std::string>(
+      "--em-acceleration",
+      [&fit_options](const std::string& v) {
+        if (v == "none") fit_options.em.acceleration = EmAcceleration::None;
+        else if (v == "squarem") fit_options.em.acceleration = EmAcceleration::Squarem;
+        else throw CLI::ValidationError("--em-acceleration", "must be none or squarem, got " + v);
+      },
+      "none: plain EM; squarem: SQUAREM steps (default: the library's)");
   double query_nats = 20.0;
   app.add_option("--query-truncate", query_nats, "culled regress/score rows: cutoff in nats (0 = skip those rows)");
   app.add_option("--dump-points", dump, "write N x 4 float32 points, then the seed indices (uint64) to FILE");

@@ -11,10 +11,12 @@ log-likelihood at most 0.05 below).
 
 Usage: seed_spread.py [--sogmm build/tools/sogmm/sogmm] [--data ../shared/data/rgbd]
                       [--seeds 20] [--n-init 1] [--csv out.csv]
-                      [--truncate NATS] [--em-acceleration none|squarem] [--tol TOL] [--case livingroom:0.02 ...]
+                      [--truncate NATS] [--em-acceleration none|squarem] [--tol TOL]
+                      [--tol-standard-errors C] [--case livingroom:0.02 ...]
 --truncate passes the truncated E-step's cutoff to every fit (0, the default:
 exact); --em-acceleration picks plain EM or SQUAREM (default: the library's); --tol sets EM's
-tolerance on the mean log-likelihood (default: the library's); --case restricts the run to the given frame:bandwidth cases.
+tolerance on the mean log-likelihood (default: the library's); --tol-standard-errors
+also stops EM when a pass gains less than C standard errors of that mean (default: the library's); --case restricts the run to the given frame:bandwidth cases.
 """
 import argparse
 import csv
@@ -64,6 +66,8 @@ def main():
     ap.add_argument("--truncate", type=float, default=0.0, help="truncated E-step cutoff in nats (0: exact)")
     ap.add_argument("--em-acceleration", choices=("none", "squarem"), help="EM acceleration of every fit")
     ap.add_argument("--tol", type=float, help="EM tolerance of every fit (default: the library's)")
+    ap.add_argument("--tol-standard-errors", type=float,
+                    help="EM also stops below this many standard errors of the mean log-likelihood")
     ap.add_argument("--case", action="append", default=[], help="frame:bandwidth to run (repeatable; default all)")
     a = ap.parse_args()
     if not os.path.isdir(a.data):
@@ -89,7 +93,8 @@ def main():
             cmd = [a.sogmm, "eval"] + frame_args(a.data, frame) + [
                 "--decimate", "5", "--bandwidth", str(bw), "--seed", str(seed), "--n-init", str(a.n_init), "--truncate", str(a.truncate),
                 "--json"] + (["--em-acceleration", a.em_acceleration] if a.em_acceleration else []) + (
-                ["--tol", str(a.tol)] if a.tol is not None else [])
+                ["--tol", str(a.tol)] if a.tol is not None else []) + (
+                ["--tol-standard-errors", str(a.tol_standard_errors)] if a.tol_standard_errors is not None else [])
             p = subprocess.run(cmd, capture_output=True, text=True)
             if p.returncode != 0:
                 sys.exit("seed_spread: %s failed: %s" % (" ".join(cmd), p.stderr.strip()))
@@ -111,7 +116,8 @@ def main():
         print("| " + " | ".join(cells) + " |", flush=True)
     if a.csv:
         keys = ["frame", "bandwidth", "seed", "n_components", "psnr", "mre", "fscore", "log_likelihood",
-                "em_iterations", "log_likelihood_heldout", "seconds_em", "seconds_total"]
+                "em_iterations", "log_likelihood_heldout", "log_likelihood_standard_error", "seconds_em",
+                "seconds_total"]
         with open(a.csv, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(keys)

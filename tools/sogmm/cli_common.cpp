@@ -76,6 +76,10 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
   on->excludes(off);
   app.add_option("--threads", o.em.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--tol", o.em.tol, "EM tolerance on the mean log-likelihood")->capture_default_str();
+  app.add_option("--tol-standard-errors", o.em.tol_standard_errors,
+                 "EM also stops when a pass gains less than this many standard errors of the mean "
+                 "log-likelihood (when above --tol; 0: --tol alone)")
+      ->capture_default_str();
   app.add_option("--max-iter", o.em.max_iter, "EM iteration limit")->capture_default_str();
   app.add_option_function<std::string>(
          "--reg-covar",
@@ -348,6 +352,9 @@ void print_evaluation(const Evaluation& e, bool json, const nlohmann::json* extr
     j["em_iterations"] = f.em.iterations;
     j["converged"] = f.em.converged;
     j["log_likelihood"] = f.em.log_likelihood;
+    // Measured only with --tol-standard-errors > 0 (EmReport::standard_error).
+    if (f.em.standard_error > 0) j["log_likelihood_standard_error"] = f.em.standard_error;
+    else j["log_likelihood_standard_error"] = nullptr;
     j["n_init"] = f.run_log_likelihoods.size();
     j["run"] = f.run;
     j["run_log_likelihoods"] = f.run_log_likelihoods;

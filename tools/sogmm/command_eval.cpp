@@ -352,9 +352,10 @@ Command add_eval_command(CLI::App& root) {
               return run_fit_and_eval(*s);
             }
             require(!any_given(*a, {"--bandwidth", "--components", "--tol", "--max-iter", "--reg-covar", "--n-init",
-                                     "--truncate", "--em-acceleration"}),
+                                     "--truncate", "--em-acceleration", "--tol-standard-errors"}),
                     ErrorCode::InvalidArgument,
-                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate/--em-acceleration apply only "
+                    "eval: --bandwidth/--components/--tol/--max-iter/--reg-covar/--n-init/--truncate/--em-acceleration/"
+                    "--tol-standard-errors apply only "
                     "without MODEL");
             if (!s->src.sequence.empty()) {
               require(!s->src.trajectory.empty(), ErrorCode::InvalidArgument, "eval: --sequence needs --trajectory FILE");

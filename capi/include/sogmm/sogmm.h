@@ -209,6 +209,11 @@ typedef int32_t sogmm_key;
  * log-likelihood would fall), fewer iterations to the same tol.
  * i64, 0 (plain EM) or 1 (SQUAREM); default 0. */
 #define SOGMM_OPT_EM_ACCELERATION 111
+/* C > 0: EM also stops when a pass changes the mean log-likelihood by less than c times its
+ * standard error (the per-point log-likelihoods' standard deviation over sqrt(N), from the same
+ * E-step), when that exceeds TOL; 0: TOL alone. TOL 0 still runs MAX_ITER iterations.
+ * f64 (standard errors), >= 0, finite; default 0. */
+#define SOGMM_OPT_TOL_STANDARD_ERRORS 131
 
 /* RGB-D back-projection. Read by sogmm_fit_frame, sogmm_map_insert_frame,
  * sogmm_frame_to_points_f32. */
