@@ -193,7 +193,7 @@ TEST(EmTruncation, FinishLeavesOutOnlyTermsBeyondTheCut) {
     kernels.log_density(block, s.params.data(), s.exact.data(), all.data(), kM, rows.data(), row_max.data(), max_lp);
     std::vector<double> stats(kM * kStatStride, 0.0);
     const double ll = kernels.finish(block, s.params.data(), s.exact.data(), all.data(), kM, rows.data(), max_lp,
-                                     row_max.data(), stats.data(), kFinishNats);
+                                     row_max.data(), stats.data(), kFinishNats, nullptr);
     // Brute force: responsibilities of all M components, and per component
     // what it may lose (its far terms, and its near terms' share of the
     // normaliser's far terms).
