@@ -301,7 +301,7 @@ func StoreFloat64(b bool) Option { return I64(OptFloat64, boolI64(b)) }
 func Compress(b bool) Option { return I64(OptCompress, boolI64(b)) }
 
 // ArrayPrecision > 0 saves each component as integer codes that move its
-// mean by at most v of its own standard deviations (format 1.4; bounds:
+// mean by at most v of its own standard deviations (format 1.5; bounds:
 // SOGMM_OPT_ARRAY_PRECISION in sogmm.h); 0 saves float arrays, bit-exact
 // (default). Outside [0, 0.5]: ErrInvalidArg.
 func ArrayPrecision(v float64) Option { return F64(OptArrayPrecision, v) }

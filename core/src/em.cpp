@@ -440,7 +440,6 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
         const double unshifted = total_ll / static_cast<double>(n);
         const double variance = std::max(0.0, total_squares / static_cast<double>(n) - unshifted * unshifted);
         standard_error = std::sqrt(variance / static_cast<double>(n));
-        rep.standard_error = standard_error;
       }
       require(std::isfinite(mean_ll), ErrorCode::Numeric, "EM: log-likelihood is not finite at iteration " +
                                                               std::to_string(passes));
@@ -512,13 +511,20 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       shift = pack_all(cur, reg, data_scale2, params, exact);
       return true;
     };
-    detail::run_squarem(w, options, pass, load, tolerance, rep, on_iteration);
+    // A kept pass is reported right after it ran: its standard error is the
+    // current one (a rejected extrapolation's is never reported).
+    const EmIterationCallback on_kept = [&](int iter, double ll) {
+      rep.standard_error = standard_error;
+      if (on_iteration) on_iteration(iter, ll);
+    };
+    detail::run_squarem(w, options, pass, load, tolerance, rep, on_kept);
   } else {
     double previous = -std::numeric_limits<double>::infinity();
     for (int iter = 1; iter <= options.max_iter; ++iter) {
       const double mean_ll = pass(w);
       rep.iterations = iter;
       rep.log_likelihood = mean_ll;
+      rep.standard_error = standard_error;
       if (on_iteration) on_iteration(iter, mean_ll);
       if (std::fabs(mean_ll - previous) < tolerance()) {
         rep.converged = true;

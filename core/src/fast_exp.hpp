@@ -6,12 +6,17 @@
 
 namespace sogmm::detail {
 
+// static: each object (the per-ISA kernels and the baseline code) keeps its
+// own copy, so a copy the compiler does not inline (e.g. at -O0) is never
+// merged across objects by the linker, which could hand an SSE2 caller the
+// AVX-512 object's instructions.
+
 /// exp(x) for x <= 0 with relative error < 1e-7 on [-87, 0] and exactly 0
 /// below -87 (where float exp would be denormal). Written with plain
 /// arithmetic and a bit cast so that compilers vectorize loops calling it
 /// (std::exp would be a library call per element). Cephes-style: x = n ln2 + r,
 /// |r| <= ln2 / 2, exp(r) by a degree-6 polynomial, 2^n built in the exponent.
-inline float fast_exp(float x) {
+static inline float fast_exp(float x) {
   // Clamped to [-87, 88] (ternaries, not fmin/fmax, which may become libm
   // calls): the integer conversion of n below is then always defined (NaN
   // maps to -87), and callers' x <= 0 is unchanged.
@@ -42,7 +47,7 @@ inline float fast_exp(float x) {
 /// 1.5 * 2^52 trick whose low mantissa bits then hold n as an integer, so 2^n
 /// is built with 64-bit integer adds and shifts (no float-to-integer
 /// conversion, which AVX2 lacks for 64-bit lanes).
-inline double fast_exp_double(double x) {
+static inline double fast_exp_double(double x) {
   constexpr double kShift = 6755399441055744.0;  // 1.5 * 2^52
   const double xc = x > -708.0 ? x : -708.0;     // also NaN -> -708
   const double t = xc * 1.4426950408889634074 + kShift;

@@ -117,7 +117,7 @@ std::vector<OptionSpec> make_table() {
       SOGMM_I64_ROW(COMPRESS, write.compress, 0, 1, "0 or 1", "", "1: zstd-compress the arrays"),
       SOGMM_F64_ROW(ARRAY_PRECISION, write.component_precision, 0.0, 0.5, finite, "[0, 0.5] (0: off)",
                     "standard deviations",
-                    "> 0: store each component as integer codes (format 1.4, spec/format.md 5.7) that move its mean by "
+                    "> 0: store each component as integer codes (format 1.5, spec/format.md 5.7) that move its mean by "
                     "at most this many of its standard deviations and its covariance's eigenvalues, in its own frame, "
                     "by at most this fraction, as MAP_COMPONENT_PRECISION bounds them, and its weight by a factor of at "
                     "most 1 +- 2^-4 before the weights are renormalised: 11-21 bytes a component on "

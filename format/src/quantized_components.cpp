@@ -375,8 +375,12 @@ bool recover_component(const float* cov, const float* mean, const Params& exact,
   const double slope = std::sqrt(exact.v * b2 / exact.lambda[0]);
   const double value_noise[4] = {kNoise * spatial, kNoise * spatial, kNoise * spatial,
                                  kNoise * ((std::abs(static_cast<double>(cov[15])) + 2 * gray * slope) + slope * slope * spatial)};
+  // Values on no grid: not a decoded component (a fresh fit's nearly always), and
+  // the rotation search below is not needed.
+  const std::vector<int> mantissa_levels = grid_levels(values, value_noise, 4, kMaxMantissaBits, true);
+  if (mantissa_levels.empty()) return false;
   const std::vector<TiltCode> tilts = tilt_candidates(readings, exact, spatial, axes_noise);
-  for (const int f : grid_levels(values, value_noise, 4, kMaxMantissaBits, true)) {
+  for (const int f : mantissa_levels) {
     cc[0] = f;
     double lambda[4];
     for (int i = 0; i < 4; ++i) {

@@ -240,7 +240,7 @@ typedef int32_t sogmm_key;
 /* 1: zstd-compress the arrays.
  * i64, 0 or 1; default 1. */
 #define SOGMM_OPT_COMPRESS 302
-/* > 0: store each component as integer codes (format 1.4, spec/format.md 5.7) that move its mean
+/* > 0: store each component as integer codes (format 1.5, spec/format.md 5.7) that move its mean
  * by at most this many of its standard deviations and its covariance's eigenvalues, in its own
  * frame, by at most this fraction, as MAP_COMPONENT_PRECISION bounds them, and its weight by a
  * factor of at most 1 +- 2^-4 before the weights are renormalised: 11-21 bytes a component on

@@ -18,7 +18,7 @@ struct WriteOptions {
   bool float64 = false;  ///< store arrays as float64 (exact widening of the float32 values)
   bool compress = true;  ///< false: arrays stored raw (no filter, no codec), component-major
   /// > 0: store each component as integer codes (spec/format.md section 5.7,
-  /// format 1.4) that move its mean by at most this many of its standard
+  /// format 1.5) that move its mean by at most this many of its standard
   /// deviations and its covariance's eigenvalues, in its own frame, by at
   /// most this fraction (the bound of MapOptions::component_precision), and
   /// its weight by a factor of at most 1 +- 2^-4 before the weights are

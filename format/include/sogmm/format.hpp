@@ -26,9 +26,10 @@
 namespace sogmm::format {
 
 /// Format version this library writes for a model of float arrays. The
-/// newest it knows is 1.4: a map is written as 1.3 (spec/format.md 2.3.2), a
-/// file with quantized components (WriteOptions::component_precision > 0) as
-/// 1.4 (spec/format.md 5.7), a map delta as 1.2.
+/// newest it knows is 1.5: a map (spec/format.md 2.3.2) and a file with
+/// quantized components (WriteOptions::component_precision > 0, section 5.7)
+/// are written as 1.5, which leaves out the fixed axis lists (section 7; 1.3
+/// and 1.4 wrote them), a map delta as 1.2.
 inline constexpr std::uint16_t kFormatMajor = 1;
 inline constexpr std::uint16_t kFormatMinor = 0;
 

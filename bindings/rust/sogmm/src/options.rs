@@ -217,7 +217,7 @@ impl OptionsBuilder {
         /// Compress arrays (default true).
         compress(bool) => SOGMM_OPT_COMPRESS as i64 i64::from;
         /// Saves: > 0 stores each component as integer codes that move its mean
-        /// by at most this many of its own standard deviations (format 1.4;
+        /// by at most this many of its own standard deviations (format 1.5;
         /// bounds: SOGMM_OPT_ARRAY_PRECISION in sogmm.h); 0 = float arrays,
         /// bit-exact (default); outside [0, 0.5]: `build` fails with
         /// `Status::InvalidArg`.
