@@ -34,6 +34,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_common.hpp"
 #include "eval_pixels.hpp"
 #include "frame_flags.hpp"
 #include "sogmm/camera.hpp"
@@ -111,14 +112,7 @@ int main(int argc, char** argv) {
   app.add_option("--tol", fit_options.em.tol, "EM tolerance on the mean log-likelihood (default: the library's)");
   app.add_option("--tol-standard-errors", fit_options.em.tol_standard_errors,
                  "EM also stops below this many standard errors of the mean log-likelihood (default: the library's)");
-  app.add_option_function<std::string>(
-      "--em-acceleration",
-      [&fit_options](const std::string& v) {
-        if (v == "none") fit_options.em.acceleration = EmAcceleration::None;
-        else if (v == "squarem") fit_options.em.acceleration = EmAcceleration::Squarem;
-        else throw CLI::ValidationError("--em-acceleration", "must be none or squarem, got " + v);
-      },
-      "none: plain EM; squarem: SQUAREM steps (default: the library's)");
+  tools::add_em_acceleration_flag(app, fit_options.em);
   double query_nats = 20.0;
   app.add_option("--query-truncate", query_nats, "culled regress/score rows: cutoff in nats (0 = skip those rows)");
   app.add_option("--dump-points", dump, "write N x 4 float32 points, then the seed indices (uint64) to FILE");

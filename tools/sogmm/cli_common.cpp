@@ -106,16 +106,20 @@ void add_fit_flags(CLI::App& app, FitOptions& o) {
                  "truncated E-step: skip components provably this many nats below each point's best "
                  "(0 = exact; 20 is a good value for full frames)")
       ->capture_default_str();
+  add_em_acceleration_flag(app, o.em);
+}
+
+void add_em_acceleration_flag(CLI::App& app, EmOptions& em) {
   app.add_option_function<std::string>(
          "--em-acceleration",
-         [&o](const std::string& v) {
-           if (v == "none") o.em.acceleration = EmAcceleration::None;
-           else if (v == "squarem") o.em.acceleration = EmAcceleration::Squarem;
+         [&em](const std::string& v) {
+           if (v == "none") em.acceleration = EmAcceleration::None;
+           else if (v == "squarem") em.acceleration = EmAcceleration::Squarem;
            else throw CLI::ValidationError("--em-acceleration", "must be none or squarem, got " + v);
          },
          "none: plain EM; squarem: SQUAREM steps (extrapolation along two EM steps, rejected when the "
          "likelihood would fall)")
-      ->default_str(o.em.acceleration == EmAcceleration::Squarem ? "squarem" : "none");
+      ->default_str(em.acceleration == EmAcceleration::Squarem ? "squarem" : "none");
 }
 
 PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, const DepthOptions& depth,

@@ -40,6 +40,10 @@ PointCloud backproject_nonempty(const LoadedFrame& frame, const Camera& camera, 
 /// --tol, --max-iter, --reg-covar auto|VALUE, --truncate.
 void add_fit_flags(CLI::App& app, FitOptions& options);
 
+/// --em-acceleration none|squarem into em.acceleration (part of add_fit_flags;
+/// on its own for tools with their own fit flags, e.g. sogmm-perf).
+void add_em_acceleration_flag(CLI::App& app, EmOptions& em);
+
 /// Where frames come from: one pair (--depth D --color C) or a posed sequence
 /// (--sequence DIR --trajectory FILE [--frames RANGE]).
 struct FrameSource {
