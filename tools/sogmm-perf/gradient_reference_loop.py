@@ -113,7 +113,7 @@ def main() -> None:
         m.insert_rgbd(*noisy[i], cam, poses[i])
     m.flush()
     dist, grad = m.surface_distance(q, gradient=True, n_threads=2)
-    print(f"map from the noisy frames 0-1 ({m.n_components_} components): distance median |error| against the "
+    print(f"map from frames 0-1 with that noise ({m.n_components_} components): distance median |error| against the "
           f"exact distance {1e3 * np.median(np.abs(dist - truth)):.2f} mm")
     print(f"  gradient vs exact: {scores(grad, exact, truth, seen)}")
     print(f"  gradient vs the nearest-noisy-point reference: {scores(grad, nearest, truth, seen)}")
