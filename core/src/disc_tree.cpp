@@ -167,6 +167,27 @@ DiscTree::Nearest DiscTree::nearest_among(const Eigen::Vector3d& x, std::uint32_
   return best;
 }
 
+bool DiscTree::nearest_face_among(const Eigen::Vector3d& x, double limit, const std::vector<std::uint32_t>& leaves,
+                                  Nearest& face) const {
+  bool found = false;
+  for (const std::uint32_t leaf : leaves) {
+    const Node& nd = nodes_[leaf];
+    const double reach = (found ? face.distance : limit) + slack_;  // the box is never the one that decides
+    if (box_distance2(nd.lo, nd.hi, x) > reach * reach) continue;
+    for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
+      const Disc& d = discs_[k];
+      const double c = (x - d.mu).dot(d.normal);
+      if (std::abs(c) > (found ? face.distance : limit) || !over_face(d, x)) continue;
+      if (found && std::abs(c) == face.distance && id_[k] > face.id) continue;
+      found = true;
+      face.distance = std::abs(c);
+      face.id = id_[k];
+      face.from = c * d.normal;
+    }
+  }
+  return found;
+}
+
 DiscTree::Nearest DiscTree::nearest(const Eigen::Vector3d& x, std::uint32_t hint,
                                     std::vector<std::pair<double, std::uint32_t>>& stack) const {
   Nearest best;

@@ -62,6 +62,15 @@ class DiscTree {
   /// least x's distance to some disc: every disc outside them is farther.
   Nearest nearest_among(const Eigen::Vector3d& x, std::uint32_t hint, const std::vector<std::uint32_t>& leaves) const;
 
+  /// Among the discs of `leaves` that x lies over (over_face()) and whose
+  /// plane is at most `limit` from x, the nearest (ties: the lowest id) into
+  /// `face` (`from`: x minus its foot on that face). False when there is
+  /// none. Complete when leaves_near() listed the leaves for a box that holds
+  /// x and a bound of at least `limit`: such a disc's foot point is within
+  /// `limit` of x, so its box is too.
+  bool nearest_face_among(const Eigen::Vector3d& x, double limit, const std::vector<std::uint32_t>& leaves,
+                          Nearest& face) const;
+
  private:
   struct Node {
     double lo[3], hi[3];

@@ -56,11 +56,20 @@ std::vector<Disc> discs_of(const Gmm& gmm, double k) {
   return out;
 }
 
+namespace {
+bool inside_ellipse(const Disc& d, double s, double t) { return (s / d.a) * (s / d.a) + (t / d.b) * (t / d.b) <= 1.0; }
+}  // namespace
+
+bool over_face(const Disc& d, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d r = x - d.mu;
+  return inside_ellipse(d, r.dot(d.e1), r.dot(d.e2));
+}
+
 // Distance of x to disc d; `from` receives x minus the nearest disc point.
 double disc_distance(const Disc& d, const Eigen::Vector3d& x, Eigen::Vector3d& from) {
   const Eigen::Vector3d r = x - d.mu;
   const double s = r.dot(d.e1), t = r.dot(d.e2), c = r.dot(d.normal);
-  if ((s / d.a) * (s / d.a) + (t / d.b) * (t / d.b) <= 1.0) {
+  if (inside_ellipse(d, s, t)) {
     from = c * d.normal;
     return std::abs(c);
   }

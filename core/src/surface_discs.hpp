@@ -24,6 +24,9 @@ struct Disc {
 /// positive definite.
 std::vector<Disc> discs_of(const Gmm& gmm, double k);
 
+/// Whether x projects along d's normal onto d (its face, not beyond its rim).
+bool over_face(const Disc& d, const Eigen::Vector3d& x);
+
 /// The distance of x to disc d; `from` receives x minus the nearest point of d.
 double disc_distance(const Disc& d, const Eigen::Vector3d& x, Eigen::Vector3d& from);
 

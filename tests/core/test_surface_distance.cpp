@@ -72,18 +72,47 @@ Result alone(const sogmm::Gmm& g, std::size_t k, const std::vector<float>& xyz) 
   return distance(one, xyz, 1);
 }
 
+// The face rule's tolerance (surface_distance.hpp): a face at most this much
+// farther than the nearest disc gives the gradient when that disc's nearest
+// point is on its rim.
+constexpr double kFaceTolerance = 0.015;
+
+// Whether component k alone answers x from its face: its gradient is its
+// normal (the smallest principal axis), not tilted towards a rim point.
+bool from_face(const sogmm::Gmm& g, std::size_t k, const double* grad) {
+  Eigen::Matrix3d cov;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) cov(i, j) = g.covariance(k)[4 * i + j];
+  const Eigen::Vector3d n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  return std::abs(n.dot(Eigen::Vector3d(grad[0], grad[1], grad[2]))) > 1.0 - 1e-12;
+}
+
 Result brute_force(const sogmm::Gmm& g, const std::vector<float>& xyz) {
   const std::size_t n = xyz.size() / 3;
+  std::vector<Result> each;
+  for (std::size_t k = 0; k < g.size(); ++k) each.push_back(alone(g, k, xyz));
   Result best;
   best.d.assign(n, std::numeric_limits<double>::infinity());
   best.g.assign(3 * n, 0.0);
-  for (std::size_t k = 0; k < g.size(); ++k) {
-    const Result r = alone(g, k, xyz);
-    for (std::size_t i = 0; i < n; ++i)
-      if (r.d[i] < best.d[i]) {  // strict: an equal distance keeps the lower id
-        best.d[i] = r.d[i];
-        std::copy(r.g.begin() + 3 * i, r.g.begin() + 3 * i + 3, best.g.begin() + 3 * i);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t win = 0;
+    for (std::size_t k = 0; k < g.size(); ++k)
+      if (each[k].d[i] < best.d[i]) {  // strict: an equal distance keeps the lower id
+        best.d[i] = each[k].d[i];
+        win = k;
       }
+    std::size_t grad_of = win;
+    if (!from_face(g, win, &each[win].g[3 * i])) {  // a rim: the nearest face within the tolerance, if any
+      double face = best.d[i] + kFaceTolerance;
+      bool found = false;
+      for (std::size_t k = 0; k < g.size(); ++k)
+        if ((found ? each[k].d[i] < face : each[k].d[i] <= face) && from_face(g, k, &each[k].g[3 * i])) {
+          face = each[k].d[i];
+          grad_of = k;
+          found = true;
+        }
+    }
+    std::copy(each[grad_of].g.begin() + 3 * i, each[grad_of].g.begin() + 3 * i + 3, best.g.begin() + 3 * i);
   }
   return best;
 }
@@ -141,6 +170,84 @@ TEST(SurfaceDistance, OneFlatComponentClosedForm) {
   EXPECT_NEAR(r.g[7], -0.3 / std::hypot(0.3, 0.2), 1e-6);
   EXPECT_NEAR(r.d[3], 0.0, 1e-12);
   EXPECT_NEAR(std::abs(r.g[11]), 1.0, 1e-9);  // on the disc: its normal
+}
+
+// Round discs of radius r (2 sigma) in the plane z = const or x = const.
+void flat_disc(sogmm::Gmm& g, std::size_t k, const Eigen::Vector3d& mu, double r, int normal_axis = 2) {
+  Eigen::Vector3d var = Eigen::Vector3d::Constant(0.25 * r * r);
+  var(normal_axis) = 1e-6;
+  set_component(g, k, 0.5, mu, var.asDiagonal());
+}
+
+TEST(SurfaceDistance, AFaceJustBehindARimGivesTheGradient) {
+  // A wide floor disc (z = 0, radius 0.5) and a small disc 5 mm above it
+  // (centre x = 0.3, radius 0.1). The point (0.19, 0, 0.02) is nearest to
+  // the small disc's rim point (0.2, 0, 0.005), at hypot(0.01, 0.015) =
+  // 18.0 mm; the floor's face under it is 20 mm away, within the 1.5 cm
+  // tolerance: the distance is the rim's, the gradient the floor's normal
+  // (the direction from the rim is 33.7 degrees off it). With the floor
+  // 3 cm lower (50 mm, beyond the tolerance) the rim's direction stays. The
+  // bounds are float32 rounding of the inputs, on every kernel (this path is
+  // scalar double code).
+  const std::vector<float> x = {0.19f, 0.0f, 0.02f};
+  for (const double floor_z : {0.0, -0.03}) {
+    sogmm::Gmm g;
+    g.resize(2);
+    flat_disc(g, 0, {0.3, 0.0, 0.005}, 0.1);
+    flat_disc(g, 1, {0.0, 0.0, floor_z}, 0.5);
+    const Result r = distance(g, x);
+    const double rim = std::hypot(0.01, 0.015);
+    EXPECT_NEAR(r.d[0], rim, 1e-6);
+    if (floor_z == 0.0) {
+      EXPECT_NEAR(r.g[0], 0.0, 1e-9);
+      EXPECT_NEAR(r.g[2], 1.0, 1e-9) << "the floor's normal";
+    } else {
+      EXPECT_NEAR(r.g[0], -0.01 / rim, 1e-5) << "the rim's direction";
+      EXPECT_NEAR(r.g[2], 0.015 / rim, 1e-5);
+    }
+    EXPECT_NEAR(r.g[1], 0.0, 1e-9);
+  }
+}
+
+TEST(SurfaceDistance, AGapBetweenCoplanarDiscsKeepsTheRimDirection) {
+  // Two discs in z = 0 with a 20 cm gap (x < -0.1 and x > 0.1). Over the
+  // gap no face lies under the point, so the gradient stays the direction
+  // from the nearest rim point (-0.1, 0, 0): (0.02, 0, 0.03) / |.|. A rule
+  // that took the nearest plane's normal regardless of its rim would give
+  // (0, 0, 1), 33.7 degrees off. Over a disc, its normal.
+  sogmm::Gmm g;
+  g.resize(2);
+  flat_disc(g, 0, {-0.3, 0.0, 0.0}, 0.2);
+  flat_disc(g, 1, {0.3, 0.0, 0.0}, 0.2);
+  const Result r = distance(g, {-0.08f, 0.0f, 0.03f, 0.15f, 0.0f, -0.01f});
+  const double rim = std::hypot(0.02, 0.03);
+  EXPECT_NEAR(r.d[0], rim, 1e-6);
+  EXPECT_NEAR(r.g[0], 0.02 / rim, 1e-5);
+  EXPECT_NEAR(r.g[2], 0.03 / rim, 1e-5);
+  EXPECT_NEAR(r.d[1], 0.01, 1e-6);
+  EXPECT_NEAR(r.g[5], -1.0, 1e-9);
+}
+
+TEST(SurfaceDistance, PerpendicularDiscsAtACorner) {
+  // A floor (z = 0, radius 0.5) and a wall (x = 0.3, centre height 0.25,
+  // radius 0.2: it ends 5 cm above the floor). (0.29, 0, 0.035): the wall's
+  // lower rim (0.3, 0, 0.05) is hypot(0.01, 0.015) = 18.0 mm away, the
+  // floor's face 35 mm (beyond the tolerance): the rim's direction.
+  // (0.29, 0, 0.025): the rim is 27 mm away, the floor 25 mm: the floor's
+  // normal. (0.28, 0, 0.2): over the wall's face, 2 cm: -x.
+  sogmm::Gmm g;
+  g.resize(2);
+  flat_disc(g, 0, {0.0, 0.0, 0.0}, 0.5);
+  flat_disc(g, 1, {0.3, 0.0, 0.25}, 0.2, 0);
+  const Result r = distance(g, {0.29f, 0.0f, 0.035f, 0.29f, 0.0f, 0.025f, 0.28f, 0.0f, 0.2f});
+  const double rim = std::hypot(0.01, 0.015);
+  EXPECT_NEAR(r.d[0], rim, 1e-6);
+  EXPECT_NEAR(r.g[0], -0.01 / rim, 1e-5);
+  EXPECT_NEAR(r.g[2], -0.015 / rim, 1e-5);
+  EXPECT_NEAR(r.d[1], 0.025, 1e-6);
+  EXPECT_NEAR(r.g[5], 1.0, 1e-9);
+  EXPECT_NEAR(r.d[2], 0.02, 1e-6);
+  EXPECT_NEAR(r.g[6], -1.0, 1e-9);
 }
 
 TEST(SurfaceDistance, RotatedDiscAgainstASampledRim) {

@@ -6,7 +6,10 @@ frames' raw clouds. Same map (frames 0-1), query points (frame 2's rays) and
 reference as occupancy_eval.py; prints, per band 2-30, 2-5 and 5-30 cm:
 
 - the map's gradient (nearest disc) against the reference, and the misses by
-  how far the nearest disc point lies from the nearest cloud point;
+  how far the nearest disc point lies from the nearest cloud point; the
+  map's gradient against the denoised reference (surface_reference.py, validated
+  on the noisy synthetic room by gradient_reference_loop.py), and the
+  nearest-point reference against it;
 - the reference against itself: the direction from frame 0's cloud against
   the one from frame 1's, for points both clouds put at the same distance;
 - the cloud's noise (off-plane RMS of 5x5-pixel patches of frame 0) and the
@@ -33,6 +36,7 @@ from scipy.spatial import cKDTree
 
 import occupancy_eval as oe
 import sogmm
+from surface_reference import denoised_directions
 
 BANDS = ((0.02, 0.30), (0.02, 0.05), (0.05, 0.30))
 
@@ -131,6 +135,9 @@ def main() -> None:
     print(f"map: frames 0-1, {m.n_components_} components; {len(q)} points of frame 2's rays within 0.5 m")
     print(f"map gradient vs the reference: {scores(grad, ref, truth)}; distance median |error| "
           f"{1e3 * np.median(np.abs(dist - truth)):.2f} mm")
+    denoised = denoised_directions(tree, q)
+    print(f"map gradient vs the denoised reference (surface_reference.py): {scores(grad, denoised, truth)}")
+    print(f"nearest-point reference vs the denoised reference: {scores(ref, denoised, truth)}")
     gap = np.linalg.norm(q - grad * dist[:, None] - near, axis=1)  # nearest disc point to nearest cloud point
     for lo, hi in ((0, 0.01), (0.01, 0.02), (0.02, 0.05), (0.05, np.inf)):
         print(f"  nearest disc point {100 * lo:.0f}-{100 * hi:.0f} cm from the nearest cloud point: "

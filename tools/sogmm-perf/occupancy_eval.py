@@ -14,7 +14,11 @@ then the rays of frame 2 on its decimated pixel grid (every valid pixel):
   surface, against the distance to the nearest point of the full-resolution
   clouds of frames 0-2 (a k-d tree; 4 mm pixel spacing at 2 m): the median
   absolute error, and the share of gradients within 10 degrees of the
-  direction from that nearest point for points 2-30 cm from it; throughput;
+  direction from that nearest point for points 2-30 cm from it, and of the
+  direction from the nearest point of the denoised clouds (surface_reference.py:
+  the nearest raw point's direction tilts with the depth noise, the denoised
+  one does not; validated in gradient_reference_loop.py);
+  throughput;
 - collision: spheres of radius 10 cm at the occupied points of frame 2 and
   20 cm in front of them (Map.collision_probability): the shares >= 0.99 and
   <= 0.01, and the time per robot and per robot-component pair tested.
@@ -36,6 +40,7 @@ from PIL import Image
 from scipy.spatial import cKDTree
 
 import sogmm
+from surface_reference import denoised_directions
 
 
 def read_trajectory(path: Path) -> list[np.ndarray]:
@@ -159,13 +164,17 @@ def main() -> None:
     print(f"distance: {sel.sum()} points within 0.5 m of the clouds: median |error| {1e3 * np.median(err):.2f} mm, "
           f"90th percentile {1e3 * np.percentile(err, 90):.1f} mm")
     direction = q - tree.data[nearest[sel]]
-    for lo, hi in ((0.02, 0.30), (0.02, 0.05), (0.05, 0.30)):
-        band = (truth[sel] >= lo) & (truth[sel] <= hi)
-        unit = direction[band] / np.linalg.norm(direction[band], axis=1, keepdims=True)
-        cosang = np.sum(unit * grad[band], axis=1)
-        print(f"  gradient: {band.sum()} points {100 * lo:.0f}-{100 * hi:.0f} cm from the surface: "
-              f"{np.mean(cosang >= np.cos(np.radians(10))):.3f} within 10 degrees of the direction from the nearest "
-              f"cloud point (median angle {np.degrees(np.median(np.arccos(np.clip(cosang, -1, 1)))):.1f} deg)")
+    in_band = (truth[sel] >= 0.02) & (truth[sel] <= 0.30)
+    denoised = np.full_like(direction, np.nan)
+    denoised[in_band] = denoised_directions(tree, q[in_band])
+    for name, ref in (("the nearest cloud point", direction), ("the nearest point of the denoised clouds (surface_reference.py)", denoised)):
+        for lo, hi in ((0.02, 0.30), (0.02, 0.05), (0.05, 0.30)):
+            band = (truth[sel] >= lo) & (truth[sel] <= hi)
+            unit = ref[band] / np.linalg.norm(ref[band], axis=1, keepdims=True)
+            cosang = np.sum(unit * grad[band], axis=1)
+            print(f"  gradient: {band.sum()} points {100 * lo:.0f}-{100 * hi:.0f} cm from the surface: "
+                  f"{np.mean(cosang >= np.cos(np.radians(10))):.3f} within 10 degrees of the direction from {name} "
+                  f"(median angle {np.degrees(np.median(np.arccos(np.clip(cosang, -1, 1)))):.1f} deg)")
     big = np.tile(q, (10, 1))
     load = os.getloadavg()[0]
     t, _ = timed(lambda: m.surface_distance(big, disc_sigmas=a.disc_sigmas, n_threads=a.threads), a.repeats)

@@ -11,7 +11,11 @@
 // disc's interior (c the offset along the normal), else the distance to the
 // nearest point of its rim (a 1-D Newton solve of the point-to-ellipse
 // problem, monotone from below). The gradient is the unit vector from that
-// nearest point to the query point (on a disc: its normal).
+// nearest point to the query point (on a disc: its normal), except where
+// that point is on a rim and the point lies over some disc's face no more
+// than 1.5 cm farther: then the normal of the nearest such face, pointing to
+// the point (a rim is mostly where a component is cut at disc_sigmas, not
+// where the surface ends; surface_distance.cpp, kFaceTolerance).
 //
 // Why not the IROS 2025 construction (Goel and Tabib, arXiv 2402.00186),
 // which measures the distance to each component's ellipsoid at a fixed
@@ -22,7 +26,7 @@
 //
 // The search is exact, bit for bit the brute-force answer (the nearest disc,
 // the lowest component id among equal distances, its distance and gradient
-// as computed for that disc alone): the discs sit in a tree of bounding
+// as computed for that disc alone, or for the face above): the discs sit in a tree of bounding
 // boxes (median splits, 4 discs a leaf). Points go in Z-order blocks of 64;
 // the first point of a block searches the tree depth first, nearer box
 // first; its nearest disc is at most `bound` from every point of the block
