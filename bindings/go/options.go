@@ -235,6 +235,12 @@ func NComponents(k int64) Option { return I64(OptNComponents, k) }
 // Tol is the EM stop tolerance (default 1e-3).
 func Tol(v float64) Option { return F64(OptTol, v) }
 
+// TolStandardErrors c > 0 also stops EM when a pass changes the mean
+// log-likelihood by less than c of its standard error (the per-point
+// log-likelihoods' spread over sqrt(N)); 0 = Tol alone (default). See
+// SOGMM_OPT_TOL_STANDARD_ERRORS in sogmm.h.
+func TolStandardErrors(c float64) Option { return F64(OptTolStandardErrors, c) }
+
 // RegCovar sets one floor, added to all four covariance diagonals in each
 // M-step (>= 0, finite in float32), or RegCovarAuto (the default).
 func RegCovar(v float64) Option { return F64(OptRegCovar, v) }

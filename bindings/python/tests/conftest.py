@@ -91,3 +91,13 @@ def livingroom():
     color = np.asarray(Image.open(folder / "color" / "00000.jpg").convert("RGB"))
     cam = sogmm.Camera.from_json(folder / "intrinsics.json")
     return depth, color, cam, folder
+
+
+def mean_moves_in_sigmas(saved, back) -> np.ndarray:
+    """Per component, how far a re-read mean moved in its own standard
+    deviations, |L^-1 (mu' - mu)| with S = L L^T the saved covariance, in
+    binary64 (the bound of SOGMM_OPT_ARRAY_PRECISION; numpy's rounding, ~1e-15
+    relative, is far inside the 1e-9 the tests allow)."""
+    d = back.means_.astype(np.float64) - saved.means_.astype(np.float64)
+    lower = np.linalg.cholesky(saved.covariances_.astype(np.float64))
+    return np.linalg.norm(np.linalg.solve(lower, d[:, :, None])[:, :, 0], axis=1)

@@ -4,13 +4,14 @@ merged by hand, revisits add nothing, bad input raises, files round-trip."""
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
 
 import sogmm
 
-from conftest import blobs, synthetic_rgbd
+from conftest import blobs, mean_moves_in_sigmas, synthetic_rgbd
 
 
 def rigid(yaw_deg: float, t) -> np.ndarray:
@@ -384,3 +385,35 @@ def test_component_precision_out_of_range_raises():
     for bad in (-0.1, 0.6, float("nan"), float("inf")):
         with pytest.raises(sogmm.InvalidArgumentError, match="component_precision"):
             sogmm.Map(component_precision=bad)
+
+
+def test_save_codes_components_at_the_files_precision_within_the_bound(tmp_path):
+    """``Map.save(component_precision=)`` (SOGMM_OPT_ARRAY_PRECISION, as
+    GMM.save): at precision P each saved mean moves by at most P of its
+    component's own standard deviations, |L^-1 (mu' - mu)| <= P with
+    S = L L^T (the encoder checks it on the decoded float32 values;
+    conftest.mean_moves_in_sigmas recomputes it in binary64, on every kernel:
+    both files hold the one fit). The default stores float
+    arrays, bit-exact. Mutation tried: the keyword not passed to the write
+    options leaves the file uncoded (size and "some mean moved" fail)."""
+    with sogmm.Map(novelty=False, **FIT) as m:
+        m.insert_points(frames()[0], POSES[1])
+        exact, coded = tmp_path / "exact.sogmm", tmp_path / "coded.sogmm"
+        m.save(exact)
+        m.save(coded, component_precision=0.5)
+        full = m.export()
+        before = coded.read_bytes()
+        for bad in (0.7, -1.0, float("nan")):
+            with pytest.raises(sogmm.InvalidArgumentError, match="component_precision"):
+                m.save(coded, component_precision=bad)
+            assert coded.read_bytes() == before
+    assert coded.stat().st_size < exact.stat().st_size
+    with sogmm.Map.load(exact) as e:
+        assert e.export().means_.tobytes() == full.means_.tobytes()
+    with sogmm.Map.load(coded) as c:
+        back = c.export()
+        assert c.stats()["n_frames"] == 1  # the provenance came along
+    sigmas = mean_moves_in_sigmas(full, back)
+    assert sigmas.max() <= 0.5 * (1 + 1e-9), sigmas.max()
+    assert sigmas.max() > 0, "the means were stored as codes, not bit for bit"
+    assert sorted(os.listdir(tmp_path)) == ["coded.sogmm", "exact.sogmm"]  # no temporary file left

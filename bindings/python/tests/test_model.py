@@ -356,14 +356,20 @@ def test_the_depth_floor_is_the_default_for_frames_and_not_for_arrays():
                                   on.covariances_)
 
 
-def test_em_acceleration_reaches_the_fit():
-    # Three overlapping clusters along x: plain EM creeps to its fixed point
-    # (tol 1e-7); SQUAREM gets there in fewer passes, no lower.
+def _creeping_fit():
+    """Three overlapping clusters along x and fit parameters (tol 1e-7) under
+    which plain EM creeps to its fixed point for hundreds of passes."""
     rng = np.random.default_rng(35)
     k = np.arange(3000) % 3
     pts = np.column_stack([0.8 * k + 0.5 * rng.standard_normal(3000), 0.2 * rng.standard_normal(3000),
                            1.0 + 0.1 * rng.standard_normal(3000), 0.3 + 0.1 * rng.standard_normal(3000)])
-    params = dict(n_components=3, seed=1, n_threads=1, tol=1e-7, max_iter=3000)
+    return pts, dict(n_components=3, seed=1, n_threads=1, tol=1e-7, max_iter=3000)
+
+
+def test_em_acceleration_reaches_the_fit():
+    # Three overlapping clusters along x: plain EM creeps to its fixed point
+    # (tol 1e-7); SQUAREM gets there in fewer passes, no lower.
+    pts, params = _creeping_fit()
     assert sogmm.SOGMM().get_params()["em_acceleration"] == "none"
     plain = sogmm.SOGMM(**params).fit(pts)
     again = sogmm.SOGMM(em_acceleration="none", **params).fit(pts)
@@ -373,3 +379,25 @@ def test_em_acceleration_reaches_the_fit():
     assert fast.info()["fit_log_likelihood"] >= plain.info()["fit_log_likelihood"] - 1e-5
     with pytest.raises(sogmm.InvalidArgumentError, match="em_acceleration"):
         sogmm.SOGMM(em_acceleration="fast", **params).fit(pts)
+
+
+def test_tol_standard_errors_reaches_the_fit():
+    # SOGMM_OPT_TOL_STANDARD_ERRORS (c): EM also stops when a pass gains less
+    # than c standard errors of the mean log-likelihood. The scene of the test
+    # above, where plain EM creeps for many passes at tol 1e-7: at c = 1 the
+    # creep (far below one standard error, ~0.02 nats at N = 3000) stops at
+    # once, so fewer passes; c = 0 is the library's default and the fit
+    # itself, bit for bit (the noise rule is the only change, on any kernel:
+    # both fits run on the same one). Mutation tried: the keyword left out of
+    # the C options (same passes: the "fewer" assert fails).
+    pts, params = _creeping_fit()
+    assert sogmm.SOGMM().get_params()["tol_standard_errors"] == 0.0
+    plain = sogmm.SOGMM(**params).fit(pts)
+    zero = sogmm.SOGMM(tol_standard_errors=0.0, **params).fit(pts)
+    noise = sogmm.SOGMM(tol_standard_errors=1.0, **params).fit(pts)
+    np.testing.assert_array_equal(plain.means_, zero.means_)
+    assert zero.info()["fit_iterations"] == plain.info()["fit_iterations"]
+    assert noise.info()["fit_iterations"] < plain.info()["fit_iterations"]
+    for bad in (-0.5, float("nan"), float("inf")):
+        with pytest.raises(sogmm.InvalidArgumentError, match="tol_standard_errors"):
+            sogmm.SOGMM(tol_standard_errors=bad, **params).fit(pts)

@@ -512,10 +512,18 @@ class Map(Queryable):
 
     # ---- files -------------------------------------------------------------------
     def save(self, path: str | os.PathLike, *, float64: bool = bool(_D.float64), compress: bool = bool(_D.compress),
-             zstd_level: int = _D.zstd_level) -> None:
+             zstd_level: int = _D.zstd_level, component_precision: float = _D.array_precision) -> None:
         """Writes the map as a world-frame .sogmm file with its frame provenance
-        (atomically). Pending points must be flushed first (InvalidArgumentError)."""
-        with _write_options(float64, compress, zstd_level) as o, self._guard.reading("save"):
+        (atomically). Pending points must be flushed first (InvalidArgumentError).
+
+        ``component_precision`` as in :meth:`GMM.save` (SOGMM_OPT_ARRAY_PRECISION):
+        > 0 stores each component as integer codes that move its mean by at
+        most that many of its standard deviations, 0 float arrays. It codes
+        the file only; the constructor's keyword of the same name
+        (SOGMM_OPT_MAP_COMPONENT_PRECISION) rounds the map's own components.
+        Out of range: InvalidArgumentError, nothing written."""
+        with _write_options(float64, compress, zstd_level, component_precision=component_precision) as o, \
+                self._guard.reading("save"):
             check(lib.sogmm_map_save(self._h(), os.fsencode(path), o.ptr))
 
     # Set by load() for the constructor's run: (path, verify_checksums, max_decoded_bytes).

@@ -465,6 +465,11 @@ class SOGMM(GMM):
             (ignored when n_components is set).
         seed: random seed (k-means++ seeding).
         tol: EM stops when the mean log-likelihood changes by less than tol.
+        tol_standard_errors: c > 0: EM also stops when a pass changes the mean
+            log-likelihood by less than c of its standard error (the per-point
+            log-likelihoods' spread over sqrt(N), from the same E-step), so it
+            stops at the data's own noise level; 0 (the library's default,
+            SOGMM_OPT_TOL_STANDARD_ERRORS) = tol alone.
         reg_covar: "auto" (default): one floor added to the x, y, z covariance
             diagonals and one to gray's, derived from the data's scales
             (1e-6 and 1e-6 for a room-sized frame with gray in [0, 1], 1 m^2
@@ -501,7 +506,8 @@ class SOGMM(GMM):
                  reg_covar: float | str = "auto", max_iter: int = _D.max_iter, n_components: int | None = None, n_threads: int = _D.threads,
                  mode_counter: str = "flat_binned", truncation_nats: float = _D.truncation_nats,
                  n_init: int = _D.n_init,
-                 dequantise_depth: bool | None = None, em_acceleration: str = _EM_ACCELERATION_DEFAULT):
+                 dequantise_depth: bool | None = None, em_acceleration: str = _EM_ACCELERATION_DEFAULT,
+                 tol_standard_errors: float = _D.tol_standard_errors):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -514,12 +520,13 @@ class SOGMM(GMM):
         self.n_init = n_init
         self.dequantise_depth = dequantise_depth
         self.em_acceleration = em_acceleration
+        self.tol_standard_errors = tol_standard_errors
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration")
+               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration", "tol_standard_errors")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -549,7 +556,8 @@ class SOGMM(GMM):
         seed = int(self.seed) & 0xFFFFFFFFFFFFFFFF
         if seed >= 2**63:
             seed -= 2**64  # the uint64 seed's bits as an int64
-        f64 = {_ffi.OPT_BANDWIDTH: self.bandwidth, _ffi.OPT_TOL: self.tol, _ffi.OPT_TRUNCATION_NATS: self.truncation_nats}
+        f64 = {_ffi.OPT_BANDWIDTH: self.bandwidth, _ffi.OPT_TOL: self.tol, _ffi.OPT_TRUNCATION_NATS: self.truncation_nats,
+               _ffi.OPT_TOL_STANDARD_ERRORS: self.tol_standard_errors}
         reg = self.reg_covar
         if isinstance(reg, str):
             if reg != "auto":

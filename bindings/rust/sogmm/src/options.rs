@@ -194,6 +194,10 @@ impl OptionsBuilder {
         };
         /// Truncated E-step margin in nats; 0 = exact (default).
         truncation_nats(f64) => SOGMM_OPT_TRUNCATION_NATS as f64 |v| v;
+        /// c > 0: EM also stops when a pass changes the mean log-likelihood by
+        /// less than c of its standard error (the per-point log-likelihoods'
+        /// spread over sqrt(N)); 0 = tol alone (default).
+        tol_standard_errors(f64) => SOGMM_OPT_TOL_STANDARD_ERRORS as f64 |v| v;
         /// Runs of k-means++ + EM (default 1).
         n_init(i64) => SOGMM_OPT_N_INIT as i64 |v| v;
         /// Forces the depth-quantisation floor on or off; the default

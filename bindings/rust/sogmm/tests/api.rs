@@ -330,11 +330,9 @@ fn option_info_reports_every_default_a_fresh_handle_holds() {
     assert_eq!(sogmm::option_info(99).unwrap_err().status(), sogmm::Status::InvalidArg);
 }
 
-/// SQUAREM (`squarem(true)`, SOGMM_OPT_EM_ACCELERATION) reaches plain EM's
-/// fixed point on three overlapping clusters in fewer passes, no lower; a
-/// value outside 0..=1 is refused.
-#[test]
-fn squarem_reaches_the_fixed_point_in_fewer_passes() {
+/// 3000 points of three overlapping clusters along x (a fixed linear
+/// congruential generator), where plain EM creeps to its fixed point.
+fn three_overlapping_clusters() -> Vec<f32> {
     let mut s: u64 = 35;
     let mut next = || {
         s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -350,6 +348,15 @@ fn squarem_reaches_the_fixed_point_in_fewer_passes() {
             0.3 + 0.3 * next(),
         ]);
     }
+    pts
+}
+
+/// SQUAREM (`squarem(true)`, SOGMM_OPT_EM_ACCELERATION) reaches plain EM's
+/// fixed point on three overlapping clusters in fewer passes, no lower; a
+/// value outside 0..=1 is refused.
+#[test]
+fn squarem_reaches_the_fixed_point_in_fewer_passes() {
+    let pts = three_overlapping_clusters();
     let fit = |squarem: bool| {
         let o = Options::builder()
             .n_components(3)
@@ -369,6 +376,34 @@ fn squarem_reaches_the_fixed_point_in_fewer_passes() {
     let mut o = Options::new().unwrap();
     assert_eq!(o.get_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION).unwrap(), 0);
     assert!(o.set_i64(sogmm::sys::SOGMM_OPT_EM_ACCELERATION, 2).is_err());
+}
+
+/// `tol_standard_errors(c)` (SOGMM_OPT_TOL_STANDARD_ERRORS) reaches the fit:
+/// on three_overlapping_clusters() plain EM creeps for hundreds of passes at tol 1e-7,
+/// far below one standard error of the mean log-likelihood, so c = 1 stops
+/// it sooner; c = 0 is the default and the fit itself; a negative c is
+/// refused. Mutation tried: the setter writing SOGMM_OPT_TOL instead (c = 0
+/// then sets tol 0: the "same as default" check fails).
+#[test]
+fn tol_standard_errors_stops_the_creep() {
+    let pts = three_overlapping_clusters();
+    let fit = |c: Option<f64>| {
+        let mut o = Options::builder()
+            .n_components(3)
+            .seed(1)
+            .threads(1)
+            .tol(1e-7)
+            .max_iter(3000);
+        if let Some(c) = c {
+            o = o.tol_standard_errors(c);
+        }
+        let m = Model::fit(&pts, Some(&o.build().unwrap())).unwrap();
+        m.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap().unwrap()
+    };
+    let (plain, zero, noise) = (fit(None), fit(Some(0.0)), fit(Some(1.0)));
+    assert_eq!(zero, plain);
+    assert!(noise < plain, "{noise} vs {plain}");
+    assert!(Options::builder().tol_standard_errors(-0.5).build().is_err());
 }
 
 /// `m` components like a map's: means spread over a metre, covariances
