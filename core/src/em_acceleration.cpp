@@ -9,6 +9,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "parallel.hpp"
+
 namespace sogmm::detail {
 namespace {
 
@@ -27,30 +29,27 @@ constexpr double kLowestLogWeight = -700.0;
 
 using Mat4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 
-// sum_k w_k |t_k - s_k|^2 in t0's Fisher metric, for the differences
-// (d_mean, d_cov, d_logw) given per component by `diff`.
+// Components per claim of the step length's parallel loop.
+constexpr std::size_t kComponentsPerClaim = 64;
+
+// |t_k - s_k|^2 in the Fisher metric of t0's component k (whose covariance
+// factor is `l`), for the differences (d_mean, d_cov, d_logw) given by `diff`.
 template <typename Diff>
-double fisher_norm2(const Working& t0, const std::vector<Eigen::LLT<Eigen::Matrix4d>>& llt,
-                    const std::vector<double>& weight, Diff diff) {
-  double total = 0.0;
-  for (std::size_t k = 0; k < t0.size(); ++k) {
-    Eigen::Vector4d dm;
-    Mat4 dc;
-    double dl = 0.0;
-    diff(k, dm, dc, dl);
-    const Eigen::Matrix4d l = llt[k].matrixL();
-    const Eigen::Vector4d y = l.triangularView<Eigen::Lower>().solve(dm);
-    // L^-1 dS L^-T: its squared Frobenius norm is tr((S^-1 dS)^2).
-    const Eigen::Matrix4d half = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d(dc));
-    const Eigen::Matrix4d whitened = l.triangularView<Eigen::Lower>().solve(half.transpose());
-    total += weight[k] * (y.squaredNorm() + 0.5 * whitened.squaredNorm() + dl * dl);
-  }
-  return total;
+double fisher_term2(const Eigen::Matrix4d& l, std::size_t k, Diff diff) {
+  Eigen::Vector4d dm;
+  Mat4 dc;
+  double dl = 0.0;
+  diff(k, dm, dc, dl);
+  const Eigen::Vector4d y = l.triangularView<Eigen::Lower>().solve(dm);
+  // L^-1 dS L^-T: its squared Frobenius norm is tr((S^-1 dS)^2).
+  const Eigen::Matrix4d half = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d(dc));
+  const Eigen::Matrix4d whitened = l.triangularView<Eigen::Lower>().solve(half.transpose());
+  return y.squaredNorm() + 0.5 * whitened.squaredNorm() + dl * dl;
 }
 
 }  // namespace
 
-double squarem_step_length(const Working& t0, const Working& t1, const Working& t2) {
+double squarem_step_length(const Working& t0, const Working& t1, const Working& t2, int threads) {
   const std::size_t m = t0.size();
   double top = -std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < m; ++k) {
@@ -60,24 +59,37 @@ double squarem_step_length(const Working& t0, const Working& t1, const Working& 
   std::vector<double> weight(m);
   double sum = 0.0;
   for (std::size_t k = 0; k < m; ++k) sum += weight[k] = std::exp(t0.log_weight[k] - top);
-  std::vector<Eigen::LLT<Eigen::Matrix4d>> llt(m);
+  // Each component's terms on the team (they are independent; this was
+  // serial between the E-steps), then summed in component order, so the
+  // length does not depend on the thread count.
+  std::vector<double> r2_term(m), v2_term(m);
+  std::vector<char> factored(m);
+  parallel_for(m, threads, kComponentsPerClaim, [&](std::size_t k, int) {
+    const Eigen::LLT<Eigen::Matrix4d> llt(Eigen::Map<const Mat4>(&t0.covariance[16 * k]));
+    factored[k] = llt.info() == Eigen::Success ? 1 : 0;
+    if (!factored[k]) return;
+    const Eigen::Matrix4d l = llt.matrixL();
+    r2_term[k] = fisher_term2(l, k, [&](std::size_t c, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
+      dm = Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * c]) - Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * c]);
+      dc = Eigen::Map<const Mat4>(&t1.covariance[16 * c]) - Eigen::Map<const Mat4>(&t0.covariance[16 * c]);
+      dl = t1.log_weight[c] - t0.log_weight[c];
+    });
+    v2_term[k] = fisher_term2(l, k, [&](std::size_t c, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
+      dm = Eigen::Map<const Eigen::Vector4d>(&t2.mean[4 * c]) - 2.0 * Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * c]) +
+           Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * c]);
+      dc = Eigen::Map<const Mat4>(&t2.covariance[16 * c]) - 2.0 * Eigen::Map<const Mat4>(&t1.covariance[16 * c]) +
+           Eigen::Map<const Mat4>(&t0.covariance[16 * c]);
+      dl = t2.log_weight[c] - 2.0 * t1.log_weight[c] + t0.log_weight[c];
+    });
+  });
+  for (std::size_t k = 0; k < m; ++k)
+    if (!factored[k]) return 0.0;
+  double r2 = 0.0, v2 = 0.0;
   for (std::size_t k = 0; k < m; ++k) {
-    weight[k] /= sum;
-    llt[k].compute(Eigen::Map<const Mat4>(&t0.covariance[16 * k]));
-    if (llt[k].info() != Eigen::Success) return 0.0;
+    const double w = weight[k] / sum;
+    r2 += w * r2_term[k];
+    v2 += w * v2_term[k];
   }
-  const double r2 = fisher_norm2(t0, llt, weight, [&](std::size_t k, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
-    dm = Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * k]) - Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * k]);
-    dc = Eigen::Map<const Mat4>(&t1.covariance[16 * k]) - Eigen::Map<const Mat4>(&t0.covariance[16 * k]);
-    dl = t1.log_weight[k] - t0.log_weight[k];
-  });
-  const double v2 = fisher_norm2(t0, llt, weight, [&](std::size_t k, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
-    dm = Eigen::Map<const Eigen::Vector4d>(&t2.mean[4 * k]) - 2.0 * Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * k]) +
-         Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * k]);
-    dc = Eigen::Map<const Mat4>(&t2.covariance[16 * k]) - 2.0 * Eigen::Map<const Mat4>(&t1.covariance[16 * k]) +
-         Eigen::Map<const Mat4>(&t0.covariance[16 * k]);
-    dl = t2.log_weight[k] - 2.0 * t1.log_weight[k] + t0.log_weight[k];
-  });
   const double a = std::sqrt(r2 / v2);
   return std::isfinite(a) ? a : 0.0;
 }
@@ -131,7 +143,7 @@ void run_squarem(Working& w, const EmOptions& options, const EmPass& pass, const
     const double ll1 = pass(w);
     if (keep(ll1) || iter == options.max_iter) break;
     // w is t2 and current: a plain step needs nothing more.
-    const double length = squarem_step_length(t0, t1, w);
+    const double length = squarem_step_length(t0, t1, w, team_size(options.threads));
     const bool capped = length >= step_max;
     double a = std::min(length, step_max);
     if (!(a > kPlain)) {

@@ -60,7 +60,8 @@ void renormalise_log_weights(std::vector<double>& log_weight);
 /// w_k (dmu^T S^-1 dmu + tr((S^-1 dS)^2) / 2 + dlogw^2), w_k, S = t0's weight
 /// and covariance), so the step length does not depend on the data's units
 /// or offset; 0 when it cannot be measured (t0 not a model, a weight below
-/// e^-700, v = 0).
-double squarem_step_length(const Working& t0, const Working& t1, const Working& t2);
+/// e^-700, v = 0). The components' terms are computed on `threads` threads
+/// and summed in component order: the same length for any thread count.
+double squarem_step_length(const Working& t0, const Working& t1, const Working& t2, int threads = 1);
 
 }  // namespace sogmm::detail

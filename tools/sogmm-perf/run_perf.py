@@ -25,9 +25,14 @@ this machine whatever the code (sogmm-corun).
 Usage (from the repository root, after tools/setup.sh):
     python3 tools/sogmm-perf/run_perf.py [--runs 5] [--baseline-root ../wt-base]
         [--cases d5s02,d5s01,d1s02,d1s02t20] [--no-warm] [--isa native,avx2] [--update-readme]
+        [--new-fit-args "--truncate 20 --em-acceleration squarem --tol-standard-errors 0.5"]
 The baseline root is a checkout whose build/tools/sogmm-perf/sogmm-perf exists.
 --update-readme also writes the report into README.md (between its run_perf
 markers), headed by the date, the machine and both commits.
+--new-fit-args gives the new build's fits extra sogmm-perf options (a
+candidate default, e.g. SQUAREM with the noise-aware stop), the baseline's fits
+keep their defaults: the same-run ratio a change of defaults would give. Not
+with --update-readme (the README's block is of the defaults).
 """
 import argparse
 import contextlib
@@ -51,13 +56,14 @@ def perf_bin(root):
     return os.path.join(root, "build", "tools", "sogmm-perf", "sogmm-perf")
 
 
-def run_fit(binary, case, threads):
+def run_fit(binary, case, threads, extra=()):
     d, bw, trunc = CASES[case]
     cmd = [binary, "--depth", os.path.join(DATA, "depth", "00000.png"), "--color",
            os.path.join(DATA, "color", "00000.jpg"), "--intrinsics", os.path.join(DATA, "intrinsics.json"),
            "--decimate", str(d), "--bandwidth", str(bw), "--threads", str(threads)]
     if trunc:
         cmd += ["--truncate", str(trunc)]
+    cmd += list(extra)
     return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
 
 
@@ -272,7 +278,8 @@ def measure(a, builds, cases):
         for _ in range(a.runs):
             for threads in (2, 1):
                 for b, binary in builds.items():
-                    runs[(b, threads)].append(run_fit(binary, case, threads))
+                    extra = a.new_fit_args.split() if b == "new" else ()
+                    runs[(b, threads)].append(run_fit(binary, case, threads, extra))
         for (b, threads), r in runs.items():
             res[(b, case, threads)] = medians(r)
         print(f"{case}: done", file=sys.stderr)
@@ -288,6 +295,9 @@ def measure(a, builds, cases):
 
 def print_report(a, cases, res, warm, warm6, corun):
     """The issue's tables for one kernel's measurements (to stdout)."""
+    if a.new_fit_args:
+        print(f"The new build's fits ran with `{a.new_fit_args}` (the baseline's with its defaults).\n")
+
     def get(b, case, key, threads=2):
         r = res.get((b, case, threads))
         return None if r is None or key not in r else r[key]
@@ -399,7 +409,12 @@ def main():
                          "no cap, the widest the CPU has); default: this environment's SOGMM_ISA")
     ap.add_argument("--update-readme", action="store_true",
                     help="also write the report into README.md between its run_perf markers")
+    ap.add_argument("--new-fit-args", default="",
+                    help="extra sogmm-perf options for the new build's fits only (e.g. a candidate default); "
+                         "not with --update-readme")
     a = ap.parse_args()
+    if a.new_fit_args and a.update_readme:
+        ap.error("--new-fit-args measures a candidate, not the defaults: not with --update-readme")
     if not os.path.isdir(DATA):
         sys.exit(f"run_perf: {DATA} not found (the real frames live in ../shared/data)")
     builds = {"new": perf_bin(ROOT)}
