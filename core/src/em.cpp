@@ -39,9 +39,6 @@ constexpr double kEmptyGuard = 10.0 * std::numeric_limits<double>::epsilon();
 // count), so the order in which partial sums are added never changes.
 constexpr std::size_t kWave = 16;
 constexpr std::size_t kMaxBlocksPerChunk = 32;
-// Components per claim of the parallel M-step and packing (a component's
-// M-step and Cholesky factor take about a microsecond).
-constexpr std::size_t kComponentsPerClaim = 64;
 // The chunks' partial statistics a parallel region may hold at once
 // (em_regions.hpp): as many waves as fit run in one region (the reduction
 // order, chunk by chunk, is the same), so that a sparse (truncated) pass, whose
@@ -253,7 +250,7 @@ double pack_all(Working& w, const RegDiagonal& reg, double data_scale2, std::vec
   params.assign(m * kParamStride, 0.f);
   exact.assign(m * kParamStride, 0.0);
   std::vector<char> packed(m);
-  detail::parallel_for(m, threads, kComponentsPerClaim, [&](std::size_t k, int) {
+  detail::parallel_for(m, threads, detail::kComponentsPerClaim, [&](std::size_t k, int) {
     packed[k] = pack_component(w, k, &params[k * kParamStride], &exact[k * kParamStride]) ? 1 : 0;
   });
   for (std::size_t k = 0; k < m; ++k)
@@ -462,7 +459,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
       // M-step: each component from its own statistics (on every thread;
       // it was serial between the E-steps), then the weights' sum in
       // component order.
-      detail::parallel_for(m, threads, kComponentsPerClaim, [&](std::size_t k, int) {
+      detail::parallel_for(m, threads, detail::kComponentsPerClaim, [&](std::size_t k, int) {
         const float* packed = &params[k * kParamStride];
         double centre[4];
         for (int i = 0; i < 4; ++i) centre[i] = packed[15] != 0.0f ? exact[k * kParamStride + i] : packed[i];
@@ -509,7 +506,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
     // on its own), then resolved in component order.
     std::vector<char> usable(m);
     const detail::EmLoad load = [&](Working& cur, const Working* fallback) {
-      detail::parallel_for(m, threads, kComponentsPerClaim, [&](std::size_t k, int) {
+      detail::parallel_for(m, threads, detail::kComponentsPerClaim, [&](std::size_t k, int) {
         float one[kParamStride];
         double one_exact[kParamStride];
         bool ok = pack_component(cur, k, one, one_exact);

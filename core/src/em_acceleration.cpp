@@ -29,9 +29,6 @@ constexpr double kLowestLogWeight = -700.0;
 
 using Mat4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 
-// Components per claim of the step length's parallel loop.
-constexpr std::size_t kComponentsPerClaim = 64;
-
 // |t_k - s_k|^2 in the Fisher metric of t0's component k (whose covariance
 // factor is `l`), for the differences (d_mean, d_cov, d_logw) given by `diff`.
 template <typename Diff>

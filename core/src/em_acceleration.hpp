@@ -62,6 +62,6 @@ void renormalise_log_weights(std::vector<double>& log_weight);
 /// or offset; 0 when it cannot be measured (t0 not a model, a weight below
 /// e^-700, v = 0). The components' terms are computed on `threads` threads
 /// and summed in component order: the same length for any thread count.
-double squarem_step_length(const Working& t0, const Working& t1, const Working& t2, int threads = 1);
+double squarem_step_length(const Working& t0, const Working& t1, const Working& t2, int threads);
 
 }  // namespace sogmm::detail

@@ -6,6 +6,11 @@
 
 namespace sogmm::detail {
 
+// Components per claim of the EM's per-component parallel loops (M-step,
+// Cholesky packing, SQUAREM's step length and load check): a component's
+// work takes about a microsecond, so a claim is worth a thread's hand-off.
+constexpr std::size_t kComponentsPerClaim = 64;
+
 // The fit's working model, in double and relative to the frame's origin:
 // float32 means would round every update to the float grid at the data's
 // offset (1 mm at 10 km), and float32 covariances cannot hold a thin

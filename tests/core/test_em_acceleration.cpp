@@ -228,9 +228,9 @@ TEST(EmAcceleration, StepLengthIsAffineInvariant) {
       const Eigen::Matrix4d mapped = a * c * a.transpose();
       c = mapped;
     }
-  const double s = sogmm::detail::squarem_step_length(t[0], t[1], t[2]);
+  const double s = sogmm::detail::squarem_step_length(t[0], t[1], t[2], 1);
   ASSERT_GT(s, 0.0);
-  EXPECT_NEAR(sogmm::detail::squarem_step_length(u[0], u[1], u[2]), s, 1e-9 * s);
+  EXPECT_NEAR(sogmm::detail::squarem_step_length(u[0], u[1], u[2], 1), s, 1e-9 * s);
   // a = 1: t0 + 2 r + v = t2; the log-weights come back renormalised.
   const sogmm::detail::Working same = sogmm::detail::squarem_extrapolate(t[0], t[1], t[2], 1.0);
   double total = 0.0;

@@ -300,6 +300,35 @@ TEST(EmProperties, TruncatedBitIdenticalForOneTwoThreeThreads) {
   }
 }
 
+// The M-step, the Cholesky packing and SQUAREM's step length and load check
+// run on the team in claims of kComponentsPerClaim (64) components: with 150
+// components a claim boundary falls inside the model for 2 and 3 threads, and
+// the bits must still not depend on the team (each component's work is its
+// own; sums are formed in component order).
+TEST(EmProperties, ComponentClaimsBitIdenticalForOneTwoThreeThreads) {
+  const std::vector<float> pts = frame_points();
+  const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(pts), 150, 4);
+  for (sogmm::EmAcceleration acc : {sogmm::EmAcceleration::None, sogmm::EmAcceleration::Squarem}) {
+    sogmm::EmOptions o;
+    o.max_iter = 8;
+    o.tol = 0.0;
+    o.reg_covar = 1e-6;
+    o.acceleration = acc;
+    std::vector<sogmm::Gmm> g;
+    std::vector<sogmm::EmReport> rep(3);
+    for (int threads : {1, 2, 3}) {
+      o.threads = threads;
+      g.push_back(sogmm::fit_em(view(pts), seeds, o, &rep[static_cast<std::size_t>(threads - 1)]));
+    }
+    ASSERT_EQ(g[0].size(), 150u);
+    for (int i : {1, 2}) {
+      EXPECT_TRUE(sogmm_test::bit_identical(g[0], g[i])) << "1 vs " << i + 1 << " threads, acceleration " << int(acc);
+      EXPECT_EQ(rep[0].log_likelihood, rep[i].log_likelihood);
+      EXPECT_EQ(rep[0].iterations, rep[i].iterations);
+    }
+  }
+}
+
 // More than one wave of chunks (N > 16 x 32 x 256 points): a cloud repeated
 // 40 times has the same EM iterates as the cloud itself (responsibilities
 // equal, sums x40), and threads still do not change a bit.
