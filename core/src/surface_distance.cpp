@@ -95,9 +95,11 @@ void surface_distance(const Gmm& gmm, const float* xyz, std::size_t n, double* d
     // each is in a leaf within `bound` of the block's box: the others search
     // those leaves only.
     // With a gradient the leaves reach kFaceTolerance farther, for the faces
-    // behind a rim (write()).
+    // behind a rim (write()), the first point's included; without one the
+    // first point is done and its distance would only widen the search
+    // (about 8% of a distance call on the 2697-component loop map).
     const detail::DiscTree::Nearest head = tree.nearest(point(first), s.hint, s.stack);
-    double lo[3], hi[3], bound = head.distance;
+    double lo[3], hi[3], bound = gradient != nullptr ? head.distance : 0.0;
     for (int k = 0; k < 3; ++k) lo[k] = hi[k] = point(first)(k);
     for (std::size_t j = first + 1; j < last; ++j) {
       const Eigen::Vector3d x = point(j);
