@@ -170,9 +170,10 @@ DiscTree::Nearest DiscTree::nearest_among(const Eigen::Vector3d& x, std::uint32_
 bool DiscTree::nearest_face_among(const Eigen::Vector3d& x, double limit, const std::vector<std::uint32_t>& leaves,
                                   Nearest& face) const {
   bool found = false;
+  const double slack = slack_ + 1e-9 * x.cwiseAbs().maxCoeff();  // as nearest_among's
   for (const std::uint32_t leaf : leaves) {
     const Node& nd = nodes_[leaf];
-    const double reach = (found ? face.distance : limit) + slack_;  // the box is never the one that decides
+    const double reach = (found ? face.distance : limit) + slack;  // the box is never the one that decides
     if (box_distance2(nd.lo, nd.hi, x) > reach * reach) continue;
     for (std::uint32_t k = nd.first; k < nd.first + nd.count; ++k) {
       const Disc& d = discs_[k];

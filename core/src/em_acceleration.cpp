@@ -30,13 +30,8 @@ constexpr double kLowestLogWeight = -700.0;
 using Mat4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
 
 // |t_k - s_k|^2 in the Fisher metric of t0's component k (whose covariance
-// factor is `l`), for the differences (d_mean, d_cov, d_logw) given by `diff`.
-template <typename Diff>
-double fisher_term2(const Eigen::Matrix4d& l, std::size_t k, Diff diff) {
-  Eigen::Vector4d dm;
-  Mat4 dc;
-  double dl = 0.0;
-  diff(k, dm, dc, dl);
+// factor is `l`), for that component's differences (dm, dc, dl).
+double fisher_term2(const Eigen::Matrix4d& l, const Eigen::Vector4d& dm, const Mat4& dc, double dl) {
   const Eigen::Vector4d y = l.triangularView<Eigen::Lower>().solve(dm);
   // L^-1 dS L^-T: its squared Frobenius norm is tr((S^-1 dS)^2).
   const Eigen::Matrix4d half = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix4d(dc));
@@ -66,18 +61,11 @@ double squarem_step_length(const Working& t0, const Working& t1, const Working& 
     factored[k] = llt.info() == Eigen::Success ? 1 : 0;
     if (!factored[k]) return;
     const Eigen::Matrix4d l = llt.matrixL();
-    r2_term[k] = fisher_term2(l, k, [&](std::size_t c, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
-      dm = Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * c]) - Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * c]);
-      dc = Eigen::Map<const Mat4>(&t1.covariance[16 * c]) - Eigen::Map<const Mat4>(&t0.covariance[16 * c]);
-      dl = t1.log_weight[c] - t0.log_weight[c];
-    });
-    v2_term[k] = fisher_term2(l, k, [&](std::size_t c, Eigen::Vector4d& dm, Mat4& dc, double& dl) {
-      dm = Eigen::Map<const Eigen::Vector4d>(&t2.mean[4 * c]) - 2.0 * Eigen::Map<const Eigen::Vector4d>(&t1.mean[4 * c]) +
-           Eigen::Map<const Eigen::Vector4d>(&t0.mean[4 * c]);
-      dc = Eigen::Map<const Mat4>(&t2.covariance[16 * c]) - 2.0 * Eigen::Map<const Mat4>(&t1.covariance[16 * c]) +
-           Eigen::Map<const Mat4>(&t0.covariance[16 * c]);
-      dl = t2.log_weight[c] - 2.0 * t1.log_weight[c] + t0.log_weight[c];
-    });
+    const Eigen::Map<const Eigen::Vector4d> m0(&t0.mean[4 * k]), m1(&t1.mean[4 * k]), m2(&t2.mean[4 * k]);
+    const Eigen::Map<const Mat4> c0(&t0.covariance[16 * k]), c1(&t1.covariance[16 * k]), c2(&t2.covariance[16 * k]);
+    r2_term[k] = fisher_term2(l, m1 - m0, c1 - c0, t1.log_weight[k] - t0.log_weight[k]);
+    v2_term[k] = fisher_term2(l, m2 - 2.0 * m1 + m0, c2 - 2.0 * c1 + c0,
+                              t2.log_weight[k] - 2.0 * t1.log_weight[k] + t0.log_weight[k]);
   });
   for (std::size_t k = 0; k < m; ++k)
     if (!factored[k]) return 0.0;

@@ -68,14 +68,12 @@ void check_inputs(const std::vector<double>& points2d, double bandwidth) {
 
 // Centres of the occupied cells of the bin-seeding grid.
 std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, BinAnchor anchor) {
-  double min_x = 0.0, min_y = 0.0;
-  if (anchor == BinAnchor::DataMin) {
-    min_x = min_y = INFINITY;
-    for (std::size_t i = 0; i < xy.size(); i += 2) {
-      min_x = std::min(min_x, xy[i]);
-      min_y = std::min(min_y, xy[i + 1]);
-    }
-  }
+  // The data's lowest coordinates: the DataMin anchor, and (below) the
+  // lowest cell of either anchor.
+  double low_x = INFINITY, low_y = INFINITY;
+  for (std::size_t i = 0; i < xy.size(); i += 2) low_x = std::min(low_x, xy[i]), low_y = std::min(low_y, xy[i + 1]);
+  const double min_x = anchor == BinAnchor::DataMin ? low_x : 0.0;
+  const double min_y = anchor == BinAnchor::DataMin ? low_y : 0.0;
   auto cell = [&](double v, double lo) {
     // Zero anchor: numpy's round (half to even) as scikit-learn's get_bin_seeds.
     // check_inputs bounds |v| / bandwidth by 1e15, so these never throw on checked input.
@@ -96,8 +94,6 @@ std::vector<double> bin_seeds(const std::vector<double>& xy, double bandwidth, B
   // index) pairs the mode count's peak memory at d = 1 was ~10 MiB higher
   // (34 against 24 MiB).
   const std::size_t n = xy.size() / 2;
-  double low_x = INFINITY, low_y = INFINITY;
-  for (std::size_t i = 0; i < n; ++i) low_x = std::min(low_x, xy[2 * i]), low_y = std::min(low_y, xy[2 * i + 1]);
   const std::int64_t lo_x = cell(low_x, min_x), lo_y = cell(low_y, min_y);
   std::vector<std::uint64_t> keys(n);
   for (std::size_t i = 0; i < n; ++i)
