@@ -33,8 +33,11 @@ constexpr double kLog2Pi = 1.8378770664093453;
 constexpr double kExpZero = -746.0;
 // Items per partial sum: fixed, so sums do not depend on threads. A model
 // source has few items, each costing a 3 x 3 factor per component pair:
-// smaller blocks let every thread work.
-constexpr std::size_t kBlock = 256;
+// smaller blocks let every thread work. A point source's coarsest level
+// scores 768 points of a 12k-point frame (at least kCoarsePoints = 512):
+// blocks of 128 split it 3 + 3 over 2 threads (256 gave 3 blocks, 2 + 1, so
+// one thread idled a third of that level).
+constexpr std::size_t kBlock = 128;
 constexpr std::size_t kModelBlock = 16;
 // The fewest points a coarse level scores. Every 16th of a 12k-point frame
 // (768) held the loop frames of the README's speed line (the same errors as
