@@ -33,8 +33,11 @@ constexpr double kLog2Pi = 1.8378770664093453;
 constexpr double kExpZero = -746.0;
 // Items per partial sum: fixed, so sums do not depend on threads. A model
 // source has few items, each costing a 3 x 3 factor per component pair:
-// smaller blocks let every thread work.
-constexpr std::size_t kBlock = 256;
+// smaller blocks let every thread work. A point source's coarsest level
+// scores 768 points of a 12k-point frame (at least kCoarsePoints = 512):
+// blocks of 128 split it 3 + 3 over 2 threads (256 gave 3 blocks, 2 + 1, so
+// one thread idled a third of that level).
+constexpr std::size_t kBlock = 128;
 constexpr std::size_t kModelBlock = 16;
 // The fewest points a coarse level scores. Every 16th of a 12k-point frame
 // (768) held the loop frames of the README's speed line (the same errors as
@@ -100,50 +103,62 @@ Eigen::Matrix3d record_precision(const double* r) {
 
 // `indexed`: also build the index (a point source looks up only the
 // coarsest level's, through detail::CandidateCache; finer levels need boxes).
-Level make_level(const Gmm& gmm, double s, double eps, bool use_gray, bool indexed) {
+// The components are prepared on the team (each its own; an index build is
+// one thread's): a serial part of every call that 2 threads cannot halve.
+Level make_level(const Gmm& gmm, double s, double eps, bool use_gray, bool indexed, int team) {
   Level level;
   Gmm smoothed = gmm;
-  level.comps.resize(gmm.size());
-  for (std::size_t m = 0; m < gmm.size(); ++m) {
-    const float* c = gmm.covariance(m);
-    Eigen::Matrix4d cov;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) cov(i, j) = 0.5 * (double(c[4 * i + j]) + double(c[4 * j + i]));
-    for (int i = 0; i < 3; ++i) {
-      cov(i, i) += s * s;
-      smoothed.covariances[16 * m + 5 * i] = static_cast<float>(cov(i, i));
+  const std::size_t count = gmm.size();
+  level.comps.resize(count);
+  level.boxes.resize(count);
+  level.records.assign(count * detail::kPairRecord, 0.0);
+  // 0: component m's spatial covariance is not positive definite (reported
+  // for the lowest such m after the loop, whatever the team).
+  std::vector<std::uint8_t> ok(count, 1);
+  constexpr std::size_t kChunk = 64;
+  detail::parallel_for((count + kChunk - 1) / kChunk, team, 1, [&](std::size_t chunk, int) {
+    for (std::size_t m = chunk * kChunk; m < std::min(count, (chunk + 1) * kChunk); ++m) {
+      const float* c = gmm.covariance(m);
+      Eigen::Matrix4d cov;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) cov(i, j) = 0.5 * (double(c[4 * i + j]) + double(c[4 * j + i]));
+      for (int i = 0; i < 3; ++i) {
+        cov(i, i) += s * s;
+        smoothed.covariances[16 * m + 5 * i] = static_cast<float>(cov(i, i));
+      }
+      Component& k = level.comps[m];
+      const float* mu = gmm.mean(m);
+      k.mu = Eigen::Vector3d(mu[0], mu[1], mu[2]);
+      k.cov = cov;
+      k.mu_gray = mu[3];
+      k.log_weight = std::log((1.0 - eps) * double(gmm.weights[m]));
+      Eigen::Matrix3d spatial = cov.topLeftCorner<3, 3>();
+      k.gain.setZero();
+      k.log_norm = std::log((1.0 - eps) * double(gmm.weights[m]));
+      if (use_gray) {
+        const double sgg = cov(3, 3);
+        k.gain = cov.block<3, 1>(0, 3) / sgg;
+        spatial -= k.gain * cov.block<1, 3>(3, 0);
+        k.mu_g = mu[3];
+        k.inv_sgg = 1.0 / sgg;
+        k.log_norm_g = -0.5 * (kLog2Pi + std::log(sgg));
+      }
+      const Eigen::LLT<Eigen::Matrix3d> llt(spatial);
+      if (!(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0)) {
+        ok[m] = 0;
+        continue;
+      }
+      k.prec = llt.solve(Eigen::Matrix3d::Identity());
+      k.log_norm -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
+      level.boxes[m] = component_box(smoothed, m, ComponentIndex::kDefaultSigmas);
+      fill_record(k, level.records.data() + m * detail::kPairRecord);
     }
-    Component& k = level.comps[m];
-    const float* mu = gmm.mean(m);
-    k.mu = Eigen::Vector3d(mu[0], mu[1], mu[2]);
-    k.cov = cov;
-    k.mu_gray = mu[3];
-    k.log_weight = std::log((1.0 - eps) * double(gmm.weights[m]));
-    Eigen::Matrix3d spatial = cov.topLeftCorner<3, 3>();
-    k.gain.setZero();
-    k.log_norm = std::log((1.0 - eps) * double(gmm.weights[m]));
-    if (use_gray) {
-      const double sgg = cov(3, 3);
-      k.gain = cov.block<3, 1>(0, 3) / sgg;
-      spatial -= k.gain * cov.block<1, 3>(3, 0);
-      k.mu_g = mu[3];
-      k.inv_sgg = 1.0 / sgg;
-      k.log_norm_g = -0.5 * (kLog2Pi + std::log(sgg));
-    }
-    const Eigen::LLT<Eigen::Matrix3d> llt(spatial);
-    require(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() > 0, ErrorCode::Numeric,
-            "registration: the spatial covariance of target component " + std::to_string(m) +
-                " is not positive definite");
-    k.prec = llt.solve(Eigen::Matrix3d::Identity());
-    k.log_norm -= 0.5 * (3 * kLog2Pi) + llt.matrixLLT().diagonal().array().log().sum();
-  }
-  level.boxes.resize(gmm.size());
-  for (std::size_t m = 0; m < gmm.size(); ++m)
-    level.boxes[m] = component_box(smoothed, m, ComponentIndex::kDefaultSigmas);
+  });
+  const auto bad = std::find(ok.begin(), ok.end(), std::uint8_t{0});
+  require(bad == ok.end(), ErrorCode::Numeric,
+          "registration: the spatial covariance of target component " +
+              std::to_string(bad - ok.begin()) + " is not positive definite");
   if (indexed) level.index.build(smoothed);
-  level.records.assign(gmm.size() * detail::kPairRecord, 0.0);
-  for (std::size_t m = 0; m < gmm.size(); ++m)
-    fill_record(level.comps[m], level.records.data() + m * detail::kPairRecord);
   return level;
 }
 
@@ -551,7 +566,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
     std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(2 * (levels - 1 - l), 4);
     const auto fewest = std::max<std::size_t>(kCoarsePoints, static_cast<std::size_t>(options.min_points));
     while (stride > 1 && n / stride < fewest) stride /= 2;
-    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray, l == 0 || model_source);
+    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray, l == 0 || model_source, team);
     const Level& level = l == 0 ? coarsest : finer;
     if (l == 0) cands.emplace(coarsest.index, model_source ? 0 : n, kCandidateMargin);
     converged = false;
