@@ -122,11 +122,14 @@ void occupancy(const Map& map, const float* xyz, std::size_t n, double* probabil
   std::vector<std::size_t> wanted;
   for (std::size_t f = 0; f < poses.size(); ++f)
     if (seen[f]) wanted.push_back(f);
+  // Each frame's depth tiles are built in the same loop (one parallel
+  // region fewer to wait at the end of).
   std::vector<std::shared_ptr<const std::vector<float>>> depth(poses.size());
-  detail::parallel_for(wanted.size(), team, 1, [&](std::size_t k, int) { depth[wanted[k]] = map.frame_depth(wanted[k], 1); });
   std::vector<detail::DepthTiles> tiles(poses.size());
-  detail::parallel_for(poses.size(), team, 1, [&](std::size_t f, int) {
-    if (depth[f]) tiles[f] = detail::DepthTiles(*depth[f], camera.width, camera.height);
+  detail::parallel_for(wanted.size(), team, 1, [&](std::size_t k, int) {
+    const std::size_t f = wanted[k];
+    depth[f] = map.frame_depth(f, 1);
+    tiles[f] = detail::DepthTiles(*depth[f], camera.width, camera.height);
   });
 
   // Per block, a frame that gives every point of the block whole evidence
