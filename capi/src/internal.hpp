@@ -20,6 +20,8 @@
 #include "sogmm/progress.hpp"
 #include "sogmm/sogmm.h"
 
+#include "registration_cache.hpp"
+
 // ---- handles -----------------------------------------------------------
 
 // Every setting is a field of the core's Settings, whose option registry
@@ -47,6 +49,7 @@ struct sogmm_fit_timings {
 struct sogmm_model {
   sogmm::Model model;
   sogmm_fit_timings timings;
+  sogmm_capi::RegistrationCache registration;  // the target prepared by the last registration to this model
 };
 
 struct sogmm_buffer {

@@ -66,7 +66,9 @@ SOGMM_API sogmm_status sogmm_register_points_f32(const sogmm_model* target, cons
     sogmm_capi::require_nonnull(points, "points");
     sogmm_capi::run_registration(target, init, options, pose_out, info_out,
                                  [&](const std::array<double, 16>& start, const sogmm_options& o) {
-                                   return sogmm::register_points(target->model.gmm, points, n, start,
+                                   const auto prepared = target->registration.get(
+                                       target->model.gmm, o.settings.registration, o.settings.query.threads);
+                                   return sogmm::register_points(*prepared, points, n, start,
                                                                  o.settings.registration, o.settings.query.threads,
                                                                  sogmm_capi::progress_sink(o));
                                  });
@@ -82,7 +84,9 @@ SOGMM_API sogmm_status sogmm_register_model(const sogmm_model* target, const sog
     sogmm_capi::require_nonnull(source, "source");
     sogmm_capi::run_registration(target, init, options, pose_out, info_out,
                                  [&](const std::array<double, 16>& start, const sogmm_options& o) {
-                                   return sogmm::register_model(target->model.gmm, source->model.gmm, start,
+                                   const auto prepared = target->registration.get(
+                                       target->model.gmm, o.settings.registration, o.settings.query.threads);
+                                   return sogmm::register_model(*prepared, source->model.gmm, start,
                                                                 o.settings.registration, o.settings.query.threads,
                                                                 sogmm_capi::progress_sink(o));
                                  });

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -160,6 +159,58 @@ Level make_level(const Gmm& gmm, double s, double eps, bool use_gray, bool index
               std::to_string(bad - ok.begin()) + " is not positive definite");
   if (indexed) level.index.build(smoothed);
   return level;
+}
+
+// Level l's smoothing: coarse_sigma halved per level, 0 on the last.
+double level_sigma(const RegistrationOptions& o, std::int32_t l) {
+  return l + 1 == o.levels ? 0.0 : o.coarse_sigma * std::ldexp(1.0, -l);
+}
+
+}  // namespace
+
+// A target's levels and outlier density for one set of level options.
+struct RegistrationTarget::Prepared {
+  std::vector<Level> levels;
+  double log_outlier = 0.0;  // log(eps / V), V the target's 3-sigma box
+  // What the levels depend on (RegistrationTarget::prepared_for).
+  std::int32_t level_count = 0;
+  double coarse_sigma = 0.0, outlier_ratio = 0.0;
+  bool use_gray = false;
+};
+
+namespace {
+
+// Validates `o` and `target` (the first errors a call reports) and builds
+// the target's levels for `o`. `index_all`: every level
+// gets an index (model sources look each level's up); otherwise only the
+// coarsest (a point source's candidate cache is built on it; finer levels
+// filter by their boxes).
+std::unique_ptr<RegistrationTarget::Prepared> prepare(const Gmm& target, const RegistrationOptions& o, int team,
+                                                      bool index_all) {
+  validate(o);
+  validate(target);
+  auto p = std::make_unique<RegistrationTarget::Prepared>();
+  p->level_count = o.levels;
+  p->coarse_sigma = o.coarse_sigma;
+  p->outlier_ratio = o.outlier_ratio;
+  p->use_gray = o.use_gray;
+  const double eps = o.outlier_ratio;
+  // The outlier density: uniform over the target's 3-sigma box.
+  Box3 span = component_box(target, 0, 3.0);
+  for (std::size_t m = 1; m < target.size(); ++m) {
+    const Box3 b = component_box(target, m, 3.0);
+    for (int k = 0; k < 3; ++k) {
+      span.lo[k] = std::min(span.lo[k], b.lo[k]);
+      span.hi[k] = std::max(span.hi[k], b.hi[k]);
+    }
+  }
+  double volume = 1.0;
+  for (int k = 0; k < 3; ++k) volume *= std::max(span.hi[k] - span.lo[k], 1e-3);
+  p->log_outlier = eps > 0 ? std::log(eps / volume) : -std::numeric_limits<double>::infinity();
+  p->levels.reserve(static_cast<std::size_t>(o.levels));
+  for (std::int32_t l = 0; l < o.levels; ++l)
+    p->levels.push_back(make_level(target, level_sigma(o, l), eps, o.use_gray, l == 0 || index_all, team));
+  return p;
 }
 
 // The sums one pass over the points gives at a pose.
@@ -402,27 +453,15 @@ struct Source {
   double weight(std::size_t i) const { return weights.empty() ? 1.0 : weights[i]; }
 };
 
-RegistrationResult register_source(const Gmm& target, const Source& src, const std::array<double, 16>& init,
-                                   const RegistrationOptions& options, int threads, const ProgressSink& progress) {
+RegistrationResult register_source(const RegistrationTarget::Prepared& target, const Source& src,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options,
+                                   int threads, const ProgressSink& progress) {
   const float* points = src.rows;
   const std::size_t n = src.n;
   const bool model_source = src.covariances != nullptr;
   const ProgressScope scope(progress);
   const int team = detail::team_size(threads);
-  const double eps = options.outlier_ratio;
-
-  // The outlier density: uniform over the target's 3-sigma box.
-  Box3 span = component_box(target, 0, 3.0);
-  for (std::size_t m = 1; m < target.size(); ++m) {
-    const Box3 b = component_box(target, m, 3.0);
-    for (int k = 0; k < 3; ++k) {
-      span.lo[k] = std::min(span.lo[k], b.lo[k]);
-      span.hi[k] = std::max(span.hi[k], b.hi[k]);
-    }
-  }
-  double volume = 1.0;
-  for (int k = 0; k < 3; ++k) volume *= std::max(span.hi[k] - span.lo[k], 1e-3);
-  const double log_outlier = eps > 0 ? std::log(eps / volume) : -std::numeric_limits<double>::infinity();
+  const double log_outlier = target.log_outlier;
 
   // The source's centroid and RMS radius (pose invariant: the step's scale);
   // a model source's are those of the points it stands for.
@@ -555,23 +594,19 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   const std::int32_t levels = options.levels;
   detail::progress_begin(Stage::Registration, std::uint64_t(levels) * std::uint64_t(options.max_iter));
   bool converged = false;
-  // The coarsest level is kept: the candidate cache is built on its index.
-  Level coarsest, finer;
-  std::optional<detail::CandidateCache> cands;
+  // The candidate cache is built on the coarsest level's index.
+  detail::CandidateCache cands(target.levels.front().index, model_source ? 0 : n, kCandidateMargin);
   for (std::int32_t l = 0; l < levels; ++l) {
-    const double s = l + 1 == levels ? 0.0 : options.coarse_sigma * std::ldexp(1.0, -l);
     // Level l of L uses every 4^(L-1-l)-th point (at most 16x fewer), keeping
     // at least kCoarsePoints and min_points: the coarse levels only bring the
     // pose within the finest level's reach, which scores every point.
     std::size_t stride = model_source ? 1 : std::size_t{1} << std::min(2 * (levels - 1 - l), 4);
     const auto fewest = std::max<std::size_t>(kCoarsePoints, static_cast<std::size_t>(options.min_points));
     while (stride > 1 && n / stride < fewest) stride /= 2;
-    (l == 0 ? coarsest : finer) = make_level(target, s, eps, options.use_gray, l == 0 || model_source, team);
-    const Level& level = l == 0 ? coarsest : finer;
-    if (l == 0) cands.emplace(coarsest.index, model_source ? 0 : n, kCandidateMargin);
+    const Level& level = target.levels[static_cast<std::size_t>(l)];
     converged = false;
     for (std::int32_t it = 0; it < options.max_iter && !converged; ++it) {
-      const Sums sums = evaluate(level, *cands, pose, false, stride);
+      const Sums sums = evaluate(level, cands, pose, false, stride);
       ++result.iterations;
       detail::progress_event(std::uint64_t(result.iterations), sums.log_likelihood / (model_source ? total_weight : double((n + stride - 1) / stride)));
       const double scale = sums.hessian.diagonal().maxCoeff();
@@ -590,7 +625,7 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   }
 
   // The figures at the final pose, on the unsmoothed model.
-  const Sums fin = evaluate(levels == 1 ? coarsest : finer, *cands, pose, true, 1);
+  const Sums fin = evaluate(target.levels.back(), cands, pose, true, 1);
   const Mat6 info_c = fin.hessian - fin.spread;  // about the centroid c
   const Eigen::Vector3d c = pose.r * centroid + pose.t;
   // xi_origin = A xi_c with A = [I 0; [c]x I]: information_origin = A^-T info_c A^-1.
@@ -628,13 +663,9 @@ RegistrationResult register_source(const Gmm& target, const Source& src, const s
   return result;
 }
 
-}  // namespace
-
-RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
-                                   const std::array<double, 16>& init, const RegistrationOptions& options,
-                                   int threads, const ProgressSink& progress) {
-  validate(options);
-  validate(target);
+// The checks of a point source, before any preparation.
+Source point_source(const float* points, std::size_t n, const std::array<double, 16>& init,
+                    const RegistrationOptions& options) {
   const std::string pose_error = rigid_pose_error(init);
   require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
   require(n >= static_cast<std::uint64_t>(options.min_points), ErrorCode::InvalidData,
@@ -645,19 +676,17 @@ RegistrationResult register_points(const Gmm& target, const float* points, std::
   Source src;
   src.rows = points;
   src.n = n;
-  return register_source(target, src, init, options, threads, progress);
+  return src;
 }
 
-RegistrationResult register_model(const Gmm& target, const Gmm& source, const std::array<double, 16>& init,
-                                  const RegistrationOptions& options, int threads, const ProgressSink& progress) {
-  validate(options);
-  validate(target);
+// The checks of a model source, before any preparation: each component
+// stands for its share of the points the model was fitted on (a model
+// without a support size: one point per component).
+Source model_source(const Gmm& source, const std::array<double, 16>& init, const RegistrationOptions& options) {
   require(source.size() > 0, ErrorCode::InvalidData, "registration: the source model has no component");
   validate(source);
   const std::string pose_error = rigid_pose_error(init);
   require(pose_error.empty(), ErrorCode::InvalidArgument, "registration: the initial pose " + pose_error);
-  // Each component stands for its share of the points the model was fitted
-  // on (a model without a support size: one point per component).
   const double support = source.support_size > 0 ? double(source.support_size) : double(source.size());
   require(support >= double(options.min_points), ErrorCode::InvalidData,
           "registration: the source model stands for " + std::to_string(static_cast<std::uint64_t>(support)) +
@@ -668,7 +697,57 @@ RegistrationResult register_model(const Gmm& target, const Gmm& source, const st
   src.covariances = source.covariances.data();
   src.weights.resize(source.size());
   for (std::size_t j = 0; j < source.size(); ++j) src.weights[j] = double(source.weights[j]) * support;
-  return register_source(target, src, init, options, threads, progress);
+  return src;
+}
+
+// `options` against the options `target` was prepared for.
+void require_prepared_for(const RegistrationTarget& target, const RegistrationOptions& options) {
+  validate(options);
+  require(target.prepared_for(options), ErrorCode::InvalidArgument,
+          "registration: the prepared target was made for other levels, coarse_sigma, outlier_ratio or use_gray");
+}
+
+}  // namespace
+
+RegistrationTarget::RegistrationTarget(const Gmm& target, const RegistrationOptions& options, int threads)
+    : prepared_(prepare(target, options, detail::team_size(threads), true)) {}
+RegistrationTarget::~RegistrationTarget() = default;
+RegistrationTarget::RegistrationTarget(RegistrationTarget&&) noexcept = default;
+RegistrationTarget& RegistrationTarget::operator=(RegistrationTarget&&) noexcept = default;
+
+bool RegistrationTarget::prepared_for(const RegistrationOptions& o) const {
+  const Prepared& p = *prepared_;
+  return p.level_count == o.levels && p.coarse_sigma == o.coarse_sigma && p.outlier_ratio == o.outlier_ratio &&
+         p.use_gray == o.use_gray;
+}
+
+RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options,
+                                   int threads, const ProgressSink& progress) {
+  const auto prepared = prepare(target, options, detail::team_size(threads), false);
+  return register_source(*prepared, point_source(points, n, init, options), init, options, threads, progress);
+}
+
+RegistrationResult register_points(const RegistrationTarget& target, const float* points, std::size_t n,
+                                   const std::array<double, 16>& init, const RegistrationOptions& options,
+                                   int threads, const ProgressSink& progress) {
+  require_prepared_for(target, options);
+  return register_source(target.prepared(), point_source(points, n, init, options), init, options, threads,
+                         progress);
+}
+
+RegistrationResult register_model(const Gmm& target, const Gmm& source, const std::array<double, 16>& init,
+                                  const RegistrationOptions& options, int threads, const ProgressSink& progress) {
+  const auto prepared = prepare(target, options, detail::team_size(threads), true);
+  return register_source(*prepared, model_source(source, init, options), init, options, threads, progress);
+}
+
+RegistrationResult register_model(const RegistrationTarget& target, const Gmm& source,
+                                  const std::array<double, 16>& init, const RegistrationOptions& options,
+                                  int threads, const ProgressSink& progress) {
+  require_prepared_for(target, options);
+  return register_source(target.prepared(), model_source(source, init, options), init, options, threads,
+                         progress);
 }
 
 }  // namespace sogmm
