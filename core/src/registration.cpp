@@ -24,7 +24,6 @@ namespace {
 
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 constexpr double kLog2Pi = 1.8378770664093453;
 // exp(x) rounds to +0 for x <= kExpZero (its smallest subnormal is
@@ -352,17 +351,11 @@ void score_item(Scratch& s, std::size_t from, std::size_t to, double top, Precis
   // first, then one J^T W J. (A model source's covariance is held at the
   // current pose within a step: the Gauss-Newton step moves its mean.)
   const Eigen::Vector3d a = x - c;
-  // The spread's terms are set (and summed) only when asked for: most
-  // evaluations do not use them.
-  Mat36 jac;
-  Vec6 gbar;
-  Mat6 ggt;
-  if (spread) {
-    jac.leftCols<3>() = -skew(a);
-    jac.rightCols<3>().setIdentity();
-    gbar.setZero();
-    ggt.setZero();
-  }
+  // Louis' spread, sum_k w G G^T - Gbar Gbar^T with G = J^T P r, is
+  // J^T (sum_k w (P r)(P r)^T - (W r)(W r)^T) J: a 3 x 3 sum per pair and
+  // one product with J per point. It is summed only when asked for: most
+  // evaluations do not use it.
+  Eigen::Matrix3d wprr = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d wp = Eigen::Matrix3d::Zero();
   Eigen::Vector3d wpr = Eigen::Vector3d::Zero();
   for (std::size_t j = from; j < to; ++j) {
@@ -373,23 +366,22 @@ void score_item(Scratch& s, std::size_t from, std::size_t to, double top, Precis
     wp += w * precision_of(j);
     wpr += w * pr;
     if (inlier) out.mahalanobis += weight * w * s.quad[j];
-    if (spread) {
-      const Vec6 g = jac.transpose() * pr;
-      gbar += w * g;
-      ggt.noalias() += w * g * g.transpose();
-    }
+    if (spread) wprr.noalias() += (w * pr) * pr.transpose();
   }
-  // With S = [a]x (S v = a x v, S^T = -S) and M = S W:
-  // J^T W J = [-M S, M; M^T, W] and J^T v = [a x v; v].
+  // With S = [a]x (S v = a x v, S^T = -S), J = [-S, I] and a symmetric C:
+  // J^T C J = [-S C S, S C; (S C)^T, C] and J^T v = [a x v; v].
   const Eigen::Matrix3d sa = skew(a);
-  const Eigen::Matrix3d m = sa * wp;
-  out.hessian.topLeftCorner<3, 3>().noalias() -= weight * (m * sa);
-  out.hessian.topRightCorner<3, 3>().noalias() += weight * m;
-  out.hessian.bottomLeftCorner<3, 3>().noalias() += weight * m.transpose();
-  out.hessian.bottomRightCorner<3, 3>().noalias() += weight * wp;
+  const auto add_jtcj = [&](Mat6& to, const Eigen::Matrix3d& cm) {
+    const Eigen::Matrix3d m = sa * cm;
+    to.topLeftCorner<3, 3>().noalias() -= weight * (m * sa);
+    to.topRightCorner<3, 3>().noalias() += weight * m;
+    to.bottomLeftCorner<3, 3>().noalias() += weight * m.transpose();
+    to.bottomRightCorner<3, 3>().noalias() += weight * cm;
+  };
+  add_jtcj(out.hessian, wp);
   out.gradient.head<3>() += weight * a.cross(wpr);
   out.gradient.tail<3>() += weight * wpr;
-  if (spread) out.spread += weight * (ggt - gbar * gbar.transpose());
+  if (spread) add_jtcj(out.spread, wprr - wpr * wpr.transpose());
 }
 
 // The pose as R, t.
