@@ -276,11 +276,16 @@ MeanShiftResult mean_shift_gaussian_blurring(const std::vector<double>& xy0, dou
 
 std::vector<double> range_gray_features(const PointsView& points) {
   std::vector<double> f(2 * points.size);
-  for (std::size_t i = 0; i < points.size; ++i) {
-    const float* p = points[i];
-    f[2 * i] = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
-    f[2 * i + 1] = p[3];
-  }
+  // In spans on the team (each feature written by one span): serial, this
+  // was ~2% of a d = 1 mode count's time with the other thread idle.
+  constexpr std::size_t kSpan = 16384;
+  detail::parallel_for((points.size + kSpan - 1) / kSpan, detail::team_size(0), 1, [&](std::size_t s, int) {
+    for (std::size_t i = s * kSpan; i < std::min(points.size, (s + 1) * kSpan); ++i) {
+      const float* p = points[i];
+      f[2 * i] = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+      f[2 * i + 1] = p[3];
+    }
+  });
   return f;
 }
 

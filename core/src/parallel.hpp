@@ -172,9 +172,11 @@ class TeamTimer {
 template <class Body>
 void parallel_for(std::size_t n, int threads, std::size_t chunk, const Body& body) {
   const LoopTimer timer;
-  // One thread: a plain loop (same order as a one-thread team), without the
-  // cost of opening a parallel region, e.g. once per k-means++ step.
-  if (threads <= 1) {
+  // One thread, or one claim's worth of work (which one member would take
+  // whole): a plain loop (same order as a one-thread team), without the
+  // cost of opening a parallel region, e.g. once per k-means++ step, or a
+  // small fit's set-up loops.
+  if (threads <= 1 || n <= std::max<std::size_t>(chunk, 1)) {
     for (std::size_t i = 0; i < n; ++i) {
       if (i % std::max<std::size_t>(chunk, 1) == 0) progress_poll();
       body(i, 0);

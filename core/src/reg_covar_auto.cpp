@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "parallel.hpp"
 #include "sogmm/checked.hpp"
 #include "sogmm/error.hpp"
 #include "sogmm/model.hpp"
@@ -44,16 +45,11 @@ double lower_median(std::vector<double>& v) {
 }
 
 // The median distance of the points (x, y, z) from their coordinate-wise
-// median; when that is 0, the largest side of their bounding box.
-double spatial_size(const PointsView& pts) {
-  std::vector<double> v(pts.size);
-  double centre[3], extent = 0.0;
-  for (int j = 0; j < 3; ++j) {
-    for (std::size_t i = 0; i < pts.size; ++i) v[i] = pts[i][j];
-    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-    extent = std::max(extent, *hi - *lo);
-    centre[j] = lower_median(v);
-  }
+// median; when that is 0, the largest side of their bounding box. `centre`
+// and `side` are the coordinates' medians and ranges (coordinate_median);
+// `v` is scratch of n doubles.
+double spatial_size(const PointsView& pts, std::vector<double>& v, const double* centre, const double* side) {
+  const double extent = std::max({side[0], side[1], side[2]});
   for (std::size_t i = 0; i < pts.size; ++i) {
     double d2 = 0.0;
     for (int j = 0; j < 3; ++j) {
@@ -66,6 +62,17 @@ double spatial_size(const PointsView& pts) {
   return median > 0.0 ? median : extent;
 }
 
+// Coordinate j of every point into v (n values), and their lower median and
+// range (max - min).
+void coordinate_median(const PointsView& pts, int j, double* v, double& median, double& side) {
+  for (std::size_t i = 0; i < pts.size; ++i) v[i] = pts[i][j];
+  const auto [lo, hi] = std::minmax_element(v, v + pts.size);
+  side = *hi - *lo;
+  const auto mid = v + (pts.size - 1) / 2;
+  std::nth_element(v, mid, v + pts.size);
+  median = *mid;
+}
+
 // The gray range that sets the gray floor: the spread between the gray
 // quantiles kGrayTail and 1 - kGrayTail, so that a few out-of-range pixels
 // (one pixel of 1000 in a GRAY_F32 frame in [0, 1]) do not set the floor of
@@ -76,8 +83,7 @@ double spatial_size(const PointsView& pts) {
 // same floor as before whenever its 1-99% spread is above 0.1, as in every
 // room frame.
 constexpr double kGrayTail = 0.01;
-double gray_range(const PointsView& pts) {
-  std::vector<float> g(pts.size);
+double gray_range(const PointsView& pts, std::vector<float>& g) {
   for (std::size_t i = 0; i < pts.size; ++i) g[i] = pts[i][3];
   const auto [lo, hi] = std::minmax_element(g.begin(), g.end());
   const double full = static_cast<double>(*hi) - *lo;
@@ -96,9 +102,26 @@ RegCovarFloors auto_reg_covar(const PointsView& points) {
   require(points.size > 0, ErrorCode::InvalidData, "automatic reg_covar: the point cloud is empty");
   RegCovarFloors f;
   f.automatic = true;
-  const double spatial = spatial_size(points);
+  // The three coordinates' medians and the gray range are order statistics
+  // of separate arrays (values, whatever the order of the work): four tasks
+  // on the team, each array allocated here on the calling thread (see
+  // mean_shift.cpp on a worker's memory). Serial, this was ~7 ms of a d = 1
+  // fit with the other thread idle.
+  std::vector<double> coordinates(3 * points.size);
+  std::vector<float> grays(points.size);
+  double centre[3], side[3], gray = 0.0;
+  // Below kTeamPoints points a team's start costs more than the tasks.
+  constexpr std::size_t kTeamPoints = 16384;
+  detail::parallel_for(4, points.size >= kTeamPoints ? detail::team_size(0) : 1, 1, [&](std::size_t task, int) {
+    const int j = static_cast<int>(task);
+    if (j < 3)
+      coordinate_median(points, j, &coordinates[j * points.size], centre[j], side[j]);
+    else
+      gray = gray_range(points, grays);
+  });
+  coordinates.resize(points.size);
+  const double spatial = spatial_size(points, coordinates, centre, side);
   f.spatial = floor_for_decade(spatial > 0.0 ? nearest_decade(spatial) : 0);
-  const double gray = gray_range(points);
   // A range within float32 rounding above a power of ten counts as that power
   // (gray in [0, 1] computed in float may end at 1.0000001).
   f.gray = floor_for_decade(gray > 0.0 ? covering_decade(gray * (1.0 - 1e-6)) : 0);

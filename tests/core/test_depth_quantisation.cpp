@@ -106,6 +106,37 @@ TEST(DepthQuantisation, FloorsTheVarianceAlongTheRay) {
   EXPECT_NEAR(far[10], s, 1e-15);
 }
 
+TEST(DepthQuantisation, LevelsAreSortedWhateverThePointOrder) {
+  // The levels 0.25, 1.00, 1.01, 1.03 and 4.0 (8 points each, in a rotating
+  // order, so the input is neither sorted nor grouped; 0.25 and 4.0 differ
+  // from the others in the float's exponent): a mean at z = 1.02 lies in the
+  // bin 1.01 - 1.03 only if the distinct depths were sorted (detect sorts
+  // the float32 bit patterns, which for z > 0 order as the values), so the
+  // floor is FloorsTheVarianceAlongTheRay's hand-computed w^2 / 12 along the
+  // optical axis. Exact comparisons of one product of doubles: the same on
+  // every kernel (no EM kernel runs here).
+  const float levels[] = {1.03f, 4.0f, 1.00f, 0.25f, 1.01f};
+  std::vector<float> pts;
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 5; ++j) pts.insert(pts.end(), {0.f, 0.f, levels[(i + j) % 5], 0.5f});
+  const sogmm::DepthQuantisation q = sogmm::DepthQuantisation::detect(view(pts));
+  ASSERT_FALSE(q.empty());
+  double cov[16] = {};
+  const double mean[4] = {0.0, 0.0, 1.02, 0.3};
+  q.floor_covariance_at(mean, cov);
+  const double w = static_cast<double>(1.03f) - static_cast<double>(1.01f);
+  EXPECT_NEAR(cov[10], w * w / 12.0, 1e-15);
+  // Beyond the outermost levels: the spacing next to 4.0 (from 1.03), and
+  // below 0.25 the spacing from 0.25 to 1.00.
+  double far[16] = {}, near[16] = {};
+  const double beyond[4] = {0.0, 0.0, 5.0, 0.3}, before[4] = {0.0, 0.0, 0.2, 0.3};
+  q.floor_covariance_at(beyond, far);
+  q.floor_covariance_at(before, near);
+  const double w_far = 4.0 - static_cast<double>(1.03f), w_near = 1.0 - 0.25;
+  EXPECT_NEAR(far[10], w_far * w_far / 12.0, 1e-15);
+  EXPECT_NEAR(near[10], w_near * w_near / 12.0, 1e-15);
+}
+
 TEST(DepthQuantisation, EmWithTheFloorDoesNotCollapseOntoLevels) {
   const std::vector<float> stored = scene(7, false), seen = scene(8, true);
   const std::vector<std::size_t> seeds = sogmm::kmeanspp_seeds(view(stored), 300, 3);
