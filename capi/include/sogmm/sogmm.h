@@ -524,7 +524,7 @@ SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_
  * points' frame (e.g. the previous frame's model moved by the relative pose
  * with sogmm_model_transform). Self-organizing (SOGMM_OPT_N_COMPONENTS = 0):
  * components of `initial` whose responsibility mass on the well-explained
- * points is below 2 points are removed; points more than 10 nats below the
+ * points is below 0.5 points are removed; points more than 10 nats below the
  * median log-likelihood under `initial` are novel, and the mode count
  * (SOGMM_OPT_BANDWIDTH) and k-means++ (SOGMM_OPT_SEED) on the novel points
  * only add that many new components; EM then runs from kept + new, at most

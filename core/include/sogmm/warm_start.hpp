@@ -17,8 +17,13 @@ struct WarmStartOptions {
   /// cloud (sum of its responsibilities over the explained, i.e. not novel,
   /// points) is below
   /// this many points is removed: it models what the new cloud no longer sees,
-  /// and EM would only shrink it to a needle on a handful of points.
-  double min_mass = 2.0;
+  /// and EM would only shrink it to a needle on a handful of points. 0.5
+  /// rather than 2: with the default pass limit, keeping the components of
+  /// 0.5-2 points raised the warm fit's PSNR over seeds 0-19 on livingroom
+  /// 0->1 by 0.14 dB (warm >= cold on 15 instead of 12 seeds) and 1->2 by
+  /// 0.12 dB, its likelihood by 0.04 nats, at 5% more components (README,
+  /// "--warm-start").
+  double min_mass = 0.5;
   /// A point is poorly explained when its log-likelihood under the initial
   /// model is more than this many nats below the median point's. For a point
   /// near one component this is a squared Mahalanobis distance about
