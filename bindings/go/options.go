@@ -26,6 +26,7 @@ const (
 	OptDequantiseDepth             Key = C.SOGMM_OPT_DEQUANTISE_DEPTH
 	OptEmAcceleration              Key = C.SOGMM_OPT_EM_ACCELERATION
 	OptTolStandardErrors           Key = C.SOGMM_OPT_TOL_STANDARD_ERRORS
+	OptWarmMaxIter                 Key = C.SOGMM_OPT_WARM_MAX_ITER
 	OptDepthScale                  Key = C.SOGMM_OPT_DEPTH_SCALE
 	OptDepthMin                    Key = C.SOGMM_OPT_DEPTH_MIN
 	OptDepthMax                    Key = C.SOGMM_OPT_DEPTH_MAX

@@ -55,7 +55,7 @@ sogmm_model* fit_to_handle(const float* points, std::size_t n, const sogmm_optio
   view.data = points;
   view.size = n;
   view.from_depth_image = from_depth_image;
-  sogmm::FitResult r = initial ? sogmm::fit_warm(view, *initial, fo, sogmm_capi::progress_sink(o))
+  sogmm::FitResult r = initial ? sogmm::fit_warm(view, *initial, fo, sogmm_capi::progress_sink(o), o.settings.warm)
                                 : sogmm::fit(view, fo, sogmm_capi::progress_sink(o));
 
   auto handle = std::make_unique<sogmm_model>();

@@ -143,6 +143,8 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
   require(std::isfinite(warm.novelty_nats) && warm.novelty_nats >= 0, ErrorCode::InvalidArgument,
           "warm start novelty_nats must be finite and >= 0, got " + checked::exact(warm.novelty_nats));
   require(options.em.threads >= 0, ErrorCode::InvalidArgument, "threads must be >= 0");
+  require(warm.max_iter >= 0, ErrorCode::InvalidArgument,
+          "warm start max_iter must be >= 0, got " + std::to_string(warm.max_iter));
   const bool fixed_k = options.n_components > 0;
   if (fixed_k)
     require(options.n_components == initial.size(), ErrorCode::InvalidArgument,
@@ -222,6 +224,10 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
     for (float& w : start.weights) w = static_cast<float>(w / total);
   }
 
+  // The warm pass cap stands in for max_iter's default only: a max_iter the
+  // user chose wins. It is for a start next to its optimum: a cold fallback
+  // (or nothing kept) is a cold fit and runs to em.max_iter like one.
+  if (warm.max_iter > 0 && rep.kept > 0 && em.max_iter == EmOptions{}.max_iter) em.max_iter = warm.max_iter;
   if (dequantises(options.dequantise_depth, points) && em.quantisation.empty())
     em.quantisation = DepthQuantisation::detect(points);
   detail::progress_begin(Stage::Em, static_cast<std::uint64_t>(em.max_iter));

@@ -214,6 +214,12 @@ typedef int32_t sogmm_key;
  * E-step), when that exceeds TOL; 0: TOL alone. TOL 0 still runs MAX_ITER iterations.
  * f64 (standard errors), >= 0, finite; default 0. */
 #define SOGMM_OPT_TOL_STANDARD_ERRORS 131
+/* A warm start (a fit given an initial model) runs at most this many EM iterations while
+ * MAX_ITER is left at its default (a MAX_ITER set to anything else wins); 0: MAX_ITER alone; a
+ * cold fit and a warm start that falls back to a cold one ignore it; a map's warm start
+ * (MAP_WARM_START) uses the default (why: WarmStartOptions::max_iter).
+ * i64 (iterations), [0, 2^31-1]; default 8. */
+#define SOGMM_OPT_WARM_MAX_ITER 145
 
 /* RGB-D back-projection. Read by sogmm_fit_frame, sogmm_map_insert_frame,
  * sogmm_frame_to_points_f32. */
@@ -518,10 +524,12 @@ SOGMM_API sogmm_status sogmm_options_set_progress(sogmm_options* options, sogmm_
  * points' frame (e.g. the previous frame's model moved by the relative pose
  * with sogmm_model_transform). Self-organizing (SOGMM_OPT_N_COMPONENTS = 0):
  * components of `initial` whose responsibility mass on the well-explained
- * points is below 2 points are removed; points more than 10 nats below the
+ * points is below 0.5 points are removed; points more than 10 nats below the
  * median log-likelihood under `initial` are novel, and the mode count
  * (SOGMM_OPT_BANDWIDTH) and k-means++ (SOGMM_OPT_SEED) on the novel points
- * only add that many new components; EM then runs from kept + new. When
+ * only add that many new components; EM then runs from kept + new, at most
+ * SOGMM_OPT_WARM_MAX_ITER iterations while SOGMM_OPT_MAX_ITER is left at its
+ * default (with N_COMPONENTS = K too; a cold fallback runs MAX_ITER). When
  * `initial` explains the points badly (fewer than half of them: the median
  * point's log-likelihood more than 10 nats below the mean log-likelihood
  * `initial` gives its own samples, e.g. a start far from the points), it is

@@ -30,6 +30,7 @@
 #include "sogmm/registration.hpp"
 #include "sogmm/render.hpp"
 #include "sogmm/surface_distance.hpp"
+#include "sogmm/warm_start.hpp"
 
 namespace sogmm {
 
@@ -45,6 +46,9 @@ struct SampleOptions {
 /// read here; map_options() fills them).
 struct Settings {
   FitOptions fit;
+  /// A warm start's rule (fits given an initial model); only its pass cap
+  /// is a setting (WARM_MAX_ITER).
+  WarmStartOptions warm;
   DepthOptions depth;
   format::WriteOptions write;
   format::ReadOptions read;
@@ -81,6 +85,7 @@ enum class OptionKey : int {
   DEQUANTISE_DEPTH = 110,
   EM_ACCELERATION = 111,
   TOL_STANDARD_ERRORS = 131,
+  WARM_MAX_ITER = 145,
   DEPTH_SCALE = 200,
   DEPTH_MIN = 201,
   DEPTH_MAX = 202,

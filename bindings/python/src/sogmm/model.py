@@ -600,7 +600,9 @@ class SOGMM(GMM):
         ``init``: warm start from a model of an earlier, overlapping cloud,
         already in these points' frame (e.g. ``prev.transform(relative_pose)``);
         the rule for keeping, removing and adding components is that of
-        ``sogmm_fit_points_f32`` with ``initial`` (needs ``n_init == 1``)."""
+        ``sogmm_fit_points_f32`` with ``initial`` (needs ``n_init == 1``), and
+        so is its EM limit: SOGMM_OPT_WARM_MAX_ITER iterations while
+        ``max_iter`` is left at its default, ``max_iter`` otherwise."""
         x = _rows(X, (4,), "X")
         if init is not None and not isinstance(init, GMM):
             raise InvalidArgumentError(f"init must be a fitted GMM or SOGMM, got {type(init).__name__}")

@@ -89,6 +89,7 @@ pub const SOGMM_OPT_N_INIT: sogmm_key = 109;
 pub const SOGMM_OPT_DEQUANTISE_DEPTH: sogmm_key = 110;
 pub const SOGMM_OPT_EM_ACCELERATION: sogmm_key = 111;
 pub const SOGMM_OPT_TOL_STANDARD_ERRORS: sogmm_key = 131;
+pub const SOGMM_OPT_WARM_MAX_ITER: sogmm_key = 145;
 pub const SOGMM_OPT_DEPTH_SCALE: sogmm_key = 200;
 pub const SOGMM_OPT_DEPTH_MIN: sogmm_key = 201;
 pub const SOGMM_OPT_DEPTH_MAX: sogmm_key = 202;
