@@ -372,6 +372,7 @@ Gmm run_em(const PointsView& points, Working w, const Frame& frame, const RegCov
   std::vector<double> nk(m);
 
   EmReport rep;
+  rep.max_iter = options.max_iter;
   double pairs_evaluated = 0.0;
   // The first model's kernel parameters; each pass packs the next.
   double shift = pack_all(w, reg, data_scale2, params, exact, threads);  // of the log-densities in params

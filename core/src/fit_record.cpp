@@ -10,7 +10,9 @@ void record_fit(Model& model, const FitResult& result, const FitOptions& options
   f.bandwidth = options.n_components > 0 ? 0.0 : options.bandwidth;
   f.n_components_requested = options.n_components;
   f.tol = options.em.tol;
-  f.max_iter = options.em.max_iter;
+  // The limit the EM ran under: a warm start's pass cap stands in for
+  // options.em.max_iter (WarmStartOptions::max_iter).
+  f.max_iter = result.em.max_iter > 0 ? result.em.max_iter : options.em.max_iter;
   f.n_iter = result.em.iterations;
   f.converged = result.em.converged;
   f.log_likelihood = result.em.log_likelihood;

@@ -104,9 +104,9 @@ std::vector<OptionSpec> make_table() {
                     "that exceeds TOL; 0: TOL alone. TOL 0 still runs MAX_ITER iterations"),
       SOGMM_I64_ROW(WARM_MAX_ITER, warm.max_iter, 0, kInt32Max, "[0, 2^31-1]", "iterations",
                     "a warm start (a fit given an initial model) runs at most this many EM iterations while MAX_ITER is "
-                    "left at its default (a MAX_ITER set to anything else wins); 0: MAX_ITER alone; a cold fit and a warm "
-                    "start that falls back to a cold one ignore it; a map's warm start (MAP_WARM_START) uses the default "
-                    "(why: WarmStartOptions::max_iter)"),
+                    "left at its default (a MAX_ITER set to anything else wins; never more than MAX_ITER); 0: MAX_ITER "
+                    "alone; a cold fit, and a warm start that keeps no component or falls back to a cold one, ignore it; "
+                    "a map's warm start (MAP_WARM_START) uses the default (why: WarmStartOptions::max_iter)"),
       // ---- RGB-D back-projection ----
       SOGMM_F64_ROW(DEPTH_SCALE, depth.depth_scale, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v) && std::isfinite(1.0 / v); },
                     "> 0, finite, 1 / value finite", "raw units per metre",

@@ -179,15 +179,13 @@ struct RegistrationTarget::Prepared {
 
 namespace {
 
-// Validates `o` and `target` (the first errors a call reports) and builds
-// the target's levels for `o`. `index_all`: every level
-// gets an index (model sources look each level's up); otherwise only the
-// coarsest (a point source's candidate cache is built on it; finer levels
-// filter by their boxes).
+// Builds `target`'s levels for `o` (both validated by the caller: they are
+// a call's first errors; a source's come next, then a level's non-positive-
+// definite component). `index_all`: every level gets an index (model sources
+// look each level's up); otherwise only the coarsest (a point source's
+// candidate cache is built on it; finer levels filter by their boxes).
 std::unique_ptr<RegistrationTarget::Prepared> prepare(const Gmm& target, const RegistrationOptions& o, int team,
                                                       bool index_all) {
-  validate(o);
-  validate(target);
   auto p = std::make_unique<RegistrationTarget::Prepared>();
   p->level_count = o.levels;
   p->coarse_sigma = o.coarse_sigma;
@@ -699,10 +697,19 @@ void require_prepared_for(const RegistrationTarget& target, const RegistrationOp
           "registration: the prepared target was made for other levels, coarse_sigma, outlier_ratio or use_gray");
 }
 
+// A RegistrationTarget's levels, checked as a call checks them first; every
+// level indexed, for both kinds of source.
+std::unique_ptr<RegistrationTarget::Prepared> checked_prepare(const Gmm& target, const RegistrationOptions& options,
+                                                              int threads) {
+  validate(options);
+  validate(target);
+  return prepare(target, options, detail::team_size(threads), true);
+}
+
 }  // namespace
 
 RegistrationTarget::RegistrationTarget(const Gmm& target, const RegistrationOptions& options, int threads)
-    : prepared_(prepare(target, options, detail::team_size(threads), true)) {}
+    : prepared_(checked_prepare(target, options, threads)) {}
 RegistrationTarget::~RegistrationTarget() = default;
 RegistrationTarget::RegistrationTarget(RegistrationTarget&&) noexcept = default;
 RegistrationTarget& RegistrationTarget::operator=(RegistrationTarget&&) noexcept = default;
@@ -716,8 +723,11 @@ bool RegistrationTarget::prepared_for(const RegistrationOptions& o) const {
 RegistrationResult register_points(const Gmm& target, const float* points, std::size_t n,
                                    const std::array<double, 16>& init, const RegistrationOptions& options,
                                    int threads, const ProgressSink& progress) {
+  validate(options);
+  validate(target);
+  const Source src = point_source(points, n, init, options);
   const auto prepared = prepare(target, options, detail::team_size(threads), false);
-  return register_source(*prepared, point_source(points, n, init, options), init, options, threads, progress);
+  return register_source(*prepared, src, init, options, threads, progress);
 }
 
 RegistrationResult register_points(const RegistrationTarget& target, const float* points, std::size_t n,
@@ -730,8 +740,11 @@ RegistrationResult register_points(const RegistrationTarget& target, const float
 
 RegistrationResult register_model(const Gmm& target, const Gmm& source, const std::array<double, 16>& init,
                                   const RegistrationOptions& options, int threads, const ProgressSink& progress) {
+  validate(options);
+  validate(target);
+  const Source src = model_source(source, init, options);
   const auto prepared = prepare(target, options, detail::team_size(threads), true);
-  return register_source(*prepared, model_source(source, init, options), init, options, threads, progress);
+  return register_source(*prepared, src, init, options, threads, progress);
 }
 
 RegistrationResult register_model(const RegistrationTarget& target, const Gmm& source,

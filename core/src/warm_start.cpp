@@ -227,7 +227,8 @@ FitResult fit_warm(const PointsView& points, const Gmm& initial, const FitOption
   // The warm pass cap stands in for max_iter's default only: a max_iter the
   // user chose wins. It is for a start next to its optimum: a cold fallback
   // (or nothing kept) is a cold fit and runs to em.max_iter like one.
-  if (warm.max_iter > 0 && rep.kept > 0 && em.max_iter == EmOptions{}.max_iter) em.max_iter = warm.max_iter;
+  if (warm.max_iter > 0 && rep.kept > 0 && em.max_iter == EmOptions{}.max_iter)
+    em.max_iter = std::min(em.max_iter, warm.max_iter);
   if (dequantises(options.dequantise_depth, points) && em.quantisation.empty())
     em.quantisation = DepthQuantisation::detect(points);
   detail::progress_begin(Stage::Em, static_cast<std::uint64_t>(em.max_iter));

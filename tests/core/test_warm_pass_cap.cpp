@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "sogmm/error.hpp"
+#include "sogmm/fit_record.hpp"
 #include "sogmm/inference.hpp"
 #include "sogmm/options.hpp"
 #include "sogmm/warm_start.hpp"
@@ -71,6 +72,15 @@ TEST(WarmPassCap, AnExplicitMaxIterWinsAndZeroLiftsTheCap) {
   EXPECT_EQ(sogmm::fit_warm(s.vb(), initial, exact_passes(3), {}, limit(4)).em.iterations, 3);
   EXPECT_EQ(sogmm::fit_warm(s.vb(), initial, exact_passes(11), {}, limit(4)).em.iterations, 11);
   EXPECT_EQ(sogmm::fit_warm(s.vb(), initial, exact_passes(), {}, limit(0)).em.iterations, sogmm::EmOptions{}.max_iter);
+  // A cap above the default limit does not raise it; the report (and the
+  // model's fit record, record_fit) names the limit the EM ran under.
+  const sogmm::FitResult above = sogmm::fit_warm(s.vb(), initial, exact_passes(), {}, limit(250));
+  EXPECT_EQ(above.em.iterations, sogmm::EmOptions{}.max_iter);
+  const sogmm::FitResult capped = sogmm::fit_warm(s.vb(), initial, exact_passes(), {}, limit(4));
+  EXPECT_EQ(capped.em.max_iter, 4);
+  sogmm::Model record;
+  sogmm::record_fit(record, capped, exact_passes());
+  EXPECT_EQ(record.fit.max_iter, 4);
   sogmm::FitOptions fixed = exact_passes();
   fixed.n_components = initial.size();
   EXPECT_EQ(sogmm::fit_warm(s.vb(), initial, fixed, {}, limit(4)).em.iterations, 4);

@@ -17,14 +17,16 @@ then the rays of frame 2 on its decimated pixel grid (every valid pixel):
   direction from that nearest point for points 2-30 cm from it, and of the
   direction from the nearest point of the denoised clouds (surface_reference.py:
   the nearest raw point's direction tilts with the depth noise, the denoised
-  one does not; validated in gradient_reference_loop.py);
-  throughput;
+  one does not; validated in gradient_reference_loop.py); at 2-5 cm, how far
+  the misses are off and how far the map's foot point (query - distance x
+  gradient) lies from the reference's; throughput;
 - collision: spheres of radius 10 cm at the occupied points of frame 2 and
   20 cm in front of them (Map.collision_probability): the shares >= 0.99 and
   <= 0.01, and the time per robot and per robot-component pair tested.
 
     SOGMM_LIBRARY_PATH=build/capi/libsogmm.so PYTHONPATH=bindings/python/src \\
       python3 tools/sogmm-perf/occupancy_eval.py [--data /work/shared/data/rgbd/livingroom]
+        [--map-bandwidth B] [--map-decimate D]   (the map's own; rays stay at --decimate)
 """
 from __future__ import annotations
 

@@ -31,6 +31,19 @@ def test_warm_start_on_moved_cloud_matches_cold_fit():
     assert init.n_components_ == prev.n_components_
 
 
+def test_warm_pass_cap_is_the_library_default_and_a_keyword():
+    # With tol 0 EM runs its whole pass limit, so n_iter_ is that limit.
+    x = blobs(seed=4)
+    prev = sogmm.SOGMM(bandwidth=0.08, seed=3).fit(x)
+    assert sogmm.SOGMM().warm_max_iter == sogmm._ffi.option_default(sogmm._ffi.OPT_WARM_MAX_ITER)
+    assert sogmm.SOGMM(bandwidth=0.08, tol=0.0).fit(x, init=prev).n_iter_ == sogmm.SOGMM().warm_max_iter
+    assert sogmm.SOGMM(bandwidth=0.08, tol=0.0, warm_max_iter=3).fit(x, init=prev).n_iter_ == 3
+    assert sogmm.SOGMM(bandwidth=0.08, tol=0.0, warm_max_iter=3, max_iter=5).fit(x, init=prev).n_iter_ == 5
+    assert sogmm.SOGMM(bandwidth=0.08, tol=0.0, warm_max_iter=3).fit(x).n_iter_ == sogmm.SOGMM().max_iter
+    with pytest.raises(sogmm.InvalidArgumentError, match="WARM_MAX_ITER|warm_max_iter"):
+        sogmm.SOGMM(bandwidth=0.08, warm_max_iter=-1).fit(x, init=prev)
+
+
 def test_warm_start_errors():
     x = blobs()
     prev = sogmm.SOGMM(bandwidth=0.08).fit(x)

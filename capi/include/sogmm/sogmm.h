@@ -215,9 +215,10 @@ typedef int32_t sogmm_key;
  * f64 (standard errors), >= 0, finite; default 0. */
 #define SOGMM_OPT_TOL_STANDARD_ERRORS 131
 /* A warm start (a fit given an initial model) runs at most this many EM iterations while
- * MAX_ITER is left at its default (a MAX_ITER set to anything else wins); 0: MAX_ITER alone; a
- * cold fit and a warm start that falls back to a cold one ignore it; a map's warm start
- * (MAP_WARM_START) uses the default (why: WarmStartOptions::max_iter).
+ * MAX_ITER is left at its default (a MAX_ITER set to anything else wins; never more than
+ * MAX_ITER); 0: MAX_ITER alone; a cold fit, and a warm start that keeps no component or falls
+ * back to a cold one, ignore it; a map's warm start (MAP_WARM_START) uses the default (why:
+ * WarmStartOptions::max_iter).
  * i64 (iterations), [0, 2^31-1]; default 8. */
 #define SOGMM_OPT_WARM_MAX_ITER 145
 

@@ -93,6 +93,7 @@ struct EmOptions {
 /// What the EM did.
 struct EmReport {
   int iterations = 0;             ///< E+M iterations run
+  int max_iter = 0;               ///< the iteration limit it ran under (EmOptions::max_iter)
   bool converged = false;         ///< stopped on tol rather than max_iter
   double log_likelihood = 0.0;    ///< mean log-likelihood per point, computed in the
                                   ///< last E-step (scikit-learn's lower_bound_)

@@ -156,7 +156,9 @@ RegistrationResult register_model(const Gmm& target, const Gmm& source, const st
 /// Its answers are bit-identical to the calls against the Gmm it was made
 /// from, with the same options. It copies what it needs (the Gmm may change
 /// or go afterwards), is immutable, and may be shared by threads. Memory:
-/// about half a kilobyte per component and level.
+/// about half a kilobyte per component and level. A moved-from target may
+/// only be assigned to or destroyed. Its preparation runs before any
+/// registration's progress scope, so it is not cancellable.
 class RegistrationTarget {
  public:
   /// Validates `target` and `options` and prepares the levels that

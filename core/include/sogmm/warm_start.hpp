@@ -32,7 +32,9 @@ struct WarmStartOptions {
   double novelty_nats = 10.0;
   /// The warm fit's EM pass limit while FitOptions::em.max_iter is left at
   /// its default (EmOptions{}.max_iter, 100): any other em.max_iter is the
-  /// user's and wins; 0: em.max_iter alone. A warm start begins next to its
+  /// user's and wins; 0: em.max_iter alone; a cap above the default does
+  /// not raise it. The model's fit record keeps the limit used
+  /// (EmReport::max_iter). A warm start begins next to its
   /// optimum: EM run to `tol` spends as many passes as a cold fit, and each
   /// pass after the first few raises the likelihood but lowers PSNR (README,
   /// "--warm-start": over seeds 0-19 on livingroom 0->1 and 1->2, 8 is the

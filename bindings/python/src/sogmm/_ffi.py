@@ -462,6 +462,7 @@ OPTION_NAMES = {
     OPT_DEQUANTISE_DEPTH: "dequantise_depth",
     OPT_EM_ACCELERATION: "em_acceleration",
     OPT_TOL_STANDARD_ERRORS: "tol_standard_errors",
+    OPT_WARM_MAX_ITER: "warm_max_iter",
     OPT_DEPTH_SCALE: "depth_scale",
     OPT_DEPTH_MIN: "depth_min",
     OPT_DEPTH_MAX: "depth_trunc",

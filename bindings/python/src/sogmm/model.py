@@ -498,6 +498,10 @@ class SOGMM(GMM):
             (extrapolation along two EM steps, rejected when the likelihood
             would fall; max_iter counts every E+M pass). The default is the
             library's (SOGMM_OPT_EM_ACCELERATION).
+        warm_max_iter: EM passes at most of a warm start (``fit(X, init=...)``)
+            while ``max_iter`` is left at its default (a ``max_iter`` set to
+            anything else wins; never more than ``max_iter``); 0 = ``max_iter``
+            alone. The default is the library's (SOGMM_OPT_WARM_MAX_ITER).
 
     After ``fit`` the estimator is also the fitted model (a :class:`GMM`).
     """
@@ -507,7 +511,7 @@ class SOGMM(GMM):
                  mode_counter: str = "flat_binned", truncation_nats: float = _D.truncation_nats,
                  n_init: int = _D.n_init,
                  dequantise_depth: bool | None = None, em_acceleration: str = _EM_ACCELERATION_DEFAULT,
-                 tol_standard_errors: float = _D.tol_standard_errors):
+                 tol_standard_errors: float = _D.tol_standard_errors, warm_max_iter: int = _D.warm_max_iter):
         self.bandwidth = bandwidth
         self.seed = seed
         self.tol = tol
@@ -521,12 +525,14 @@ class SOGMM(GMM):
         self.dequantise_depth = dequantise_depth
         self.em_acceleration = em_acceleration
         self.tol_standard_errors = tol_standard_errors
+        self.warm_max_iter = warm_max_iter
         self._ptr = None
         self._finalizer = None
         self._cache = {}
 
     _PARAMS = ("bandwidth", "seed", "tol", "reg_covar", "max_iter", "n_components", "n_threads", "mode_counter",
-               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration", "tol_standard_errors")
+               "truncation_nats", "n_init", "dequantise_depth", "em_acceleration", "tol_standard_errors",
+               "warm_max_iter")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -549,7 +555,7 @@ class SOGMM(GMM):
             k = 0
         elif isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
             raise InvalidArgumentError(f"n_components must be None or an int >= 1, got {k!r}")
-        for name in ("seed", "max_iter", "n_threads", "n_init"):
+        for name in ("seed", "max_iter", "n_threads", "n_init", "warm_max_iter"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
                 raise InvalidArgumentError(f"{name} must be an int, got {v!r}")
@@ -577,6 +583,7 @@ class SOGMM(GMM):
                                         else int(bool(self.dequantise_depth))),
             _ffi.OPT_MODE_COUNTER: _MODE_COUNTERS[self.mode_counter],
             _ffi.OPT_EM_ACCELERATION: _EM_ACCELERATIONS[self.em_acceleration],
+            _ffi.OPT_WARM_MAX_ITER: int(self.warm_max_iter),
         }
         f64.update(extra_f64 or {})
         i64.update(extra_i64 or {})
@@ -601,8 +608,8 @@ class SOGMM(GMM):
         already in these points' frame (e.g. ``prev.transform(relative_pose)``);
         the rule for keeping, removing and adding components is that of
         ``sogmm_fit_points_f32`` with ``initial`` (needs ``n_init == 1``), and
-        so is its EM limit: SOGMM_OPT_WARM_MAX_ITER iterations while
-        ``max_iter`` is left at its default, ``max_iter`` otherwise."""
+        so is its EM limit: ``warm_max_iter`` passes while ``max_iter`` is
+        left at its default, ``max_iter`` otherwise."""
         x = _rows(X, (4,), "X")
         if init is not None and not isinstance(init, GMM):
             raise InvalidArgumentError(f"init must be a fitted GMM or SOGMM, got {type(init).__name__}")
