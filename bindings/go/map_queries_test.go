@@ -167,6 +167,34 @@ func TestMapInsertCancelLeavesTheMapUnchanged(t *testing.T) {
 
 // A warm start from a fixed-K fit of the same points keeps K and does not
 // lower the likelihood (EM is monotone); it refuses a K mismatch.
+// The warm pass cap (OptWarmMaxIter) reaches the core through the options:
+// with tol 0 EM runs its whole limit, which the fit record keeps.
+func TestFitWarmPassCap(t *testing.T) {
+	pts := twoBlobs(2000)
+	o, _ := NewOptions(NComponents(2), Seed(1))
+	defer o.Close()
+	cold := mustFit(t, pts, o)
+	if err := o.SetF64(OptTol, 0); err != nil {
+		t.Fatal(err)
+	}
+	if err := o.SetI64(OptWarmMaxIter, 3); err != nil {
+		t.Fatal(err)
+	}
+	warm, err := FitWarm(context.Background(), pts, cold, o)
+	if err != nil {
+		t.Fatal(err)
+	}
+	defer warm.Close()
+	n, _ := warm.InfoI64(InfoFitIterations)
+	limit, _ := warm.InfoI64(InfoFitMaxIter)
+	if n != 3 || limit != 3 {
+		t.Fatalf("warm pass cap 3: %d iterations, recorded limit %d", n, limit)
+	}
+	if err := o.SetI64(OptWarmMaxIter, -1); !errors.Is(err, ErrInvalidArg) {
+		t.Fatalf("negative cap: %v", err)
+	}
+}
+
 func TestFitWarm(t *testing.T) {
 	pts := twoBlobs(2000)
 	o, _ := NewOptions(NComponents(2), Seed(1), Threads(2))

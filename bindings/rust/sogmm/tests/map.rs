@@ -234,6 +234,24 @@ fn a_cancelled_insert_or_flush_leaves_the_map_as_it_was() {
     assert_eq!(pending.stats().unwrap().n_pending, 0);
 }
 
+// The warm pass cap (SOGMM_OPT_WARM_MAX_ITER) reaches the core through the
+// options: with tol 0 EM runs its whole limit, which the fit record keeps.
+#[test]
+fn warm_pass_cap_is_an_option() {
+    let pts = blobs(3000, 9);
+    let cold = Model::fit(&pts, Some(&Options::builder().n_components(3).seed(2).build().unwrap())).unwrap();
+    let capped = Options::builder()
+        .n_components(3)
+        .seed(2)
+        .f64(sogmm::sys::SOGMM_OPT_TOL, 0.0)
+        .i64(sogmm::sys::SOGMM_OPT_WARM_MAX_ITER, 3)
+        .build()
+        .unwrap();
+    let warm = Model::fit_warm(&pts, &cold, Some(&capped)).unwrap();
+    assert_eq!(warm.info_i64(sogmm::sys::SOGMM_INFO_FIT_ITERATIONS).unwrap(), Some(3));
+    assert_eq!(warm.info_i64(sogmm::sys::SOGMM_INFO_FIT_MAX_ITER).unwrap(), Some(3));
+}
+
 #[test]
 fn warm_start_from_a_fit_of_the_same_points() {
     let pts = blobs(3000, 9);
