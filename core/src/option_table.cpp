@@ -216,7 +216,7 @@ std::vector<OptionSpec> make_table() {
                     "distance to the surface: each component is the disc of its two largest principal axes out to this "
                     "many standard deviations"),
       SOGMM_I64_ROW(REGISTRATION_MAX_ITER, registration.max_iter, 1, kInt32Max, "[1, 2^31-1]", "iterations",
-                    "registration: EM / Gauss-Newton iterations per coarse-to-fine level"),
+                    "registration: steps (each scores every source point of the level) per coarse-to-fine level"),
       SOGMM_F64_ROW(REGISTRATION_TOL, registration.tol, 0.0, kInf, [](double v) { return v > 0 && std::isfinite(v); },
                     "> 0, finite", "m",
                     "registration: a level ends when a step moves the source by less than this (|t| + |rotation| x RMS "

@@ -1,14 +1,17 @@
 // Hand-made registration scenes shared by the registration tests: planes
-// tiled by flat components, and rigid poses.
+// tiled by flat components, rigid poses, and points sampled from a scene.
 #pragma once
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <utility>
 #include <vector>
 
 #include "sogmm/gmm.hpp"
+#include "sogmm/inference.hpp"
 #include "test_util.hpp"
 
 namespace sogmm_test {
@@ -47,6 +50,18 @@ inline Eigen::Matrix4d rigid(double deg, Eigen::Vector3d axis, Eigen::Vector3d t
   m.topLeftCorner<3, 3>() = Eigen::AngleAxisd(deg * M_PI / 180, axis.normalized()).toRotationMatrix();
   m.topRightCorner<3, 1>() = t;
   return m;
+}
+
+// `n` points of `g` (sampled with `seed`), moved by `move`: rows x, y, z, gray.
+inline std::vector<float> samples(const sogmm::Gmm& g, std::size_t n, const Eigen::Matrix4d& move,
+                                  std::uint64_t seed = 7) {
+  std::vector<float> pts(4 * n);
+  sogmm::sample(g, n, seed, 4, pts.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector4d y = move * Eigen::Vector4d(pts[4 * i], pts[4 * i + 1], pts[4 * i + 2], 1.0);
+    for (int k = 0; k < 3; ++k) pts[4 * i + k] = static_cast<float>(y(k));
+  }
+  return pts;
 }
 
 }  // namespace sogmm_test

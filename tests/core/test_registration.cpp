@@ -25,20 +25,9 @@ using Pose = std::array<double, 16>;
 using sogmm_test::planes;
 using sogmm_test::pose_error;
 using sogmm_test::rigid;
+using sogmm_test::samples;
 
 constexpr Pose kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-// `n` points of `g` (seeded), moved by `move` (rows x, y, z, gray).
-std::vector<float> samples(const sogmm::Gmm& g, std::size_t n, const Eigen::Matrix4d& move) {
-  std::vector<float> pts(4 * n);
-  sogmm::sample(g, n, 7, 4, pts.data());
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector4d x(pts[4 * i], pts[4 * i + 1], pts[4 * i + 2], 1.0);
-    const Eigen::Vector4d y = move * x;
-    for (int k = 0; k < 3; ++k) pts[4 * i + k] = static_cast<float>(y(k));
-  }
-  return pts;
-}
 
 }  // namespace
 

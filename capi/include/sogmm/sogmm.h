@@ -359,7 +359,7 @@ typedef int32_t sogmm_key;
 #define SOGMM_OPT_SURFACE_DISC_SIGMAS 702
 
 /* Registration. Read by sogmm_register_points_f32 and sogmm_register_model. */
-/* Registration: EM / Gauss-Newton iterations per coarse-to-fine level.
+/* Registration: steps (each scores every source point of the level) per coarse-to-fine level.
  * i64 (iterations), [1, 2^31-1]; default 30. */
 #define SOGMM_OPT_REGISTRATION_MAX_ITER 800
 /* Registration: a level ends when a step moves the source by less than this (|t| + |rotation| x
@@ -1260,7 +1260,7 @@ SOGMM_API sogmm_status sogmm_map_collision_probability(const sogmm_map* map, con
 typedef struct sogmm_registration_info {
   size_t struct_size;     /* in: sizeof(sogmm_registration_info) as the caller knows it */
   int32_t status;         /* SOGMM_REGISTRATION_* */
-  int32_t iterations;     /* EM / Gauss-Newton iterations, summed over the levels */
+  int32_t iterations;     /* steps (Newton or EM / Gauss-Newton), summed over the levels */
   double log_likelihood;  /* mean log-likelihood per source point at the pose (model plus outlier term) */
   double inlier_ratio;    /* fraction of points the mixture explains better than the outlier term */
   double rmse;            /* Mahalanobis RMS of the inliers per dimension (about 1 when they fit) */
@@ -1278,7 +1278,8 @@ typedef struct sogmm_registration_info {
  * pose_out (row-major 4 x 4) maps source points into the target's frame.
  * It maximises the points' log-likelihood under the target's 4-D density
  * (REGISTRATION_USE_GRAY 1, the default; 0: its 3-D marginal) mixed with a uniform
- * outlier term, by EM / Gauss-Newton steps coarse to fine (formula and why:
+ * outlier term, by Newton steps on the observed information (EM / Gauss-Newton
+ * steps where it leaves a direction unconstrained) coarse to fine (formula and why:
  * core/include/sogmm/registration.hpp), from `init` (a rigid 4 x 4 pose;
  * NULL = identity). Always check info_out->status: pose_out is the last
  * iterate, an estimate only with SOGMM_REGISTRATION_CONVERGED (and, along
