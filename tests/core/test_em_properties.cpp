@@ -2,6 +2,8 @@
 // instruction-set independence, the truncated E-step within its bound, the
 // multi-wave path, and large rotated geometry against scikit-learn.
 #include <gtest/gtest.h>
+#include <sys/types.h>
+#include <unistd.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -399,11 +401,20 @@ TEST(EmProperties, RegionsPerPassDoNotChangeABit) {
 // "threadsafe" death-test style re-executes the test binary) and reports its
 // log-likelihood through a file; on a CPU without AVX2 or AVX-512 the cap
 // simply selects the best kernel it has.
+// Where the child for `isa` of test process `pid` writes its result: named
+// by the process, since ctest runs this test and its isa_* copies at once
+// (and other checkouts may too), and a shared name let one run remove
+// another's file before it was read.
+namespace {
+std::string kernel_result_file(const std::string& isa, pid_t pid) {
+  return ::testing::TempDir() + "sogmm_em_kernel_" + isa + "_" + std::to_string(pid) + ".txt";
+}
+}  // namespace
+
 TEST(EmProperties, EveryKernelAgrees) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   std::vector<double> ll, plane_ll;
   for (const std::string isa : {"sse2", "avx2", "best"}) {
-    const std::string file = ::testing::TempDir() + "sogmm_em_kernel_" + isa + ".txt";
     EXPECT_EXIT(
         {
           if (isa == "best") ::unsetenv("SOGMM_ISA");
@@ -419,6 +430,8 @@ TEST(EmProperties, EveryKernelAgrees) {
           const std::vector<float> plane = large_geometry_points("plane_1km_1cm");
           o.reg_covar = 1e-6;  // thin components: the double kernels (auto gives 1 m^2 and float32 kernels)
           sogmm::fit_em(view(plane), sogmm::kmeanspp_seeds(view(plane), 10, 1), o, &plane_rep);
+          // The child's parent is the test process that reads the file.
+          const std::string file = kernel_result_file(isa, ::getppid());
           std::FILE* f = std::fopen(file.c_str(), "w");
           const bool ok = f != nullptr &&
                           std::fprintf(f, "%a %s %a\n", rep.log_likelihood, rep.kernel, plane_rep.log_likelihood) > 0 &&
@@ -437,7 +450,7 @@ TEST(EmProperties, EveryKernelAgrees) {
       {"sse2", "sse2"}, {"avx2", has_avx2 ? "avx2" : "sse2"},
       {"best", has_avx512 ? "avx512" : (has_avx2 ? "avx2" : "sse2")}};
   for (const std::string isa : {"sse2", "avx2", "best"}) {
-    const std::string file = ::testing::TempDir() + "sogmm_em_kernel_" + isa + ".txt";
+    const std::string file = kernel_result_file(isa, ::getpid());
     std::ifstream in(file);
     std::string text, ran, plane_text;
     ASSERT_TRUE(static_cast<bool>(in >> text >> ran >> plane_text)) << isa << ": no result in " << file;
