@@ -418,17 +418,22 @@ Vec6 gauss_newton_step(const Sums& sums, double scale) {
 
 // The Newton step on the log-likelihood itself: its curvature is the observed
 // information, hessian - spread (Louis' formula), so it converges
-// quadratically (the synthetic loop's frames took 9-10 iterations instead of
-// 18-30). Only where the observed information constrains every direction
-// (its eigenvalues, rotation scaled by the source's radius, above
-// degeneracy_ratio times the largest, the test of the Degenerate status):
-// along a direction it barely constrains, the Newton step is large and
-// arbitrary (a plane's slides wandered to max_iter). Elsewhere the
-// Gauss-Newton step. The step's length is also capped at kNewtonStepCap
-// Gauss-Newton steps: the observed information at the start of a level holds
-// only near it, and on a wall view the uncapped step overshot the slide 8-fold.
+// quadratically where the Gauss-Newton step converges linearly (the synthetic
+// loop's frames took 9-10 iterations instead of 18-30). Only where the
+// observed information, rotation scaled by the source's radius, is positive
+// definite with its eigenvalues within kNewtonMinEigenRatio of the largest:
+// along a direction held more weakly than that, a Newton step is gradient
+// noise amplified 1e4-fold and more, and on a wall the coarse levels
+// wandered along the slide to max_iter. Elsewhere the Gauss-Newton step. A
+// direction held weakly but above that (a wall view's slide, under the
+// default Degenerate ratio of 1e-3) is where Newton gains most: loop frame
+// 150's finest level took 3 steps instead of 6. The step's length is also
+// capped at kNewtonStepCap Gauss-Newton steps: the observed information at
+// the start of a level holds only near it, and on that wall view the
+// uncapped step overshot the slide 8-fold.
+constexpr double kNewtonMinEigenRatio = 1e-4;
 constexpr double kNewtonStepCap = 3.0;
-Vec6 newton_step(const Sums& sums, double scale, double radius, double degeneracy_ratio) {
+Vec6 newton_step(const Sums& sums, double scale, double radius) {
   const Vec6 gauss_newton = gauss_newton_step(sums, scale);
   Vec6 d;
   d << radius, radius, radius, 1, 1, 1;
@@ -436,7 +441,7 @@ Vec6 newton_step(const Sums& sums, double scale, double radius, double degenerac
   const Mat6 scaled = d.cwiseInverse().asDiagonal() * (0.5 * (observed + observed.transpose())) * d.cwiseInverse().asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Mat6> eig(scaled, Eigen::EigenvaluesOnly);
   const Vec6 ev = eig.eigenvalues();
-  if (!(ev.minCoeff() > degeneracy_ratio * ev.maxCoeff())) return gauss_newton;
+  if (!(ev.minCoeff() > kNewtonMinEigenRatio * ev.maxCoeff())) return gauss_newton;
   Vec6 step = -(0.5 * (observed + observed.transpose())).ldlt().solve(sums.gradient);
   const auto length = [radius](const Vec6& v) { return v.head<3>().norm() * radius + v.tail<3>().norm(); };
   const double cap = kNewtonStepCap * length(gauss_newton);
@@ -658,7 +663,7 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
       // (Newton steps ended livingroom 0 -> 1 at 0.59 instead of 0.47 cm):
       // it takes Gauss-Newton steps.
       const Vec6 step = model_source ? gauss_newton_step(sums, scale)
-                                     : newton_step(sums, scale, radius, options.degeneracy_ratio);
+                                     : newton_step(sums, scale, radius);
       if (!step.allFinite()) break;
       converged = step.tail<3>().norm() + step.head<3>().norm() * radius < options.tol;
       if (converged && finest && !model_source) {

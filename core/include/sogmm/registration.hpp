@@ -12,12 +12,13 @@
 // J over a left perturbation of the pose) and Louis' spread (below). A point
 // source then takes a Newton step on the log-likelihood, whose curvature is
 // the observed information (the first minus the spread), capped at 3
-// Gauss-Newton steps; where the observed information leaves some direction
-// unconstrained (the degeneracy_ratio test) it takes the Gauss-Newton (EM)
-// step of sum_ik w_ik (x_i - mu_k)^T P_k (x_i - mu_k) / 2 instead, as a model
-// source always does. Newton converges quadratically where EM is linear and
-// slow along weakly held directions (the synthetic loop's frames: 9-14
-// iterations instead of 18-30; a wall view's finest level 3 instead of 6). A
+// Gauss-Newton steps; where the observed information holds some direction
+// less than 1e-4 as firmly as the best-held one (or not at all) it takes the
+// Gauss-Newton (EM) step of sum_ik w_ik (x_i - mu_k)^T P_k (x_i - mu_k) / 2
+// instead, as a model source always does. Newton converges quadratically
+// where EM is linear and slow along weakly held directions (the synthetic
+// loop's frames: 9-10 iterations instead of 18-30; a wall view's finest level
+// 3 instead of 6). A
 // level ends at the first pose whose step is below tol; at the last level
 // that pose is the answer, with its own figures. Flat components make this a
 // point-to-plane cost near the surface and a point-to-point one at edges; the
