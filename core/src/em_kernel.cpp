@@ -9,6 +9,9 @@
 
 #include "em_kernel.hpp"
 #include "fast_exp.hpp"
+#if defined(__AVX512F__)
+#include "em_statistics_avx512.hpp"
+#endif
 
 #ifndef SOGMM_ISA
 #error "compile with -DSOGMM_ISA=<name>"
@@ -63,37 +66,12 @@ void add_statistics(const Block& block, int first, int last, const T* q, const f
   const float* __restrict pz = block.xyzg[2];
   const float* __restrict pg = block.xyzg[3];
   const T m0 = q[0], m1 = q[1], m2 = q[2], m3 = q[3];
-  // On AVX-512 (32 vector registers) one pass holds all 15 accumulators;
-  // elsewhere two passes, each with few enough accumulators to stay in
+  // Two passes over the block, each with few enough accumulators to stay in
   // registers (15 at once spill on AVX2's 16 vector registers). Each
-  // accumulator sees the same operations in the same order either way; every
-  // product r * d_i is also used by a further product, as in one pass, so the
-  // compiler never fuses it into its sum (which would round differently).
+  // accumulator sees the same operations in the same order as in one pass;
+  // every product r * d_i is also used by a further product, as in one pass,
+  // so the compiler never fuses it into its sum (which would round differently).
   T s0 = 0, s1 = 0, c00 = 0, c01 = 0, c02 = 0, c03 = 0;
-  T s2 = 0, s3 = 0, s4 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
-#if defined(__AVX512F__)
-#pragma omp simd reduction(+ : s0, s1, c00, c01, c02, c03, s2, s3, s4, c11, c12, c13, c22, c23, c33)
-  for (int p = first; p < last; ++p) {
-    const T r = e[p] * inv_sum[p];
-    const T d0 = px[p] - m0, d1 = py[p] - m1, d2 = pz[p] - m2, d3 = pg[p] - m3;
-    const T r0 = r * d0, r1 = r * d1, r2 = r * d2, r3 = r * d3;
-    s0 += r;
-    s1 += r0;
-    c00 += r0 * d0;
-    c01 += r0 * d1;
-    c02 += r0 * d2;
-    c03 += r0 * d3;
-    s2 += r1;
-    s3 += r2;
-    s4 += r3;
-    c11 += r1 * d1;
-    c12 += r1 * d2;
-    c13 += r1 * d3;
-    c22 += r2 * d2;
-    c23 += r2 * d3;
-    c33 += r3 * d3;
-  }
-#else
 #pragma omp simd reduction(+ : s0, s1, c00, c01, c02, c03)
   for (int p = first; p < last; ++p) {
     const T r = e[p] * inv_sum[p];
@@ -106,6 +84,7 @@ void add_statistics(const Block& block, int first, int last, const T* q, const f
     c02 += r0 * d2;
     c03 += r0 * d3;
   }
+  T s2 = 0, s3 = 0, s4 = 0, c11 = 0, c12 = 0, c13 = 0, c22 = 0, c23 = 0, c33 = 0;
 #pragma omp simd reduction(+ : s2, s3, s4, c11, c12, c13, c22, c23, c33)
   for (int p = first; p < last; ++p) {
     const T r = e[p] * inv_sum[p];
@@ -121,7 +100,6 @@ void add_statistics(const Block& block, int first, int last, const T* q, const f
     c23 += r2 * d3;
     c33 += r3 * d3;
   }
-#endif
   st[0] += s0;
   st[1] += s1;
   st[2] += s2;
@@ -278,7 +256,11 @@ double em_finish(const Block& block, const float* params, const double* exact, c
     if (params[at + 15] != 0.0f)
       add_statistics(block, first, last, exact + at, rows + i * kBlock, inv_sum, st);
     else
+#if defined(__AVX512F__)
+      add_statistics_avx512(block, first, last, params + at, rows + i * kBlock, inv_sum, st);
+#else
       add_statistics(block, first, last, params + at, rows + i * kBlock, inv_sum, st);
+#endif
   }
   return log_likelihood;
 }
