@@ -257,6 +257,8 @@ double em_finish(const Block& block, const float* params, const double* exact, c
       add_statistics(block, first, last, exact + at, rows + i * kBlock, inv_sum, st);
     else
 #if defined(__AVX512F__)
+      // The same floats as add_statistics<float>, its lanes summed for all
+      // 15 sums at once (em_statistics_avx512.hpp).
       add_statistics_avx512(block, first, last, params + at, rows + i * kBlock, inv_sum, st);
 #else
       add_statistics(block, first, last, params + at, rows + i * kBlock, inv_sum, st);
