@@ -113,8 +113,12 @@ void TruncatedScan::evaluate(const EmKernels& kernels, const Block& block, std::
     std::sort(list_.begin(), list_.end());
   }
   kernels.log_density(block, params.data(), exact.data(), list_.data(), list_.size(), rows, row_lp_max, max_lp);
+  // The lowest running maximum as a vector reduction (a minimum does not
+  // round; +0 and -0 give the same cut): as a scalar chain of dependent
+  // minimums it was ~40% of this function's own time.
   float worst = max_lp[0];
-  for (int p = 1; p < block.count; ++p) worst = std::min(worst, max_lp[p]);
+#pragma omp simd reduction(min : worst)
+  for (int p = 1; p < block.count; ++p) worst = max_lp[p] < worst ? max_lp[p] : worst;
   const double cut = static_cast<double>(worst) - nats_;
   memory.cut[b] = cut;
   const std::size_t first = list_.size();
