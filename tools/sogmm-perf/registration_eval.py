@@ -128,15 +128,23 @@ def open3d_baselines(data: Path, camera, truth_of, repeats: int):
               f"median {1000 * statistics.median(times):.0f} ms")
 
 
+def keywords(args) -> dict:
+    """The register() keywords the command line sets."""
+    kw = dict(n_threads=args.threads)
+    if args.no_gray:
+        kw["use_gray"] = False
+    if args.depth_noise is not None:
+        kw["depth_noise"] = args.depth_noise
+    return kw
+
+
 def loop_rows(args) -> None:
     """Frames of the synthetic loop registered to the map of the whole loop."""
     camera = sogmm.Camera.from_json(args.loop_dir / "intrinsics.json")
     ids, poses = sogmm.read_trajectory(args.loop_dir / "trajectory.log")
     world = {int(i): p for i, p in zip(ids, poses)}
     target = sogmm.Map.load(args.loop_map).export()
-    kw = dict(n_threads=args.threads)
-    if args.no_gray:
-        kw["use_gray"] = False
+    kw = keywords(args)
     rng = np.random.default_rng(1)
     print(f"loop map {args.loop_map}: M = {target.n_components_}; load average {os.getloadavg()[0]:.1f}; "
           f"threads {args.threads}; starts {args.loop_cm:g} cm / {args.loop_deg:g} deg off the truth")
@@ -177,6 +185,8 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--no-gray", action="store_true",
                     help="register with the geometry alone (use_gray=False; the library's default scores gray too)")
+    ap.add_argument("--depth-noise", type=float,
+                    help="the source points' depth noise k, sigma_z = k z^2 (depth_noise; default: the library's)")
     ap.add_argument("--no-open3d", action="store_true")
     ap.add_argument("--loop-dir", type=Path, help="the synthetic loop (sogmm demo --write-frame DIR --loop)")
     ap.add_argument("--loop-map", type=Path, help="its map at the true poses (sogmm map DIR --trajectory ...)")
@@ -206,11 +216,11 @@ def main() -> None:
     for a, _ in PAIRS:
         if a not in models:
             models[a] = sogmm.SOGMM(bandwidth=0.02, seed=0).fit(points[a])
-    kw = dict(n_threads=args.threads)
-    if args.no_gray:
-        kw["use_gray"] = False
+    kw = keywords(args)
     use_gray = kw.get("use_gray", bool(sogmm._ffi.DEFAULTS.registration_use_gray))
-    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {use_gray}")
+    depth_noise = kw.get("depth_noise", sogmm._ffi.DEFAULTS.registration_depth_noise)
+    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {use_gray}; "
+          f"depth_noise {depth_noise:g}")
     def rows(label, source_of):
         """One row per pair: `source_of(b)` registered to the earlier frame's model from the identity."""
         for a, b in PAIRS:

@@ -72,6 +72,16 @@ struct RegistrationOptions {
   double degeneracy_ratio = 1e-3;
   /// Fewer finite source points than this: Error(InvalidData). >= 6.
   std::int64_t min_points = 100;
+  /// k of the source's depth noise sigma_z = k z^2 (1/m; z a point's depth,
+  /// its third coordinate in the sensor's frame, which the source points are
+  /// in): each point p is scored under N(x; mu_k, Sigma_k + u u^T) with
+  /// u = k z R p, its depth error moved along its ray into the target frame,
+  /// as D2D adds a source component's covariance. A disparity-based sensor's
+  /// error grows as z^2; the target's components, fitted to one frame's
+  /// points, are thinner than the noise where it is correlated over a
+  /// component (quantisation steps). [0, 1]; 0: off. Point sources only (a
+  /// model source's covariances hold its noise already).
+  double depth_noise = 0.0;
 };
 
 /// Throws Error(InvalidArgument) naming the first bad setting.
