@@ -4,7 +4,7 @@
 // mantissa switch, and seeded ones up to 1e300 (large exponents: the e ln 2
 // split). Bounds: the series' truncation is below 3e-17, the division and
 // the Horner steps a few 2^-53 each. Mutation tried: the ln2_lo term dropped
-// (fails from x ~ 1e6 on, where e ln2_lo passes 1e-15 of log x).
+// (fails: e ln2_lo is 2.8e-10 of e ln 2).
 #include <gtest/gtest.h>
 
 #include <cmath>

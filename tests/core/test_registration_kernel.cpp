@@ -125,7 +125,7 @@ TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
 // log 5. The sums differ by roundings and by fast_log_ge1's 1e-15 relative:
 // bounds of 1e-10 relative leave a margin of 10^4 over the inverse's
 // conditioning (below 10^2 here). Mutation tried: 0.5 * log(grow) dropped
-// (fails the log-density by ~0.1).
+// (fails the log-density).
 TEST(RegistrationKernel, PairsWithDepthNoiseAddTheRankOneCovariance) {
   TestRng rng(11);
   const std::size_t m = 30, count = 2000;
