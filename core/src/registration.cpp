@@ -459,6 +459,7 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
   const int team = detail::team_size(threads);
   const double log_outlier = target.log_outlier;
   const double depth_noise = model_source ? 0.0 : options.depth_noise;
+  const bool noisy = depth_noise > 0;
 
   // The source's centroid and RMS radius (pose invariant: the step's scale);
   // a model source's are those of the points it stands for.
@@ -519,17 +520,18 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
           // along its ray, so sigma_z = depth_noise z^2 gives u = depth_noise
           // z R p (none for a point not in front of the sensor).
           const Eigen::Vector3d u =
-              depth_noise > 0 && p[2] > 0 ? Eigen::Vector3d(depth_noise * double(p[2]) * (x - pose.t))
-                                          : Eigen::Vector3d::Zero();
+              noisy && p[2] > 0 ? Eigen::Vector3d(depth_noise * double(p[2]) * (x - pose.t)) : Eigen::Vector3d::Zero();
           for (std::uint32_t id : near) {
             sc.ids[count] = id;
             sc.x[count] = xyz[0];
             sc.y[count] = xyz[1];
             sc.z[count] = xyz[2];
             sc.gray[count] = p[3];
-            sc.ux[count] = u(0);
-            sc.uy[count] = u(1);
-            sc.uz[count] = u(2);
+            if (noisy) {  // only with noise: the plain kernel reads none of them
+              sc.ux[count] = u(0);
+              sc.uy[count] = u(1);
+              sc.uz[count] = u(2);
+            }
             // Box3::contains without a branch per bound (about half the
             // candidates fail, unpredictably).
             const Box3& b = level.boxes[id];
@@ -538,7 +540,6 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
           }
         }
         sc.first.push_back(count);
-        const bool noisy = depth_noise > 0;
         kernels.pairs(level.records.data(),
                       {sc.ids.data(), sc.x.data(), sc.y.data(), sc.z.data(), sc.gray.data(),
                        noisy ? sc.ux.data() : nullptr, sc.uy.data(), sc.uz.data(), sc.term.data(), sc.pr_x.data(),
