@@ -80,7 +80,11 @@ struct RegistrationOptions {
   /// error grows as z^2; the target's components, fitted to one frame's
   /// points, are thinner than the noise where it is correlated over a
   /// component (quantisation steps). [0, 1]; 0: off. Point sources only (a
-  /// model source's covariances hold its noise already).
+  /// model source's covariances hold its noise already). Off by default: it
+  /// is the sensor's, and modelling noise a sensor does not have costs
+  /// accuracy (the synthetic loop, depth exact to the millimetre, tracked
+  /// with 0.001: ATE 0.80 against 0.58 cm); 0.001 suits the shared
+  /// living-room frames (README, Registration).
   double depth_noise = 0.0;
 };
 
