@@ -64,6 +64,7 @@ const (
 	OptRegistrationMinInlierRatio  Key = C.SOGMM_OPT_REGISTRATION_MIN_INLIER_RATIO
 	OptRegistrationDegeneracyRatio Key = C.SOGMM_OPT_REGISTRATION_DEGENERACY_RATIO
 	OptRegistrationMinPoints       Key = C.SOGMM_OPT_REGISTRATION_MIN_POINTS
+	OptRegistrationDepthNoise      Key = C.SOGMM_OPT_REGISTRATION_DEPTH_NOISE
 	OptTrackingOdometry            Key = C.SOGMM_OPT_TRACKING_ODOMETRY
 	OptTrackingMaxDisagreement     Key = C.SOGMM_OPT_TRACKING_MAX_DISAGREEMENT
 )

@@ -240,6 +240,10 @@ std::vector<OptionSpec> make_table() {
                     "unobservable"),
       SOGMM_I64_ROW(REGISTRATION_MIN_POINTS, registration.min_points, 6, kI64Max, ">= 6", "points",
                     "registration: fewer finite source points are SOGMM_E_INVALID_DATA"),
+      SOGMM_F64_ROW(REGISTRATION_DEPTH_NOISE, registration.depth_noise, 0.0, 1.0, finite, "[0, 1] (0: off)", "1/m",
+                    "registration: a source point's depth error has standard deviation this x z^2 (z its depth in "
+                    "the sensor's frame, the source's own), added along its ray to each component's covariance; "
+                    "point sources only; 0: off"),
       SOGMM_I64_ROW(TRACKING_ODOMETRY, tracking.odometry, 0, 1, "0 or 1", "",
                     "tracking: 1 registers a frame the map does not accept to the last inserted frame too and inserts "
                     "it when the two agree or the map has too few inliers to judge; 0 inserts only frames the map "

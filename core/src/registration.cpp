@@ -238,13 +238,18 @@ struct Scratch {
   std::vector<double> pair_top;       // a point source: the pair's point's largest log-density
   std::vector<double> term;  // each pair's log-density, then exp(it - the largest)
   std::vector<double> pr_x, pr_y, pr_z, quad;  // P r and r^T P r
+  // A point source with depth noise: each pair's noise axis u, P u and
+  // 1 / (1 + u^T P u) (registration_kernel.hpp).
+  std::vector<double> ux, uy, uz, pu_x, pu_y, pu_z, shrink;
   std::vector<Eigen::Matrix3d> prec;  // a model source: each pair's own precision
   std::vector<std::size_t> first;     // a point source: each point's first pair, then the end
   std::vector<Eigen::Vector3d> moved;  // a point source: the block's points at the pose
   std::vector<std::uint32_t> query;   // CandidateCache::near's scratch
   std::vector<double> top;            // a point source: each point's largest log-density
   void resize(std::size_t count) {
-    for (auto* v : {&x, &y, &z, &gray, &pair_top, &term, &pr_x, &pr_y, &pr_z, &quad}) v->resize(count);
+    for (auto* v : {&x, &y, &z, &gray, &pair_top, &term, &pr_x, &pr_y, &pr_z, &quad, &ux, &uy, &uz, &pu_x, &pu_y,
+                    &pu_z, &shrink})
+      v->resize(count);
   }
 };
 
@@ -472,6 +477,7 @@ void validate(const RegistrationOptions& o) {
   require_option(OptionKey::REGISTRATION_MIN_INLIER_RATIO, o.min_inlier_ratio, "registration min_inlier_ratio");
   require_option(OptionKey::REGISTRATION_DEGENERACY_RATIO, o.degeneracy_ratio, "registration degeneracy_ratio");
   require_option(OptionKey::REGISTRATION_MIN_POINTS, o.min_points, "registration min_points");
+  require_option(OptionKey::REGISTRATION_DEPTH_NOISE, o.depth_noise, "registration depth_noise");
 }
 
 const char* status_name(RegistrationStatus status) {
@@ -505,6 +511,8 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
   const ProgressScope scope(progress);
   const int team = detail::team_size(threads);
   const double log_outlier = target.log_outlier;
+  const double depth_noise = model_source ? 0.0 : options.depth_noise;
+  const bool noisy = depth_noise > 0;
 
   // The source's centroid and RMS radius (pose invariant: the step's scale);
   // a model source's are those of the points it stands for.
@@ -561,12 +569,22 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
             sc.resize(sc.ids.size());
           }
           const double xyz[3] = {x(0), x(1), x(2)};
+          // The depth-noise axis: a depth error e moves the point by e p / z
+          // along its ray, so sigma_z = depth_noise z^2 gives u = depth_noise
+          // z R p (none for a point not in front of the sensor).
+          const Eigen::Vector3d u =
+              noisy && p[2] > 0 ? Eigen::Vector3d(depth_noise * double(p[2]) * (x - pose.t)) : Eigen::Vector3d::Zero();
           for (std::uint32_t id : near) {
             sc.ids[count] = id;
             sc.x[count] = xyz[0];
             sc.y[count] = xyz[1];
             sc.z[count] = xyz[2];
             sc.gray[count] = p[3];
+            if (noisy) {  // only with noise: the plain kernel reads none of them
+              sc.ux[count] = u(0);
+              sc.uy[count] = u(1);
+              sc.uz[count] = u(2);
+            }
             // Box3::contains without a branch per bound (about half the
             // candidates fail, unpredictably).
             const Box3& b = level.boxes[id];
@@ -576,8 +594,10 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
         }
         sc.first.push_back(count);
         kernels.pairs(level.records.data(),
-                      {sc.ids.data(), sc.x.data(), sc.y.data(), sc.z.data(), sc.gray.data(), sc.term.data(),
-                       sc.pr_x.data(), sc.pr_y.data(), sc.pr_z.data(), sc.quad.data()},
+                      {sc.ids.data(), sc.x.data(), sc.y.data(), sc.z.data(), sc.gray.data(),
+                       noisy ? sc.ux.data() : nullptr, sc.uy.data(), sc.uz.data(), sc.term.data(), sc.pr_x.data(),
+                       sc.pr_y.data(), sc.pr_z.data(), sc.quad.data(), sc.pu_x.data(), sc.pu_y.data(),
+                       sc.pu_z.data(), sc.shrink.data()},
                       count);
         // Each point's largest log-density beside its pairs, then every
         // pair's term in one pass.
@@ -587,8 +607,15 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
           std::fill(sc.pair_top.begin() + sc.first[v], sc.pair_top.begin() + sc.first[v + 1], sc.top[v]);
         }
         kernels.terms(sc.term.data(), sc.pair_top.data(), sc.term.data(), count);
+        // With depth noise a pair's precision is the record's less the
+        // kernel's rank-one update.
         const auto precision_of = [&](std::size_t j) {
-          return record_precision(level.records.data() + std::size_t{detail::kPairRecord} * sc.ids[j]);
+          Eigen::Matrix3d prec = record_precision(level.records.data() + std::size_t{detail::kPairRecord} * sc.ids[j]);
+          if (noisy) {
+            const Eigen::Vector3d pu(sc.pu_x[j], sc.pu_y[j], sc.pu_z[j]);
+            prec.noalias() -= sc.shrink[j] * pu * pu.transpose();
+          }
+          return prec;
         };
         for (std::size_t v = 0; v < last - first; ++v) {
           // As for a model source: an item with no density is left out.

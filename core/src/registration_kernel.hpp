@@ -40,13 +40,26 @@ enum PairField : int {
 };
 
 /// The pairs of a block: inputs (candidate id, the point at the current
-/// pose and its gray) and outputs per pair.
+/// pose and its gray, and optionally the point's depth-noise axis u) and
+/// outputs per pair.
+///
+/// With u (ux non-null): the point's own noise u u^T is added to the
+/// component's (conditional) spatial covariance S, as the source component's
+/// is in D2D, so the pair's precision is the rank-one update (Sherman-
+/// Morrison) P' = (S + u u^T)^-1 = P - shrink (P u)(P u)^T with shrink =
+/// 1 / (1 + u^T P u), and log det grows by log(1 + u^T P u) (fast_log.hpp).
+/// The outputs are then P' r, r^T P' r and the log-density under S + u u^T;
+/// P u and shrink give P' to the caller. u = 0 gives exactly the values
+/// without u.
 struct RegistrationPairs {
   const std::uint32_t* id;
   const double *x, *y, *z, *gray;
+  const double *ux, *uy, *uz;   ///< the depth-noise axis (null: no noise; then pu and shrink are not written)
   double* log_density;
   double *pr_x, *pr_y, *pr_z;   ///< P r with r the (gray-conditioned) residual x - mu - gain (gray - mu_gray)
   double* quad;                 ///< r^T P r
+  double *pu_x, *pu_y, *pu_z;   ///< with u: P u (P before the update)
+  double* shrink;               ///< with u: 1 / (1 + u^T P u)
 };
 
 /// Scores pairs 0..count-1 against `records` (kPairRecord doubles per

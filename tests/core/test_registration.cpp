@@ -116,6 +116,46 @@ TEST(Registration, SinglePlaneIsDegenerate) {
   EXPECT_NEAR(std::asin(p(2, 1)) * 180 / M_PI, 2.0, 0.1);
 }
 
+namespace {
+
+// Two components 1 m apart, each with a grid of points about it, in a frame
+// with z > 0 (as a sensor's).
+struct TwoComponents {
+  sogmm::Gmm g;
+  std::vector<float> pts;
+  std::vector<Eigen::Matrix4d> stored;
+  TwoComponents();
+};
+
+TwoComponents::TwoComponents() : stored(2) {
+  Eigen::Matrix4d a;
+  a << 0.05, 0.01, 0.0, 0.0, -0.01, 0.03, 0.005, 0.0, 0.02, 0.0, 0.01, 0.0, 0.01, -0.02, 0.005, 0.05;
+  const Eigen::Vector4d mus[2] = {{0.3, -0.2, 1.5, 0.4}, {1.3, 0.1, 1.8, 0.6}};
+  const Eigen::Matrix4d flip = Eigen::Vector4d(1, -1, 1, 1).asDiagonal();
+  const Eigen::Matrix4d covs[2] = {a * a.transpose(), flip * a.transpose() * a * flip};
+  g.resize(2);
+  for (std::size_t k = 0; k < 2; ++k) sogmm_test::set_component(g, k, 0.5, mus[k], covs[k]);
+  g.support_size = 1;
+  // Per component a 7 x 7 x 7 grid mu + L u (L L^T the spatial covariance,
+  // u in [-1, 1]^3): Mahalanobis radius at most sqrt(3), so every point
+  // stays inside its own 3-sigma box near the identity, where this spread
+  // holds the pose. Gray varies along the grid.
+  for (std::size_t k = 0; k < 2; ++k) {
+    stored[k] = sogmm_test::cov_of(g, k);
+    stored[k] = 0.5 * (stored[k] + stored[k].transpose()).eval();
+    const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(stored[k].topLeftCorner<3, 3>()).matrixL();
+    for (int i = -3; i <= 3; ++i)
+      for (int j = -3; j <= 3; ++j)
+        for (int l = -3; l <= 3; ++l) {
+          const Eigen::Vector3d x = mus[k].head<3>() + chol * Eigen::Vector3d(i, j, l) / 3.0;
+          for (int d = 0; d < 3; ++d) pts.push_back(float(x(d)));
+          pts.push_back(float(mus[k](3) + 0.01 * (i - j + l)));
+        }
+  }
+}
+
+}  // namespace
+
 // Two components 1 m apart (3-sigma boxes about 0.15 m wide) and no outlier
 // term: every point has one candidate and responsibility exactly 1, so
 // Louis' correction vanishes and the information about the origin is the
@@ -129,33 +169,10 @@ TEST(Registration, SinglePlaneIsDegenerate) {
 // relative bound, which leaves room for rounding only (no kernel-dispatched
 // code runs here, so every kernel gives the same sums).
 TEST(Registration, InformationIsTheGaussNewtonSum) {
-  Eigen::Matrix4d a;
-  a << 0.05, 0.01, 0.0, 0.0, -0.01, 0.03, 0.005, 0.0, 0.02, 0.0, 0.01, 0.0, 0.01, -0.02, 0.005, 0.05;
-  const Eigen::Vector4d mus[2] = {{0.3, -0.2, 1.5, 0.4}, {1.3, 0.1, 1.8, 0.6}};
-  const Eigen::Matrix4d flip = Eigen::Vector4d(1, -1, 1, 1).asDiagonal();
-  const Eigen::Matrix4d covs[2] = {a * a.transpose(), flip * a.transpose() * a * flip};
-  sogmm::Gmm g;
-  g.resize(2);
-  for (std::size_t k = 0; k < 2; ++k) sogmm_test::set_component(g, k, 0.5, mus[k], covs[k]);
-  g.support_size = 1;
-  // Per component a 7 x 7 x 7 grid mu + L u (L L^T the spatial covariance,
-  // u in [-1, 1]^3): Mahalanobis radius at most sqrt(3), so every point
-  // stays inside its own 3-sigma box near the identity, where this spread
-  // holds the pose. Gray varies along the grid.
-  std::vector<float> pts;
-  std::vector<Eigen::Matrix4d> stored(2);
-  for (std::size_t k = 0; k < 2; ++k) {
-    stored[k] = sogmm_test::cov_of(g, k);
-    stored[k] = 0.5 * (stored[k] + stored[k].transpose()).eval();
-    const Eigen::Matrix3d chol = Eigen::LLT<Eigen::Matrix3d>(stored[k].topLeftCorner<3, 3>()).matrixL();
-    for (int i = -3; i <= 3; ++i)
-      for (int j = -3; j <= 3; ++j)
-        for (int l = -3; l <= 3; ++l) {
-          const Eigen::Vector3d x = mus[k].head<3>() + chol * Eigen::Vector3d(i, j, l) / 3.0;
-          for (int d = 0; d < 3; ++d) pts.push_back(float(x(d)));
-          pts.push_back(float(mus[k](3) + 0.01 * (i - j + l)));
-        }
-  }
+  const TwoComponents scene;
+  const sogmm::Gmm& g = scene.g;
+  const std::vector<float>& pts = scene.pts;
+  const std::vector<Eigen::Matrix4d>& stored = scene.stored;
   const std::size_t n = pts.size() / 4, per = n / 2;
   for (bool gray : {false, true}) {
     sogmm::RegistrationOptions o;
@@ -181,6 +198,64 @@ TEST(Registration, InformationIsTheGaussNewtonSum) {
       jac << 0, x(2), -x(1), 1, 0, 0, -x(2), 0, x(0), 0, 1, 0, x(1), -x(0), 0, 0, 0, 1;
       expected += jac.transpose() * spatial.inverse() * jac;
     }
+    Eigen::Matrix<double, 6, 6> info;
+    for (int i = 0; i < 36; ++i) info(i / 6, i % 6) = r.information[i];
+    EXPECT_LT((info - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff()) << "gray " << gray;
+  }
+}
+
+// With depth noise k, each point p (here the grids of TwoComponents, z of
+// 1.2 to 2.1 m) is scored under its component's (conditional) spatial
+// covariance plus u u^T, u = k z R p (R the returned rotation): computed
+// here by forming that 3 x 3 covariance and inverting it, independently of
+// the kernel's rank-one update. With one candidate per point and no outlier
+// term, the mean log-likelihood is the mean of log 0.5 + (with gray) the
+// gray marginal + log N(r; 0, S + u u^T), and the information the sum of
+// J^T (S + u u^T)^-1 J (the source covariance held, as in the step). k =
+// 0.01 makes u 1.4 to 4.4 cm, larger than the components' 1-5 cm sigmas, so
+// a formula that dropped u, its log det, or rotated it wrongly is off by far
+// more than the 1e-9 relative bounds (rounding and fast_log_ge1's 1e-15).
+TEST(Registration, DepthNoiseAddsEachPointsRayCovariance) {
+  const TwoComponents scene;
+  const std::size_t n = scene.pts.size() / 4, per = n / 2;
+  for (bool gray : {false, true}) {
+    sogmm::RegistrationOptions o;
+    o.use_gray = gray;
+    o.outlier_ratio = 0.0;
+    o.levels = 1;
+    o.depth_noise = 0.01;
+    const sogmm::RegistrationResult r = sogmm::register_points(
+        scene.g, scene.pts.data(), n, sogmm_test::pose_array(rigid(1.0, {0, 0, 1}, {0.002, 0, 0})), o);
+    ASSERT_EQ(r.status, RegistrationStatus::Converged) << sogmm::status_name(r.status);
+    const Eigen::Matrix4d pose = sogmm_test::pose_matrix(r.pose);
+    const Eigen::Matrix3d rot = pose.topLeftCorner<3, 3>();
+    Eigen::Matrix<double, 6, 6> expected = Eigen::Matrix<double, 6, 6>::Zero();
+    double log_likelihood = 0.0;
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::size_t k = p / per;
+      const Eigen::Matrix4d& c = scene.stored[k];
+      const Eigen::Vector3d src(scene.pts[4 * p], scene.pts[4 * p + 1], scene.pts[4 * p + 2]);
+      const Eigen::Vector3d x = rot * src + pose.topRightCorner<3, 1>();
+      const double dg = double(scene.pts[4 * p + 3]) - double(scene.g.mean(k)[3]);
+      Eigen::Matrix3d spatial = c.topLeftCorner<3, 3>();
+      Eigen::Vector3d res = x - Eigen::Vector3d(scene.g.mean(k)[0], scene.g.mean(k)[1], scene.g.mean(k)[2]);
+      double lp = std::log(0.5);
+      if (gray) {
+        spatial -= c.block<3, 1>(0, 3) * c.block<1, 3>(3, 0) / c(3, 3);
+        res -= c.block<3, 1>(0, 3) / c(3, 3) * dg;
+        lp += -0.5 * std::log(2 * M_PI * c(3, 3)) - 0.5 * dg * dg / c(3, 3);
+      }
+      const Eigen::Vector3d u = 0.01 * src(2) * (rot * src);
+      const Eigen::Matrix3d cov = spatial + u * u.transpose();
+      const Eigen::Matrix3d prec = cov.inverse();
+      lp += -0.5 * std::log((2 * M_PI) * (2 * M_PI) * (2 * M_PI) * cov.determinant()) - 0.5 * res.dot(prec * res);
+      log_likelihood += lp;
+      Eigen::Matrix<double, 3, 6> jac;
+      jac << 0, x(2), -x(1), 1, 0, 0, -x(2), 0, x(0), 0, 1, 0, x(1), -x(0), 0, 0, 0, 1;
+      expected += jac.transpose() * prec * jac;
+    }
+    log_likelihood /= double(n);
+    EXPECT_NEAR(r.log_likelihood, log_likelihood, 1e-9 * std::abs(log_likelihood)) << "gray " << gray;
     Eigen::Matrix<double, 6, 6> info;
     for (int i = 0; i < 36; ++i) info(i / 6, i % 6) = r.information[i];
     EXPECT_LT((info - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff()) << "gray " << gray;
@@ -245,4 +320,10 @@ TEST(Registration, BadInput) {
   o.outlier_ratio = 1.0;
   sogmm_test::expect_error([&] { sogmm::register_points(corner, src.data(), 500, kIdentity, o); },
                            ErrorCode::InvalidArgument, {"outlier_ratio"}, "outlier ratio 1");
+  o = {};
+  for (double bad : {-1e-3, std::numeric_limits<double>::quiet_NaN(), 1.5}) {
+    o.depth_noise = bad;
+    sogmm_test::expect_error([&] { sogmm::register_points(corner, src.data(), 500, kIdentity, o); },
+                             ErrorCode::InvalidArgument, {"depth_noise"}, "depth noise out of range");
+  }
 }

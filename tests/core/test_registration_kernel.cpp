@@ -92,8 +92,9 @@ TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
     gray[j] = rng.uniform();
   }
   registration_kernels().pairs(records.data(),
-                               {id.data(), x.data(), y.data(), z.data(), gray.data(), lp.data(), px.data(),
-                                py.data(), pz.data(), quad.data()},
+                               {id.data(), x.data(), y.data(), z.data(), gray.data(), nullptr, nullptr, nullptr,
+                                lp.data(), px.data(), py.data(), pz.data(), quad.data(), nullptr, nullptr, nullptr,
+                                nullptr},
                                count);
   for (std::size_t j = 0; j < count; ++j) {
     const double* r = records.data() + id[j] * kPairRecord;
@@ -113,6 +114,88 @@ TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
     EXPECT_NEAR(px[j], pr(0), 1e-12 * pr_scale);
     EXPECT_NEAR(py[j], pr(1), 1e-12 * pr_scale);
     EXPECT_NEAR(pz[j], pr(2), 1e-12 * pr_scale);
+  }
+}
+
+// With a depth-noise axis u per pair: the log-density of N(x; mu + gain dg,
+// P^-1 + u u^T) written out with Eigen (the covariance formed, factored and
+// inverted: no rank-one formula), and that covariance's inverse against the
+// kernel's P - shrink (P u)(P u)^T. u of 1 to 20 mm against sigmas of ~1 cm:
+// the update changes the terms by up to a few units, the log det by up to
+// log 5. The sums differ by roundings and by fast_log_ge1's 1e-15 relative:
+// bounds of 1e-10 relative leave a margin of 10^4 over the inverse's
+// conditioning (below 10^2 here). Mutation tried: 0.5 * log(grow) dropped
+// (fails the log-density).
+TEST(RegistrationKernel, PairsWithDepthNoiseAddTheRankOneCovariance) {
+  TestRng rng(11);
+  const std::size_t m = 30, count = 2000;
+  std::vector<double> records(m * kPairRecord);
+  std::vector<Eigen::Matrix3d> prec(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    double* r = records.data() + k * kPairRecord;
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = rng.normal();
+    prec[k] = a * a.transpose() / 1e-4 + 100.0 * Eigen::Matrix3d::Identity();
+    const int upper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+    for (int e = 0; e < 6; ++e) r[kP00 + e] = prec[k](upper[e][0], upper[e][1]);
+    for (int d = 0; d < 3; ++d) {
+      r[kMuX + d] = rng.uniform();
+      r[kGainX + d] = 0.1 * rng.normal();
+    }
+    r[kMuGray] = rng.uniform();
+    r[kInvSgg] = 1.0 / (0.01 + 0.1 * rng.uniform());
+    r[kLogNorm] = 5.0 * rng.normal();
+    r[kLogNormGray] = rng.normal();
+  }
+  std::vector<std::uint32_t> id(count);
+  std::vector<double> x(count), y(count), z(count), gray(count), ux(count), uy(count), uz(count), lp(count),
+      px(count), py(count), pz(count), quad(count), pux(count), puy(count), puz(count), shrink(count);
+  for (std::size_t j = 0; j < count; ++j) {
+    id[j] = static_cast<std::uint32_t>(rng.uniform() * m) % m;
+    const double* r = records.data() + id[j] * kPairRecord;
+    x[j] = r[kMuX] + 0.03 * rng.normal();
+    y[j] = r[kMuY] + 0.03 * rng.normal();
+    z[j] = r[kMuZ] + 0.03 * rng.normal();
+    gray[j] = rng.uniform();
+    Eigen::Vector3d u(rng.normal(), rng.normal(), rng.normal());
+    u *= (0.001 + 0.019 * rng.uniform()) / u.norm();
+    ux[j] = u(0);
+    uy[j] = u(1);
+    uz[j] = u(2);
+  }
+  registration_kernels().pairs(records.data(),
+                               {id.data(), x.data(), y.data(), z.data(), gray.data(), ux.data(), uy.data(), uz.data(),
+                                lp.data(), px.data(), py.data(), pz.data(), quad.data(), pux.data(), puy.data(),
+                                puz.data(), shrink.data()},
+                               count);
+  for (std::size_t j = 0; j < count; ++j) {
+    const double* r = records.data() + id[j] * kPairRecord;
+    const Eigen::Vector3d u(ux[j], uy[j], uz[j]);
+    const Eigen::Matrix3d cov0 = prec[id[j]].inverse();
+    const Eigen::Matrix3d cov = cov0 + u * u.transpose();
+    const Eigen::LLT<Eigen::Matrix3d> llt0(cov0), llt(cov);
+    const double log_grow = 2.0 * (llt.matrixLLT().diagonal().array().log().sum() -
+                                   llt0.matrixLLT().diagonal().array().log().sum());
+    const Eigen::Matrix3d p_new = llt.solve(Eigen::Matrix3d::Identity());
+    const double dg = gray[j] - r[kMuGray];
+    const Eigen::Vector3d res = Eigen::Vector3d(x[j], y[j], z[j]) - Eigen::Vector3d(r[kMuX], r[kMuY], r[kMuZ]) -
+                                dg * Eigen::Vector3d(r[kGainX], r[kGainY], r[kGainZ]);
+    const Eigen::Vector3d pr = p_new * res;
+    const double q = res.dot(pr);
+    const double gray_term = 0.5 * dg * dg * r[kInvSgg];
+    const double want = r[kLogNorm] + r[kLogNormGray] - gray_term - 0.5 * log_grow - 0.5 * q;
+    const double q_scale = res.cwiseAbs().dot(prec[id[j]].cwiseAbs() * res.cwiseAbs());
+    const double scale = std::abs(r[kLogNorm]) + std::abs(r[kLogNormGray]) + gray_term + log_grow + 0.5 * q_scale;
+    ASSERT_NEAR(lp[j], want, 1e-10 * scale) << "pair " << j;
+    ASSERT_NEAR(quad[j], q, 1e-10 * q_scale) << "pair " << j;
+    const double pr_scale = prec[id[j]].cwiseAbs().maxCoeff() * res.cwiseAbs().sum();
+    EXPECT_NEAR(px[j], pr(0), 1e-10 * pr_scale);
+    EXPECT_NEAR(py[j], pr(1), 1e-10 * pr_scale);
+    EXPECT_NEAR(pz[j], pr(2), 1e-10 * pr_scale);
+    // The caller's precision P - shrink (P u)(P u)^T.
+    const Eigen::Vector3d pu(pux[j], puy[j], puz[j]);
+    const Eigen::Matrix3d p_kernel = prec[id[j]] - shrink[j] * pu * pu.transpose();
+    ASSERT_LE((p_kernel - p_new).cwiseAbs().maxCoeff(), 1e-10 * prec[id[j]].cwiseAbs().maxCoeff()) << "pair " << j;
   }
 }
 

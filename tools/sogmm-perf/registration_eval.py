@@ -13,7 +13,10 @@ seeded perturbations of the true pose (random axis, angle uniform in
 direction) start the registration: a trial recovers when the status is
 converged and the pose is within 1 cm and 0.5 degrees; a "false success" is a
 converged status with a pose outside those bounds (what must not happen).
-Times are medians of the calls (2 threads by default; the machine is shared,
+With --phases, each pair's later frame is also decimated from the 25 pixel
+offsets and the median and range of the errors printed: the errors at offset
+(0, 0) are one draw of that spread. --depth-noise K sets the source points'
+depth noise (sigma_z = K z^2, SOGMM_OPT_REGISTRATION_DEPTH_NOISE). Times are medians of the calls (2 threads by default; the machine is shared,
 so the load average is printed).
 
 With Open3D importable (a venv with `pip install open3d==0.19.0`; 0.20.0 also
@@ -128,15 +131,23 @@ def open3d_baselines(data: Path, camera, truth_of, repeats: int):
               f"median {1000 * statistics.median(times):.0f} ms")
 
 
+def keywords(args) -> dict:
+    """The register() keywords the command line sets."""
+    kw = dict(n_threads=args.threads)
+    if args.no_gray:
+        kw["use_gray"] = False
+    if args.depth_noise is not None:
+        kw["depth_noise"] = args.depth_noise
+    return kw
+
+
 def loop_rows(args) -> None:
     """Frames of the synthetic loop registered to the map of the whole loop."""
     camera = sogmm.Camera.from_json(args.loop_dir / "intrinsics.json")
     ids, poses = sogmm.read_trajectory(args.loop_dir / "trajectory.log")
     world = {int(i): p for i, p in zip(ids, poses)}
     target = sogmm.Map.load(args.loop_map).export()
-    kw = dict(n_threads=args.threads)
-    if args.no_gray:
-        kw["use_gray"] = False
+    kw = keywords(args)
     rng = np.random.default_rng(1)
     print(f"loop map {args.loop_map}: M = {target.n_components_}; load average {os.getloadavg()[0]:.1f}; "
           f"threads {args.threads}; starts {args.loop_cm:g} cm / {args.loop_deg:g} deg off the truth")
@@ -167,6 +178,29 @@ def loop_rows(args) -> None:
           f"(load average {os.getloadavg()[0]:.1f})")
 
 
+def phase_rows(args, camera, models, truth_of, kw) -> None:
+    """Per pair, the errors of the later frame's d = 5 points taken from each of
+    the 25 pixel offsets (the image cropped by (dx, dy) before the decimation,
+    the principal point moved with it) against the same model: the errors at
+    offset (0, 0) are one draw of this spread."""
+    import dataclasses
+    for a, b in PAIRS:
+        depth, color = sogmm.read_frame(args.data / "depth" / f"{b:05d}.png", args.data / "color" / f"{b:05d}.jpg")
+        errors = []
+        for dy in range(5):
+            for dx in range(5):
+                h, w = camera.height - 5, camera.width - 5
+                cam = dataclasses.replace(camera, width=w, height=h, cx=camera.cx - dx, cy=camera.cy - dy)
+                pts = sogmm.rgbd_to_points(np.ascontiguousarray(depth[dy:dy + h, dx:dx + w]),
+                                           np.ascontiguousarray(color[dy:dy + h, dx:dx + w]), cam, decimate=5)
+                pose, _ = sogmm.register(pts, models[a], **kw)
+                errors.append(pose_error(pose, truth_of(a, b)))
+        e = np.array(errors)
+        print(f"  sogmm {a}->{b} over 25 sampling offsets: translation median {np.median(e[:, 0]):.2f} cm "
+              f"(min {e[:, 0].min():.2f}, max {e[:, 0].max():.2f}), rotation median {np.median(e[:, 1]):.3f} deg "
+              f"(min {e[:, 1].min():.3f}, max {e[:, 1].max():.3f})")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data", type=Path, default=Path("/work/shared/data/rgbd/livingroom"))
@@ -177,6 +211,11 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--no-gray", action="store_true",
                     help="register with the geometry alone (use_gray=False; the library's default scores gray too)")
+    ap.add_argument("--depth-noise", type=float,
+                    help="the source points' depth noise k, sigma_z = k z^2 (depth_noise; default: the library's)")
+    ap.add_argument("--phases", action="store_true",
+                    help="also register the later frame decimated from each of the 25 pixel offsets (0-4, 0-4): "
+                         "the spread of the errors over equally valid samplings")
     ap.add_argument("--no-open3d", action="store_true")
     ap.add_argument("--loop-dir", type=Path, help="the synthetic loop (sogmm demo --write-frame DIR --loop)")
     ap.add_argument("--loop-map", type=Path, help="its map at the true poses (sogmm map DIR --trajectory ...)")
@@ -206,11 +245,11 @@ def main() -> None:
     for a, _ in PAIRS:
         if a not in models:
             models[a] = sogmm.SOGMM(bandwidth=0.02, seed=0).fit(points[a])
-    kw = dict(n_threads=args.threads)
-    if args.no_gray:
-        kw["use_gray"] = False
+    kw = keywords(args)
     use_gray = kw.get("use_gray", bool(sogmm._ffi.DEFAULTS.registration_use_gray))
-    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {use_gray}")
+    depth_noise = kw.get("depth_noise", sogmm._ffi.DEFAULTS.registration_depth_noise)
+    print(f"load average {os.getloadavg()[0]:.1f}; threads {args.threads}; use_gray {use_gray}; "
+          f"depth_noise {depth_noise:g}")
     def rows(label, source_of):
         """One row per pair: `source_of(b)` registered to the earlier frame's model from the identity."""
         for a, b in PAIRS:
@@ -226,6 +265,8 @@ def main() -> None:
                   f"source {size}, M = {models[a].n_components_}, median {1000 * statistics.median(times):.1f} ms")
 
     rows("sogmm", lambda b: points[b])
+    if args.phases:
+        phase_rows(args, camera, models, truth_of, kw)
     own = {b: sogmm.SOGMM(bandwidth=0.02, seed=0).fit(points[b]) for _, b in PAIRS}
     rows("sogmm D2D", lambda b: own[b])
     rng = np.random.default_rng(0)

@@ -246,6 +246,11 @@ Command add_map_command(CLI::App& root) {
                 "without --trajectory or with --refine-poses: register with gray too (the 4-D density; the default,\n"
                 "SOGMM_OPT_REGISTRATION_USE_GRAY), which holds the pose where the geometry alone lets a frame slide\n"
                 "(a wall, a floor); --no-registration-gray: the geometry alone (and no odometry)");
+  app->add_option("--registration-depth-noise", s->registration.depth_noise,
+                  "without --trajectory or with --refine-poses: k of the frames' depth noise sigma_z = k z^2 (1/m),\n"
+                  "added along each point's ray to the map's components when registering "
+                  "(SOGMM_OPT_REGISTRATION_DEPTH_NOISE; 0: off)")
+      ->capture_default_str();
   app->add_flag("--no-odometry", s->no_odometry,
                 "tracking: insert only frames whose map registration converged (SOGMM_OPT_TRACKING_ODOMETRY 0); by\n"
                 "default a frame the map does not accept is registered to the last inserted frame too and inserted\n"

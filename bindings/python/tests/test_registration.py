@@ -109,3 +109,27 @@ def test_the_old_keyword_still_works_with_a_warning():
         sogmm.register(src, model, source_points=src)
     with pytest.raises(TypeError, match="target_model"):
         sogmm.register(src)
+
+
+def test_depth_noise_reaches_the_library():
+    """depth_noise (SOGMM_OPT_REGISTRATION_DEPTH_NOISE): refused out of range,
+    a reweighting that still recovers the pose of unbiased points, and
+    ignored by a model source (bitwise the same pose)."""
+    model = planes([0, 1, 2], support_size=30000)
+    truth = rigid(5.0, [1, 2, 3], [0.02, -0.01, 0.03])
+    src = moved(model.sample(3000, seed=1), np.linalg.inv(truth))
+    src[:, 2] += 1.0  # in front of a sensor at the origin (z > 0), as frames are
+    shifted = np.eye(4)
+    shifted[2, 3] = -1.0
+    truth = truth @ shifted
+    with pytest.raises(sogmm.InvalidArgumentError, match="DEPTH_NOISE"):
+        sogmm.register(src, model, depth_noise=-1.0)
+    plain, _ = sogmm.register(src, model, init=truth)
+    noisy, info = sogmm.register(src, model, init=truth, depth_noise=0.002)
+    assert info["status"] == "converged"
+    assert np.abs(noisy - truth).max() < 1e-3
+    assert not np.array_equal(noisy, plain)  # it did reach the scoring
+    source = model.transform(np.linalg.inv(truth))
+    a, _ = sogmm.register(source, model)
+    b, _ = sogmm.register(source, model, depth_noise=0.01)
+    assert np.array_equal(a, b)

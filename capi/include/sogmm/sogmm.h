@@ -390,6 +390,11 @@ typedef int32_t sogmm_key;
 /* Registration: fewer finite source points are SOGMM_E_INVALID_DATA.
  * i64 (points), >= 6; default 100. */
 #define SOGMM_OPT_REGISTRATION_MIN_POINTS 808
+/* Registration: a source point's depth error has standard deviation this x z^2 (z its depth in
+ * the sensor's frame, the source's own), added along its ray to each component's covariance;
+ * point sources only; 0: off.
+ * f64 (1/m), [0, 1] (0: off); default 0. */
+#define SOGMM_OPT_REGISTRATION_DEPTH_NOISE 809
 /* Tracking: 1 registers a frame the map does not accept to the last inserted frame too and
  * inserts it when the two agree or the map has too few inliers to judge; 0 inserts only frames
  * the map accepts.

@@ -27,6 +27,9 @@
 // With use_gray, each component scores the point's gray by its gray marginal
 // and its position by the conditional N(x; mu_x|g, Sigma_x|g): the 4-D joint
 // density, as colored ICP adds the photometric term.
+// With depth_noise k, a point p of the source (in its sensor's frame) adds
+// u u^T, u = k z R p, to each component's (conditional) spatial covariance:
+// its depth error sigma_z = k z^2 along its ray (RegistrationOptions).
 //
 // Coarse to fine: `levels` levels smooth the target by s = coarse_sigma,
 // coarse_sigma / 2, ..., and the last level by 0 (the model itself), so a
@@ -83,6 +86,22 @@ struct RegistrationOptions {
   double degeneracy_ratio = 1e-3;
   /// Fewer finite source points than this: Error(InvalidData). >= 6.
   std::int64_t min_points = 100;
+  /// k of the source's depth noise sigma_z = k z^2 (1/m; z a point's depth,
+  /// its third coordinate in the sensor's frame, which the source points are
+  /// in): each point p is scored under N(x; mu_k, Sigma_k + u u^T) with
+  /// u = k z R p, its depth error moved along its ray into the target frame,
+  /// as D2D adds a source component's covariance. A disparity-based sensor's
+  /// error grows as z^2; the target's components, fitted to one frame's
+  /// points, are thinner than the noise where it is correlated over a
+  /// component (quantisation steps). [0, 1]; 0: off. Point sources only (a
+  /// model source's covariances hold its noise already). A point's
+  /// candidate components are still those whose 3-sigma box holds it. Off by
+  /// default: it
+  /// is the sensor's, and modelling noise a sensor does not have costs
+  /// accuracy (the synthetic loop, depth exact to the millimetre, tracked
+  /// with 0.001: ATE 0.80 against 0.58 cm); 0.001 suits the shared
+  /// living-room frames (README, Registration).
+  double depth_noise = 0.0;
 };
 
 /// Throws Error(InvalidArgument) naming the first bad setting.

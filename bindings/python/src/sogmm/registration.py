@@ -35,7 +35,8 @@ def register(source=None, target_model: GMM = None, init=None, *, source_points=
              levels: int = _D.registration_levels, coarse_sigma: float = _D.registration_coarse_sigma,
              min_inlier_ratio: float = _D.registration_min_inlier_ratio,
              degeneracy_ratio: float = _D.registration_degeneracy_ratio,
-             min_points: int = _D.registration_min_points, n_threads: int = _D.threads) -> tuple[np.ndarray, dict]:
+             min_points: int = _D.registration_min_points, depth_noise: float = _D.registration_depth_noise,
+             n_threads: int = _D.threads) -> tuple[np.ndarray, dict]:
     """The rigid pose that best explains ``source`` under ``target_model``.
 
     Args:
@@ -49,6 +50,11 @@ def register(source=None, target_model: GMM = None, init=None, *, source_points=
         init: 4 x 4 rigid initial guess, source to target frame (None = identity).
         source_points: the keyword this argument had before it also took a
             model; deprecated (a DeprecationWarning), use ``source``.
+        depth_noise: k of the source points' depth noise sigma_z = k z^2
+            (1/m; points in the sensor's frame, z their depth), added along
+            each point's ray to the components' covariances; 0 off; point
+            sources only (SOGMM_OPT_REGISTRATION_DEPTH_NOISE). The other
+            keywords are the SOGMM_OPT_REGISTRATION_* options.
 
     Returns ``(pose, info)``: ``pose`` a 4 x 4 float64 array mapping source
     points into the target frame; ``info`` a dict with ``status``
@@ -73,7 +79,7 @@ def register(source=None, target_model: GMM = None, init=None, *, source_points=
     info = RegistrationInfo(struct_size=ctypes.sizeof(RegistrationInfo))
     f64 = {_ffi.OPT_REGISTRATION_TOL: tol, _ffi.OPT_REGISTRATION_OUTLIER_RATIO: outlier_ratio,
            _ffi.OPT_REGISTRATION_COARSE_SIGMA: coarse_sigma, _ffi.OPT_REGISTRATION_MIN_INLIER_RATIO: min_inlier_ratio,
-           _ffi.OPT_REGISTRATION_DEGENERACY_RATIO: degeneracy_ratio}
+           _ffi.OPT_REGISTRATION_DEGENERACY_RATIO: degeneracy_ratio, _ffi.OPT_REGISTRATION_DEPTH_NOISE: depth_noise}
     i64 = {_ffi.OPT_REGISTRATION_MAX_ITER: max_iter, _ffi.OPT_REGISTRATION_USE_GRAY: int(bool(use_gray)),
            _ffi.OPT_REGISTRATION_LEVELS: levels, _ffi.OPT_REGISTRATION_MIN_POINTS: min_points,
            _ffi.OPT_THREADS: n_threads}
