@@ -59,16 +59,14 @@ TEST(RegistrationKernel, TermsAreExpWithinItsBound) {
   EXPECT_GT(normal, lp.size() * 9 / 10);
 }
 
-TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
-  TestRng rng(9);
-  const std::size_t m = 40, count = 3000;
-  std::vector<double> records(m * kPairRecord);
-  std::vector<Eigen::Matrix3d> prec(m);
-  for (std::size_t k = 0; k < m; ++k) {
+// m random pair records (records: m x kPairRecord) and their spatial
+// precisions (sigmas of ~1 cm), drawn from rng.
+void random_records(TestRng& rng, std::vector<double>& records, std::vector<Eigen::Matrix3d>& prec) {
+  for (std::size_t k = 0; k < prec.size(); ++k) {
     double* r = records.data() + k * kPairRecord;
     Eigen::Matrix3d a;
     for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = rng.normal();
-    prec[k] = a * a.transpose() / 1e-4 + 100.0 * Eigen::Matrix3d::Identity();  // sigmas of ~1 cm
+    prec[k] = a * a.transpose() / 1e-4 + 100.0 * Eigen::Matrix3d::Identity();
     const int upper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
     for (int e = 0; e < 6; ++e) r[kP00 + e] = prec[k](upper[e][0], upper[e][1]);
     for (int d = 0; d < 3; ++d) {
@@ -80,6 +78,14 @@ TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
     r[kLogNorm] = 5.0 * rng.normal();
     r[kLogNormGray] = rng.normal();
   }
+}
+
+TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
+  TestRng rng(9);
+  const std::size_t m = 40, count = 3000;
+  std::vector<double> records(m * kPairRecord);
+  std::vector<Eigen::Matrix3d> prec(m);
+  random_records(rng, records, prec);
   std::vector<std::uint32_t> id(count);
   std::vector<double> x(count), y(count), z(count), gray(count), lp(count), px(count), py(count), pz(count),
       quad(count);
@@ -131,22 +137,7 @@ TEST(RegistrationKernel, PairsWithDepthNoiseAddTheRankOneCovariance) {
   const std::size_t m = 30, count = 2000;
   std::vector<double> records(m * kPairRecord);
   std::vector<Eigen::Matrix3d> prec(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    double* r = records.data() + k * kPairRecord;
-    Eigen::Matrix3d a;
-    for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = rng.normal();
-    prec[k] = a * a.transpose() / 1e-4 + 100.0 * Eigen::Matrix3d::Identity();
-    const int upper[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
-    for (int e = 0; e < 6; ++e) r[kP00 + e] = prec[k](upper[e][0], upper[e][1]);
-    for (int d = 0; d < 3; ++d) {
-      r[kMuX + d] = rng.uniform();
-      r[kGainX + d] = 0.1 * rng.normal();
-    }
-    r[kMuGray] = rng.uniform();
-    r[kInvSgg] = 1.0 / (0.01 + 0.1 * rng.uniform());
-    r[kLogNorm] = 5.0 * rng.normal();
-    r[kLogNormGray] = rng.normal();
-  }
+  random_records(rng, records, prec);
   std::vector<std::uint32_t> id(count);
   std::vector<double> x(count), y(count), z(count), gray(count), ux(count), uy(count), uz(count), lp(count),
       px(count), py(count), pz(count), quad(count), pux(count), puy(count), puz(count), shrink(count);
