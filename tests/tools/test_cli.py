@@ -489,6 +489,18 @@ def mode_map(tmp):
     check(len(poses) == 10, "--trajectory-out: %d poses for 10 frames" % len(poses))
     ate = max([np.linalg.norm((np.linalg.inv(truth[0]) @ t)[:3, 3] - e[:3, 3]) for t, e in zip(truth, poses)] + [0])
     check(ate <= 0.01, "map without a trajectory: largest position error %.4f m" % ate)
+    # --registration-depth-noise reaches the registration (other poses; the
+    # loop's exact depth needs none, but 10 frames stay within 1 cm).
+    noisy_est_log = os.path.join(tmp, "estimated_noise.log")
+    run_json(["map", slow, "--frames", "0:10", "--registration-depth-noise", 0.001, "-o",
+              os.path.join(tmp, "est_noise.sogmm"), "--trajectory-out", noisy_est_log])
+    blocks = open(noisy_est_log).read().split("\n")
+    noisy_poses = [np.array(" ".join(blocks[5 * k + 1:5 * k + 5]).split(), dtype=float).reshape(4, 4)
+                   for k in range(len(blocks) // 5)]
+    check(len(noisy_poses) == 10 and any(not np.array_equal(a, b) for a, b in zip(poses, noisy_poses)),
+          "--registration-depth-noise changed no pose")
+    ate = max(np.linalg.norm((np.linalg.inv(truth[0]) @ t)[:3, 3] - e[:3, 3]) for t, e in zip(truth, noisy_poses))
+    check(ate <= 0.01, "map --registration-depth-noise 0.001: largest position error %.4f m" % ate)
     # --refine-poses: the same frames with a trajectory off by 3 cm and 1
     # degree per frame (seeded) are registered from those poses and land
     # within 1 cm of the truth; without it they stay 3 cm off.
@@ -541,6 +553,7 @@ def mode_map(tmp):
     err(["map", bad, "--trajectory", traj, "--threshold", "nan"] + badargs, 2, "threshold")
     err(["map", bad, "--trajectory", traj, "--trajectory-out", traj] + badargs, 2, "trajectory")  # would replace an input
     err(["map", bad, "--trajectory", traj, "--batch", 0] + badargs, 2, "batch")
+    err(["map", bad, "--registration-depth-noise", 2] + badargs, 2, "depth_noise")
     write_png16(os.path.join(bad, "depth", "00001.png"), np.zeros((480, 640), np.uint16))
     err(["map", bad, "--trajectory", traj] + badargs, 3, "00001.png")  # empty frame
     write_png16(os.path.join(bad, "depth", "00001.png"), np.full((240, 320), 1500, np.uint16))

@@ -103,6 +103,7 @@ int run_map(MapState& s) {
   s.options.novelty = !s.no_novelty;
   s.tracking.odometry = !s.no_odometry;
   validate(s.tracking);
+  validate(s.registration);  // before any file is read, so an error names the option, not a frame
   s.options.fusion = s.fusion != "off";
   s.options.fusion_method = s.fusion == "kl" ? FusionMethod::KL : FusionMethod::Hellinger;
   Map map(s.options);  // checks the options before any file is read
