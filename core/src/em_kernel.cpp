@@ -9,7 +9,7 @@
 
 #include "em_kernel.hpp"
 #include "fast_exp.hpp"
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
 #include "em_statistics_avx512.hpp"
 #endif
 
@@ -256,7 +256,7 @@ double em_finish(const Block& block, const float* params, const double* exact, c
     if (params[at + 15] != 0.0f)
       add_statistics(block, first, last, exact + at, rows + i * kBlock, inv_sum, st);
     else
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
       // The same floats as add_statistics<float>, its lanes summed for all
       // 15 sums at once (em_statistics_avx512.hpp).
       add_statistics_avx512(block, first, last, params + at, rows + i * kBlock, inv_sum, st);

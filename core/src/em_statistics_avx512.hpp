@@ -22,7 +22,8 @@
 #if defined(__GNUC__) && !defined(__clang__)
 // GCC 12's AVX-512 intrinsics start from _mm512_undefined_ps() and warn that
 // it "may be used uninitialized" (GCC bug 105593, fixed in 13): not ours (as
-// in occupancy_kernel.cpp).
+// in occupancy_kernel.cpp). Only for this header: pushed here, popped at its end.
+#pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 
@@ -135,3 +136,7 @@ void add_statistics_avx512(const Block& block, int first, int last, const float*
 
 }  // namespace
 }  // namespace sogmm::detail::SOGMM_ISA
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif

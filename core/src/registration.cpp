@@ -246,10 +246,11 @@ struct Scratch {
   std::vector<Eigen::Vector3d> moved;  // a point source: the block's points at the pose
   std::vector<std::uint32_t> query;   // CandidateCache::near's scratch
   std::vector<double> top;            // a point source: each point's largest log-density
-  void resize(std::size_t count) {
-    for (auto* v : {&x, &y, &z, &gray, &pair_top, &term, &pr_x, &pr_y, &pr_z, &quad, &ux, &uy, &uz, &pu_x, &pu_y,
-                    &pu_z, &shrink})
-      v->resize(count);
+  // The noise axes only with depth noise: the plain kernel touches none.
+  void resize(std::size_t count, bool noise_axes = false) {
+    for (auto* v : {&x, &y, &z, &gray, &pair_top, &term, &pr_x, &pr_y, &pr_z, &quad}) v->resize(count);
+    if (noise_axes)
+      for (auto* v : {&ux, &uy, &uz, &pu_x, &pu_y, &pu_z, &shrink}) v->resize(count);
   }
 };
 
@@ -566,7 +567,7 @@ RegistrationResult register_source(const RegistrationTarget::Prepared& target, c
           sc.moved.push_back(x);
           if (sc.ids.size() < count + near.size()) {
             sc.ids.resize(2 * (count + near.size()));
-            sc.resize(sc.ids.size());
+            sc.resize(sc.ids.size(), noisy);
           }
           const double xyz[3] = {x(0), x(1), x(2)};
           // The depth-noise axis: a depth error e moves the point by e p / z

@@ -130,7 +130,7 @@ TEST(RegistrationKernel, PairsAreTheGaussiansLogDensity) {
 // the update changes the terms by up to a few units, the log det by up to
 // log 5. The sums differ by roundings and by fast_log_ge1's 1e-15 relative:
 // bounds of 1e-10 relative leave a margin of 10^4 over the inverse's
-// conditioning (below 10^2 here). Mutation tried: 0.5 * log(grow) dropped
+// conditioning (about 10^3 here). Mutation tried: 0.5 * log(grow) dropped
 // (fails the log-density).
 TEST(RegistrationKernel, PairsWithDepthNoiseAddTheRankOneCovariance) {
   TestRng rng(11);

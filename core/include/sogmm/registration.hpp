@@ -29,12 +29,14 @@
 // density, as colored ICP adds the photometric term.
 // With depth_noise k, a point p of the source (in its sensor's frame) adds
 // u u^T, u = k z R p, to each component's (conditional) spatial covariance:
-// its depth error sigma_z = k z^2 along its ray (RegistrationOptions).
+// its depth error sigma_z = k z^2 along its ray (RegistrationOptions). u
+// turns with the pose but is held at the current rotation within a step, as
+// a model source's covariances are: the answer is that fixed point.
 //
 // Coarse to fine: `levels` levels smooth the target by s = coarse_sigma,
 // coarse_sigma / 2, ..., and the last level by 0 (the model itself), so a
 // start a few centimetres off still sees the surface; the smooth coarse
-// levels use every 2nd or 4th point. Each point tests only
+// levels use every 16th and 4th point. Each point tests only
 // the components whose 3-sigma box (ComponentIndex) holds it.
 //
 // What comes back. The pose; the mean log-likelihood, the inlier ratio (a
