@@ -204,8 +204,11 @@ TEST(Registration, InformationIsTheGaussNewtonSum) {
   }
 }
 
-// With depth noise k, each point p (here the grids of TwoComponents, z of
-// 1.2 to 2.1 m) is scored under its component's (conditional) spatial
+// With depth noise k, each point p (here the grids of TwoComponents, given
+// in a sensor frame turned by 20 degrees and 0.6 m away from the target's, so
+// that R p differs from the target-frame point and p's depth z from its
+// target-frame z; u taken from the target-frame point fails it) is scored
+// under its component's (conditional) spatial
 // covariance plus u u^T, u = k z R p (R the returned rotation): computed
 // here by forming that 3 x 3 covariance and inverting it, independently of
 // the kernel's rank-one update. With one candidate per point and no outlier
@@ -218,6 +221,13 @@ TEST(Registration, InformationIsTheGaussNewtonSum) {
 TEST(Registration, DepthNoiseAddsEachPointsRayCovariance) {
   const TwoComponents scene;
   const std::size_t n = scene.pts.size() / 4, per = n / 2;
+  const Eigen::Matrix4d sensor = rigid(20.0, {1, 2, 3}, {0.3, -0.2, -0.5});  // sensor to target frame
+  std::vector<float> pts = scene.pts;
+  for (std::size_t p = 0; p < n; ++p) {
+    const Eigen::Vector4d y = sensor.inverse() * Eigen::Vector4d(pts[4 * p], pts[4 * p + 1], pts[4 * p + 2], 1.0);
+    ASSERT_GT(y(2), 0.5);  // in front of the sensor
+    for (int d = 0; d < 3; ++d) pts[4 * p + d] = static_cast<float>(y(d));
+  }
   for (bool gray : {false, true}) {
     sogmm::RegistrationOptions o;
     o.use_gray = gray;
@@ -225,7 +235,7 @@ TEST(Registration, DepthNoiseAddsEachPointsRayCovariance) {
     o.levels = 1;
     o.depth_noise = 0.01;
     const sogmm::RegistrationResult r = sogmm::register_points(
-        scene.g, scene.pts.data(), n, sogmm_test::pose_array(rigid(1.0, {0, 0, 1}, {0.002, 0, 0})), o);
+        scene.g, pts.data(), n, sogmm_test::pose_array(sensor * rigid(1.0, {0, 0, 1}, {0.002, 0, 0})), o);
     ASSERT_EQ(r.status, RegistrationStatus::Converged) << sogmm::status_name(r.status);
     const Eigen::Matrix4d pose = sogmm_test::pose_matrix(r.pose);
     const Eigen::Matrix3d rot = pose.topLeftCorner<3, 3>();
@@ -234,9 +244,9 @@ TEST(Registration, DepthNoiseAddsEachPointsRayCovariance) {
     for (std::size_t p = 0; p < n; ++p) {
       const std::size_t k = p / per;
       const Eigen::Matrix4d& c = scene.stored[k];
-      const Eigen::Vector3d src(scene.pts[4 * p], scene.pts[4 * p + 1], scene.pts[4 * p + 2]);
+      const Eigen::Vector3d src(pts[4 * p], pts[4 * p + 1], pts[4 * p + 2]);
       const Eigen::Vector3d x = rot * src + pose.topRightCorner<3, 1>();
-      const double dg = double(scene.pts[4 * p + 3]) - double(scene.g.mean(k)[3]);
+      const double dg = double(pts[4 * p + 3]) - double(scene.g.mean(k)[3]);
       Eigen::Matrix3d spatial = c.topLeftCorner<3, 3>();
       Eigen::Vector3d res = x - Eigen::Vector3d(scene.g.mean(k)[0], scene.g.mean(k)[1], scene.g.mean(k)[2]);
       double lp = std::log(0.5);
